@@ -1,0 +1,96 @@
+//! The crate's error type.
+//!
+//! One enum for everything numeric (models, discretisation, simulation, and the
+//! modules built on them). Every variant carries the context needed to act on it:
+//! which parameter, which matrix entry, which operation.
+
+/// Everything that can go wrong in `ctrlab`'s numeric code.
+///
+/// The enum is `#[non_exhaustive]`: later releases add variants without a
+/// breaking change, so match with a wildcard arm.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, MassSpring};
+///
+/// let mut plant = MassSpring::nominal();
+/// plant.m1 = -1.0;
+/// let err = plant.validate().unwrap_err();
+/// assert!(matches!(err, Error::InvalidParameter { name: "m1", .. }));
+/// assert!(err.to_string().contains("m1"));
+/// ```
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A scalar parameter is out of its valid range (a non-positive mass, a
+    /// negative spring, a non-positive time step, …).
+    #[error("invalid parameter `{name}` = {value}: {reason}")]
+    InvalidParameter {
+        /// The parameter's name as it appears in the API (`"m1"`, `"dt"`, …).
+        name: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What the value must satisfy.
+        reason: &'static str,
+    },
+    /// A matrix handed to a constructor has a NaN or infinite entry.
+    #[error("matrix {matrix} has a non-finite entry {value} at row {row}, column {col}")]
+    NonFinite {
+        /// Which matrix (`"A"`, `"B"`, `"C"`, `"D"`).
+        matrix: &'static str,
+        /// Zero-based row of the first bad entry.
+        row: usize,
+        /// Zero-based column of the first bad entry.
+        col: usize,
+        /// The entry itself.
+        value: f64,
+    },
+    /// A matrix that has to be inverted is singular (or numerically so).
+    #[error("singular matrix in {operation}")]
+    Singular {
+        /// The operation that needed the inverse (`"Tustin discretisation"`, …).
+        operation: &'static str,
+    },
+    /// A computation produced a non-finite result from finite input (overflow,
+    /// typically a time step far too large for the model's dynamics).
+    #[error("{operation} overflowed to a non-finite result")]
+    Overflow {
+        /// The operation that overflowed.
+        operation: &'static str,
+    },
+}
+
+/// Checks that every entry of a matrix is finite; names the first bad one.
+pub(crate) fn check_finite<const R: usize, const C: usize>(
+    matrix: &'static str,
+    m: &nalgebra::SMatrix<f64, R, C>,
+) -> Result<(), Error> {
+    for c in 0..C {
+        for r in 0..R {
+            let value = m[(r, c)];
+            if !value.is_finite() {
+                return Err(Error::NonFinite {
+                    matrix,
+                    row: r,
+                    col: c,
+                    value,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks a time step: finite and strictly positive.
+pub(crate) fn check_dt(dt: f64) -> Result<(), Error> {
+    if dt.is_finite() && dt > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name: "dt",
+            value: dt,
+            reason: "time step must be finite and > 0 s",
+        })
+    }
+}

@@ -1,0 +1,250 @@
+//! The lab's plant: two carts joined by springs, the second pushed by a DC motor
+//! (LAB.md equations (1)–(3) and (14)).
+
+use nalgebra::{SMatrix, SVector, matrix};
+
+use crate::error::Error;
+use crate::integrate::Dynamics;
+use crate::model::{Continuous, StateSpace};
+
+/// Which cart's position is the model's output `y`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Output {
+    /// `y = x1`, position of cart 1 (the one tied to the wall), m.
+    Cart1,
+    /// `y = x2`, position of cart 2 (the driven one), m.
+    Cart2,
+}
+
+impl Output {
+    /// Index of this output's position in the state `[x1, v1, x2, v2]`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::Output;
+    /// assert_eq!(Output::Cart1.state_index(), 0);
+    /// assert_eq!(Output::Cart2.state_index(), 2);
+    /// ```
+    pub fn state_index(self) -> usize {
+        match self {
+            Output::Cart1 => 0,
+            Output::Cart2 => 2,
+        }
+    }
+
+    /// The selection row `C` that picks this cart's position out of the state.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::Output;
+    /// # use nalgebra::matrix;
+    /// assert_eq!(Output::Cart2.selection(), matrix![0.0, 0.0, 1.0, 0.0]);
+    /// ```
+    pub fn selection(self) -> SMatrix<f64, 1, 4> {
+        let mut c = SMatrix::<f64, 1, 4>::zeros();
+        c[self.state_index()] = 1.0;
+        c
+    }
+}
+
+/// Physical parameters of the two-cart mass-spring rig, SI units.
+///
+/// ```text
+///  wall |--k1--[ m1 ]--k2--[ m2 ]<== F = gain · u
+///            x1 ->        x2 ->
+/// ```
+///
+/// State `x = [x1 (m), x1' (m/s), x2 (m), x2' (m/s)]`, input `u`: the motor
+/// drive in whatever unit `gain` converts to newtons (volts on the rig,
+/// newtons with `gain = 1` in simulation).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{MassSpring, Output};
+///
+/// let plant = MassSpring::nominal();
+/// let sys = plant.state_space(Output::Cart2)?;
+/// assert_eq!(sys.a()[(1, 0)], -(1000.0 + 1000.0) / 1.3);
+/// // A 10 N push deflects the carts 10 mm and 20 mm at rest.
+/// let (x1, x2) = plant.static_deflection(10.0)?;
+/// assert!((x1 - 0.010).abs() < 1e-15 && (x2 - 0.020).abs() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MassSpring {
+    /// Mass of cart 1, kg (> 0).
+    pub m1: f64,
+    /// Mass of cart 2, kg (> 0).
+    pub m2: f64,
+    /// Spring between the wall and cart 1, N/m (≥ 0).
+    pub k1: f64,
+    /// Spring between the carts, N/m (≥ 0).
+    pub k2: f64,
+    /// Viscous friction on cart 1, N·s/m (≥ 0).
+    pub b1: f64,
+    /// Viscous friction on cart 2, N·s/m (≥ 0).
+    pub b2: f64,
+    /// Motor gain K in `F = K u`, N per input unit (N/V on the rig; 1 for a
+    /// force input) (≥ 0).
+    pub gain: f64,
+}
+
+impl MassSpring {
+    /// The lab's simulation values: m1 = 1.3 kg, m2 = 0.7 kg,
+    /// k1 = k2 = 1000 N/m, b1 = 10 N·s/m, b2 = 5 N·s/m, gain 1 (force input).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::MassSpring;
+    /// let p = MassSpring::nominal();
+    /// assert_eq!((p.m1, p.m2, p.k1, p.k2, p.b1, p.b2, p.gain), (1.3, 0.7, 1000.0, 1000.0, 10.0, 5.0, 1.0));
+    /// ```
+    pub fn nominal() -> Self {
+        Self {
+            m1: 1.3,
+            m2: 0.7,
+            k1: 1000.0,
+            k2: 1000.0,
+            b1: 10.0,
+            b2: 5.0,
+            gain: 1.0,
+        }
+    }
+
+    /// Checks every parameter: masses finite and > 0, springs, frictions and
+    /// gain finite and ≥ 0.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] naming the first bad field.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{MassSpring, Error};
+    /// let p = MassSpring { k2: f64::NAN, ..MassSpring::nominal() };
+    /// assert!(matches!(p.validate(), Err(Error::InvalidParameter { name: "k2", .. })));
+    /// ```
+    pub fn validate(&self) -> Result<(), Error> {
+        for (name, value) in [("m1", self.m1), ("m2", self.m2)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    reason: "mass must be finite and > 0 kg",
+                });
+            }
+        }
+        for (name, value) in [
+            ("k1", self.k1),
+            ("k2", self.k2),
+            ("b1", self.b1),
+            ("b2", self.b2),
+            ("gain", self.gain),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be finite and >= 0",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The state matrix `A` of equation (3), without validation.
+    fn a_matrix(&self) -> SMatrix<f64, 4, 4> {
+        let Self {
+            m1,
+            m2,
+            k1,
+            k2,
+            b1,
+            b2,
+            ..
+        } = *self;
+        matrix![
+            0.0, 1.0, 0.0, 0.0;
+            -(k1 + k2) / m1, -b1 / m1, k2 / m1, 0.0;
+            0.0, 0.0, 0.0, 1.0;
+            k2 / m2, 0.0, -k2 / m2, -b2 / m2
+        ]
+    }
+
+    /// The continuous model of equations (3)/(14) with output `y` the chosen
+    /// cart's position (m).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] from [`validate`](Self::validate).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{MassSpring, Output};
+    /// let sys = MassSpring::nominal().state_space(Output::Cart1)?;
+    /// assert_eq!(sys.c()[(0, 0)], 1.0);
+    /// assert_eq!(sys.b()[(3, 0)], 1.0 / 0.7);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn state_space(&self, output: Output) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
+        self.validate()?;
+        let b = matrix![0.0; 0.0; 0.0; self.gain / self.m2];
+        StateSpace::continuous(self.a_matrix(), b, output.selection(), SMatrix::zeros())
+    }
+
+    /// Rest positions `(x1, x2)` in metres under a constant force `force` (N) on
+    /// cart 2: `x1 = F/k1`, `x2 = F/k1 + F/k2` (the springs are in series).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] for invalid parameters, a zero spring (no
+    /// rest position) or a non-finite force.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::MassSpring;
+    /// let (x1, x2) = MassSpring::nominal().static_deflection(50.0)?;
+    /// assert!((x1 - 0.05).abs() < 1e-15 && (x2 - 0.10).abs() < 1e-15);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn static_deflection(&self, force: f64) -> Result<(f64, f64), Error> {
+        self.validate()?;
+        if !force.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "force",
+                value: force,
+                reason: "must be finite",
+            });
+        }
+        for (name, value) in [("k1", self.k1), ("k2", self.k2)] {
+            if value == 0.0 {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    reason: "a zero spring has no rest position",
+                });
+            }
+        }
+        let x1 = force / self.k1;
+        Ok((x1, x1 + force / self.k2))
+    }
+}
+
+/// The plant's equations of motion (1) as a [`Dynamics`], input in the unit
+/// `gain` converts to newtons. Parameters are used as they are: call
+/// [`validate`](MassSpring::validate) first.
+impl Dynamics<4, 1> for MassSpring {
+    #[inline]
+    fn derivative(&self, _t: f64, x: &SVector<f64, 4>, u: &SVector<f64, 1>) -> SVector<f64, 4> {
+        let mut dx = self.a_matrix() * x;
+        dx[3] += self.gain / self.m2 * u[0];
+        dx
+    }
+}

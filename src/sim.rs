@@ -1,0 +1,337 @@
+//! Time responses: continuous simulation on a time grid ([`simulate`]),
+//! discrete simulation open or closed loop ([`simulate_discrete`],
+//! [`simulate_discrete_feedback`]) and the unit [`step_response`].
+//!
+//! The inner loops are [`StateSpace::step_mut`] and
+//! [`Integrator::step_mut`], which allocate nothing; the functions here
+//! allocate only their output, once, up front.
+
+use nalgebra::SVector;
+
+use crate::discretize::zoh;
+use crate::error::{Error, check_dt};
+use crate::integrate::{Integrator, Rk4};
+use crate::model::{Continuous, Discrete, StateSpace};
+
+/// Largest number of samples a simulation will allocate for (10⁸); a longer
+/// request is almost certainly a unit mistake (ms for s) and is refused
+/// rather than exhausting memory.
+pub const MAX_SAMPLES: usize = 100_000_000;
+
+/// A simulated time response: sample times (s), states and outputs, in the
+/// model's units (SI for the crate's own models). All three have one entry
+/// per sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Response<const N: usize, const P: usize> {
+    /// Sample times, s.
+    pub t: Vec<f64>,
+    /// State at each sample.
+    pub x: Vec<SVector<f64, N>>,
+    /// Output at each sample.
+    pub y: Vec<SVector<f64, P>>,
+}
+
+impl<const N: usize, const P: usize> Response<N, P> {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            t: Vec::with_capacity(n),
+            x: Vec::with_capacity(n),
+            y: Vec::with_capacity(n),
+        }
+    }
+
+    /// Number of samples.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{MassSpring, Output, sim::step_response};
+    /// let r = step_response(&MassSpring::nominal().state_space(Output::Cart2)?, 1.0, 0.01)?;
+    /// assert_eq!(r.len(), 101);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// True when there are no samples.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{MassSpring, Output, sim::step_response};
+    /// let r = step_response(&MassSpring::nominal().state_space(Output::Cart2)?, 1.0, 0.01)?;
+    /// assert!(!r.is_empty());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// Output channel `i` as a plain vector, e.g. to hand to step metrics.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{MassSpring, Output, sim::step_response};
+    /// let r = step_response(&MassSpring::nominal().state_space(Output::Cart2)?, 1.0, 0.01)?;
+    /// assert_eq!(r.output(0).len(), r.len());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn output(&self, i: usize) -> Vec<f64> {
+        self.y.iter().map(|y| y[i]).collect()
+    }
+}
+
+/// How [`simulate`] advances a continuous model between grid points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Solver {
+    /// Exact for the held input: one ZOH discretisation per distinct interval
+    /// length (once for a uniform grid).
+    #[default]
+    Zoh,
+    /// `substeps` RK4 steps per grid interval (≥ 1).
+    Rk4 {
+        /// RK4 steps per interval.
+        substeps: usize,
+    },
+}
+
+/// A uniform time grid `0, dt, 2 dt, …, n dt` with `n = round(t_end / dt)`, s.
+///
+/// # Errors
+///
+/// [`Error::InvalidParameter`] for a bad `dt` (finite, > 0), a `t_end` that is
+/// not finite or shorter than one step, or more than [`MAX_SAMPLES`] samples.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::sim::time_grid;
+/// let t = time_grid(0.01, 0.002)?;
+/// assert_eq!(t.len(), 6);
+/// assert!((t[5] - 0.01).abs() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn time_grid(t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
+    check_dt(dt)?;
+    if !(t_end.is_finite() && t_end >= dt) {
+        return Err(Error::InvalidParameter {
+            name: "t_end",
+            value: t_end,
+            reason: "must be finite and at least one time step, s",
+        });
+    }
+    let n = (t_end / dt).round();
+    if n >= MAX_SAMPLES as f64 {
+        return Err(Error::InvalidParameter {
+            name: "t_end",
+            value: t_end,
+            reason: "t_end / dt exceeds MAX_SAMPLES",
+        });
+    }
+    Ok((0..=n as usize).map(|k| k as f64 * dt).collect())
+}
+
+/// Simulates a continuous model over the time grid `t` (s, strictly
+/// increasing) from state `x0`.
+///
+/// The input is sampled at each grid time and held until the next, as a
+/// digital controller applies it; use a finer grid for a smooth input.
+/// [`Solver::Zoh`] is exact for that input, [`Solver::Rk4`] integrates it.
+///
+/// # Errors
+///
+/// [`Error::InvalidParameter`] named `"t"` for an empty, non-finite or
+/// non-increasing grid (or more than [`MAX_SAMPLES`] points), named
+/// `"substeps"` for zero RK4 sub-steps, named `"input"` for a non-finite input
+/// sample; errors of [`discretize`](StateSpace::discretize).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{MassSpring, Output, sim::{simulate, time_grid, Solver}};
+/// use nalgebra::vector;
+///
+/// let sys = MassSpring::nominal().state_space(Output::Cart2)?;
+/// let t = time_grid(10.0, 0.002)?;
+/// let r = simulate(&sys, &t, vector![0.0, 0.0, 0.0, 0.0], |_t| vector![10.0], Solver::Zoh)?;
+/// // 10 N on cart 2 settles at 20 mm.
+/// assert!((r.y.last().unwrap()[0] - 0.020).abs() < 1e-9);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn simulate<const N: usize, const M: usize, const P: usize>(
+    sys: &StateSpace<N, M, P, Continuous>,
+    t: &[f64],
+    x0: SVector<f64, N>,
+    mut input: impl FnMut(f64) -> SVector<f64, M>,
+    solver: Solver,
+) -> Result<Response<N, P>, Error> {
+    check_grid(t)?;
+    crate::error::check_finite("x0", &x0)?;
+    if let Solver::Rk4 { substeps: 0 } = solver {
+        return Err(Error::InvalidParameter {
+            name: "substeps",
+            value: 0.0,
+            reason: "RK4 needs at least one sub-step per interval",
+        });
+    }
+    let mut out = Response::with_capacity(t.len());
+    let mut x = x0;
+    // ZOH matrices, recomputed only when the interval length changes.
+    let mut cached: Option<(f64, StateSpace<N, M, P, Discrete>)> = None;
+    for (k, &tk) in t.iter().enumerate() {
+        let u = input(tk);
+        if u.iter().any(|v| !v.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "input",
+                value: u
+                    .iter()
+                    .copied()
+                    .find(|v| !v.is_finite())
+                    .unwrap_or(f64::NAN),
+                reason: "input samples must be finite",
+            });
+        }
+        out.t.push(tk);
+        out.x.push(x);
+        out.y.push(sys.output(&x, &u));
+        let Some(&next) = t.get(k + 1) else { break };
+        let h = next - tk;
+        match solver {
+            Solver::Zoh => {
+                let same = matches!(&cached, Some((hc, _)) if (hc - h).abs() <= 1e-12 * h);
+                if !same {
+                    let (ad, bd) = zoh(sys.a(), sys.b(), h)?;
+                    let d = StateSpace::from_computed(ad, bd, *sys.c(), *sys.d(), h, "ZOH")?;
+                    cached = Some((h, d));
+                }
+                if let Some((_, d)) = &cached {
+                    d.step_mut(&mut x, &u);
+                }
+            }
+            Solver::Rk4 { substeps } => {
+                let hs = h / substeps as f64;
+                for s in 0..substeps {
+                    Rk4.step_mut(sys, tk + s as f64 * hs, hs, &mut x, &u);
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn check_grid(t: &[f64]) -> Result<(), Error> {
+    let bad = |value: f64, reason| Error::InvalidParameter {
+        name: "t",
+        value,
+        reason,
+    };
+    if t.is_empty() {
+        return Err(bad(f64::NAN, "time grid is empty"));
+    }
+    if t.len() > MAX_SAMPLES {
+        return Err(bad(t.len() as f64, "time grid longer than MAX_SAMPLES"));
+    }
+    if let Some(&v) = t.iter().find(|v| !v.is_finite()) {
+        return Err(bad(v, "time grid must be finite"));
+    }
+    if let Some(w) = t.windows(2).find(|w| w[1] <= w[0]) {
+        return Err(bad(w[1], "time grid must be strictly increasing"));
+    }
+    Ok(())
+}
+
+/// Simulates a discrete model open loop: one sample per input, `t[k] = k dt`,
+/// `y[k] = C x[k] + D u[k]`, then `x[k+1] = A x[k] + B u[k]`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{StateSpace, sim::simulate_discrete};
+/// use nalgebra::{matrix, vector};
+///
+/// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
+/// let r = simulate_discrete(&sys, vector![0.0], &[vector![1.0]; 3]);
+/// assert_eq!(r.output(0), vec![0.0, 1.0, 1.5]);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
+    sys: &StateSpace<N, M, P, Discrete>,
+    x0: SVector<f64, N>,
+    inputs: &[SVector<f64, M>],
+) -> Response<N, P> {
+    simulate_discrete_feedback(sys, x0, inputs.len(), |k, _x| inputs[k])
+}
+
+/// Simulates a discrete model for `steps` samples with the input computed
+/// from the current sample index and state, `u[k] = control(k, &x[k])`: a
+/// closed loop around any controller.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{StateSpace, sim::simulate_discrete_feedback};
+/// use nalgebra::{matrix, vector};
+///
+/// // x[k+1] = x + u with u = -0.5 x halves the state every sample.
+/// let sys = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
+/// let r = simulate_discrete_feedback(&sys, vector![8.0], 4, |_k, x| -0.5 * x);
+/// assert_eq!(r.output(0), vec![8.0, 4.0, 2.0, 1.0]);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize>(
+    sys: &StateSpace<N, M, P, Discrete>,
+    x0: SVector<f64, N>,
+    steps: usize,
+    mut control: impl FnMut(usize, &SVector<f64, N>) -> SVector<f64, M>,
+) -> Response<N, P> {
+    let steps = steps.min(MAX_SAMPLES);
+    let dt = sys.dt();
+    let mut out = Response::with_capacity(steps);
+    let mut x = x0;
+    for k in 0..steps {
+        let u = control(k, &x);
+        out.t.push(k as f64 * dt);
+        out.x.push(x);
+        out.y.push(sys.output(&x, &u));
+        sys.step_mut(&mut x, &u);
+    }
+    out
+}
+
+/// The unit step response of a single-input continuous model from rest, on
+/// the grid [`time_grid`]`(t_end, dt)`, computed exactly (ZOH is exact for a
+/// step).
+///
+/// # Errors
+///
+/// As [`time_grid`] and [`discretize`](StateSpace::discretize).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{StateSpace, sim::step_response};
+/// use nalgebra::matrix;
+///
+/// // First-order lag, τ = 0.5 s: y(τ) = 1 - e^-1.
+/// let sys = StateSpace::continuous(matrix![-2.0], matrix![2.0], matrix![1.0], matrix![0.0])?;
+/// let r = step_response(&sys, 1.0, 0.5)?;
+/// assert!((r.y[1][0] - (1.0 - (-1.0f64).exp())).abs() < 1e-14);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn step_response<const N: usize, const P: usize>(
+    sys: &StateSpace<N, 1, P, Continuous>,
+    t_end: f64,
+    dt: f64,
+) -> Result<Response<N, P>, Error> {
+    let t = time_grid(t_end, dt)?;
+    simulate(
+        sys,
+        &t,
+        SVector::zeros(),
+        |_| SVector::from_element(1.0),
+        Solver::Zoh,
+    )
+}

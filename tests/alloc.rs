@@ -1,0 +1,97 @@
+//! Proves the inner loops allocate nothing, with a counting global allocator.
+//!
+//! This file is its own test binary, so the allocator sees only these tests;
+//! the count is per thread, so tests running in parallel do not disturb it.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use ctrlab::{Integrator, MassSpring, Method, Output, Rk4};
+use nalgebra::{SVector, vector};
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+// SAFETY: forwards every call to the system allocator unchanged; the only
+// addition is a thread-local counter, which itself never allocates.
+#[allow(unsafe_code)]
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made by `f` on this thread.
+fn allocations(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.with(Cell::get);
+    f();
+    ALLOCATIONS.with(Cell::get) - before
+}
+
+#[test]
+fn the_counter_sees_allocations() {
+    // Guards against a counter that cannot fail.
+    assert!(allocations(|| drop(std::hint::black_box(vec![1u8; 16]))) >= 1);
+}
+
+#[test]
+fn discrete_step_allocates_nothing() {
+    let d = MassSpring::nominal()
+        .state_space(Output::Cart2)
+        .unwrap()
+        .discretize(0.002, Method::Zoh)
+        .unwrap();
+    let mut x = SVector::<f64, 4>::zeros();
+    let n = allocations(|| {
+        for _ in 0..1000 {
+            d.step_mut(&mut x, &vector![1.0]);
+            x = d.step(&x, &vector![-1.0]);
+        }
+    });
+    assert_eq!(n, 0);
+    assert!(x.iter().all(|v| v.is_finite()) && x.norm() > 0.0);
+}
+
+#[test]
+fn rk4_step_allocates_nothing() {
+    let plant = MassSpring::nominal();
+    let sys = plant.state_space(Output::Cart2).unwrap();
+    let mut x = SVector::<f64, 4>::zeros();
+    let n = allocations(|| {
+        for k in 0..1000 {
+            Rk4.step_mut(&sys, k as f64 * 1e-3, 1e-3, &mut x, &vector![1.0]);
+            Rk4.step_mut(&plant, k as f64 * 1e-3, 1e-3, &mut x, &vector![1.0]);
+        }
+    });
+    assert_eq!(n, 0);
+    assert!(x.norm() > 0.0);
+}
+
+#[test]
+fn zoh_discretisation_allocates_nothing() {
+    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let mut ad00 = 0.0;
+    let n = allocations(|| {
+        let d = sys.discretize(0.002, Method::Zoh).unwrap();
+        ad00 = d.a()[(0, 0)];
+    });
+    assert_eq!(n, 0);
+    assert!(ad00 > 0.99 && ad00 < 1.0);
+}
