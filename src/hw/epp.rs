@@ -11,7 +11,7 @@ use super::HwError;
 /// cycle ([`write_register`](Self::write_register),
 /// [`read_register`](Self::read_register)).
 ///
-/// Implemented by [`Ppdev`](super::Ppdev) (the real port, feature `ppdev`),
+/// Implemented by `Ppdev` (the real port, feature `ppdev`, Linux),
 /// [`SimulatedCard`](super::SimulatedCard) and the fakes in
 /// [`testing`](super::testing); and, like embedded-hal traits, by `&mut T`
 /// for any port `T`, so a driver can borrow a port instead of owning it.

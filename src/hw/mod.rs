@@ -4,7 +4,7 @@
 //! The layers, bottom up:
 //!
 //! - [`EppPort`]: the three IEEE 1284 EPP primitives (address write, data
-//!   read, data write), with [`HwError`]. Implemented by [`Ppdev`] (Linux
+//!   read, data write), with [`HwError`]. Implemented by `Ppdev` (Linux
 //!   `/dev/parportN`, feature `ppdev`), by [`SimulatedCard`], and by the
 //!   fakes in [`testing`].
 //! - [`Pc104`]: the card driver (PWM duty, counters latched together and

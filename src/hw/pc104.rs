@@ -1,42 +1,72 @@
 //! [`Pc104`], the driver of the lab's FPGA card, and its [`RegisterMap`].
 //!
-//! # The default register map
-//!
-//! No register map of the real "PC104CARD" is published, so this crate
-//! assumes the one below ([`RegisterMap::default`]); a card that differs is
-//! described by another [`RegisterMap`] without forking the driver. Every
-//! byte is accessed with its own EPP address cycle (no auto-increment).
-//!
-//! | address | register | access |
-//! |---|---|---|
-//! | `0x00` | card ID | read |
-//! | `0x01` | control: bit 0 latch all counters, bit 1 clear all counters, bit 2 kick the watchdog (strobes, self-clearing) | write |
-//! | `0x10 + 2n` | PWM channel n (0–3), low byte: duty bits 0–7 | write |
-//! | `0x11 + 2n` | PWM channel n, high byte: duty bits 8–9 in bits 0–1, bit 7 direction (1 = negative); the channel takes the new duty when this byte is written | write |
-//! | `0x20 + 4n … 0x23 + 4n` | encoder counter n (0–3), the latched 32-bit count, little-endian, low byte at the lowest address | read |
-//!
-//! A PWM duty is a magnitude 0…1000 (0.1 % steps) plus a direction bit; the
-//! driver writes the low byte first and the high byte last, so the card
-//! applies magnitude and direction together and they cannot glitch apart.
-//! The counters are latched together by one control write, so the counts of
-//! all four encoders belong to the same instant; they are read as 32-bit
-//! counts that wrap, and the driver unwraps them into `i64` positions.
+//! The default register map is documented on [`RegisterMap`] and in the
+//! README.
 
 use super::{EppPort, HwError};
 
 /// Number of PWM channels on the card.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{PWM_CHANNELS, RegisterMap};
+/// assert_eq!(RegisterMap::default().pwm_low.len(), PWM_CHANNELS);
+/// ```
 pub const PWM_CHANNELS: usize = 4;
 /// Number of encoder counters on the card.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{ENCODER_CHANNELS, RegisterMap};
+/// assert_eq!(RegisterMap::default().encoder.len(), ENCODER_CHANNELS);
+/// ```
 pub const ENCODER_CHANNELS: usize = 4;
 /// Largest PWM duty magnitude: 1000 = 100 %, in steps of 0.1 %.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{MAX_DUTY, Pc104, testing::RegisterFile};
+/// let mut pc104 = Pc104::new(RegisterFile::new());
+/// assert!(pc104.set_pwm(0, MAX_DUTY).is_ok());
+/// assert!(pc104.set_pwm(0, MAX_DUTY + 1).is_err());
+/// ```
 pub const MAX_DUTY: i16 = 1000;
 /// Direction bit in a PWM high byte: set for a negative duty.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{PWM_DIRECTION_BIT, pwm_bytes};
+/// assert_eq!(pwm_bytes(-1).1, PWM_DIRECTION_BIT);
+/// ```
 pub const PWM_DIRECTION_BIT: u8 = 0x80;
 
 /// Where the card's registers are, and which control bits do what.
 ///
-/// The default is the map documented in the [module docs](self) and the
-/// README.
+/// # The default map
+///
+/// No register map of the real "PC104CARD" is published, so this crate
+/// assumes the one below ([`RegisterMap::default`]); a card that differs is
+/// described by another [`RegisterMap`] without forking the driver. Every
+/// byte is accessed with its own EPP address cycle (no auto-increment).
+///
+/// | address | register | access |
+/// |---|---|---|
+/// | `0x00` | card ID | read |
+/// | `0x01` | control: bit 0 latch all counters, bit 1 clear all counters, bit 2 kick the watchdog (strobes, self-clearing) | write |
+/// | `0x10 + 2n` | PWM channel n (0–3), low byte: duty bits 0–7 | write |
+/// | `0x11 + 2n` | PWM channel n, high byte: duty bits 8–9 in bits 0–1, bit 7 direction (1 = negative); the channel takes the new duty when this byte is written | write |
+/// | `0x20 + 4n … 0x23 + 4n` | encoder counter n (0–3), the latched 32-bit count, little-endian, low byte at the lowest address | read |
+///
+/// A PWM duty is a magnitude 0…1000 (0.1 % steps) plus a direction bit; the
+/// driver writes the low byte first and the high byte last, so the card
+/// applies magnitude and direction together and they cannot glitch apart.
+/// The counters are latched together by one control write, so the counts of
+/// all four encoders belong to the same instant; they are read as 32-bit
+/// counts that wrap, and the driver unwraps them into `i64` positions.
 ///
 /// # Examples
 ///

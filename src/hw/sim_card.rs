@@ -138,7 +138,7 @@ enum Time {
 /// inside: an [`EppPort`] that a [`Pc104`](super::Pc104) driver talks to
 /// exactly as to the real card.
 ///
-/// - Registers as in its [`RegisterMap`]; unmapped and write-only addresses
+/// - Registers as in its [`RegisterMap`](super::RegisterMap); unmapped and write-only addresses
 ///   read `0xff` (an open bus), writes to them are ignored.
 /// - Every access first advances the plant to the current time of its
 ///   [`TimeBase`] with RK4 sub-steps (≤ `max_substep`), holding the motor
@@ -192,6 +192,14 @@ pub struct SimulatedCard {
 impl Default for SimulatedCard {
     /// The default configuration on a private [`VirtualClock`] (reach it with
     /// [`clock`](SimulatedCard::clock)).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::SimulatedCard;
+    /// let card = SimulatedCard::default();
+    /// assert_eq!((card.time(), card.voltage()), (0.0, 0.0));
+    /// ```
     fn default() -> Self {
         Self::virtual_time(SimulatedCardConfig::default(), &VirtualClock::new())
             .expect("the default configuration is valid")

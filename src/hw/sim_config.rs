@@ -7,10 +7,18 @@ use super::pc104::{ENCODER_CHANNELS, PWM_CHANNELS};
 use super::{HwError, RegisterMap};
 use crate::{Error, MassSpring};
 
-/// The ID the simulated card answers in its ID register.
+/// The ID the simulated card answers in its ID register (`0xa5`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{Pc104, SimulatedCard, SIMULATED_CARD_ID};
+/// assert_eq!(Pc104::new(SimulatedCard::default()).read_id()?, SIMULATED_CARD_ID);
+/// # Ok::<(), ctrlab::hw::HwError>(())
+/// ```
 pub const SIMULATED_CARD_ID: u8 = 0xa5;
 
-/// Everything about a [`SimulatedCard`]: the plant inside and how the card
+/// Everything about a [`SimulatedCard`](super::SimulatedCard): the plant inside and how the card
 /// sees it.
 ///
 /// The defaults: the [`default_truth`](Self::default_truth) plant, the
