@@ -12,6 +12,8 @@
 //! - [`integrate`]: the [`Dynamics`] trait and the [`Rk4`] and [`Euler`]
 //!   steppers.
 //! - [`sim`]: continuous and discrete simulation and step responses.
+//! - [`hw`]: the lab's card over the parallel port (EPP), its register-level
+//!   simulation, and the [`Rig`](hw::Rig) a controller runs against.
 //!
 //! Units are SI throughout (m, m/s, N, V, s); the lab's millimetres appear
 //! only in printed tables and at named conversions.
@@ -36,6 +38,7 @@
 
 pub mod discretize;
 mod error;
+pub mod hw;
 pub mod integrate;
 mod linalg;
 pub mod model;

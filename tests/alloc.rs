@@ -95,3 +95,32 @@ fn zoh_discretisation_allocates_nothing() {
     assert_eq!(n, 0);
     assert!(ad00 > 0.99 && ad00 < 1.0);
 }
+
+#[test]
+fn rig_loop_iteration_on_the_simulated_card_allocates_nothing() {
+    use ctrlab::hw::{
+        Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock,
+    };
+    let clock = VirtualClock::new();
+    let config = SimulatedCardConfig {
+        coulomb_friction: [0.5, 0.5],
+        encoder_noise: 0.5,
+        ..Default::default()
+    };
+    let card = SimulatedCard::virtual_time(config, &clock).unwrap();
+    let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002).unwrap();
+    // The lab's gain [0 0 10 0.1] per mm in SI, toward x2 = 10 mm.
+    let k = nalgebra::SMatrix::<f64, 1, 4>::new(0.0, 0.0, 10_000.0, 100.0);
+    let target = vector![0.0, 0.0, 0.010, 0.0];
+    let mut x = SVector::<f64, 4>::zeros();
+    let n = allocations(|| {
+        for _ in 0..1000 {
+            clock.advance_nanos(2_000_000);
+            // Latch and kick, read both counters, control update, PWM write.
+            x = rig.read_state().unwrap();
+            rig.apply_voltage((k * (target - x))[0]).unwrap();
+        }
+    });
+    assert_eq!(n, 0);
+    assert!(x[2] > 0.005, "the loop moved cart 2: {x}");
+}

@@ -1,0 +1,123 @@
+//! [`VirtualClock`]: shared simulated time for the simulated card and the
+//! control loop.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use super::HwError;
+
+/// A cheap, cloneable handle to shared simulated time, counted in whole
+/// nanoseconds from zero.
+///
+/// Every clone sees the same time. A [`SimulatedCard`](super::SimulatedCard)
+/// built on a virtual clock advances its plant to the clock's time whenever
+/// it is accessed, so a loop that advances the clock by exactly one period
+/// per tick advances the plant by exactly one period per tick, as fast as
+/// the CPU allows. Time only moves forward.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::VirtualClock;
+///
+/// let clock = VirtualClock::new();
+/// let card_side = clock.clone();
+/// clock.advance(0.002)?;
+/// assert_eq!(card_side.now_nanos(), 2_000_000);
+/// assert_eq!(card_side.now(), 0.002);
+/// # Ok::<(), ctrlab::hw::HwError>(())
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct VirtualClock {
+    nanos: Arc<AtomicU64>,
+}
+
+impl VirtualClock {
+    /// A clock at time zero.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::VirtualClock;
+    /// assert_eq!(VirtualClock::new().now(), 0.0);
+    /// ```
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The current time, s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::VirtualClock;
+    /// let clock = VirtualClock::new();
+    /// clock.advance_nanos(1_500_000_000);
+    /// assert_eq!(clock.now(), 1.5);
+    /// ```
+    pub fn now(&self) -> f64 {
+        self.now_nanos() as f64 * 1e-9
+    }
+
+    /// The current time, ns.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::VirtualClock;
+    /// let clock = VirtualClock::new();
+    /// clock.advance_nanos(7);
+    /// assert_eq!(clock.now_nanos(), 7);
+    /// ```
+    pub fn now_nanos(&self) -> u64 {
+        self.nanos.load(Ordering::Acquire)
+    }
+
+    /// Moves time forward by `dt` seconds, rounded to the nearest
+    /// nanosecond.
+    ///
+    /// # Errors
+    ///
+    /// [`HwError::InvalidCommand`] when `dt` is negative or not finite (time
+    /// is left unchanged).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::{HwErrorKind, VirtualClock};
+    /// let clock = VirtualClock::new();
+    /// clock.advance(0.25)?;
+    /// assert_eq!(clock.now_nanos(), 250_000_000);
+    /// assert_eq!(clock.advance(-1.0).unwrap_err().kind(), HwErrorKind::InvalidCommand);
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    pub fn advance(&self, dt: f64) -> Result<(), HwError> {
+        let nanos = dt * 1e9;
+        if !(nanos.is_finite() && nanos >= 0.0 && nanos < u64::MAX as f64) {
+            return Err(HwError::InvalidCommand {
+                what: "clock advance (s)",
+                channel: None,
+                value: dt,
+                limit: u64::MAX as f64 * 1e-9,
+            });
+        }
+        self.advance_nanos(nanos.round() as u64);
+        Ok(())
+    }
+
+    /// Moves time forward by `dt` nanoseconds (u64 nanoseconds last 584 years).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::VirtualClock;
+    /// let clock = VirtualClock::new();
+    /// for _ in 0..500 {
+    ///     clock.advance_nanos(2_000_000);
+    /// }
+    /// assert_eq!(clock.now(), 1.0);
+    /// ```
+    pub fn advance_nanos(&self, dt: u64) {
+        self.nanos.fetch_add(dt, Ordering::AcqRel);
+    }
+}

@@ -1,0 +1,322 @@
+//! [`Ppdev`]: the real parallel port through Linux's `ppdev` driver
+//! (`/dev/parportN`), in IEEE 1284 EPP mode. Feature `ppdev`, Linux only.
+//!
+//! This is the only file of the crate with `unsafe` code: the `ioctl`
+//! calls. Reads and writes go through `std::fs::File`.
+#![allow(unsafe_code)]
+
+use std::fs::{File, OpenOptions};
+use std::io::{self, Read, Write};
+use std::os::fd::AsRawFd;
+use std::os::unix::fs::OpenOptionsExt;
+use std::path::Path;
+
+use super::{CycleKind, EppPort, HwError};
+
+/// The `ppdev` ioctl request numbers and `parport` mode bits this driver
+/// uses, computed like the kernel's `_IO`/`_IOR`/`_IOW` macros for the
+/// target architecture (from `linux/ppdev.h` and `linux/parport.h`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::ioctl;
+/// #[cfg(target_arch = "x86_64")]
+/// assert_eq!(ioctl::PPSETMODE, 0x4004_7080);
+/// assert_eq!(ioctl::IEEE1284_MODE_EPP | ioctl::IEEE1284_ADDR, 0x2040);
+/// ```
+pub mod ioctl {
+    use std::ffi::{c_int, c_uint};
+    use std::mem::size_of;
+
+    #[cfg(any(
+        target_arch = "powerpc",
+        target_arch = "powerpc64",
+        target_arch = "mips",
+        target_arch = "mips64",
+        target_arch = "sparc",
+        target_arch = "sparc64"
+    ))]
+    mod layout {
+        pub const NONE: u32 = 1;
+        pub const READ: u32 = 2;
+        pub const WRITE: u32 = 4;
+        pub const SIZE_BITS: u32 = 13;
+    }
+    #[cfg(not(any(
+        target_arch = "powerpc",
+        target_arch = "powerpc64",
+        target_arch = "mips",
+        target_arch = "mips64",
+        target_arch = "sparc",
+        target_arch = "sparc64"
+    )))]
+    mod layout {
+        pub const NONE: u32 = 0;
+        pub const WRITE: u32 = 1;
+        pub const READ: u32 = 2;
+        pub const SIZE_BITS: u32 = 14;
+    }
+
+    /// `PP_IOCTL`, the ioctl type of ppdev.
+    const PP: u32 = b'p' as u32;
+
+    /// The kernel's `_IOC(dir, 'p', nr, size)`.
+    const fn ioc(dir: u32, nr: u32, size: usize) -> u32 {
+        (dir << (16 + layout::SIZE_BITS)) | ((size as u32) << 16) | (PP << 8) | nr
+    }
+
+    /// `_IOW('p', 0x80, int)`: set the IEEE 1284 mode for read/write.
+    pub const PPSETMODE: u32 = ioc(layout::WRITE, 0x80, size_of::<c_int>());
+    /// `_IO('p', 0x8b)`: claim the port.
+    pub const PPCLAIM: u32 = ioc(layout::NONE, 0x8b, 0);
+    /// `_IO('p', 0x8c)`: release the port.
+    pub const PPRELEASE: u32 = ioc(layout::NONE, 0x8c, 0);
+    /// `_IO('p', 0x8f)`: register exclusively (before `PPCLAIM`).
+    pub const PPEXCL: u32 = ioc(layout::NONE, 0x8f, 0);
+    /// `_IOR('p', 0x97, unsigned int)`: the port's hardware modes.
+    pub const PPGETMODES: u32 = ioc(layout::READ, 0x97, size_of::<c_uint>());
+
+    /// `PARPORT_MODE_EPP` in `PPGETMODES`: the port has hardware EPP.
+    pub const PARPORT_MODE_EPP: c_uint = 1 << 2;
+    /// `IEEE1284_MODE_EPP` for `PPSETMODE`.
+    pub const IEEE1284_MODE_EPP: c_int = 1 << 6;
+    /// `IEEE1284_ADDR`, or'ed into the mode for address cycles.
+    pub const IEEE1284_ADDR: c_int = 1 << 13;
+}
+
+/// A Linux parallel port in EPP mode through `ppdev`.
+///
+/// [`open`](Self::open) opens `/dev/parportN` non-blocking, registers
+/// exclusively (`PPEXCL`), claims the port (`PPCLAIM`), checks the hardware
+/// has EPP (`PPGETMODES`) and selects EPP data cycles (`PPSETMODE`). Address
+/// cycles switch the mode to EPP | `IEEE1284_ADDR` and back (only when the
+/// cycle kind changes). There is no `PPNEGOT`: the card is not an IEEE 1284
+/// peripheral that negotiates. Dropping the port releases it (`PPRELEASE`).
+///
+/// Errors: a short read or write is [`HwError::Timeout`]; `EACCES`/`EPERM`
+/// are [`HwError::Permission`]; `ENOENT`, `ENODEV` and `ENXIO` are
+/// [`HwError::NotPresent`]; anything else is [`HwError::Io`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{HwErrorKind, Ppdev};
+/// let err = Ppdev::open("/dev/nonexistent").unwrap_err();
+/// assert_eq!(err.kind(), HwErrorKind::NotPresent);
+/// ```
+#[derive(Debug)]
+pub struct Ppdev {
+    file: File,
+    device: String,
+    /// `Some(true)` in address mode, `Some(false)` in data mode.
+    address_mode: Option<bool>,
+}
+
+impl Ppdev {
+    /// Opens and claims `path` (e.g. `/dev/parport0`) in EPP mode.
+    ///
+    /// # Errors
+    ///
+    /// [`HwError::NotPresent`] (no such device, or no EPP),
+    /// [`HwError::Permission`], [`HwError::Io`] naming the failed step.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{HwErrorKind, Ppdev};
+    /// // /dev/null opens but is no parallel port: the first ioctl fails.
+    /// let err = Ppdev::open("/dev/null").unwrap_err();
+    /// assert_eq!(err.kind(), HwErrorKind::Io);
+    /// assert!(err.to_string().contains("PPEXCL"));
+    /// ```
+    pub fn open(path: impl AsRef<Path>) -> Result<Self, HwError> {
+        let path = path.as_ref();
+        let device = path.display().to_string();
+        let file = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(path)
+            .map_err(|e| os_error(&device, "open", e))?;
+        ioctl_none(&file, ioctl::PPEXCL).map_err(|e| os_error(&device, "PPEXCL", e))?;
+        ioctl_none(&file, ioctl::PPCLAIM).map_err(|e| os_error(&device, "PPCLAIM", e))?;
+        // Claimed: from here on, dropping `port` releases it.
+        let mut port = Self {
+            file,
+            device,
+            address_mode: None,
+        };
+        let modes = port.get_modes()?;
+        if modes & ioctl::PARPORT_MODE_EPP == 0 {
+            return Err(HwError::NotPresent {
+                device: port.device.clone(),
+                reason: format!(
+                    "the port has no hardware EPP (PPGETMODES = {modes:#x}); enable EPP in the BIOS"
+                ),
+            });
+        }
+        port.set_mode(false)?;
+        Ok(port)
+    }
+
+    /// The device path.
+    ///
+    /// # Examples
+    ///
+    /// ```no_run
+    /// use ctrlab::hw::Ppdev;
+    /// let port = Ppdev::open("/dev/parport0")?;
+    /// assert_eq!(port.device(), "/dev/parport0");
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    pub fn device(&self) -> &str {
+        &self.device
+    }
+
+    fn get_modes(&self) -> Result<libc::c_uint, HwError> {
+        let mut modes: libc::c_uint = 0;
+        // SAFETY: PPGETMODES writes one `unsigned int` through its pointer
+        // argument; `modes` is a live, aligned c_uint for the whole call, and
+        // the fd is owned by `self.file`, open for the call's duration.
+        let rc = unsafe {
+            libc::ioctl(
+                self.file.as_raw_fd(),
+                ioctl::PPGETMODES as libc::Ioctl,
+                &mut modes as *mut libc::c_uint,
+            )
+        };
+        if rc < 0 {
+            return Err(os_error(
+                &self.device,
+                "PPGETMODES",
+                io::Error::last_os_error(),
+            ));
+        }
+        Ok(modes)
+    }
+
+    /// Selects EPP address (`true`) or data (`false`) cycles, if not already.
+    fn set_mode(&mut self, address: bool) -> Result<(), HwError> {
+        if self.address_mode == Some(address) {
+            return Ok(());
+        }
+        let mode: libc::c_int = if address {
+            ioctl::IEEE1284_MODE_EPP | ioctl::IEEE1284_ADDR
+        } else {
+            ioctl::IEEE1284_MODE_EPP
+        };
+        // SAFETY: PPSETMODE reads one `int` through its pointer argument;
+        // `mode` is a live, aligned c_int for the whole call, and the fd is
+        // owned by `self.file`, open for the call's duration.
+        let rc = unsafe {
+            libc::ioctl(
+                self.file.as_raw_fd(),
+                ioctl::PPSETMODE as libc::Ioctl,
+                &mode as *const libc::c_int,
+            )
+        };
+        if rc < 0 {
+            self.address_mode = None;
+            return Err(os_error(
+                &self.device,
+                "PPSETMODE",
+                io::Error::last_os_error(),
+            ));
+        }
+        self.address_mode = Some(address);
+        Ok(())
+    }
+
+    fn write_byte(&mut self, cycle: CycleKind, byte: u8) -> Result<(), HwError> {
+        match self.file.write(&[byte]) {
+            Ok(1) => Ok(()),
+            Ok(_) => Err(timeout(cycle)),
+            Err(e) => Err(transfer_error(&self.device, cycle, e)),
+        }
+    }
+}
+
+impl EppPort for Ppdev {
+    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+        self.set_mode(true)?;
+        self.write_byte(CycleKind::AddressWrite, address)
+    }
+
+    fn read_data(&mut self) -> Result<u8, HwError> {
+        self.set_mode(false)?;
+        let mut byte = [0u8; 1];
+        match self.file.read(&mut byte) {
+            Ok(1) => Ok(byte[0]),
+            Ok(_) => Err(timeout(CycleKind::DataRead)),
+            Err(e) => Err(transfer_error(&self.device, CycleKind::DataRead, e)),
+        }
+    }
+
+    fn write_data(&mut self, value: u8) -> Result<(), HwError> {
+        self.set_mode(false)?;
+        self.write_byte(CycleKind::DataWrite, value)
+    }
+}
+
+impl Drop for Ppdev {
+    fn drop(&mut self) {
+        // Nothing to do about a failed release in a destructor; closing the
+        // file (which follows) releases the port in the kernel as well.
+        if ioctl_none(&self.file, ioctl::PPRELEASE).is_err() {}
+    }
+}
+
+/// An argumentless (`_IO`) ppdev ioctl.
+fn ioctl_none(file: &File, request: u32) -> io::Result<()> {
+    // SAFETY: `request` is one of ppdev's `_IO` requests, which take no
+    // argument and touch no user memory; the fd is owned by `file`, open for
+    // the call's duration.
+    let rc = unsafe { libc::ioctl(file.as_raw_fd(), request as libc::Ioctl) };
+    if rc < 0 {
+        Err(io::Error::last_os_error())
+    } else {
+        Ok(())
+    }
+}
+
+fn timeout(cycle: CycleKind) -> HwError {
+    HwError::Timeout {
+        cycle,
+        register: None,
+    }
+}
+
+/// A failed read or write: would-block and timeouts are EPP timeouts.
+fn transfer_error(device: &str, cycle: CycleKind, e: io::Error) -> HwError {
+    match e.raw_os_error() {
+        Some(libc::EAGAIN | libc::ETIMEDOUT) => timeout(cycle),
+        _ => os_error(
+            device,
+            match cycle {
+                CycleKind::DataRead => "read",
+                CycleKind::AddressWrite | CycleKind::DataWrite => "write",
+            },
+            e,
+        ),
+    }
+}
+
+/// Maps an OS error to the matching [`HwError`].
+fn os_error(device: &str, operation: &'static str, e: io::Error) -> HwError {
+    match e.raw_os_error() {
+        Some(libc::EACCES | libc::EPERM) => HwError::Permission {
+            device: device.to_owned(),
+            source: e,
+        },
+        Some(libc::ENOENT | libc::ENODEV | libc::ENXIO) => HwError::NotPresent {
+            device: device.to_owned(),
+            reason: format!("{operation}: {e}"),
+        },
+        _ => HwError::Io {
+            device: device.to_owned(),
+            operation,
+            source: e,
+        },
+    }
+}

@@ -1,0 +1,490 @@
+//! The simulated card against independent references (the exact ZOH model,
+//! static deflections, a hand-switched watchdog reference), and the rig's
+//! safety: saturation, travel limits, non-finite commands, drop.
+
+use ctrlab::hw::testing::RecordingPort;
+use ctrlab::hw::{
+    Calibration, CycleKind, EppPort, HwError, HwErrorKind, MassSpringRig, Pc104, Rig,
+    SIMULATED_CARD_ID, SimulatedCard, SimulatedCardConfig, VirtualClock,
+};
+use ctrlab::{MassSpring, Method, Output};
+use nalgebra::{SVector, vector};
+
+/// 80 mm per 8192 counts.
+const MPC: f64 = 0.080 / 8192.0;
+const PERIOD_NS: u64 = 2_000_000;
+
+fn sim(config: SimulatedCardConfig) -> (VirtualClock, SimulatedCard) {
+    let clock = VirtualClock::new();
+    let card = SimulatedCard::virtual_time(config, &clock).unwrap();
+    (clock, card)
+}
+
+fn nominal_config() -> SimulatedCardConfig {
+    SimulatedCardConfig {
+        truth: MassSpring::nominal(),
+        ..Default::default()
+    }
+}
+
+// ---- the simulated card ----------------------------------------------------
+
+#[test]
+fn card_id_and_probe() {
+    let mut pc104 = Pc104::new(SimulatedCard::default());
+    assert_eq!(
+        pc104.probe_id(SIMULATED_CARD_ID).unwrap(),
+        SIMULATED_CARD_ID
+    );
+    let err = pc104.probe_id(0x3c).unwrap_err();
+    assert_eq!(err.kind(), HwErrorKind::NotPresent);
+    assert!(err.to_string().contains("0xa5"), "{err}");
+    // An unmapped address reads an open bus.
+    assert_eq!(pc104.port_mut().read_register(0x99).unwrap(), 0xff);
+}
+
+#[test]
+fn plant_matches_the_exact_zoh_discretisation() {
+    // The card's RK4 sub-steps against the crate's exact ZOH model: the
+    // voltage is held between accesses, so the two agree to RK4's error.
+    let truth = SimulatedCardConfig::default_truth();
+    let (clock, card) = sim(SimulatedCardConfig {
+        watchdog_timeout: None,
+        ..Default::default()
+    });
+    let mut pc104 = Pc104::new(card);
+    let d = truth
+        .state_space(Output::Cart2)
+        .unwrap()
+        .discretize(0.002, Method::Zoh)
+        .unwrap();
+    let mut x = SVector::<f64, 4>::zeros();
+    let mut scale = 1e-3f64;
+    for k in 0..1000 {
+        // A varying, quantisable input: duty steps of 0.1 %.
+        let duty = ((k % 50) as i16 - 25) * 8;
+        pc104.set_pwm(0, duty).unwrap();
+        let volts = 24.0 * f64::from(duty) / 1000.0;
+        x = d.step(&x, &vector![volts]);
+        clock.advance_nanos(PERIOD_NS);
+        pc104.latch().unwrap();
+        let got = pc104.port().true_state();
+        scale = scale.max(x.norm());
+        // RK4's local error is about (hω)⁵/120 of the state, with the
+        // fastest mode ω ≈ 62 rad/s and h = 0.25 ms: 7e-12 per sub-step,
+        // 5.6e-8 after the 8000 sub-steps of this run. Observed: 1e-8 at
+        // step 80, growing linearly.
+        assert!((got - x).norm() <= 1e-7 * scale, "step {k}: {got} vs {x}");
+    }
+}
+
+#[test]
+fn a_latch_captures_the_counts_of_the_state_at_that_instant() {
+    let (clock, card) = sim(SimulatedCardConfig {
+        initial_state: vector![0.004, 0.0, -0.013, 0.0],
+        watchdog_timeout: None,
+        ..Default::default()
+    });
+    let mut pc104 = Pc104::new(card);
+    for _ in 0..200 {
+        clock.advance_nanos(1_300_000);
+        pc104.latch().unwrap();
+        let truth = pc104.port().true_state();
+        assert_eq!(pc104.port().time(), clock.now());
+        // Advancing the clock after the latch does not change what is read.
+        clock.advance_nanos(700_000);
+        let c1 = pc104.read_counter(0).unwrap();
+        let c2 = pc104.read_counter(1).unwrap();
+        assert_eq!(c1, (truth[0] / MPC).round() as i64);
+        assert_eq!(c2, (truth[2] / MPC).round() as i64);
+    }
+}
+
+#[test]
+fn clearing_zeroes_the_counters_where_the_carts_are() {
+    let (clock, card) = sim(SimulatedCardConfig {
+        initial_state: vector![0.004, 0.0, 0.013, 0.0],
+        ..Default::default()
+    });
+    let mut pc104 = Pc104::new(card);
+    pc104.latch().unwrap();
+    assert_eq!(pc104.read_counter(1).unwrap(), (0.013 / MPC).round() as i64);
+    pc104.clear_counters().unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(pc104.read_counter(0).unwrap(), 0);
+    assert_eq!(pc104.read_counter(1).unwrap(), 0);
+    // Afterwards the counters follow the carts from there.
+    clock.advance(0.01).unwrap();
+    pc104.latch().unwrap();
+    let x = pc104.port().true_state();
+    let expected = ((x[2] / MPC).round() - (0.013 / MPC).round()) as i64;
+    assert_eq!(pc104.read_counter(1).unwrap(), expected);
+    assert_ne!(expected, 0);
+}
+
+#[test]
+fn watchdog_zeroes_the_pwm_when_not_kicked() {
+    let config = SimulatedCardConfig {
+        initial_state: vector![0.0, 0.0, 0.0, 0.0],
+        ..Default::default()
+    };
+    let (clock, card) = sim(config.clone());
+    let mut pc104 = Pc104::new(card);
+    pc104.set_pwm(0, 500).unwrap();
+    clock.advance(0.050).unwrap();
+    pc104.kick_watchdog().unwrap(); // at 50 ms: the deadline moves to 150 ms
+    clock.advance(0.099).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(
+        pc104.port().pwm_duty(0),
+        500,
+        "149 ms: still kicked in time"
+    );
+    clock.advance(0.002).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(pc104.port().pwm_duty(0), 0, "151 ms: the watchdog tripped");
+    assert_eq!(pc104.port().voltage(), 0.0);
+    // Until a kick, new duties are refused.
+    pc104.set_pwm(0, 300).unwrap();
+    assert_eq!(pc104.port().pwm_duty(0), 0);
+    pc104.kick_watchdog().unwrap();
+    pc104.set_pwm(0, 300).unwrap();
+    assert_eq!(pc104.port().pwm_duty(0), 300);
+
+    // The trip happened at exactly 150 ms of card time: the same card with no
+    // watchdog, switched off by hand at 150 ms, ends in the same state.
+    let (clock2, card2) = sim(SimulatedCardConfig {
+        watchdog_timeout: None,
+        ..config
+    });
+    let mut reference = Pc104::new(card2);
+    reference.set_pwm(0, 500).unwrap();
+    clock2.advance(0.150).unwrap();
+    reference.set_pwm(0, 0).unwrap();
+    clock2.advance(0.001).unwrap();
+    reference.latch().unwrap();
+    let (a, b) = (pc104.port().true_state(), reference.port().true_state());
+    assert!((a - b).norm() <= 1e-12 * b.norm(), "{a} vs {b}");
+    assert!(b[2] > 0.0);
+}
+
+#[test]
+fn noise_is_seeded_and_of_the_configured_size() {
+    let run = |seed: u64| {
+        let (_clock, card) = sim(SimulatedCardConfig {
+            encoder_noise: 3.0,
+            seed,
+            ..Default::default()
+        });
+        let mut pc104 = Pc104::new(card);
+        (0..4000)
+            .map(|_| {
+                pc104.latch().unwrap();
+                // The plant is at rest at 0: the count is pure noise.
+                pc104.read_raw_counter(1).unwrap() as i32
+            })
+            .collect::<Vec<_>>()
+    };
+    let a = run(1);
+    assert_eq!(a, run(1));
+    assert_ne!(a, run(2));
+    let n = a.len() as f64;
+    let mean = a.iter().map(|&c| f64::from(c)).sum::<f64>() / n;
+    let var = a
+        .iter()
+        .map(|&c| (f64::from(c) - mean).powi(2))
+        .sum::<f64>()
+        / n;
+    // Rounding adds 1/12 count² to σ² = 9; 4000 samples: the standard error
+    // of the mean is 0.05 counts, of the variance about 0.2 counts².
+    assert!(mean.abs() < 0.25, "mean {mean}");
+    assert!((var - (9.0 + 1.0 / 12.0)).abs() < 1.0, "variance {var}");
+}
+
+#[test]
+fn coulomb_friction_sticks_below_breakaway_and_stops_in_the_dead_band() {
+    let truth = MassSpring::nominal();
+    let (clock, card) = sim(SimulatedCardConfig {
+        truth,
+        coulomb_friction: [0.0, 2.0],
+        watchdog_timeout: None,
+        ..Default::default()
+    });
+    let mut pc104 = Pc104::new(card);
+    // 1.008 N (42 ‰ of 24 V with the nominal 1 N/V) against 2 N: no motion.
+    pc104.set_pwm(0, 42).unwrap();
+    clock.advance(2.0).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(pc104.port().true_state(), SVector::<f64, 4>::zeros());
+
+    // 12 N: cart 2 breaks away, oscillates, and sticks for good somewhere
+    // in the dead band where the springs and motor are within ±2 N.
+    pc104.set_pwm(0, 500).unwrap();
+    clock.advance(10.0).unwrap();
+    pc104.latch().unwrap();
+    let x = pc104.port().true_state();
+    assert_eq!(x[3], 0.0, "cart 2 has stuck");
+    let force_on_cart2 = truth.k2 * (x[0] - x[2]) + 12.0;
+    assert!(force_on_cart2.abs() <= 2.0, "net force {force_on_cart2} N");
+    // Cart 1 has no friction: it has settled where its springs balance.
+    let x1_rest = truth.k2 * x[2] / (truth.k1 + truth.k2);
+    assert!((x[0] - x1_rest).abs() < 1e-9, "{x}");
+    // And the dead band is a real band: frictionless, x2 would be 24 mm.
+    assert!(x[2] > 0.020 && x[2] < 0.028, "{x}");
+}
+
+#[test]
+fn invalid_configurations_are_refused() {
+    let default = SimulatedCardConfig::default();
+    for (bad, name) in [
+        (
+            SimulatedCardConfig {
+                max_substep: 0.0,
+                ..default.clone()
+            },
+            "max_substep",
+        ),
+        (
+            SimulatedCardConfig {
+                encoder_noise: -1.0,
+                ..default.clone()
+            },
+            "encoder_noise",
+        ),
+        (
+            SimulatedCardConfig {
+                encoder_channels: [1, 1],
+                ..default.clone()
+            },
+            "encoder_channels",
+        ),
+        (
+            SimulatedCardConfig {
+                watchdog_timeout: Some(f64::NAN),
+                ..default.clone()
+            },
+            "watchdog_timeout",
+        ),
+        (
+            SimulatedCardConfig {
+                truth: MassSpring {
+                    m2: 0.0,
+                    ..MassSpring::nominal()
+                },
+                ..default.clone()
+            },
+            "m2",
+        ),
+    ] {
+        match SimulatedCard::real_time(bad) {
+            Err(HwError::InvalidConfig { name: got, .. }) => assert_eq!(got, name),
+            other => panic!("expected InvalidConfig for {name}, got {other:?}"),
+        }
+    }
+}
+
+// ---- the rig ---------------------------------------------------------------
+
+fn rig_on(config: SimulatedCardConfig) -> (VirtualClock, MassSpringRig<SimulatedCard>) {
+    let (clock, card) = sim(config);
+    let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002).unwrap();
+    (clock, rig)
+}
+
+/// Holds `volts` for `seconds`, reading every 2 ms; returns the last state.
+fn hold(clock: &VirtualClock, rig: &mut impl Rig, volts: f64, seconds: f64) -> SVector<f64, 4> {
+    let mut x = rig.read_state().unwrap();
+    for _ in 0..(seconds / 0.002).round() as usize {
+        rig.apply_voltage(volts).unwrap();
+        clock.advance_nanos(PERIOD_NS);
+        x = rig.read_state().unwrap();
+    }
+    x
+}
+
+#[test]
+fn open_loop_reaches_the_static_deflection_of_the_truth() {
+    for (config, volts) in [
+        (nominal_config(), 12.0),
+        (SimulatedCardConfig::default(), 3.0),
+        (SimulatedCardConfig::default(), -4.8),
+    ] {
+        let truth = config.truth;
+        let (clock, mut rig) = rig_on(config);
+        let x = hold(&clock, &mut rig, volts, 10.0);
+        // 12 V, 3 V and -4.8 V are exact multiples of the 24 mV duty step.
+        let (x1, x2) = truth.static_deflection(truth.gain * volts).unwrap();
+        // Encoder quantisation: half a count (plus the residual transient,
+        // e^(-35) of the initial deflection after 10 s: nothing).
+        assert!(
+            (x[0] - x1).abs() <= MPC / 2.0 + 1e-9,
+            "{truth:?}: x1 {} vs {x1}",
+            x[0]
+        );
+        assert!(
+            (x[2] - x2).abs() <= MPC / 2.0 + 1e-9,
+            "{truth:?}: x2 {} vs {x2}",
+            x[2]
+        );
+        assert_eq!((x[1], x[3]), (0.0, 0.0), "at rest the counts do not change");
+    }
+}
+
+#[test]
+fn speeds_are_count_differences_over_the_period() {
+    let (clock, mut rig) = rig_on(nominal_config());
+    let mut previous = rig.read_state().unwrap();
+    let mut moved = false;
+    for _ in 0..200 {
+        rig.apply_voltage(10.0).unwrap();
+        clock.advance_nanos(PERIOD_NS);
+        let x = rig.read_state().unwrap();
+        for i in [0, 2] {
+            let expected = (x[i] - previous[i]) / 0.002;
+            assert!((x[i + 1] - expected).abs() <= 1e-9 * expected.abs().max(1.0));
+        }
+        moved |= x[3] > 0.01;
+        previous = x;
+    }
+    assert!(moved);
+}
+
+#[test]
+fn voltages_saturate_and_quantise() {
+    let (_clock, mut rig) = rig_on(SimulatedCardConfig::default());
+    for (volts, duty) in [
+        (100.0, 1000),
+        (-1e9, -1000),
+        (24.0, 1000),
+        (6.0, 250),
+        (0.0119, 0),
+        (0.0121, 1),
+        (-0.0372, -2), // -1.55 counts of 0.1 %
+    ] {
+        rig.apply_voltage(volts).unwrap();
+        assert_eq!(rig.card().port().pwm_duty(0), duty, "{volts} V");
+    }
+}
+
+#[test]
+fn non_finite_voltage_halts_the_rig() {
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let (_clock, mut rig) = rig_on(SimulatedCardConfig::default());
+        rig.apply_voltage(10.0).unwrap();
+        let err = rig.apply_voltage(bad).unwrap_err();
+        assert_eq!(err.kind(), HwErrorKind::InvalidCommand, "{bad}");
+        assert_eq!(rig.card().port().pwm_duty(0), 0, "{bad}");
+    }
+}
+
+#[test]
+fn travel_limit_breach_halts_the_rig() {
+    let (clock, mut rig) = rig_on(SimulatedCardConfig::default());
+    let mut err = None;
+    // 24 V on the default truth would deflect cart 2 by 0.41 m.
+    for _ in 0..5000 {
+        rig.apply_voltage(24.0).unwrap();
+        clock.advance_nanos(PERIOD_NS);
+        if let Err(e) = rig.read_state() {
+            err = Some(e);
+            break;
+        }
+    }
+    match err {
+        Some(HwError::TravelLimit {
+            cart: 2,
+            position,
+            limit,
+        }) => {
+            assert_eq!(limit, 0.15);
+            assert!(position > 0.15 && position < 0.16, "{position}");
+        }
+        other => panic!("expected a travel-limit breach of cart 2, got {other:?}"),
+    }
+    assert_eq!(rig.card().port().pwm_duty(0), 0);
+}
+
+#[test]
+fn dropping_the_rig_zeroes_the_pwm() {
+    let (_clock, mut card) = sim(SimulatedCardConfig::default());
+    {
+        let mut rig =
+            MassSpringRig::new(Pc104::new(&mut card), Calibration::default(), 0.002).unwrap();
+        rig.apply_voltage(-12.0).unwrap();
+        assert_eq!(rig.card().port().pwm_duty(0), -500);
+    }
+    assert_eq!(card.pwm_duty(0), 0);
+}
+
+#[test]
+fn read_state_kicks_the_watchdog_and_stopping_trips_it() {
+    let (clock, mut rig) = rig_on(SimulatedCardConfig::default());
+    // A 1 s run of a loop that reads and writes every period: never trips.
+    let x = hold(&clock, &mut rig, 1.2, 1.0);
+    assert!(x[2] > 0.0);
+    assert_eq!(rig.card().port().pwm_duty(0), 50);
+    // The loop stops: 100 ms later the card has zeroed the PWM by itself.
+    clock.advance(0.101).unwrap();
+    rig.card_mut().port_mut().sync();
+    assert_eq!(rig.card().port().pwm_duty(0), 0);
+}
+
+#[test]
+fn encoder_signs_and_channels_follow_the_calibration() {
+    let (clock, card) = sim(SimulatedCardConfig {
+        initial_state: vector![0.002, 0.0, 0.005, 0.0],
+        encoder_channels: [3, 2],
+        ..Default::default()
+    });
+    let cal = Calibration {
+        sign: [-1.0, 1.0],
+        encoder_channels: [3, 2],
+        ..Calibration::default()
+    };
+    let mut rig = MassSpringRig::new(Pc104::new(card), cal, 0.002).unwrap();
+    clock.advance(0.0).unwrap();
+    let x = rig.read_state().unwrap();
+    assert_eq!(x[0], -(0.002 / MPC).round() * MPC);
+    assert_eq!(x[2], (0.005 / MPC).round() * MPC);
+}
+
+#[test]
+fn a_dead_port_surfaces_as_an_error_from_the_rig() {
+    // Cycle 0 is the latch's address write.
+    let (_clock, card) = sim(SimulatedCardConfig::default());
+    let port = RecordingPort::new(card).fail_from(0);
+    let mut rig = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap();
+    let err = rig.read_state().unwrap_err();
+    assert!(matches!(
+        err,
+        HwError::Timeout {
+            cycle: CycleKind::AddressWrite,
+            register: Some(0x01)
+        }
+    ));
+}
+
+#[test]
+fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
+    // An iteration is 22 cycles: latch+kick (2), two counters (2 × 8), PWM (4).
+    const CYCLES: usize = 22;
+    for k in 0..CYCLES {
+        let (clock, card) = sim(SimulatedCardConfig::default());
+        let port = RecordingPort::new(card).fail_at(CYCLES + k);
+        let mut rig = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap();
+        rig.read_state().unwrap();
+        rig.apply_voltage(6.0).unwrap();
+        assert_eq!(rig.card().port().attempts(), CYCLES);
+        clock.advance_nanos(PERIOD_NS);
+        let result = rig.read_state().and_then(|_| rig.apply_voltage(3.0));
+        let err = result.expect_err("the injected fault surfaces");
+        assert_eq!(err.kind(), HwErrorKind::Timeout, "cycle {k}");
+        // Cut in the read (k < 18) the new command is never sent; cut in the
+        // PWM write (even after its low byte, k = 20, 21) the card keeps the
+        // previous duty whole: only the high byte applies a duty.
+        assert_eq!(rig.card().port().inner().pwm_duty(0), 250, "cycle {k}");
+        // The port works again: the caller's halt reaches the card.
+        rig.halt().unwrap();
+        assert_eq!(rig.card().port().inner().pwm_duty(0), 0, "cycle {k}");
+    }
+}
