@@ -12,6 +12,10 @@
 //! - [`integrate`]: the [`Dynamics`] trait and the [`Rk4`] and [`Euler`]
 //!   steppers.
 //! - [`sim`]: continuous and discrete simulation and step responses.
+//! - [`analysis`]: poles, stability, DC gain, damping, controllability and
+//!   observability.
+//! - [`design`]: the [`Controller`] trait, [`StateFeedback`] (the lab's
+//!   per-millimetre form and the textbook form), [`acker`], [`lqr`], [`dlqr`].
 //!
 //! Units are SI throughout (m, m/s, N, V, s); the lab's millimetres appear
 //! only in printed tables and at named conversions.
@@ -34,6 +38,8 @@
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
 
+pub mod analysis;
+pub mod design;
 pub mod discretize;
 mod error;
 pub mod integrate;
@@ -41,6 +47,8 @@ mod linalg;
 pub mod model;
 pub mod sim;
 
+pub use analysis::Damping;
+pub use design::{Controller, Lqr, StateFeedback, acker, dlqr, lqr};
 pub use discretize::Method;
 pub use error::Error;
 pub use integrate::{Dynamics, Euler, Integrator, Rk4};
