@@ -52,13 +52,15 @@ fn dc_gain_with_a_pole_at_the_origin_is_singular() {
     )
     .unwrap();
     assert!(matches!(free_cart.dc_gain(), Err(Error::Singular { .. })));
-    let acc = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    let acc =
+        StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
     assert!(matches!(acc.dc_gain(), Err(Error::Singular { .. })));
 }
 
 #[test]
 fn dc_gain_includes_feedthrough() {
-    let sys = StateSpace::continuous(matrix![-4.0], matrix![2.0], matrix![3.0], matrix![0.5]).unwrap();
+    let sys =
+        StateSpace::continuous(matrix![-4.0], matrix![2.0], matrix![3.0], matrix![0.5]).unwrap();
     assert!((sys.dc_gain().unwrap()[(0, 0)] - (1.5 + 0.5)).abs() < 1e-15);
 }
 
@@ -66,11 +68,35 @@ fn dc_gain_includes_feedthrough() {
 fn stability_in_both_domains() {
     let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
     assert!(plant.is_stable().unwrap());
-    assert!(plant.discretize(0.002, Method::Zoh).unwrap().is_stable().unwrap());
-    let unstable = StateSpace::continuous(matrix![0.1, 1.0; -1.0, 0.1], matrix![0.0; 1.0], matrix![1.0, 0.0], matrix![0.0]).unwrap();
+    assert!(
+        plant
+            .discretize(0.002, Method::Zoh)
+            .unwrap()
+            .is_stable()
+            .unwrap()
+    );
+    let unstable = StateSpace::continuous(
+        matrix![0.1, 1.0; -1.0, 0.1],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
     assert!(!unstable.is_stable().unwrap());
-    assert!(!unstable.discretize(0.01, Method::Zoh).unwrap().is_stable().unwrap());
-    let undamped = StateSpace::continuous(matrix![0.0, 1.0; -1.0, 0.0], matrix![0.0; 1.0], matrix![1.0, 0.0], matrix![0.0]).unwrap();
+    assert!(
+        !unstable
+            .discretize(0.01, Method::Zoh)
+            .unwrap()
+            .is_stable()
+            .unwrap()
+    );
+    let undamped = StateSpace::continuous(
+        matrix![0.0, 1.0; -1.0, 0.0],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
     assert!(!undamped.is_stable().unwrap());
 }
 
@@ -95,13 +121,18 @@ fn damping_of_a_second_order_system_and_its_discretisation() {
         assert!((p.natural_frequency - wn).abs() < 1e-9);
         assert!((p.damping_ratio - zeta).abs() < 1e-9);
     }
-    let integrator = StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
+    let integrator =
+        StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
     let d0 = integrator.damping().unwrap()[0];
     assert_eq!((d0.natural_frequency, d0.damping_ratio), (0.0, -1.0));
     assert_eq!(d0.time_constant, f64::INFINITY);
-    let deadbeat = StateSpace::discrete(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    let deadbeat =
+        StateSpace::discrete(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
     let z0 = deadbeat.damping().unwrap()[0];
-    assert_eq!((z0.natural_frequency, z0.damping_ratio, z0.time_constant), (f64::INFINITY, 1.0, 0.0));
+    assert_eq!(
+        (z0.natural_frequency, z0.damping_ratio, z0.time_constant),
+        (f64::INFINITY, 1.0, 0.0)
+    );
 }
 
 #[test]
@@ -123,7 +154,10 @@ fn controllability_and_observability_of_the_lab_plant() {
     assert_eq!(rank(&sys.observability().unwrap(), None).unwrap(), 4);
     // A zero spring between the carts cuts cart 1 off from the motor and cart
     // 2's position off from cart 1.
-    let cut = MassSpring { k2: 0.0, ..MassSpring::nominal() };
+    let cut = MassSpring {
+        k2: 0.0,
+        ..MassSpring::nominal()
+    };
     let s = cut.state_space(Output::Cart2).unwrap();
     assert!(!s.is_controllable().unwrap());
     assert!(!s.is_observable().unwrap());
@@ -138,14 +172,26 @@ fn rank_is_relative_to_the_largest_singular_value() {
         assert_eq!(rank(&m, None).unwrap(), 1, "scale {scale}");
     }
     assert_eq!(rank(&DMatrix::<f64>::zeros(3, 2), None).unwrap(), 0);
-    assert!(matches!(rank(&dmatrix![1.0], Some(-1.0)), Err(Error::InvalidParameter { name: "rtol", .. })));
-    assert!(matches!(rank(&dmatrix![f64::NAN], None), Err(Error::NonFinite { .. })));
+    assert!(matches!(
+        rank(&dmatrix![1.0], Some(-1.0)),
+        Err(Error::InvalidParameter { name: "rtol", .. })
+    ));
+    assert!(matches!(
+        rank(&dmatrix![f64::NAN], None),
+        Err(Error::NonFinite { .. })
+    ));
 }
 
 #[test]
 fn huge_powers_overflow_into_an_error_not_nan() {
     let a = SMatrix::<f64, 4, 4>::from_element(1e120);
-    let sys = StateSpace::continuous(a, matrix![1.0; 1.0; 1.0; 1.0], matrix![1.0, 0.0, 0.0, 0.0], matrix![0.0]).unwrap();
+    let sys = StateSpace::continuous(
+        a,
+        matrix![1.0; 1.0; 1.0; 1.0],
+        matrix![1.0, 0.0, 0.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
     assert!(matches!(sys.controllability(), Err(Error::Overflow { .. })));
     assert!(matches!(sys.is_observable(), Err(Error::Overflow { .. })));
 }

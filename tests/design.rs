@@ -46,7 +46,14 @@ fn lab_law_in_si_equals_the_lab_law_in_millimetres() {
 #[test]
 fn non_finite_lab_gain_is_an_error() {
     let err = StateFeedback::from_lab_gains([0.0, f64::NAN, 1.0, 0.0], Output::Cart2).unwrap_err();
-    assert!(matches!(err, Error::NonFinite { matrix: "K", col: 1, .. }));
+    assert!(matches!(
+        err,
+        Error::NonFinite {
+            matrix: "K",
+            col: 1,
+            ..
+        }
+    ));
 }
 
 #[test]
@@ -55,7 +62,12 @@ fn closed_loop_poles_match_the_fixture_rows() {
     let rows = fx["feedback"].as_array().unwrap();
     assert!(!rows.is_empty());
     for row in rows {
-        let kf: Vec<f64> = row["kf"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let kf: Vec<f64> = row["kf"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
         let output = match row["cart"].as_u64().unwrap() {
             1 => Output::Cart1,
             _ => Output::Cart2,
@@ -68,7 +80,10 @@ fn closed_loop_poles_match_the_fixture_rows() {
         assert_eq!(got.len(), want.len());
         // Both are sorted by real part, then imaginary part.
         for (g, w) in got.iter().zip(&want) {
-            assert!((g - w).norm() <= 1e-9 * w.norm(), "Kf {kf:?}: pole {g} vs {w}");
+            assert!(
+                (g - w).norm() <= 1e-9 * w.norm(),
+                "Kf {kf:?}: pole {g} vs {w}"
+            );
         }
         assert_eq!(cl.is_stable().unwrap(), row["stable"].as_bool().unwrap());
     }
@@ -107,7 +122,8 @@ fn prefilter_removes_the_steady_state_error() {
 #[test]
 fn prefilter_refuses_a_closed_loop_without_dc_gain() {
     // An integrator plant with no feedback: pole at s = 0.
-    let plant = StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
+    let plant =
+        StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
     assert!(matches!(
         StateFeedback::with_prefilter(&plant, matrix![0.0]),
         Err(Error::Singular { .. })
@@ -171,7 +187,10 @@ fn acker_refuses_uncontrollable_plants_and_unpaired_targets() {
         Err(Error::InvalidParameter { name: "poles", .. })
     ));
     let nan = [Complex::new(f64::NAN, 0.0); 4];
-    assert!(matches!(acker(&plant, &nan), Err(Error::InvalidParameter { name: "poles", .. })));
+    assert!(matches!(
+        acker(&plant, &nan),
+        Err(Error::InvalidParameter { name: "poles", .. })
+    ));
 }
 
 /// Relative CARE residual, computed here independently of the library.
@@ -206,8 +225,13 @@ fn dare_residual<const N: usize, const M: usize>(
 #[test]
 fn scalar_care_matches_the_closed_form() {
     // 2 a X − b² X² / r + q = 0  ⇒  X = r (a + √(a² + b² q / r)) / b².
-    for &(a, b, q, r) in &[(1.0, 1.0, 1.0, 1.0), (3.0, 0.5, 2.0, 0.1), (-2.0, 2.0, 5.0, 3.0)] {
-        let sys = StateSpace::continuous(matrix![a], matrix![b], matrix![1.0], matrix![0.0]).unwrap();
+    for &(a, b, q, r) in &[
+        (1.0, 1.0, 1.0, 1.0),
+        (3.0, 0.5, 2.0, 0.1),
+        (-2.0, 2.0, 5.0, 3.0),
+    ] {
+        let sys =
+            StateSpace::continuous(matrix![a], matrix![b], matrix![1.0], matrix![0.0]).unwrap();
         let sol = lqr(&sys, &matrix![q], &matrix![r]).unwrap();
         let x = r * (a + (a * a + b * b * q / r).sqrt()) / (b * b);
         assert!((sol.riccati[(0, 0)] - x).abs() <= 1e-12 * x, "a = {a}");
@@ -218,12 +242,21 @@ fn scalar_care_matches_the_closed_form() {
 #[test]
 fn scalar_dare_matches_the_closed_form() {
     // X = q + a² X r / (r + b² X)  ⇒  b² X² + (r − a² r − q b²) X − q r = 0.
-    for &(a, b, q, r) in &[(1.5, 1.0, 1.0, 1.0), (0.5, 0.2, 3.0, 0.1), (-2.0, 1.0, 0.5, 2.0)] {
-        let sys = StateSpace::discrete(matrix![a], matrix![b], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    for &(a, b, q, r) in &[
+        (1.5, 1.0, 1.0, 1.0),
+        (0.5, 0.2, 3.0, 0.1),
+        (-2.0, 1.0, 0.5, 2.0),
+    ] {
+        let sys =
+            StateSpace::discrete(matrix![a], matrix![b], matrix![1.0], matrix![0.0], 0.1).unwrap();
         let sol = dlqr(&sys, &matrix![q], &matrix![r]).unwrap();
         let (qa, qb, qc) = (b * b, r - a * a * r - q * b * b, -q * r);
         let x = (-qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa);
-        assert!((sol.riccati[(0, 0)] - x).abs() <= 1e-12 * x, "a = {a}: {} vs {x}", sol.riccati[(0, 0)]);
+        assert!(
+            (sol.riccati[(0, 0)] - x).abs() <= 1e-12 * x,
+            "a = {a}: {} vs {x}",
+            sol.riccati[(0, 0)]
+        );
     }
 }
 
@@ -271,13 +304,15 @@ fn lqr_stabilises_an_unstable_plant() {
     assert!(!d.is_stable().unwrap());
     let dsol = dlqr(&d, &q, &r).unwrap();
     assert!(dare_residual(d.a(), d.b(), &q, &r, &dsol.riccati) < 1e-9);
-    let dcl = StateSpace::discrete(d.a() - d.b() * dsol.gain, *d.b(), *d.c(), *d.d(), 0.05).unwrap();
+    let dcl =
+        StateSpace::discrete(d.a() - d.b() * dsol.gain, *d.b(), *d.c(), *d.d(), 0.05).unwrap();
     assert!(dcl.is_stable().unwrap());
 }
 
 #[test]
 fn lqr_refuses_bad_weights_and_undetectable_problems() {
-    let sys = StateSpace::continuous(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
+    let sys =
+        StateSpace::continuous(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
     assert!(matches!(
         lqr(&sys, &matrix![-1.0], &matrix![1.0]),
         Err(Error::InvalidMatrix { matrix: "Q", .. })
@@ -291,7 +326,13 @@ fn lqr_refuses_bad_weights_and_undetectable_problems() {
         Err(Error::NonFinite { matrix: "Q", .. })
     ));
     let q = matrix![1.0, 2.0; 0.0, 1.0];
-    let sys2 = StateSpace::continuous(matrix![-1.0, 0.0; 0.0, -1.0], matrix![1.0; 1.0], matrix![1.0, 0.0], matrix![0.0]).unwrap();
+    let sys2 = StateSpace::continuous(
+        matrix![-1.0, 0.0; 0.0, -1.0],
+        matrix![1.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
     assert!(matches!(
         lqr(&sys2, &q, &matrix![1.0]),
         Err(Error::InvalidMatrix { matrix: "Q", .. })
@@ -302,13 +343,29 @@ fn lqr_refuses_bad_weights_and_undetectable_problems() {
         Err(Error::Unstable { .. })
     ));
     // Unstable mode the input cannot reach.
-    let unreachable = StateSpace::continuous(matrix![1.0, 0.0; 0.0, -1.0], matrix![0.0; 1.0], matrix![1.0, 0.0], matrix![0.0]).unwrap();
-    assert!(lqr(&unreachable, &SMatrix::<f64, 2, 2>::identity(), &matrix![1.0]).is_err());
+    let unreachable = StateSpace::continuous(
+        matrix![1.0, 0.0; 0.0, -1.0],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    assert!(
+        lqr(
+            &unreachable,
+            &SMatrix::<f64, 2, 2>::identity(),
+            &matrix![1.0]
+        )
+        .is_err()
+    );
 }
 
 /// A random 4-state single-input system whose controllability matrix is
 /// reasonably conditioned, so placement is well posed.
-fn random_system(entries: [f64; 16], b: [f64; 4]) -> Option<(SMatrix<f64, 4, 4>, SMatrix<f64, 4, 1>)> {
+fn random_system(
+    entries: [f64; 16],
+    b: [f64; 4],
+) -> Option<(SMatrix<f64, 4, 4>, SMatrix<f64, 4, 1>)> {
     let a = SMatrix::<f64, 4, 4>::from_row_slice(&entries);
     let b = SMatrix::<f64, 4, 1>::from_column_slice(&b);
     let mut ctrb = SMatrix::<f64, 4, 4>::zeros();
