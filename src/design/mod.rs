@@ -58,10 +58,37 @@ pub use place::acker;
 pub trait Controller<const N: usize, const M: usize> {
     /// One control step: `reference` in SI (m for the lab), `state` in SI;
     /// returns the plant input (N or V for the lab). Allocates nothing.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Controller, Output, StateFeedback};
+    /// use nalgebra::vector;
+    ///
+    /// let mut c = StateFeedback::from_lab_gains([1.0, 0.0, 0.0, 0.0], Output::Cart1)?;
+    /// // 15 mm setpoint, cart 1 at 10 mm: 1 per mm · 5 mm.
+    /// let u = c.update(0.015, &vector![0.010, 0.0, 0.0, 0.0]);
+    /// assert!((u[0] - 5.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     fn update(&mut self, reference: f64, state: &SVector<f64, N>) -> SVector<f64, M>;
 
     /// Clears internal state (integrators, filters) before a new run. The
     /// default does nothing, which is right for a static law.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Controller, Output, StateFeedback};
+    /// use nalgebra::vector;
+    ///
+    /// let mut c = StateFeedback::from_lab_gains([0.0, 0.0, 1.0, 0.0], Output::Cart2)?;
+    /// let x = vector![0.0, 0.0, 0.01, 0.0];
+    /// let before = c.update(0.02, &x);
+    /// c.reset(); // a static law has nothing to forget
+    /// assert_eq!(c.update(0.02, &x), before);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     fn reset(&mut self) {}
 }
 
