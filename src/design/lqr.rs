@@ -1,27 +1,5 @@
-//! Linear-quadratic regulators: the algebraic Riccati equations solved by a
-//! structure-preserving doubling algorithm (SDA).
-//!
-//! **Method.** The discrete equation
-//! `X = Aᵀ X A − Aᵀ X B (R + Bᵀ X B)⁻¹ Bᵀ X A + Q` is the fixed point of the
-//! SDA of Chu, Fan and Lin (2005): with `E₀ = A`, `G₀ = B R⁻¹ Bᵀ`, `H₀ = Q`,
-//!
-//! ```text
-//! W = I + G H,  E ← E W⁻¹ E,  G ← G + E W⁻¹ G Eᵀ,  H ← H + Eᵀ H W⁻¹ E
-//! ```
-//!
-//! and `H → X` quadratically. The continuous equation
-//! `Aᵀ X + X A − X B R⁻¹ Bᵀ X + Q = 0` is first mapped to that form by the
-//! Cayley transform of its Hamiltonian with a shift `γ > 0`
-//! (`A_γ = A − γ I`, `W_γ = A_γᵀ + Q A_γ⁻¹ G`, `E₀ = I + 2γ W_γ⁻ᵀ`,
-//! `G₀ = 2γ A_γ⁻¹ G W_γ⁻¹`, `H₀ = 2γ W_γ⁻¹ Q A_γ⁻¹`; Chu, Fan, Lin and Weng,
-//! 2004). Neither needs a stable or invertible `A`, so both converge for
-//! unstable plants: the only requirements are the usual LQR ones, `(A, B)`
-//! stabilisable and `(A, Q)` detectable, with no closed-loop pole on the
-//! stability boundary. Everything runs on `N × N` stack matrices.
-//!
-//! Every solution is checked: the relative residual of its Riccati equation
-//! is returned in [`Lqr::residual`], and a solution whose closed loop is not
-//! stable is refused with [`Error::Unstable`].
+//! Linear-quadratic regulators by a structure-preserving doubling algorithm;
+//! the method is documented on [`Lqr`].
 
 use nalgebra::{Complex, DMatrix, SMatrix};
 
@@ -38,9 +16,44 @@ const STEP_RTOL: f64 = 1e-15;
 /// A continuous solution with a relative residual above this is retried with
 /// another Cayley shift; the best one is kept.
 const GOOD_RESIDUAL: f64 = 1e-13;
+/// Newton refinement steps after the doubling, at most.
+const REFINE_STEPS: usize = 3;
 
 /// A solved linear-quadratic regulator: the gain, the Riccati solution, the
 /// closed-loop poles, and how well the Riccati equation is satisfied.
+///
+/// # Method
+///
+/// The discrete equation
+/// `X = Aᵀ X A − Aᵀ X B (R + Bᵀ X B)⁻¹ Bᵀ X A + Q` is the fixed point of the
+/// SDA of Chu, Fan and Lin (2005): with `E₀ = A`, `G₀ = B R⁻¹ Bᵀ`, `H₀ = Q`,
+///
+/// ```text
+/// W = I + G H,  E ← E W⁻¹ E,  G ← G + E W⁻¹ G Eᵀ,  H ← H + Eᵀ H W⁻¹ E
+/// ```
+///
+/// and `H → X` quadratically. The continuous equation
+/// `Aᵀ X + X A − X B R⁻¹ Bᵀ X + Q = 0` is first mapped to that form by the
+/// Cayley transform of its Hamiltonian with a shift `γ > 0`
+/// (`A_γ = A − γ I`, `W_γ = A_γᵀ + Q A_γ⁻¹ G`, `E₀ = I + 2γ W_γ⁻ᵀ`,
+/// `G₀ = 2γ A_γ⁻¹ G W_γ⁻¹`, `H₀ = 2γ W_γ⁻¹ Q A_γ⁻¹`; Chu, Fan, Lin and Weng,
+/// 2004). Neither needs a stable or invertible `A`, so both converge for
+/// unstable plants: the only requirements are the usual LQR ones, `(A, B)`
+/// stabilisable and `(A, Q)` detectable, with no closed-loop pole on the
+/// stability boundary. Everything runs on `N × N` stack matrices. The shift
+/// starts at `γ = max(‖A‖_F, √(‖G‖_F ‖Q‖_F))`, the scale of the
+/// Hamiltonian's eigenvalues; if the residual is above 1e-13 a few other
+/// shifts (γ/2, 2γ, γ/4, 4γ, γ/10, 10γ) are tried and the best solution kept.
+///
+/// On an ill-conditioned problem (a large `X` from nearly cancelling terms)
+/// the doubling alone can stop at a relative residual of about 1e-9. Up to
+/// three Newton steps follow it (a Lyapunov equation for the continuous
+/// case, a Stein equation for the discrete one, solved in Kronecker form),
+/// each kept only if it lowers the residual.
+///
+/// Every solution is checked: the relative residual of its Riccati equation
+/// is returned in [`Lqr::residual`], and a solution whose closed loop is not
+/// stable is refused with [`Error::Unstable`].
 ///
 /// # Examples
 ///
@@ -77,8 +90,8 @@ pub struct Lqr<const N: usize, const M: usize> {
 
 /// Continuous-time LQR: the gain `K = R⁻¹ Bᵀ X` minimising
 /// `∫ (xᵀ Q x + uᵀ R u) dt`, with `X` from the continuous algebraic Riccati
-/// equation (solved by SDA after a Cayley transform; see the [module
-/// docs](self)). Same results as python-control's `lqr(A, B, Q, R)`.
+/// equation (solved by SDA after a Cayley transform; see [`Lqr`]). The
+/// problem python-control's `lqr(A, B, Q, R)` solves.
 ///
 /// # Errors
 ///
@@ -139,7 +152,7 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
         })();
         match attempt {
             Ok((x, iterations)) => {
-                let res = care_residual(&a, &g, q, &x);
+                let res = care_eval(&a, &b, &r_inv_bt, q, &x).1;
                 if best.as_ref().is_none_or(|(_, _, r)| res < *r) {
                     best = Some((x, iterations, res));
                 }
@@ -156,6 +169,18 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
             iterations: MAX_ITERATIONS,
         }));
     };
+    let (x, residual) = refine(
+        x,
+        residual,
+        |x| care_eval(&a, &b, &r_inv_bt, q, x),
+        |x, res| {
+            // Newton step: (A − G X)ᵀ Δ + Δ (A − G X) = −Res(X).
+            let ac_t = (a - b * (r_inv_bt * x)).transpose();
+            let id = DMatrix::<f64>::identity(N, N);
+            let ac_t = DMatrix::from_fn(N, N, |i, j| ac_t[(i, j)]);
+            (id.kronecker(&ac_t) + ac_t.kronecker(&id), -res)
+        },
+    );
     let gain = r_inv_bt * x;
     finish(gain, x, &(a - b * gain), residual, iterations, |p| {
         p.re < 0.0
@@ -164,8 +189,8 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
 
 /// Discrete-time LQR: the gain `K = (R + Bᵀ X B)⁻¹ Bᵀ X A` minimising
 /// `Σ (xᵀ Q x + uᵀ R u)`, with `X` from the discrete algebraic Riccati
-/// equation (solved by SDA; see the [module docs](self)). Same results as
-/// python-control's `dlqr(A, B, Q, R)`.
+/// equation (solved by SDA; see [`Lqr`]). The problem
+/// python-control's `dlqr(A, B, Q, R)` solves.
 ///
 /// # Errors
 ///
@@ -195,17 +220,22 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
     let r_inv_bt = Lu::new(r, "LQR (R)")?.solve(&b.transpose());
     let g = symmetric(&(b * r_inv_bt));
     let (x, iterations) = sda(a, g, *q)?;
-    let bt_x = b.transpose() * x;
-    let gain = Lu::new(&(r + bt_x * b), "DLQR (R + Bᵀ X B)")?.solve(&(bt_x * a));
-    // Residual of X = Aᵀ X A − Aᵀ X B K + Q (K already holds the inverse).
-    let terms = [
-        (a.transpose() * x * a).norm(),
-        x.norm(),
-        (a.transpose() * bt_x.transpose() * gain).norm(),
-        q.norm(),
-    ];
-    let lhs = a.transpose() * x * a - a.transpose() * bt_x.transpose() * gain + q - x;
-    let residual = relative(lhs.norm(), &terms);
+    let eval = |x: &SMatrix<f64, N, N>| match dare_gain(&a, &b, r, x) {
+        Ok(gain) => dare_eval(&a, &b, q, x, &gain),
+        Err(_) => (SMatrix::zeros(), f64::INFINITY),
+    };
+    let (_, residual) = eval(&x);
+    let (x, residual) = refine(x, residual, eval, |x, res| {
+        // Newton (Hewer) step: Δ − A_clᵀ Δ A_cl = Res(X), A_cl = A − B K(X).
+        let gain = dare_gain(&a, &b, r, x).unwrap_or_else(|_| SMatrix::zeros());
+        let ac_t = (a - b * gain).transpose();
+        let ac_t = DMatrix::from_fn(N, N, |i, j| ac_t[(i, j)]);
+        (
+            DMatrix::identity(N * N, N * N) - ac_t.kronecker(&ac_t),
+            *res,
+        )
+    });
+    let gain = dare_gain(&a, &b, r, &x)?;
     finish(gain, x, &(a - b * gain), residual, iterations, |z| {
         z.norm() < 1.0
     })
@@ -274,16 +304,88 @@ fn finish<const N: usize, const M: usize>(
     })
 }
 
-fn care_residual<const N: usize>(
+/// The CARE left side `Aᵀ X + X A − X G X + Q` and its relative norm.
+///
+/// `X G X` is formed as `(X B)(R⁻¹ Bᵀ X)`: with a large `X`, the product
+/// `(X G) X` loses about `ε ‖X G‖ ‖X‖`, which can be a 1e-9 part of the
+/// result, while the factored form stays near `ε ‖X G X‖`.
+fn care_eval<const N: usize, const M: usize>(
     a: &SMatrix<f64, N, N>,
-    g: &SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, M>,
+    r_inv_bt: &SMatrix<f64, M, N>,
     q: &SMatrix<f64, N, N>,
     x: &SMatrix<f64, N, N>,
-) -> f64 {
+) -> (SMatrix<f64, N, N>, f64) {
     let at_x = a.transpose() * x;
-    let xgx = x * g * x;
+    let xgx = (x * b) * (r_inv_bt * x);
     let lhs = at_x + at_x.transpose() - xgx + q;
-    relative(lhs.norm(), &[2.0 * at_x.norm(), xgx.norm(), q.norm()])
+    let rel = relative(lhs.norm(), &[2.0 * at_x.norm(), xgx.norm(), q.norm()]);
+    (lhs, rel)
+}
+
+/// `K = (R + Bᵀ X B)⁻¹ Bᵀ X A`.
+fn dare_gain<const N: usize, const M: usize>(
+    a: &SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, M>,
+    r: &SMatrix<f64, M, M>,
+    x: &SMatrix<f64, N, N>,
+) -> Result<SMatrix<f64, M, N>, Error> {
+    let bt_x = b.transpose() * x;
+    Ok(Lu::new(&(r + bt_x * b), "DLQR (R + Bᵀ X B)")?.solve(&(bt_x * a)))
+}
+
+/// The DARE residual `Aᵀ X A − Aᵀ X B K + Q − X` (with `K` the optimal gain
+/// for `X`) and its relative norm.
+fn dare_eval<const N: usize, const M: usize>(
+    a: &SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, M>,
+    q: &SMatrix<f64, N, N>,
+    x: &SMatrix<f64, N, N>,
+    gain: &SMatrix<f64, M, N>,
+) -> (SMatrix<f64, N, N>, f64) {
+    let atxa = a.transpose() * x * a;
+    let cross = (a.transpose() * (x * b)) * gain;
+    let lhs = atxa - cross + q - x;
+    let rel = relative(lhs.norm(), &[atxa.norm(), x.norm(), cross.norm(), q.norm()]);
+    (lhs, rel)
+}
+
+/// Newton refinement of a Riccati solution: up to [`REFINE_STEPS`] steps,
+/// each kept only if it lowers the relative residual. `step` returns the
+/// Kronecker form `(L, rhs)` of the correction's linear (Lyapunov or Stein)
+/// equation `L vec(Δ) = vec(rhs)`; `N²` unknowns, so this is for the small
+/// models this crate targets.
+fn refine<const N: usize>(
+    mut x: SMatrix<f64, N, N>,
+    mut residual: f64,
+    eval: impl Fn(&SMatrix<f64, N, N>) -> (SMatrix<f64, N, N>, f64),
+    step: impl Fn(&SMatrix<f64, N, N>, &SMatrix<f64, N, N>) -> (DMatrix<f64>, SMatrix<f64, N, N>),
+) -> (SMatrix<f64, N, N>, f64) {
+    for _ in 0..REFINE_STEPS {
+        if residual <= 4.0 * f64::EPSILON {
+            break;
+        }
+        let (res, _) = eval(&x);
+        let (l, rhs) = step(&x, &res);
+        let Some(delta) = l
+            .lu()
+            .solve(&DMatrix::from_column_slice(N * N, 1, rhs.as_slice()))
+        else {
+            break;
+        };
+        if delta.iter().any(|v| !v.is_finite()) {
+            break;
+        }
+        let next = symmetric(&(x + SMatrix::<f64, N, N>::from_column_slice(delta.as_slice())));
+        let (_, next_residual) = eval(&next);
+        if next_residual < residual {
+            x = next;
+            residual = next_residual;
+        } else {
+            break;
+        }
+    }
+    (x, residual)
 }
 
 fn relative(err: f64, terms: &[f64]) -> f64 {
