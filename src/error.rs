@@ -59,6 +59,86 @@ pub enum Error {
         /// The operation that overflowed.
         operation: &'static str,
     },
+    /// A response did not settle inside its band before the end of the
+    /// record (or diverged), so its step metrics are not defined.
+    #[error(
+        "response not settled: it is outside the settling band at t = {last_outside} s, \
+         after the start of the final window at t = {window_start} s"
+    )]
+    NotSettled {
+        /// Time (s, from the first sample) at which the response last enters
+        /// the band, or the last sample time if it ends outside.
+        last_outside: f64,
+        /// Start (s, from the first sample) of the final window the response
+        /// has to stay inside the band for.
+        window_start: f64,
+    },
+    /// A model is unstable where a stable one is needed (step metrics of a
+    /// model, a Riccati solution that does not stabilise).
+    #[error("{operation}: unstable pole {re} + {im}i")]
+    Unstable {
+        /// The operation that needed stability.
+        operation: &'static str,
+        /// Real part of the first offending pole (continuous: ≥ 0).
+        re: f64,
+        /// Imaginary part of that pole.
+        im: f64,
+    },
+    /// The pair (A, B) is not controllable to working precision.
+    #[error("uncontrollable: controllability matrix has rank {rank} of {states}")]
+    Uncontrollable {
+        /// Numerical rank of the controllability matrix.
+        rank: usize,
+        /// Number of states (the full rank).
+        states: usize,
+    },
+    /// Data handed to an algorithm are malformed: non-finite samples, a
+    /// non-increasing time axis, too few samples.
+    #[error("invalid data `{what}` at index {index}: {reason}")]
+    InvalidData {
+        /// Which input (`"t"`, `"y"`, …).
+        what: &'static str,
+        /// Zero-based index of the first bad sample (or the length, when
+        /// there are too few).
+        index: usize,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// Two inputs that must have one entry per sample have different lengths.
+    #[error("length mismatch: `{what}` has {found} entries, expected {expected}")]
+    LengthMismatch {
+        /// Which input has the wrong length.
+        what: &'static str,
+        /// The length it should have.
+        expected: usize,
+        /// The length it has.
+        found: usize,
+    },
+    /// A matrix argument violates a structural requirement (symmetric,
+    /// positive definite, …).
+    #[error("invalid matrix {matrix}: {reason}")]
+    InvalidMatrix {
+        /// Which matrix (`"Q"`, `"R"`, …).
+        matrix: &'static str,
+        /// What it must satisfy.
+        reason: &'static str,
+    },
+    /// An iterative algorithm did not converge.
+    #[error("{operation} did not converge after {iterations} iterations")]
+    NoConvergence {
+        /// The algorithm (`"Schur decomposition"`, `"Riccati doubling"`, …).
+        operation: &'static str,
+        /// Iterations spent.
+        iterations: usize,
+    },
+    /// Writing a figure failed (feature `plot`).
+    #[error("cannot write figure {path}: {reason}")]
+    Plot {
+        /// The file being written.
+        path: String,
+        /// The backend's message.
+        reason: String,
+    },
 }
 
 /// Checks that every entry of a matrix is finite; names the first bad one.

@@ -14,6 +14,13 @@
 //! - [`sim`]: continuous and discrete simulation and step responses.
 //! - [`hw`]: the lab's card over the parallel port (EPP), its register-level
 //!   simulation, and the [`Rig`](hw::Rig) a controller runs against.
+//! - [`analysis`]: poles, stability, DC gain, damping, controllability and
+//!   observability.
+//! - [`design`]: the [`Controller`] trait, [`StateFeedback`] (the lab's
+//!   per-millimetre form and the textbook form), [`acker`], [`lqr`], [`dlqr`].
+//! - [`metrics`]: [`step_info`] / [`step_info_of`] (rise and settling time,
+//!   overshoot, steady state) with interpolated crossing times.
+//! - `plot` (feature `plot`): SVG figures of time responses.
 //!
 //! Units are SI throughout (m, m/s, N, V, s); the lab's millimetres appear
 //! only in printed tables and at named conversions.
@@ -36,17 +43,25 @@
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
 
+pub mod analysis;
+pub mod design;
 pub mod discretize;
 mod error;
 pub mod hw;
 pub mod integrate;
 mod linalg;
+pub mod metrics;
 pub mod model;
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod sim;
 
+pub use analysis::Damping;
+pub use design::{Controller, Lqr, StateFeedback, acker, dlqr, lqr};
 pub use discretize::Method;
 pub use error::Error;
 pub use integrate::{Dynamics, Euler, Integrator, Rk4};
+pub use metrics::{StepInfo, StepInfoOptions, step_info, step_info_of};
 pub use model::{Continuous, Discrete, Domain, MassSpring, Output, StateSpace};
 pub use sim::{Response, step_response};
 

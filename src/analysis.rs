@@ -1,0 +1,493 @@
+//! Properties of a linear model: poles, stability, DC gain, damping, and
+//! controllability / observability with a numerical rank test.
+//!
+//! Everything here is a method on [`StateSpace`] except [`rank`]. These are
+//! design-time computations, not inner loops: eigenvalues and singular values
+//! go through a heap `DMatrix` (nalgebra's Schur and SVD), which keeps the
+//! signatures free of typenum bounds.
+//!
+//! # Examples
+//!
+//! ```
+//! use ctrlab::{MassSpring, Output};
+//!
+//! let plant = MassSpring::nominal().state_space(Output::Cart2)?;
+//! assert!(plant.is_stable()?);
+//! assert!(plant.is_controllable()? && plant.is_observable()?);
+//! // 1 N on cart 2 moves it 2 mm at rest.
+//! assert!((plant.dc_gain()?[(0, 0)] - 0.002).abs() < 1e-15);
+//! # Ok::<(), ctrlab::Error>(())
+//! ```
+
+use nalgebra::{Complex, DMatrix, SMatrix};
+
+use crate::error::Error;
+use crate::linalg::Lu;
+use crate::model::{Continuous, Discrete, Domain, StateSpace};
+
+/// Iteration cap for the Schur and SVD iterations, per matrix dimension.
+const ITERATIONS_PER_DIM: usize = 200;
+
+/// Natural frequency, damping ratio and time constant of one pole, the
+/// columns of MATLAB's `damp`.
+///
+/// For a discrete model the pole `z` is first mapped to `s = ln(z) / dt`,
+/// as MATLAB does. Definitions: `natural_frequency = |s|` (rad/s),
+/// `damping_ratio = −Re(s) / |s|`, `time_constant = −1 / Re(s)` (s). Edge
+/// cases, chosen so nothing is NaN: a pole at `s = 0` has `ωn = 0`, `ζ = −1`
+/// (MATLAB's convention) and `τ = +∞`; a discrete pole at `z = 0` has
+/// `ωn = +∞`, `ζ = 1`, `τ = 0`. Unstable poles have a negative `ζ` and `τ`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::StateSpace;
+/// use nalgebra::matrix;
+///
+/// // ωn = 10 rad/s, ζ = 0.3: x'' + 6 x' + 100 x = u.
+/// let sys = StateSpace::continuous(matrix![0.0, 1.0; -100.0, -6.0], matrix![0.0; 1.0],
+///                                  matrix![1.0, 0.0], matrix![0.0])?;
+/// for d in sys.damping()? {
+///     assert!((d.natural_frequency - 10.0).abs() < 1e-12);
+///     assert!((d.damping_ratio - 0.3).abs() < 1e-12);
+///     assert!((d.time_constant - 1.0 / 3.0).abs() < 1e-12);
+/// }
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Damping {
+    /// The pole itself (`s` for continuous, `z` for discrete models).
+    pub pole: Complex<f64>,
+    /// Natural frequency `ωn = |s|`, rad/s.
+    pub natural_frequency: f64,
+    /// Damping ratio `ζ = −Re(s) / |s|` (dimensionless).
+    pub damping_ratio: f64,
+    /// Time constant `τ = −1 / Re(s)`, s.
+    pub time_constant: f64,
+}
+
+impl Damping {
+    fn of_s(pole: Complex<f64>, s: Complex<f64>) -> Self {
+        let wn = s.norm();
+        if wn == 0.0 {
+            return Self {
+                pole,
+                natural_frequency: 0.0,
+                damping_ratio: -1.0,
+                time_constant: f64::INFINITY,
+            };
+        }
+        Self {
+            pole,
+            natural_frequency: wn,
+            damping_ratio: -s.re / wn,
+            time_constant: if s.re == 0.0 {
+                f64::INFINITY
+            } else {
+                -1.0 / s.re
+            },
+        }
+    }
+}
+
+/// Numerical rank of a matrix: the number of singular values above
+/// `rtol · σ_max`.
+///
+/// `rtol = None` uses NumPy's `matrix_rank` default, `max(rows, cols) · ε`.
+/// The tolerance is relative, so the answer does not depend on the units the
+/// matrix is written in.
+///
+/// # Errors
+///
+/// [`Error::InvalidParameter`] named `"rtol"` for a negative or non-finite
+/// tolerance; [`Error::NonFinite`] for a NaN or infinite entry;
+/// [`Error::NoConvergence`] if the SVD iteration fails.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::analysis::rank;
+/// use nalgebra::dmatrix;
+///
+/// let m = dmatrix![1.0, 2.0; 2.0, 4.0 + 1e-12];
+/// assert_eq!(rank(&m, None)?, 2);        // 1e-12 is far above ε
+/// assert_eq!(rank(&m, Some(1e-9))?, 1);  // but not above 1e-9
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn rank(m: &DMatrix<f64>, rtol: Option<f64>) -> Result<usize, Error> {
+    let sv = singular_values(m, "matrix")?;
+    let rtol = match rtol {
+        Some(r) if r.is_finite() && r >= 0.0 => r,
+        Some(r) => {
+            return Err(Error::InvalidParameter {
+                name: "rtol",
+                value: r,
+                reason: "relative tolerance must be finite and >= 0",
+            });
+        }
+        None => m.nrows().max(m.ncols()) as f64 * f64::EPSILON,
+    };
+    let max = sv.iter().copied().fold(0.0, f64::max);
+    Ok(sv.iter().filter(|&&s| s > rtol * max && s > 0.0).count())
+}
+
+fn singular_values(m: &DMatrix<f64>, name: &'static str) -> Result<Vec<f64>, Error> {
+    if let Some((i, v)) = m.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            matrix: name,
+            row: i % m.nrows(),
+            col: i / m.nrows(),
+            value: *v,
+        });
+    }
+    if m.is_empty() {
+        return Ok(Vec::new());
+    }
+    let iterations = ITERATIONS_PER_DIM * m.nrows().max(m.ncols());
+    let svd = m
+        .clone()
+        .try_svd(false, false, f64::EPSILON, iterations)
+        .ok_or(Error::NoConvergence {
+            operation: "singular value decomposition",
+            iterations,
+        })?;
+    Ok(svd.singular_values.iter().copied().collect())
+}
+
+/// Eigenvalues of a square matrix, sorted by real part then imaginary part
+/// (ascending), the order python-control's fixtures use.
+pub(crate) fn eigenvalues<const N: usize>(
+    a: &SMatrix<f64, N, N>,
+) -> Result<[Complex<f64>; N], Error> {
+    let mut out = [Complex::new(0.0, 0.0); N];
+    if N == 0 {
+        return Ok(out);
+    }
+    let iterations = ITERATIONS_PER_DIM * N;
+    let schur = DMatrix::from_fn(N, N, |r, c| a[(r, c)])
+        .try_schur(f64::EPSILON, iterations)
+        .ok_or(Error::NoConvergence {
+            operation: "Schur decomposition (eigenvalues)",
+            iterations,
+        })?;
+    for (o, e) in out.iter_mut().zip(schur.complex_eigenvalues().iter()) {
+        *o = *e;
+    }
+    if out.iter().any(|p| !(p.re.is_finite() && p.im.is_finite())) {
+        return Err(Error::Overflow {
+            operation: "eigenvalues",
+        });
+    }
+    out.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+    Ok(out)
+}
+
+/// The block `[M, A M, A² M, …]` of `powers` terms (controllability when
+/// `M = B`), as a heap matrix N × (powers·K).
+fn krylov<const N: usize, const K: usize>(
+    a: &SMatrix<f64, N, N>,
+    m: &SMatrix<f64, N, K>,
+    name: &'static str,
+) -> Result<DMatrix<f64>, Error> {
+    let mut out = DMatrix::zeros(N, N * K);
+    let mut block = *m;
+    for p in 0..N {
+        for c in 0..K {
+            for r in 0..N {
+                let v = block[(r, c)];
+                if !v.is_finite() {
+                    return Err(Error::Overflow { operation: name });
+                }
+                out[(r, p * K + c)] = v;
+            }
+        }
+        block = a * block;
+    }
+    Ok(out)
+}
+
+impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M, P, D> {
+    /// The poles (eigenvalues of `A`), sorted by real part and then by
+    /// imaginary part, ascending; for a continuous model the most damped come
+    /// first. Units: rad/s for continuous models, dimensionless `z` for
+    /// discrete ones.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::NoConvergence`] if the Schur iteration fails (not seen on
+    /// finite matrices in practice).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{MassSpring, Output};
+    ///
+    /// let p = MassSpring::nominal().state_space(Output::Cart2)?.poles()?;
+    /// // Two lightly damped pairs, about 20 rad/s and 50 rad/s.
+    /// assert!(p.iter().all(|p| p.re < 0.0 && p.im.abs() > 20.0));
+    /// assert_eq!(p[0].conj(), p[1]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn poles(&self) -> Result<[Complex<f64>; N], Error> {
+        eigenvalues(self.a())
+    }
+
+    /// The controllability matrix `[B, A B, …, A^(N−1) B]`, N × (N·M).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Overflow`] if a power of `A` overflows.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::{dmatrix, matrix};
+    ///
+    /// let sys = StateSpace::continuous(matrix![0.0, 1.0; 0.0, 0.0], matrix![0.0; 1.0],
+    ///                                  matrix![1.0, 0.0], matrix![0.0])?;
+    /// assert_eq!(sys.controllability()?, dmatrix![0.0, 1.0; 1.0, 0.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn controllability(&self) -> Result<DMatrix<f64>, Error> {
+        krylov(self.a(), self.b(), "controllability matrix")
+    }
+
+    /// The observability matrix `[C; C A; …; C A^(N−1)]`, (N·P) × N.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Overflow`] if a power of `A` overflows.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::{dmatrix, matrix};
+    ///
+    /// let sys = StateSpace::continuous(matrix![0.0, 1.0; 0.0, 0.0], matrix![0.0; 1.0],
+    ///                                  matrix![1.0, 0.0], matrix![0.0])?;
+    /// assert_eq!(sys.observability()?, dmatrix![1.0, 0.0; 0.0, 1.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn observability(&self) -> Result<DMatrix<f64>, Error> {
+        // Observability of (A, C) is controllability of (Aᵀ, Cᵀ), transposed.
+        Ok(krylov(
+            &self.a().transpose(),
+            &self.c().transpose(),
+            "observability matrix",
+        )?
+        .transpose())
+    }
+
+    /// True when the controllability matrix has full rank `N` by
+    /// [`rank`] with the default relative tolerance.
+    ///
+    /// # Errors
+    ///
+    /// As [`controllability`](Self::controllability) and [`rank`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::matrix;
+    ///
+    /// // The input drives only the first of two decoupled states.
+    /// let sys = StateSpace::continuous(matrix![-1.0, 0.0; 0.0, -2.0], matrix![1.0; 0.0],
+    ///                                  matrix![1.0, 1.0], matrix![0.0])?;
+    /// assert!(!sys.is_controllable()?);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn is_controllable(&self) -> Result<bool, Error> {
+        Ok(rank(&self.controllability()?, None)? == N)
+    }
+
+    /// True when the observability matrix has full rank `N` by [`rank`] with
+    /// the default relative tolerance.
+    ///
+    /// # Errors
+    ///
+    /// As [`observability`](Self::observability) and [`rank`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{MassSpring, Output};
+    ///
+    /// // Either cart's position alone reveals the whole state.
+    /// assert!(MassSpring::nominal().state_space(Output::Cart1)?.is_observable()?);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn is_observable(&self) -> Result<bool, Error> {
+        Ok(rank(&self.observability()?, None)? == N)
+    }
+}
+
+impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continuous> {
+    /// True when every pole has a strictly negative real part.
+    ///
+    /// A pole exactly on the imaginary axis (an integrator, an undamped
+    /// oscillator) is not stable.
+    ///
+    /// # Errors
+    ///
+    /// As [`poles`](Self::poles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::matrix;
+    ///
+    /// let lag = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+    /// let integrator = StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+    /// assert!(lag.is_stable()? && !integrator.is_stable()?);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn is_stable(&self) -> Result<bool, Error> {
+        Ok(self.poles()?.iter().all(|p| p.re < 0.0))
+    }
+
+    /// The steady-state gain `−C A⁻¹ B + D` (output units per input unit;
+    /// m/N for the lab plant).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Singular`] when `A` is singular to working precision, i.e.
+    /// a pole at `s = 0`: the gain is infinite or undefined, and is reported
+    /// instead of returned as inf/NaN.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{StateSpace, Error};
+    /// use nalgebra::matrix;
+    ///
+    /// let lag = StateSpace::continuous(matrix![-2.0], matrix![4.0], matrix![1.0], matrix![0.0])?;
+    /// assert_eq!(lag.dc_gain()?, matrix![2.0]);
+    /// let integrator = StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+    /// assert!(matches!(integrator.dc_gain(), Err(Error::Singular { .. })));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn dc_gain(&self) -> Result<SMatrix<f64, P, M>, Error> {
+        let x = Lu::new(self.a(), "DC gain (pole at s = 0)")?.solve(self.b());
+        finite_gain(self.d() - self.c() * x)
+    }
+
+    /// [`Damping`] (natural frequency, damping ratio, time constant) of each
+    /// pole, in the order of [`poles`](Self::poles).
+    ///
+    /// # Errors
+    ///
+    /// As [`poles`](Self::poles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{MassSpring, Output};
+    ///
+    /// let d = MassSpring::nominal().state_space(Output::Cart2)?.damping()?;
+    /// // Both modes of the rig are lightly damped.
+    /// assert!(d.iter().all(|d| d.damping_ratio > 0.0 && d.damping_ratio < 0.2));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn damping(&self) -> Result<[Damping; N], Error> {
+        Ok(self.poles()?.map(|p| Damping::of_s(p, p)))
+    }
+}
+
+impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discrete> {
+    /// True when every pole lies strictly inside the unit circle, `|z| < 1`.
+    ///
+    /// # Errors
+    ///
+    /// As [`poles`](Self::poles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::matrix;
+    ///
+    /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
+    /// assert!(sys.is_stable()?);
+    /// let acc = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
+    /// assert!(!acc.is_stable()?);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn is_stable(&self) -> Result<bool, Error> {
+        Ok(self.poles()?.iter().all(|p| p.norm() < 1.0))
+    }
+
+    /// The steady-state gain `C (I − A)⁻¹ B + D`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Singular`] when `I − A` is singular to working precision (a
+    /// pole at `z = 1`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{MassSpring, Method, Output};
+    ///
+    /// // ZOH keeps the DC gain: 2 mm per newton on cart 2.
+    /// let d = MassSpring::nominal().state_space(Output::Cart2)?.discretize(0.002, Method::Zoh)?;
+    /// assert!((d.dc_gain()?[(0, 0)] - 0.002).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn dc_gain(&self) -> Result<SMatrix<f64, P, M>, Error> {
+        let i_minus_a = SMatrix::<f64, N, N>::identity() - self.a();
+        let x = Lu::new(&i_minus_a, "DC gain (pole at z = 1)")?.solve(self.b());
+        finite_gain(self.c() * x + self.d())
+    }
+
+    /// [`Damping`] of each pole, after mapping `z` to `s = ln(z) / dt` as
+    /// MATLAB's `damp` does, in the order of [`poles`](Self::poles).
+    ///
+    /// # Errors
+    ///
+    /// As [`poles`](Self::poles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::matrix;
+    ///
+    /// // z = e^(−2 · 0.1): the discrete image of s = −2.
+    /// let sys = StateSpace::discrete(matrix![(-0.2f64).exp()], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
+    /// let d = sys.damping()?[0];
+    /// assert!((d.natural_frequency - 2.0).abs() < 1e-12 && (d.time_constant - 0.5).abs() < 1e-12);
+    /// assert!((d.damping_ratio - 1.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn damping(&self) -> Result<[Damping; N], Error> {
+        let dt = self.dt();
+        Ok(self.poles()?.map(|z| {
+            if z.norm() == 0.0 {
+                Damping {
+                    pole: z,
+                    natural_frequency: f64::INFINITY,
+                    damping_ratio: 1.0,
+                    time_constant: 0.0,
+                }
+            } else {
+                Damping::of_s(z, z.ln() / dt)
+            }
+        }))
+    }
+}
+
+fn finite_gain<const P: usize, const M: usize>(
+    g: SMatrix<f64, P, M>,
+) -> Result<SMatrix<f64, P, M>, Error> {
+    if g.iter().all(|v| v.is_finite()) {
+        Ok(g)
+    } else {
+        Err(Error::Overflow {
+            operation: "DC gain",
+        })
+    }
+}

@@ -1,0 +1,194 @@
+//! SVG figures of time responses (feature `plot`).
+//!
+//! One small, general entry point, [`responses_svg`]: any number of labelled
+//! `(t, y)` series on one pair of axes, written as an SVG file. Built on
+//! `plotters` with only its SVG backend, so it needs no system fonts or
+//! libraries.
+//!
+//! # Examples
+//!
+//! ```
+//! use ctrlab::plot::{Series, responses_svg};
+//!
+//! let t: Vec<f64> = (0..100).map(|k| k as f64 * 0.01).collect();
+//! let y: Vec<f64> = t.iter().map(|t| 1.0 - (-t / 0.2f64).exp()).collect();
+//! let path = std::env::temp_dir().join("ctrlab_plot_doc.svg");
+//! responses_svg(&path, "First order", "t (s)", "y", &[Series::new("τ = 0.2 s", &t, &y)])?;
+//! assert!(std::fs::read_to_string(&path).unwrap().contains("<svg"));
+//! # Ok::<(), ctrlab::Error>(())
+//! ```
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use crate::error::Error;
+
+/// Figure size in pixels.
+const SIZE: (u32, u32) = (960, 600);
+/// Points drawn per series at most; longer series are thinned to every k-th
+/// sample, which keeps files small and is invisible at this size.
+///
+/// # Examples
+///
+/// ```
+/// // A 20 s record at 0.5 ms (40 001 samples) is drawn through every 21st.
+/// assert_eq!(40_001usize.div_ceil(ctrlab::plot::MAX_POINTS), 21);
+/// ```
+pub const MAX_POINTS: usize = 2000;
+
+/// One labelled curve: `y` against `t`, equal lengths, any units.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::plot::Series;
+///
+/// let s = Series::new("x2", &[0.0, 1.0], &[0.0, 0.5]);
+/// assert_eq!(s.label, "x2");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Series<'a> {
+    /// Legend entry.
+    pub label: &'a str,
+    /// Abscissae (usually time, s).
+    pub t: &'a [f64],
+    /// Ordinates, one per abscissa.
+    pub y: &'a [f64],
+}
+
+impl<'a> Series<'a> {
+    /// A series from its label and data.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::plot::Series;
+    ///
+    /// let s = Series::new("cart 2", &[0.0, 0.1], &[0.0, 30.0]);
+    /// assert_eq!(s.y[1], 30.0);
+    /// ```
+    pub fn new(label: &'a str, t: &'a [f64], y: &'a [f64]) -> Self {
+        Self { label, t, y }
+    }
+}
+
+/// Writes every series on one pair of axes to an SVG file at `path`, with a
+/// title, axis labels and a legend. Axis ranges cover all finite points;
+/// non-finite points are skipped; a series longer than [`MAX_POINTS`] is
+/// drawn through every k-th sample (and its last).
+///
+/// # Errors
+///
+/// [`Error::LengthMismatch`] if a series' `t` and `y` differ in length;
+/// [`Error::InvalidData`] if there is no finite point at all;
+/// [`Error::Plot`] if the file cannot be written.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, plot::{Series, responses_svg}};
+///
+/// let path = std::env::temp_dir().join("ctrlab_plot_mismatch.svg");
+/// let err = responses_svg(&path, "bad", "t", "y", &[Series::new("s", &[0.0, 1.0], &[0.0])]).unwrap_err();
+/// assert!(matches!(err, Error::LengthMismatch { .. }));
+/// ```
+pub fn responses_svg(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series<'_>],
+) -> Result<(), Error> {
+    let path = path.as_ref();
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for s in series {
+        if s.t.len() != s.y.len() {
+            return Err(Error::LengthMismatch {
+                what: "series y",
+                expected: s.t.len(),
+                found: s.y.len(),
+            });
+        }
+        for (&t, &y) in s.t.iter().zip(s.y) {
+            if t.is_finite() && y.is_finite() {
+                x0 = x0.min(t);
+                x1 = x1.max(t);
+                y0 = y0.min(y);
+                y1 = y1.max(y);
+            }
+        }
+    }
+    if !(x0.is_finite() && y0.is_finite()) {
+        return Err(Error::InvalidData {
+            what: "series",
+            index: 0,
+            reason: "no finite point to plot",
+        });
+    }
+    if x1 <= x0 {
+        x1 = x0 + 1.0;
+    }
+    let pad = if y1 > y0 {
+        0.05 * (y1 - y0)
+    } else {
+        0.5 * y0.abs().max(1.0)
+    };
+    let (y0, y1) = (y0 - pad, y1 + pad);
+
+    let plot_err = |e: &dyn std::fmt::Display| Error::Plot {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    };
+    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| plot_err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(|e| plot_err(&e))?;
+    for (i, s) in series.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        // Every k-th sample (and the last), at most MAX_POINTS per series.
+        let stride = s.t.len().div_ceil(MAX_POINTS).max(1);
+        let last = s.t.len().saturating_sub(1);
+        let points =
+            s.t.iter()
+                .zip(s.y)
+                .enumerate()
+                .filter(move |(i, _)| i % stride == 0 || *i == last)
+                .map(|(_, p)| p)
+                .filter(|(t, y)| t.is_finite() && y.is_finite())
+                .map(|(&t, &y)| (t, y));
+        chart
+            .draw_series(LineSeries::new(points, color.stroke_width(2)))
+            .map_err(|e| plot_err(&e))?
+            .label(s.label)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(SeriesLabelPosition::LowerRight)
+        .draw()
+        .map_err(|e| plot_err(&e))?;
+    root.present().map_err(|e| plot_err(&e))?;
+    Ok(())
+}

@@ -1,0 +1,223 @@
+//! Poles, stability, DC gain, damping and rank tests against the fixture and
+//! closed-form values.
+
+mod common;
+
+use ctrlab::analysis::rank;
+use ctrlab::{Error, MassSpring, Method, Output, StateSpace};
+use nalgebra::{Complex, DMatrix, SMatrix, dmatrix, matrix};
+use proptest::prelude::*;
+
+#[test]
+fn poles_match_the_fixture_sorted() {
+    let fx = common::nominal_fixture();
+    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let got = sys.poles().unwrap();
+    let mut want: Vec<Complex<f64>> = fx["poles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| Complex::new(p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+        .collect();
+    want.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).norm() <= 1e-9 * w.norm(), "{g} vs {w}");
+    }
+    // Sorted by real part, then imaginary part.
+    for w in got.windows(2) {
+        assert!(w[0].re < w[1].re || (w[0].re == w[1].re && w[0].im <= w[1].im));
+    }
+}
+
+#[test]
+fn dc_gain_is_the_static_deflection() {
+    let plant = MassSpring::nominal();
+    for (output, want) in [(Output::Cart1, 1.0 / 1000.0), (Output::Cart2, 2.0 / 1000.0)] {
+        let sys = plant.state_space(output).unwrap();
+        let g = sys.dc_gain().unwrap()[(0, 0)];
+        assert!((g - want).abs() <= 1e-14 * want, "{output:?}");
+        // ZOH preserves the DC gain exactly (in exact arithmetic).
+        let d = sys.discretize(0.002, Method::Zoh).unwrap();
+        assert!((d.dc_gain().unwrap()[(0, 0)] - want).abs() <= 1e-10 * want);
+    }
+}
+
+#[test]
+fn dc_gain_with_a_pole_at_the_origin_is_singular() {
+    let free_cart = StateSpace::continuous(
+        matrix![0.0, 1.0; 0.0, -1.0],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    assert!(matches!(free_cart.dc_gain(), Err(Error::Singular { .. })));
+    let acc =
+        StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    assert!(matches!(acc.dc_gain(), Err(Error::Singular { .. })));
+}
+
+#[test]
+fn dc_gain_includes_feedthrough() {
+    let sys =
+        StateSpace::continuous(matrix![-4.0], matrix![2.0], matrix![3.0], matrix![0.5]).unwrap();
+    assert!((sys.dc_gain().unwrap()[(0, 0)] - (1.5 + 0.5)).abs() < 1e-15);
+}
+
+#[test]
+fn stability_in_both_domains() {
+    let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    assert!(plant.is_stable().unwrap());
+    assert!(
+        plant
+            .discretize(0.002, Method::Zoh)
+            .unwrap()
+            .is_stable()
+            .unwrap()
+    );
+    let unstable = StateSpace::continuous(
+        matrix![0.1, 1.0; -1.0, 0.1],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    assert!(!unstable.is_stable().unwrap());
+    assert!(
+        !unstable
+            .discretize(0.01, Method::Zoh)
+            .unwrap()
+            .is_stable()
+            .unwrap()
+    );
+    let undamped = StateSpace::continuous(
+        matrix![0.0, 1.0; -1.0, 0.0],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    assert!(!undamped.is_stable().unwrap());
+}
+
+#[test]
+fn damping_of_a_second_order_system_and_its_discretisation() {
+    let (wn, zeta) = (12.0, 0.25);
+    let sys = StateSpace::continuous(
+        matrix![0.0, 1.0; -wn * wn, -2.0 * zeta * wn],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    for d in sys.damping().unwrap() {
+        assert!((d.natural_frequency - wn).abs() < 1e-12);
+        assert!((d.damping_ratio - zeta).abs() < 1e-12);
+        assert!((d.time_constant - 1.0 / (zeta * wn)).abs() < 1e-12);
+    }
+    // ZOH maps s to e^(s dt); damp maps it back.
+    let d = sys.discretize(0.01, Method::Zoh).unwrap();
+    for p in d.damping().unwrap() {
+        assert!((p.natural_frequency - wn).abs() < 1e-9);
+        assert!((p.damping_ratio - zeta).abs() < 1e-9);
+    }
+    let integrator =
+        StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
+    let d0 = integrator.damping().unwrap()[0];
+    assert_eq!((d0.natural_frequency, d0.damping_ratio), (0.0, -1.0));
+    assert_eq!(d0.time_constant, f64::INFINITY);
+    let deadbeat =
+        StateSpace::discrete(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    let z0 = deadbeat.damping().unwrap()[0];
+    assert_eq!(
+        (z0.natural_frequency, z0.damping_ratio, z0.time_constant),
+        (f64::INFINITY, 1.0, 0.0)
+    );
+}
+
+#[test]
+fn controllability_and_observability_of_the_lab_plant() {
+    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let c = sys.controllability().unwrap();
+    assert_eq!((c.nrows(), c.ncols()), (4, 4));
+    // Column j is A^j B.
+    let a = sys.a();
+    let b = sys.b();
+    for j in 0..4 {
+        let col = a.pow(j as u32) * b;
+        for i in 0..4 {
+            assert_eq!(c[(i, j)], col[i]);
+        }
+    }
+    assert!(sys.is_controllable().unwrap());
+    assert!(sys.is_observable().unwrap());
+    assert_eq!(rank(&sys.observability().unwrap(), None).unwrap(), 4);
+    // A zero spring between the carts cuts cart 1 off from the motor and cart
+    // 2's position off from cart 1.
+    let cut = MassSpring {
+        k2: 0.0,
+        ..MassSpring::nominal()
+    };
+    let s = cut.state_space(Output::Cart2).unwrap();
+    assert!(!s.is_controllable().unwrap());
+    assert!(!s.is_observable().unwrap());
+    assert_eq!(rank(&s.controllability().unwrap(), None).unwrap(), 2);
+}
+
+#[test]
+fn rank_is_relative_to_the_largest_singular_value() {
+    // The same rank-1 matrix at wildly different scales.
+    for scale in [1e-200, 1.0, 1e200] {
+        let m = dmatrix![1.0, 2.0; 2.0, 4.0] * scale;
+        assert_eq!(rank(&m, None).unwrap(), 1, "scale {scale}");
+    }
+    assert_eq!(rank(&DMatrix::<f64>::zeros(3, 2), None).unwrap(), 0);
+    assert!(matches!(
+        rank(&dmatrix![1.0], Some(-1.0)),
+        Err(Error::InvalidParameter { name: "rtol", .. })
+    ));
+    assert!(matches!(
+        rank(&dmatrix![f64::NAN], None),
+        Err(Error::NonFinite { .. })
+    ));
+}
+
+#[test]
+fn huge_powers_overflow_into_an_error_not_nan() {
+    let a = SMatrix::<f64, 4, 4>::from_element(1e120);
+    let sys = StateSpace::continuous(
+        a,
+        matrix![1.0; 1.0; 1.0; 1.0],
+        matrix![1.0, 0.0, 0.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    assert!(matches!(sys.controllability(), Err(Error::Overflow { .. })));
+    assert!(matches!(sys.is_observable(), Err(Error::Overflow { .. })));
+}
+
+proptest! {
+    #[test]
+    fn poles_of_a_block_diagonal_matrix_are_its_blocks(
+        sigma in proptest::array::uniform2(-50.0..50.0f64),
+        omega in proptest::array::uniform2(0.1..80.0f64),
+    ) {
+        // Rotation-scaling blocks [σ ω; −ω σ] have poles σ ± iω.
+        let a = matrix![
+            sigma[0], omega[0], 0.0, 0.0;
+            -omega[0], sigma[0], 0.0, 0.0;
+            0.0, 0.0, sigma[1], omega[1];
+            0.0, 0.0, -omega[1], sigma[1]
+        ];
+        let sys = StateSpace::continuous(a, SMatrix::<f64, 4, 1>::zeros(), SMatrix::<f64, 1, 4>::zeros(), matrix![0.0]).unwrap();
+        let got = sys.poles().unwrap();
+        for (s, w) in sigma.iter().zip(&omega) {
+            for sign in [1.0, -1.0] {
+                let want = Complex::new(*s, sign * w);
+                let err = got.iter().map(|g| (g - want).norm()).fold(f64::INFINITY, f64::min);
+                prop_assert!(err <= 1e-12 * want.norm().max(1.0), "{} missed by {}", want, err);
+            }
+        }
+        prop_assert_eq!(sys.is_stable().unwrap(), sigma.iter().all(|s| *s < 0.0));
+    }
+}
