@@ -361,8 +361,9 @@ fn voltages_saturate_and_quantise() {
         (0.0121, 1),
         (-0.0372, -2), // -1.55 counts of 0.1 %
     ] {
-        rig.apply_voltage(volts).unwrap();
+        let applied = rig.apply_voltage(volts).unwrap();
         assert_eq!(rig.card().port().pwm_duty(0), duty, "{volts} V");
+        assert_eq!(applied, f64::from(duty) * 24.0 / 1000.0, "{volts} V");
     }
 }
 
@@ -476,7 +477,7 @@ fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
         rig.apply_voltage(6.0).unwrap();
         assert_eq!(rig.card().port().attempts(), CYCLES);
         clock.advance_nanos(PERIOD_NS);
-        let result = rig.read_state().and_then(|_| rig.apply_voltage(3.0));
+        let result = rig.read_state().and_then(|_| rig.apply_voltage(3.0).map(drop));
         let err = result.expect_err("the injected fault surfaces");
         assert_eq!(err.kind(), HwErrorKind::Timeout, "cycle {k}");
         // Cut in the read (k < 18) the new command is never sent; cut in the

@@ -62,6 +62,9 @@ pub enum HwErrorKind {
     /// A configuration value (register map, calibration, simulated card) is
     /// invalid.
     InvalidConfig,
+    /// The control loop missed its deadlines too many times in a row; the
+    /// rig has been halted.
+    Overrun,
 }
 
 /// Everything that can go wrong in the `hw` module. Each variant carries the
@@ -149,6 +152,18 @@ pub enum HwError {
         /// What the value must satisfy.
         reason: &'static str,
     },
+    /// The control loop overran its period too many times in a row.
+    #[error(
+        "control loop overran its {period} s period {consecutive} times in a row (last tick took {last_tick} s); rig halted"
+    )]
+    Overrun {
+        /// Consecutive overruns when the loop gave up.
+        consecutive: usize,
+        /// The loop's period, s.
+        period: f64,
+        /// How long the last tick's work took, s.
+        last_tick: f64,
+    },
 }
 
 fn register_suffix(register: Option<u8>) -> String {
@@ -178,6 +193,7 @@ impl HwError {
             HwError::TravelLimit { .. } => HwErrorKind::TravelLimit,
             HwError::InvalidCommand { .. } => HwErrorKind::InvalidCommand,
             HwError::InvalidConfig { .. } => HwErrorKind::InvalidConfig,
+            HwError::Overrun { .. } => HwErrorKind::Overrun,
         }
     }
 

@@ -36,13 +36,15 @@ pub trait Rig {
     /// beyond its limit.
     fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError>;
 
-    /// Applies `volts` to the motor (saturated to the rig's range).
+    /// Applies `volts` to the motor (saturated to the rig's range) and
+    /// returns the voltage actually applied, V (after saturation and the
+    /// card's quantisation), which is what a recording should hold.
     ///
     /// # Errors
     ///
     /// Port errors; [`HwError::InvalidCommand`] (after halting) for a
     /// non-finite voltage.
-    fn apply_voltage(&mut self, volts: f64) -> Result<(), HwError>;
+    fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError>;
 
     /// Stops the motor (zero voltage).
     ///
@@ -67,7 +69,7 @@ pub trait Rig {
     /// struct Still;
     /// impl Rig for Still {
     ///     fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError> { Ok(SVector::zeros()) }
-    ///     fn apply_voltage(&mut self, _: f64) -> Result<(), HwError> { Ok(()) }
+    ///     fn apply_voltage(&mut self, _: f64) -> Result<f64, HwError> { Ok(0.0) }
     ///     fn halt(&mut self) -> Result<(), HwError> { Ok(()) }
     /// }
     /// assert!(Still.kick_watchdog().is_ok());
@@ -83,7 +85,7 @@ impl<R: Rig + ?Sized> Rig for &mut R {
         (**self).read_state()
     }
     #[inline]
-    fn apply_voltage(&mut self, volts: f64) -> Result<(), HwError> {
+    fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError> {
         (**self).apply_voltage(volts)
     }
     #[inline]
@@ -230,7 +232,7 @@ fn invalid(name: &'static str, value: f64, reason: &'static str) -> HwError {
 /// let clock = VirtualClock::new();
 /// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
 /// let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
-/// rig.apply_voltage(100.0)?; // saturates at 24 V
+/// assert_eq!(rig.apply_voltage(100.0)?, 24.0); // saturates at 24 V
 /// assert_eq!(rig.card().port().pwm_duty(0), 1000);
 /// clock.advance(0.02)?;
 /// let x = rig.read_state()?;
@@ -374,7 +376,7 @@ impl<P: EppPort> Rig for MassSpringRig<P> {
         Ok(x)
     }
 
-    fn apply_voltage(&mut self, volts: f64) -> Result<(), HwError> {
+    fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError> {
         if !volts.is_finite() {
             // As for a travel-limit breach: report the cause.
             self.halt().ok();
@@ -386,7 +388,8 @@ impl<P: EppPort> Rig for MassSpringRig<P> {
             });
         }
         let duty = self.duty(volts);
-        self.card.set_pwm(self.calibration.pwm_channel, duty)
+        self.card.set_pwm(self.calibration.pwm_channel, duty)?;
+        Ok(f64::from(duty) / f64::from(MAX_DUTY) * self.calibration.volts_full_scale)
     }
 
     fn halt(&mut self) -> Result<(), HwError> {
