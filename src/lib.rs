@@ -12,6 +12,11 @@
 //! - [`integrate`]: the [`Dynamics`] trait and the [`Rk4`] and [`Euler`]
 //!   steppers.
 //! - [`sim`]: continuous and discrete simulation and step responses.
+//! - [`data`]: [`Recording`]s of a run (time, input, cart states) and their
+//!   CSV form, units in the header.
+//! - [`ident`]: least squares by QR ([`LeastSquares`]), recursive least
+//!   squares ([`Rls`]) and the lab's two-cart identification
+//!   ([`ident::mass_spring`]).
 //!
 //! Units are SI throughout (m, m/s, N, V, s); the lab's millimetres appear
 //! only in printed tables and at named conversions.
@@ -34,15 +39,19 @@
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
 
+pub mod data;
 pub mod discretize;
 mod error;
+pub mod ident;
 pub mod integrate;
 mod linalg;
 pub mod model;
 pub mod sim;
 
+pub use data::Recording;
 pub use discretize::Method;
 pub use error::Error;
+pub use ident::{LeastSquares, LeastSquaresFit, Rls};
 pub use integrate::{Dynamics, Euler, Integrator, Rk4};
 pub use model::{Continuous, Discrete, Domain, MassSpring, Output, StateSpace};
 pub use sim::{Response, step_response};
