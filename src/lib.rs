@@ -46,6 +46,7 @@ pub mod ident;
 pub mod integrate;
 mod linalg;
 pub mod model;
+mod reduce;
 pub mod sim;
 
 pub use data::Recording;
