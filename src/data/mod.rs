@@ -261,10 +261,7 @@ fn check_time(t: &[f64]) -> Result<f64, (usize, String)> {
     // Fast vectorisable pass: every interval within 1 % of a positive mean
     // implies a strictly increasing column. The loops below find and
     // describe the culprit otherwise.
-    let worst = t
-        .windows(2)
-        .map(|w| (w[1] - w[0] - dt).abs())
-        .fold(0.0f64, f64::max);
+    let worst = crate::reduce::max_step_deviation(t, dt);
     if dt > 0.0 && worst <= limit {
         return Ok(dt);
     }

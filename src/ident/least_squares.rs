@@ -17,12 +17,13 @@ pub const DEFAULT_MAX_CONDITION: f64 = 1e10;
 /// time or as columns, and [`solve`](Self::solve) returns the estimate with
 /// its statistics.
 ///
-/// The solver is Householder QR of the augmented matrix `[Φ D⁻¹ | λ]`,
-/// where `D` scales every column of `Φ` by a power of two (exactly, without
-/// rounding) to a norm in [1/√2, √2): the normal equations
-/// `ΦᵀΦ` are never formed (they square the condition number), and the rank
-/// test does not depend on the parameters' units. The workspace is kept
-/// between solves.
+/// The solver is Householder QR of the augmented matrix `[Φ | λ] = Q R`:
+/// the last column of `R` holds `Qᵀλ` and the residual norm, so one
+/// factorisation gives the estimate, its covariance and the fit. The normal
+/// equations `ΦᵀΦ` are never formed (they square the condition number).
+/// The rank test uses the condition number of `Φ` with its columns scaled
+/// to unit norm, so it does not depend on the parameters' units. The
+/// workspace is kept between solves.
 ///
 /// # Examples
 ///
@@ -81,10 +82,9 @@ pub struct LeastSquaresFit {
     /// Fit in percent, `(1 − ‖r‖ / ‖λ − mean λ‖) · 100` (MATLAB's
     /// `compare` NRMSE fit); same convention as `r_squared` for constant `λ`.
     pub fit_percent: f64,
-    /// Condition number of the column-equilibrated regressor `Φ D⁻¹` (ratio
-    /// of its extreme singular values, columns scaled by powers of two to
-    /// norms in [1/√2, √2)); independent of the parameters' units up to that
-    /// factor.
+    /// Condition number of the column-equilibrated regressor `Φ D⁻¹` (`D`
+    /// scales every column to unit norm): the ratio of its extreme singular
+    /// values, independent of the parameters' units.
     pub condition: f64,
     /// Number of rows used.
     pub rows: usize,
@@ -297,7 +297,7 @@ impl LeastSquares {
     }
 }
 
-/// Solves `Φ θ ≈ λ` given column-major `a = [Φ | λ]` (`m` rows, `p + 1`
+/// Solves `Φ θ ≈ λ` by QR, given column-major `a = [Φ | λ]` (`m` rows, `p + 1`
 /// columns), destroying `a`.
 pub(crate) fn solve_augmented(
     a: &mut [f64],
@@ -322,9 +322,14 @@ pub(crate) fn solve_augmented(
         })
     };
 
+    for (j, col) in a.chunks_exact(m).take(p).enumerate() {
+        if let Some(e) = non_finite(j, col) {
+            return Err(e);
+        }
+    }
     // Spread of λ about its mean, before QR overwrites it. A non-finite sum
-    // means a non-finite entry (or overflow, which the exact check below
-    // tells apart).
+    // means a non-finite entry (or overflow, which the exact check tells
+    // apart).
     let lam = &a[p * m..];
     let total = sum_by(lam, |v| v);
     if !total.is_finite()
@@ -334,29 +339,6 @@ pub(crate) fn solve_augmented(
     }
     let mean = total / m as f64;
     let sst = sum_by(lam, |v| (v - mean) * (v - mean));
-
-    // Equilibrate: scale every regressor column by a power of two (exact,
-    // no rounding) to a norm in [1/√2, √2). The sum of squares doubles as
-    // the finiteness check.
-    let mut scale = vec![1.0; p];
-    for (j, col) in a.chunks_exact_mut(m).take(p).enumerate() {
-        let mut norm = sum_by(col, |v| v * v).sqrt();
-        if !norm.is_finite() {
-            if let Some(e) = non_finite(j, col) {
-                return Err(e);
-            }
-            // Overflow of the squares (entries beyond 1e154): measure the
-            // column scaled by its largest entry instead.
-            let big = col.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
-            norm = sum_by(col, |v| (v / big) * (v / big)).sqrt() * big;
-        }
-        if norm > 0.0 && norm.is_finite() {
-            let s = 2f64.powi((norm.log2().round() as i32).clamp(-1020, 1020));
-            let inv = 1.0 / s; // exact: s is a power of two
-            col.iter_mut().for_each(|v| *v *= inv);
-            scale[j] = s;
-        }
-    }
 
     let n = p + 1;
     // Tall and narrow (a handful of columns): blocking buys nothing and
@@ -380,7 +362,16 @@ pub(crate) fn solve_augmented(
     // The upper triangle of `a` now holds R_aug = [R z; 0 ρ], |ρ| = ‖r‖.
     let r = |i: usize, j: usize| a[j * m + i];
 
-    let rmat = DMatrix::from_fn(p, p, |i, j| if i <= j { r(i, j) } else { 0.0 });
+    // Householder QR commutes with column scaling, so the equilibrated
+    // regressor Φ D⁻¹ (unit columns) has the triangular factor R D⁻¹, with
+    // ‖Φ_j‖ = ‖R_j‖: its singular values give a unit-free condition number.
+    let mut rmat = DMatrix::from_fn(p, p, |i, j| if i <= j { r(i, j) } else { 0.0 });
+    for j in 0..p {
+        let norm = rmat.column(j).norm();
+        if norm > 0.0 {
+            rmat.column_mut(j).unscale_mut(norm);
+        }
+    }
     let sv = rmat.singular_values();
     let smax = sv.max();
     let smin = sv.min();
@@ -412,13 +403,7 @@ pub(crate) fn solve_augmented(
     }
     let ssr = r(p, p) * r(p, p);
     let sigma2 = ssr / (m - p) as f64;
-    let mut covariance = &rinv * rinv.transpose() * sigma2;
-    for i in 0..p {
-        theta[i] /= scale[i];
-        for j in 0..p {
-            covariance[(i, j)] /= scale[i] * scale[j];
-        }
-    }
+    let covariance = &rinv * rinv.transpose() * sigma2;
     let std_errors = covariance.diagonal().map(f64::sqrt);
     let (r_squared, fit_percent) = if sst > 0.0 {
         (1.0 - ssr / sst, (1.0 - (ssr / sst).sqrt()) * 100.0)

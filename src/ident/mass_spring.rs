@@ -307,16 +307,12 @@ fn stage2(
     let (x1, x2, u) = (&p.rec.x1[..], &p.rec.x2[..], &p.rec.u[..]);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
+    let ks = 1..=m;
     buf.clear();
-    buf.resize(3 * m, 0.0);
-    let (c0, rest) = buf.split_at_mut(m);
-    let (c1, lam) = rest.split_at_mut(m);
-    for i in 0..m {
-        let k = i + 1;
-        c0[i] = t2 * input(scheme, u, k);
-        c1[i] = -t * vel(scheme, x2, k);
-        lam[i] = m2 * (x2[k + 1] - 2.0 * x2[k] + x2[k - 1]) + k2 * t2 * (x2[k] - x1[k]);
-    }
+    buf.reserve(3 * m);
+    buf.extend(ks.clone().map(|k| t2 * input(scheme, u, k)));
+    buf.extend(ks.clone().map(|k| -t * vel(scheme, x2, k)));
+    buf.extend(ks.map(|k| m2 * (x2[k + 1] - 2.0 * x2[k] + x2[k - 1]) + k2 * t2 * (x2[k] - x1[k])));
     solve_augmented(buf, m, 2, DEFAULT_MAX_CONDITION)
 }
 
@@ -363,17 +359,12 @@ pub fn identify(
     let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
-    let mut buf = vec![0.0; 3 * m];
-    {
-        let (c0, rest) = buf.split_at_mut(m);
-        let (c1, lam) = rest.split_at_mut(m);
-        for i in 0..m {
-            let k = i + 1;
-            c0[i] = t2 * (2.0 * x1[k] - x2[k]);
-            c1[i] = t * vel(scheme, x1, k);
-            lam[i] = m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1]);
-        }
-    }
+    // Column-major [Φ | λ], rows k = 1 … N − 2.
+    let ks = 1..=m;
+    let mut buf = Vec::with_capacity(3 * m);
+    buf.extend(ks.clone().map(|k| t2 * (2.0 * x1[k] - x2[k])));
+    buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
+    buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
     let first = solve_augmented(&mut buf, m, 2, DEFAULT_MAX_CONDITION)?;
     let [k12, b1] = estimates::<2>(&first);
     let second = stage2(&p, m2, k12.value, scheme, &mut buf)?;
@@ -423,19 +414,12 @@ pub fn identify_separate_springs(
     let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
-    let mut buf = vec![0.0; 4 * m];
-    {
-        let (c0, rest) = buf.split_at_mut(m);
-        let (c1, rest) = rest.split_at_mut(m);
-        let (c2, lam) = rest.split_at_mut(m);
-        for i in 0..m {
-            let k = i + 1;
-            c0[i] = t2 * x1[k];
-            c1[i] = t2 * (x1[k] - x2[k]);
-            c2[i] = t * vel(scheme, x1, k);
-            lam[i] = m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1]);
-        }
-    }
+    let ks = 1..=m;
+    let mut buf = Vec::with_capacity(4 * m);
+    buf.extend(ks.clone().map(|k| t2 * x1[k]));
+    buf.extend(ks.clone().map(|k| t2 * (x1[k] - x2[k])));
+    buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
+    buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
     let first = solve_augmented(&mut buf, m, 3, DEFAULT_MAX_CONDITION)?;
     let [k1, k2, b1] = estimates::<3>(&first);
     let second = stage2(&p, m2, k2.value, scheme, &mut buf)?;
