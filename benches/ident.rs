@@ -24,8 +24,21 @@ fn recording() -> Recording {
     };
     let sys = plant.state_space(Output::Cart2).unwrap();
     let t = time_grid((SAMPLES - 1) as f64 * 0.002, 0.002).unwrap();
-    let square = |t: f64| if (t / 0.2).floor() as i64 % 2 == 0 { 2.0 } else { -2.0 };
-    let r = simulate(&sys, &t, SVector::zeros(), |t| vector![square(t)], Solver::Zoh).unwrap();
+    let square = |t: f64| {
+        if (t / 0.2).floor() as i64 % 2 == 0 {
+            2.0
+        } else {
+            -2.0
+        }
+    };
+    let r = simulate(
+        &sys,
+        &t,
+        SVector::zeros(),
+        |t| vector![square(t)],
+        Solver::Zoh,
+    )
+    .unwrap();
     let q = |x: f64| (x * 102_400.0).round() / 102_400.0;
     let mut rec = Recording::with_capacity(t.len());
     for (k, &tk) in t.iter().enumerate() {
@@ -40,9 +53,10 @@ fn benches(c: &mut Criterion) {
     c.bench_function("identify, Scheme::Lab, 5000 samples (two stages)", |b| {
         b.iter(|| identify(black_box(&rec), 1.3, 0.7, Scheme::Lab).unwrap())
     });
-    c.bench_function("identify, Scheme::Central, 5000 samples (two stages)", |b| {
-        b.iter(|| identify(black_box(&rec), 1.3, 0.7, Scheme::Central).unwrap())
-    });
+    c.bench_function(
+        "identify, Scheme::Central, 5000 samples (two stages)",
+        |b| b.iter(|| identify(black_box(&rec), 1.3, 0.7, Scheme::Central).unwrap()),
+    );
     c.bench_function("Rls<2> update", |b| {
         let mut rls = Rls::<2>::new(0.999, 1e3).unwrap();
         let mut k = 0u32;

@@ -54,7 +54,11 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
         }
     }
     let path = path.unwrap_or_else(|| {
-        concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv").to_string()
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/ident_square_wave.csv"
+        )
+        .to_string()
     });
     Ok(Args { path, m1, m2 })
 }
@@ -74,7 +78,10 @@ fn print_estimate(name: &str, e: &MassSpringEstimate) {
             100.0 * p.relative_error()
         );
     }
-    for (stage, fit) in [("stage 1 [k12, b1]", &e.first), ("stage 2 [K, b2]", &e.second)] {
+    for (stage, fit) in [
+        ("stage 1 [k12, b1]", &e.first),
+        ("stage 2 [K, b2]", &e.second),
+    ] {
         println!(
             "  {stage:<18} fit {:6.2} %, R² {:.5}, condition {:.3e}, {} rows",
             fit.fit_percent, fit.r_squared, fit.condition, fit.rows
@@ -106,7 +113,11 @@ fn run(args: &Args) -> Result<(), ctrlab::Error> {
         let row: Vec<String> = (0..4).map(|c| format!("{:>11.4}", a[(r, c)])).collect();
         let label = if r == 1 { "A = " } else { "    " };
         let blabel = if r == 1 { "B = " } else { "    " };
-        println!("  {label}[{} ]   {blabel}[{:>9.4} ]", row.join(""), b[(r, 0)]);
+        println!(
+            "  {label}[{} ]   {blabel}[{:>9.4} ]",
+            row.join(""),
+            b[(r, 0)]
+        );
     }
     Ok(())
 }

@@ -32,17 +32,32 @@ fn millimetres_are_read_as_metres() {
             .t
             .iter()
             .enumerate()
-            .map(|(k, t)| format!("{:?},2,{t:?},{:?},{},-{},7\n", rec.x2[k], rec.x1[k], k * 10, k * 20))
+            .map(|(k, t)| {
+                format!(
+                    "{:?},2,{t:?},{:?},{},-{},7\n",
+                    rec.x2[k],
+                    rec.x1[k],
+                    k * 10,
+                    k * 20
+                )
+            })
             .collect::<String>();
     let rec2 = Recording::from_reader(si.as_bytes()).unwrap();
-    assert_eq!((&rec2.t, &rec2.u, &rec2.x1, &rec2.x2), (&rec.t, &rec.u, &rec.x1, &rec.x2));
+    assert_eq!(
+        (&rec2.t, &rec2.u, &rec2.x1, &rec2.x2),
+        (&rec.t, &rec.u, &rec.x1, &rec.x2)
+    );
     assert_eq!(rec2.v1.as_ref().unwrap()[3], 0.030);
     assert_eq!(rec2.v2.as_ref().unwrap()[2], -0.040);
 }
 
 #[test]
 fn fixture_reads_with_its_documented_shape() {
-    let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv")).unwrap();
+    let rec = Recording::read_csv(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/ident_square_wave.csv"
+    ))
+    .unwrap();
     assert_eq!(rec.len(), 2500);
     assert!((rec.sample_period().unwrap() - 0.002).abs() < 1e-12);
     assert!(rec.u.iter().all(|u| u.abs() == 2.0));
@@ -57,17 +72,35 @@ fn each_malformed_input_names_its_line() {
     let (line, reason) = csv_err(&GOOD.replace("x1_mm", "x1"));
     assert_eq!(line, 1);
     assert!(reason.contains("no unit"), "{reason}");
-    assert_eq!(csv_err(&GOOD.replace("t_s,u,", "t_s,u,x1_m,")).0, 1, "duplicate column");
-    assert!(csv_err(&GOOD.replace("x2_mm\n", "x2_mm,v1_mm_s\n").replace(",0.048828125\n", ",0.048828125,1\n")).1.contains("pairs"));
+    assert_eq!(
+        csv_err(&GOOD.replace("t_s,u,", "t_s,u,x1_m,")).0,
+        1,
+        "duplicate column"
+    );
+    assert!(
+        csv_err(
+            &GOOD
+                .replace("x2_mm\n", "x2_mm,v1_mm_s\n")
+                .replace(",0.048828125\n", ",0.048828125,1\n")
+        )
+        .1
+        .contains("pairs")
+    );
 
     // Non-number on data line 4 (file line 4).
     let (line, reason) = csv_err(&GOOD.replace("0.004,2,0,0.1953125", "0.004,2,zero,0.1953125"));
     assert_eq!(line, 4);
-    assert!(reason.contains("x1_mm") && reason.contains("zero"), "{reason}");
+    assert!(
+        reason.contains("x1_mm") && reason.contains("zero"),
+        "{reason}"
+    );
     assert_eq!(csv_err(&GOOD.replace("0.006,2,", "0.006,NaN,")).0, 5);
     assert_eq!(csv_err(&GOOD.replace("0.006,2,", "0.006,inf,")).0, 5);
     // Wrong number of fields on line 3.
-    assert_eq!(csv_err(&GOOD.replace("0.002,2,0,0.048828125", "0.002,2,0")).0, 3);
+    assert_eq!(
+        csv_err(&GOOD.replace("0.002,2,0,0.048828125", "0.002,2,0")).0,
+        3
+    );
 
     // Time goes backwards on line 5.
     let (line, reason) = csv_err(&GOOD.replace("0.006,", "0.003,"));
@@ -78,7 +111,10 @@ fn each_malformed_input_names_its_line() {
     // Irregular: one sample 0.5 ms late (25 % of the interval), line 6.
     let (line, reason) = csv_err(&GOOD.replace("0.008,", "0.0085,"));
     assert_eq!(line, 6);
-    assert!(reason.contains("irregular") && reason.contains('%'), "{reason}");
+    assert!(
+        reason.contains("irregular") && reason.contains('%'),
+        "{reason}"
+    );
 
     // Too few rows: reported on the last line.
     let short: String = GOOD.lines().take(4).map(|l| format!("{l}\n")).collect();
@@ -90,7 +126,10 @@ fn each_malformed_input_names_its_line() {
     let mut bytes = GOOD.as_bytes().to_vec();
     let at = GOOD.find("0.002").unwrap();
     bytes[at] = 0xff;
-    assert!(matches!(Recording::from_reader(&bytes[..]), Err(Error::Csv { line: 3, .. })));
+    assert!(matches!(
+        Recording::from_reader(&bytes[..]),
+        Err(Error::Csv { line: 3, .. })
+    ));
 }
 
 #[test]
@@ -115,10 +154,16 @@ fn file_round_trip_and_writer_refusals() {
 
     let mut ragged = rec.clone();
     ragged.x1.pop();
-    assert!(matches!(ragged.to_writer(Vec::new()), Err(Error::InvalidRecording { index: 5, .. })));
+    assert!(matches!(
+        ragged.to_writer(Vec::new()),
+        Err(Error::InvalidRecording { index: 5, .. })
+    ));
     let mut nan = rec;
     nan.u[2] = f64::NAN;
-    assert!(matches!(nan.to_writer(Vec::new()), Err(Error::InvalidRecording { index: 2, .. })));
+    assert!(matches!(
+        nan.to_writer(Vec::new()),
+        Err(Error::InvalidRecording { index: 2, .. })
+    ));
 }
 
 fn finite() -> impl Strategy<Value = f64> {

@@ -27,8 +27,8 @@ fn exact_data_gives_the_exact_solution() {
         ls.push_row(&phi, y).unwrap();
     }
     let fit = ls.solve().unwrap();
-    for i in 0..3 {
-        assert!((fit.theta[i] - theta[i]).abs() < 1e-13, "{}", fit.theta[i]);
+    for (got, want) in fit.theta.iter().zip(theta) {
+        assert!((got - want).abs() < 1e-13, "{got} vs {want}");
     }
     assert!(fit.residual_rms < 1e-14);
     assert!((fit.r_squared - 1.0).abs() < 1e-12 && fit.fit_percent > 99.9999);
@@ -54,7 +54,11 @@ fn statistics_match_the_textbook_formulas() {
     let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
     let slope = sxy / sxx;
     let icpt = my - slope * mx;
-    let ssr: f64 = xs.iter().zip(&ys).map(|(x, y)| (y - icpt - slope * x).powi(2)).sum();
+    let ssr: f64 = xs
+        .iter()
+        .zip(&ys)
+        .map(|(x, y)| (y - icpt - slope * x).powi(2))
+        .sum();
     let sst: f64 = ys.iter().map(|y| (y - my).powi(2)).sum();
     let s2 = ssr / (n - 2.0);
     assert!((fit.theta[1] - slope).abs() < 1e-12 && (fit.theta[0] - icpt).abs() < 1e-12);
@@ -75,22 +79,37 @@ fn ill_conditioned_qr_keeps_digits_the_normal_equations_lose() {
     let c0: Vec<f64> = (0..m).map(|_| 1.0 + r()).collect();
     let c1: Vec<f64> = c0.iter().map(|v| v + 1e-7 * r()).collect();
     let theta = [1.0, 1.0];
-    let y: Vec<f64> = c0.iter().zip(&c1).map(|(a, b)| a * theta[0] + b * theta[1]).collect();
+    let y: Vec<f64> = c0
+        .iter()
+        .zip(&c1)
+        .map(|(a, b)| a * theta[0] + b * theta[1])
+        .collect();
 
     let mut ls = LeastSquares::new(2);
     ls.push_columns(&[&c0, &c1], &y).unwrap();
     let fit = ls.solve().unwrap();
-    let qr_err = (0..2).map(|i| (fit.theta[i] - theta[i]).abs()).fold(0.0, f64::max);
+    let qr_err = (0..2)
+        .map(|i| (fit.theta[i] - theta[i]).abs())
+        .fold(0.0, f64::max);
 
     let phi = DMatrix::from_fn(m, 2, |i, j| if j == 0 { c0[i] } else { c1[i] });
     let lam = DVector::from_vec(y);
-    let ne = (phi.transpose() * &phi).lu().solve(&(phi.transpose() * lam)).expect("normal equations solve");
+    let ne = (phi.transpose() * &phi)
+        .lu()
+        .solve(&(phi.transpose() * lam))
+        .expect("normal equations solve");
     let ne_err = (0..2).map(|i| (ne[i] - theta[i]).abs()).fold(0.0, f64::max);
 
-    println!("condition {:e}: QR error {qr_err:e}, normal equations error {ne_err:e}", fit.condition);
+    println!(
+        "condition {:e}: QR error {qr_err:e}, normal equations error {ne_err:e}",
+        fit.condition
+    );
     assert!(fit.condition > 1e6);
     assert!(qr_err < 1e-6, "QR error {qr_err:e}");
-    assert!(ne_err > 1e3 * qr_err, "normal equations should lose digits: {ne_err:e} vs {qr_err:e}");
+    assert!(
+        ne_err > 1e3 * qr_err,
+        "normal equations should lose digits: {ne_err:e} vs {qr_err:e}"
+    );
 }
 
 #[test]
@@ -111,26 +130,48 @@ fn rank_deficiency_is_an_error() {
     }
     // A zero column (no excitation).
     let mut ls = LeastSquares::new(2);
-    ls.push_columns(&[&[1.0, 2.0, 3.0], &[0.0; 3]], &[1.0, 2.0, 3.0]).unwrap();
+    ls.push_columns(&[&[1.0, 2.0, 3.0], &[0.0; 3]], &[1.0, 2.0, 3.0])
+        .unwrap();
     assert_eq!(
         ls.solve(),
-        Err(Error::RankDeficient { rank: 1, condition: f64::INFINITY })
+        Err(Error::RankDeficient {
+            rank: 1,
+            condition: f64::INFINITY
+        })
     );
 }
 
 #[test]
 fn bad_shapes_and_values_are_errors() {
     let mut ls = LeastSquares::new(2);
-    assert!(matches!(ls.solve(), Err(Error::TooFewSamples { needed: 3, got: 0, .. })));
+    assert!(matches!(
+        ls.solve(),
+        Err(Error::TooFewSamples {
+            needed: 3,
+            got: 0,
+            ..
+        })
+    ));
     ls.push_row(&[1.0, 2.0], 1.0).unwrap();
     ls.push_row(&[1.0, 3.0], 1.0).unwrap();
-    assert!(matches!(ls.solve(), Err(Error::TooFewSamples { got: 2, .. })));
+    assert!(matches!(
+        ls.solve(),
+        Err(Error::TooFewSamples { got: 2, .. })
+    ));
     assert!(ls.push_row(&[1.0, 2.0, 3.0], 1.0).is_err());
     assert!(ls.push_columns(&[&[1.0]], &[1.0]).is_err());
     assert!(ls.push_columns(&[&[1.0], &[1.0, 2.0]], &[1.0]).is_err());
     assert_eq!(ls.rows(), 2);
     ls.push_row(&[1.0, f64::NAN], 1.0).unwrap();
-    assert!(matches!(ls.solve(), Err(Error::NonFinite { matrix: "regressor", row: 2, col: 1, .. })));
+    assert!(matches!(
+        ls.solve(),
+        Err(Error::NonFinite {
+            matrix: "regressor",
+            row: 2,
+            col: 1,
+            ..
+        })
+    ));
     let mut zero = LeastSquares::new(0);
     assert!(matches!(zero.solve(), Err(Error::TooFewSamples { .. })));
 }
@@ -142,7 +183,8 @@ fn rls_with_forgetting_tracks_a_parameter_change() {
     for k in 0..2000 {
         let theta = if k < 1000 { [1.0, 2.0] } else { [3.0, -1.0] };
         let phi = vector![r(), r()];
-        rls.update(&phi, phi[0] * theta[0] + phi[1] * theta[1]).unwrap();
+        rls.update(&phi, phi[0] * theta[0] + phi[1] * theta[1])
+            .unwrap();
     }
     assert!((rls.theta() - vector![3.0, -1.0]).norm() < 1e-6);
     assert_eq!(rls.updates(), 2000);
@@ -184,9 +226,9 @@ proptest! {
         // largest contribution (θ_j of a tiny column is known only that well).
         let size = |j: usize| 10f64.powi(scales[j]);
         let signal = (0..3).map(|j| theta[j].abs() * size(j)).fold(1e-300, f64::max);
-        for j in 0..3 {
-            let err = (fit.theta[j] - theta[j]).abs() * size(j) / signal;
-            prop_assert!(err < 1e-10, "theta[{j}] {} vs {} (err {err:e})", fit.theta[j], theta[j]);
+        for (j, (got, want)) in fit.theta.iter().zip(theta).enumerate() {
+            let err = (got - want).abs() * size(j) / signal;
+            prop_assert!(err < 1e-10, "theta[{}] {} vs {} (err {:e})", j, got, want, err);
         }
     }
 }

@@ -167,9 +167,7 @@ impl Recording {
             let missing = if has_v1 { "v2" } else { "v1" };
             return Err(csv_error(
                 1,
-                format!(
-                    "velocity columns come in pairs: missing {missing}_m_s or {missing}_mm_s"
-                ),
+                format!("velocity columns come in pairs: missing {missing}_m_s or {missing}_mm_s"),
             ));
         }
 
@@ -312,10 +310,7 @@ impl Recording {
         }
         let io = |e: csv::Error| match e.into_kind() {
             csv::ErrorKind::Io(e) => Error::io("writing CSV", &e),
-            other => Error::io(
-                "writing CSV",
-                &std::io::Error::other(format!("{other:?}")),
-            ),
+            other => Error::io("writing CSV", &std::io::Error::other(format!("{other:?}"))),
         };
         let mut w = csv::Writer::from_writer(writer);
         w.write_record(&header).map_err(io)?;

@@ -375,8 +375,12 @@ pub(crate) fn solve_augmented(
     let sv = rmat.singular_values();
     let smax = sv.max();
     let smin = sv.min();
-    let condition = if smin > 0.0 { smax / smin } else { f64::INFINITY };
-    if !(condition <= max_condition) {
+    let condition = if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
+    if condition.is_nan() || condition > max_condition {
         let rank = sv.iter().filter(|&&s| s * max_condition > smax).count();
         return Err(Error::RankDeficient { rank, condition });
     }
