@@ -11,6 +11,8 @@
 //! fit of each least-squares stage, then the identified state equations.
 //! The CSV format is described at `ctrlab::Recording::from_reader`.
 
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::process::ExitCode;
 
 use ctrlab::Recording;
@@ -63,78 +65,99 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<Args, String> {
     Ok(Args { path, m1, m2 })
 }
 
-fn print_estimate(name: &str, e: &MassSpringEstimate) {
-    println!("{name} scheme:");
+fn print_estimate(out: &mut String, name: &str, e: &MassSpringEstimate) {
+    writeln!(out, "{name} scheme:").unwrap_or_default();
     for (label, unit, p) in [
         ("k12", "N/m", e.k12),
         ("b1", "N s/m", e.b1),
         ("K", "N/V", e.gain),
         ("b2", "N s/m", e.b2),
     ] {
-        println!(
+        writeln!(
+            out,
             "  {label:>3} = {:>12.5} ± {:<10.5} {unit:<6} ({:.3} %)",
             p.value,
             p.std_error,
             100.0 * p.relative_error()
-        );
+        )
+        .unwrap_or_default();
     }
     for (stage, fit) in [
         ("stage 1 [k12, b1]", &e.first),
         ("stage 2 [K, b2]", &e.second),
     ] {
-        println!(
+        writeln!(
+            out,
             "  {stage:<18} fit {:6.2} %, R² {:.5}, condition {:.3e}, {} rows",
             fit.fit_percent, fit.r_squared, fit.condition, fit.rows
-        );
+        )
+        .unwrap_or_default();
     }
 }
 
-fn run(args: &Args) -> Result<(), ctrlab::Error> {
+/// Identifies and formats the report (written to a `String`, so a closed
+/// pipe cannot interrupt it half way).
+fn run(args: &Args) -> Result<String, ctrlab::Error> {
     let rec = Recording::read_csv(&args.path)?;
-    println!(
+    let mut out = String::new();
+    let w = &mut out;
+    writeln!(
+        w,
         "{}: {} samples, T = {} ms, m1 = {} kg, m2 = {} kg\n",
         args.path,
         rec.len(),
         rec.sample_period()? * 1e3,
         args.m1,
         args.m2
-    );
+    )
+    .unwrap_or_default();
     let lab = identify(&rec, args.m1, args.m2, Scheme::Lab)?;
     let central = identify(&rec, args.m1, args.m2, Scheme::Central)?;
-    print_estimate("Lab (equations (6)-(11))", &lab);
-    println!();
-    print_estimate("Central (bias-free)", &central);
-    println!();
-    println!("Identified state equations (Central), x = [x1 m, x1' m/s, x2 m, x2' m/s], u in V:");
-    println!("  x' = A x + B u,  y = x2");
+    print_estimate(w, "Lab (equations (6)-(11))", &lab);
+    writeln!(w).unwrap_or_default();
+    print_estimate(w, "Central (bias-free)", &central);
+    writeln!(w).unwrap_or_default();
+    writeln!(
+        w,
+        "Identified state equations (Central), x = [x1 m, x1' m/s, x2 m, x2' m/s], u in V:\n  x' = A x + B u,  y = x2"
+    )
+    .unwrap_or_default();
     let sys = central.state_space()?;
     let (a, b) = (sys.a(), sys.b());
     for r in 0..4 {
         let row: Vec<String> = (0..4).map(|c| format!("{:>11.4}", a[(r, c)])).collect();
-        let label = if r == 1 { "A = " } else { "    " };
-        let blabel = if r == 1 { "B = " } else { "    " };
-        println!(
-            "  {label}[{} ]   {blabel}[{:>9.4} ]",
-            row.join(""),
-            b[(r, 0)]
-        );
+        let (al, bl) = if r == 1 {
+            ("A = ", "B = ")
+        } else {
+            ("    ", "    ")
+        };
+        writeln!(w, "  {al}[{} ]   {bl}[{:>9.4} ]", row.join(""), b[(r, 0)]).unwrap_or_default();
     }
-    Ok(())
+    Ok(out)
 }
 
 fn main() -> ExitCode {
     let args = match parse_args(std::env::args().skip(1)) {
         Ok(a) => a,
+        Err(msg) if msg.is_empty() => {
+            println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
         Err(msg) => {
-            if !msg.is_empty() {
-                eprintln!("error: {msg}");
-            }
-            eprintln!("{USAGE}");
+            eprintln!("error: {msg}\n{USAGE}");
             return ExitCode::from(2);
         }
     };
     match run(&args) {
-        Ok(()) => ExitCode::SUCCESS,
+        // A closed pipe (`| head`) is not worth a panic or an error.
+        Ok(report) => match std::io::stdout().lock().write_all(report.as_bytes()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: writing the report: {e}");
+                ExitCode::FAILURE
+            }
+        },
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE

@@ -3,6 +3,21 @@
 //! A [`Recording`] is what simulation and the rig produce and what
 //! identification and step metrics consume. It reads and writes CSV whose
 //! header names carry the unit (see [`Recording::from_reader`]).
+//!
+//! # Examples
+//!
+//! ```
+//! use ctrlab::Recording;
+//!
+//! let log = "t_s,u,x1_mm,x2_mm\n0,1,0,0\n0.002,1,0,0.05\n0.004,1,0.01,0.2\n\
+//!            0.006,1,0.05,0.4\n0.008,1,0.1,0.7\n0.010,1,0.2,1.1\n";
+//! let rec = Recording::from_reader(log.as_bytes())?;
+//! assert_eq!(rec.x2[5], 0.0011); // metres inside
+//! let mut out = Vec::new();
+//! rec.to_writer(&mut out)?; // written back in metres
+//! assert!(String::from_utf8(out).unwrap().starts_with("t_s,u,x1_m,x2_m\n"));
+//! # Ok::<(), ctrlab::Error>(())
+//! ```
 
 mod csv;
 
@@ -14,11 +29,34 @@ use crate::error::Error;
 /// the identifiers in [`ident::mass_spring`](crate::ident::mass_spring)
 /// can use (three unknowns, one residual degree of freedom, and the two
 /// samples the finite differences consume).
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{data::MIN_ROWS, Error, Recording};
+/// let header_and_five_rows = "t_s,u,x1_m,x2_m\n0,0,0,0\n1,0,0,0\n2,0,0,0\n3,0,0,0\n4,0,0,0\n";
+/// assert_eq!(MIN_ROWS, 6);
+/// assert!(matches!(Recording::from_reader(header_and_five_rows.as_bytes()), Err(Error::Csv { line: 6, .. })));
+/// ```
 pub const MIN_ROWS: usize = 6;
 
 /// Largest accepted deviation of one sampling interval from the mean
 /// interval, as a fraction of the mean (1 %). The identifiers assume a
 /// uniform sampling period.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{data::MAX_JITTER, Recording};
+/// let mut rec = Recording::new();
+/// for k in 0..10 {
+///     rec.push(k as f64 * 0.002, 0.0, 0.0, 0.0);
+/// }
+/// rec.t[5] += 0.5 * MAX_JITTER * 0.002; // half the limit: accepted
+/// assert!(rec.sample_period().is_ok());
+/// rec.t[5] += 1.0 * MAX_JITTER * 0.002; // 1.5 times the limit: refused
+/// assert!(rec.sample_period().is_err());
+/// ```
 pub const MAX_JITTER: f64 = 0.01;
 
 /// One run of the rig or of a simulation: column vectors of equal length,
@@ -46,7 +84,7 @@ pub const MAX_JITTER: f64 = 0.01;
 /// with_v.push_state(0.0, 2.0, &vector![0.001, 0.1, 0.002, 0.2]);
 /// assert_eq!(with_v.v2.as_deref(), Some(&[0.2][..]));
 /// ```
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Recording {
     /// Sample times, s, strictly increasing.
     pub t: Vec<f64>,
@@ -62,6 +100,13 @@ pub struct Recording {
     pub v2: Option<Vec<f64>>,
 }
 
+/// Same as [`Recording::new`].
+impl Default for Recording {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Recording {
     /// An empty recording, ready to take samples with or without velocities.
     ///
@@ -73,11 +118,7 @@ impl Recording {
     /// assert!(rec.is_empty());
     /// ```
     pub fn new() -> Self {
-        Self {
-            v1: Some(Vec::new()),
-            v2: Some(Vec::new()),
-            ..Self::default()
-        }
+        Self::with_capacity(0)
     }
 
     /// An empty recording with room for `n` samples in every column

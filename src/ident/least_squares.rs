@@ -11,6 +11,20 @@ use crate::reduce::{first_non_finite, sum_by};
 /// Default limit on the column-equilibrated condition number (10¹⁰, i.e.
 /// more than ten of the sixteen significant digits lost): above it a
 /// regressor counts as rank deficient.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{Error, ident::{LeastSquares, DEFAULT_MAX_CONDITION}};
+/// // Columns 1e-12 apart in angle: condition ≈ 10¹², beyond the default.
+/// let mut ls = LeastSquares::new(2);
+/// ls.push_columns(&[&[1.0, 1.0, 1.0], &[1.0, 1.0, 1.0 + 2e-12]], &[1.0, 2.0, 3.0])?;
+/// match ls.solve() {
+///     Err(Error::RankDeficient { condition, .. }) => assert!(condition > DEFAULT_MAX_CONDITION),
+///     other => panic!("{other:?}"),
+/// }
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const DEFAULT_MAX_CONDITION: f64 = 1e10;
 
 /// Linear least squares `Φ θ ≈ λ`: rows `φ(k)ᵀ θ = λ(k)` are pushed one at a
