@@ -453,3 +453,28 @@ proptest! {
         prop_assert!(rel(s.gain.value, gain) < 0.01 && rel(s.b2.value, b2) < 0.01 && rel(s.b1.value, b1) < 0.01);
     }
 }
+
+#[test]
+fn rls_on_the_lab_regressors_agrees_with_the_batch_estimate() {
+    // Stage 1 of Scheme::Central, row by row through Rls<2> (factor 1).
+    let (rec, _) = fixture();
+    let batch = identify(&rec, 1.3, 0.7, Scheme::Central).unwrap();
+    let (x1, x2, t) = (&rec.x1, &rec.x2, DT);
+    // Rows are ~1e-8 in size, so ΦᵀΦ ~ 1e-13: P₀ = 1e22 makes the prior's
+    // pull (1/P₀ against ΦᵀΦ) about 1e-9 relative.
+    let mut rls = ctrlab::Rls::<2>::new(1.0, 1e22).unwrap();
+    for k in 1..rec.len() - 1 {
+        let phi = vector![
+            t * t * (2.0 * x1[k] - x2[k]),
+            t * 0.5 * (x1[k + 1] - x1[k - 1])
+        ];
+        rls.update(&phi, 1.3 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1]))
+            .unwrap();
+    }
+    let (k12, b1) = (rls.theta()[0], rls.theta()[1]);
+    println!(
+        "RLS k12 {k12} vs batch {}, b1 {b1} vs {}",
+        batch.k12.value, batch.b1.value
+    );
+    assert!(rel(k12, batch.k12.value) < 1e-8 && rel(b1, batch.b1.value) < 1e-8);
+}
