@@ -138,3 +138,16 @@ fn recording_push_allocates_nothing_within_capacity() {
     assert_eq!(n, 0);
     assert_eq!(rec.x1.len(), 1000);
 }
+
+#[test]
+fn least_squares_push_row_allocates_nothing_within_capacity() {
+    let mut ls = ctrlab::LeastSquares::with_capacity(2, 1000);
+    let n = allocations(|| {
+        for k in 0..1000 {
+            let x = k as f64;
+            ls.push_row(&[1.0, x], 2.0 + 3.0 * x).unwrap();
+        }
+    });
+    assert_eq!(n, 0);
+    assert!((ls.solve().unwrap().theta[1] - 3.0).abs() < 1e-12);
+}
