@@ -139,6 +139,69 @@ pub enum Error {
         /// The backend's message.
         reason: String,
     },
+    /// A CSV recording is malformed: a missing or unit-less column, a value
+    /// that is not a finite number, a time column that does not increase or
+    /// is not uniformly sampled, too few rows, or bytes the CSV parser rejects.
+    #[error("CSV line {line}: {reason}")]
+    Csv {
+        /// One-based line number in the input (the header is line 1).
+        line: u64,
+        /// What is wrong on that line, with the offending value.
+        reason: String,
+    },
+    /// A least-squares regressor does not determine every parameter: its
+    /// column-equilibrated condition number exceeds the solver's limit
+    /// (typically a run with no excitation, or two collinear regressors).
+    #[error("rank-deficient regressor: numerical rank {rank}, condition number {condition:e}")]
+    RankDeficient {
+        /// Number of singular values above the tolerance.
+        rank: usize,
+        /// Ratio of largest to smallest singular value of the
+        /// column-equilibrated regressor (`inf` when a column is zero).
+        condition: f64,
+    },
+    /// Too few samples (or regression rows) for the requested computation.
+    #[error("{what}: need at least {needed} samples, got {got}")]
+    TooFewSamples {
+        /// What needed them (`"least squares"`, `"mass-spring identification"`, …).
+        what: &'static str,
+        /// Minimum number required.
+        needed: usize,
+        /// Number supplied.
+        got: usize,
+    },
+    /// An in-memory recording is inconsistent: columns of different lengths,
+    /// a non-finite value, or a time column that is not strictly increasing
+    /// and uniformly sampled.
+    #[error("invalid recording at sample {index}: {reason}")]
+    InvalidRecording {
+        /// Zero-based sample index at fault.
+        index: usize,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Reading or writing a file failed. Holds the error kind and message
+    /// rather than `std::io::Error` so that `Error` stays `Clone + PartialEq`.
+    #[error("{context}: {message}")]
+    Io {
+        /// What was being done, with the path (`"reading log.csv"`).
+        context: String,
+        /// The I/O error's kind.
+        kind: std::io::ErrorKind,
+        /// The I/O error's message.
+        message: String,
+    },
+}
+
+impl Error {
+    /// An [`Error::Io`] from an I/O error and what was being done.
+    pub(crate) fn io(context: impl Into<String>, err: &std::io::Error) -> Self {
+        Error::Io {
+            context: context.into(),
+            kind: err.kind(),
+            message: err.to_string(),
+        }
+    }
 }
 
 /// Checks that every entry of a matrix is finite; names the first bad one.

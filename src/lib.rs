@@ -21,6 +21,11 @@
 //! - [`metrics`]: [`step_info`] / [`step_info_of`] (rise and settling time,
 //!   overshoot, steady state) with interpolated crossing times.
 //! - `plot` (feature `plot`): SVG figures of time responses.
+//! - [`data`]: [`Recording`]s of a run (time, input, cart states) and their
+//!   CSV form, units in the header.
+//! - [`ident`]: least squares by QR ([`LeastSquares`]), recursive least
+//!   squares ([`Rls`]) and the lab's two-cart identification
+//!   ([`ident::mass_spring`]).
 //!
 //! Units are SI throughout (m, m/s, N, V, s); the lab's millimetres appear
 //! only in printed tables and at named conversions.
@@ -44,22 +49,27 @@
 #![deny(unsafe_code)]
 
 pub mod analysis;
+pub mod data;
 pub mod design;
 pub mod discretize;
 mod error;
 pub mod hw;
+pub mod ident;
 pub mod integrate;
 mod linalg;
 pub mod metrics;
 pub mod model;
 #[cfg(feature = "plot")]
 pub mod plot;
+mod reduce;
 pub mod sim;
 
 pub use analysis::Damping;
+pub use data::Recording;
 pub use design::{Controller, Lqr, StateFeedback, acker, dlqr, lqr};
 pub use discretize::Method;
 pub use error::Error;
+pub use ident::{LeastSquares, LeastSquaresFit, Rls};
 pub use integrate::{Dynamics, Euler, Integrator, Rk4};
 pub use metrics::{StepInfo, StepInfoOptions, step_info, step_info_of};
 pub use model::{Continuous, Discrete, Domain, MassSpring, Output, StateSpace};

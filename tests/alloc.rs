@@ -178,3 +178,59 @@ fn state_feedback_update_allocates_nothing() {
     // The loop did something: cart 2 moved towards the setpoint.
     assert!(x[2] > 0.02 && x[2] < 0.035);
 }
+
+#[test]
+fn rls_update_allocates_nothing() {
+    let mut rls = ctrlab::Rls::<4>::new(0.99, 1e3).unwrap();
+    let mut err = 0.0;
+    let n = allocations(|| {
+        for k in 0..1000 {
+            let x = k as f64 * 1e-2;
+            let phi = vector![1.0, x.sin(), x.cos(), (2.0 * x).sin()];
+            err = rls.update(&phi, 0.5 + 2.0 * x.sin()).unwrap();
+        }
+    });
+    assert_eq!(n, 0);
+    assert!(err.abs() < 1e-6 && (rls.theta()[1] - 2.0).abs() < 1e-6);
+}
+
+#[test]
+fn recording_push_state_allocates_nothing_within_capacity() {
+    let mut rec = ctrlab::Recording::with_capacity(1000);
+    let n = allocations(|| {
+        for k in 0..1000 {
+            let t = k as f64 * 0.002;
+            rec.push_state(t, 1.0, &vector![t, 1.0, 2.0 * t, 2.0]);
+        }
+    });
+    assert_eq!(n, 0);
+    assert_eq!(rec.len(), 1000);
+    assert_eq!(rec.v2.as_ref().map(Vec::len), Some(1000));
+    // Past capacity it does allocate: the counter would see it.
+    assert!(allocations(|| rec.push_state(2.0, 1.0, &vector![0.0, 0.0, 0.0, 0.0])) > 0);
+}
+
+#[test]
+fn recording_push_allocates_nothing_within_capacity() {
+    let mut rec = ctrlab::Recording::with_capacity(1000);
+    let n = allocations(|| {
+        for k in 0..1000 {
+            rec.push(k as f64 * 0.002, 1.0, 0.001, 0.002);
+        }
+    });
+    assert_eq!(n, 0);
+    assert_eq!(rec.x1.len(), 1000);
+}
+
+#[test]
+fn least_squares_push_row_allocates_nothing_within_capacity() {
+    let mut ls = ctrlab::LeastSquares::with_capacity(2, 1000);
+    let n = allocations(|| {
+        for k in 0..1000 {
+            let x = k as f64;
+            ls.push_row(&[1.0, x], 2.0 + 3.0 * x).unwrap();
+        }
+    });
+    assert_eq!(n, 0);
+    assert!((ls.solve().unwrap().theta[1] - 3.0).abs() < 1e-12);
+}

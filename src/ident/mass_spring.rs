@@ -1,0 +1,526 @@
+//! The lab's regressors: the two-cart plant's parameters from a recording
+//! (LAB.md section 2.2, equations (4)–(11)).
+//!
+//! Both carts' equations of motion are linear in the unknowns once the
+//! masses are known. The identification runs in two stages, as in the lab:
+//!
+//! 1. cart 1, `m1 x1'' + b1 x1' + k1 x1 + k2 (x1 − x2) = 0`, gives the
+//!    springs and `b1`;
+//! 2. cart 2, `m2 x2'' + b2 x2' + k2 (x2 − x1) = K u`, with `k2` from stage
+//!    1, gives the motor gain `K` and `b2`.
+//!
+//! Every row is multiplied by `T²` as in the lab's code (equations (6), (9));
+//! that scaling does not change the estimate. The standard errors of stage
+//! 2 treat `k2` as exact.
+
+use crate::data::Recording;
+use crate::error::Error;
+use crate::ident::least_squares::{DEFAULT_MAX_CONDITION, LeastSquaresFit, solve_augmented};
+use crate::model::{Continuous, MassSpring, Output, StateSpace};
+
+/// How derivatives and the input are taken from the samples.
+///
+/// Row `k` uses samples `k − 1`, `k`, `k + 1` for `k = 1 … N − 2`; the
+/// acceleration is always the central second difference
+/// `[x(k+1) − 2x(k) + x(k−1)] / T²` (equation (5)).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::ident::mass_spring::Scheme;
+/// assert_ne!(Scheme::Lab, Scheme::Central);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Scheme {
+    /// The lab's formulas exactly (equations (6)–(11)): backward-difference
+    /// velocity `[x(k) − x(k−1)] / T` and input `u(k)`. Reproduces the
+    /// lab's MATLAB numbers, biases included (about 1 % on `k12`, 2–5 % on
+    /// `K` and `b2`: the velocity is half a sample late, and under a
+    /// zero-order hold the second difference at `k` sees the mean of
+    /// `u(k−1)` and `u(k)`).
+    Lab,
+    /// Central-difference velocity `[x(k+1) − x(k−1)] / (2T)` and the input
+    /// averaged over the two hold intervals the second difference spans,
+    /// `[u(k−1) + u(k)] / 2`: removes the half-sample bias (within 0.1 % on
+    /// exact, encoder-quantised data).
+    Central,
+}
+
+/// One identified parameter and its standard error (same unit).
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::ident::mass_spring::Estimate;
+/// let k = Estimate { value: 950.0, std_error: 1.9 };
+/// assert!((k.relative_error() - 0.002).abs() < 1e-15);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// The estimate.
+    pub value: f64,
+    /// Its standard error from the least-squares covariance.
+    pub std_error: f64,
+}
+
+impl Estimate {
+    /// `std_error / |value|`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::ident::mass_spring::Estimate;
+    /// assert_eq!(Estimate { value: -2.0, std_error: 0.5 }.relative_error(), 0.25);
+    /// ```
+    pub fn relative_error(&self) -> f64 {
+        self.std_error / self.value.abs()
+    }
+}
+
+/// The parameters identified by [`identify`] (equal springs `k1 = k2 = k12`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+/// assert!((est.k12.value - 950.0).abs() < 0.003 * 950.0);
+/// let sys = est.state_space()?; // the identified model, output cart 2
+/// assert!((sys.b()[(3, 0)] - est.gain.value / 0.7).abs() < 1e-12);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct MassSpringEstimate {
+    /// Spring constant `k1 = k2`, N/m.
+    pub k12: Estimate,
+    /// Viscous friction of cart 1, N·s/m.
+    pub b1: Estimate,
+    /// Motor gain `K`, N per input unit (N/V on the rig).
+    pub gain: Estimate,
+    /// Viscous friction of cart 2, N·s/m.
+    pub b2: Estimate,
+    /// Mass of cart 1 used, kg.
+    pub m1: f64,
+    /// Mass of cart 2 used, kg.
+    pub m2: f64,
+    /// Sampling period of the recording, s.
+    pub dt: f64,
+    /// The scheme used.
+    pub scheme: Scheme,
+    /// Stage 1 fit (`θ = [k12, b1]`): fit %, R², condition number, ….
+    pub first: LeastSquaresFit,
+    /// Stage 2 fit (`θ = [K, b2]`).
+    pub second: LeastSquaresFit,
+}
+
+impl MassSpringEstimate {
+    /// The identified plant as [`MassSpring`] parameters.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let p = identify(&rec, 1.3, 0.7, Scheme::Lab)?.plant();
+    /// assert_eq!(p.k1, p.k2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn plant(&self) -> MassSpring {
+        MassSpring {
+            m1: self.m1,
+            m2: self.m2,
+            k1: self.k12.value,
+            k2: self.k12.value,
+            b1: self.b1.value,
+            b2: self.b2.value,
+            gain: self.gain.value,
+        }
+    }
+
+    /// The identified continuous model (equation (3)), output the position
+    /// of cart 2, input in the recording's input unit.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] when an estimate is negative (e.g. a
+    /// friction estimate from a run with too little motion).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+    /// let a = *est.state_space()?.a();
+    /// assert_eq!(a[(1, 0)], -2.0 * est.k12.value / 1.3);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
+        self.plant().state_space(Output::Cart2)
+    }
+}
+
+/// The parameters identified by [`identify_separate_springs`] (`k1 ≠ k2`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+/// // The fixture's springs are equal: both estimates find 950 N/m.
+/// assert!((est.k1.value / est.k2.value - 1.0).abs() < 0.01);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeparateSpringsEstimate {
+    /// Spring between the wall and cart 1, N/m.
+    pub k1: Estimate,
+    /// Spring between the carts, N/m.
+    pub k2: Estimate,
+    /// Viscous friction of cart 1, N·s/m.
+    pub b1: Estimate,
+    /// Motor gain `K`, N per input unit.
+    pub gain: Estimate,
+    /// Viscous friction of cart 2, N·s/m.
+    pub b2: Estimate,
+    /// Mass of cart 1 used, kg.
+    pub m1: f64,
+    /// Mass of cart 2 used, kg.
+    pub m2: f64,
+    /// Sampling period of the recording, s.
+    pub dt: f64,
+    /// The scheme used.
+    pub scheme: Scheme,
+    /// Stage 1 fit (`θ = [k1, k2, b1]`).
+    pub first: LeastSquaresFit,
+    /// Stage 2 fit (`θ = [K, b2]`).
+    pub second: LeastSquaresFit,
+}
+
+impl SeparateSpringsEstimate {
+    /// The identified plant as [`MassSpring`] parameters.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+    /// assert_eq!(est.plant().k2, est.k2.value);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn plant(&self) -> MassSpring {
+        MassSpring {
+            m1: self.m1,
+            m2: self.m2,
+            k1: self.k1.value,
+            k2: self.k2.value,
+            b1: self.b1.value,
+            b2: self.b2.value,
+            gain: self.gain.value,
+        }
+    }
+
+    /// The identified continuous model, output the position of cart 2.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] when an estimate is negative.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+    /// assert_eq!(est.state_space()?.a()[(3, 0)], est.k2.value / 0.7);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
+        self.plant().state_space(Output::Cart2)
+    }
+}
+
+/// Validated inputs shared by both identifiers.
+struct Prepared<'a> {
+    rec: &'a Recording,
+    dt: f64,
+    rows: usize,
+}
+
+fn prepare<'a>(rec: &'a Recording, m1: f64, m2: f64) -> Result<Prepared<'a>, Error> {
+    for (name, value) in [("m1", m1), ("m2", m2)] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(Error::InvalidParameter {
+                name,
+                value,
+                reason: "mass must be finite and > 0 kg",
+            });
+        }
+    }
+    if rec.len() < crate::data::MIN_ROWS {
+        return Err(Error::TooFewSamples {
+            what: "mass-spring identification",
+            needed: crate::data::MIN_ROWS,
+            got: rec.len(),
+        });
+    }
+    let dt = rec.sample_period()?;
+    Ok(Prepared {
+        rec,
+        dt,
+        rows: rec.len() - 2,
+    })
+}
+
+/// `T ·` (velocity `· T`) at row `k` of position `x`: the velocity
+/// regressor of equations (6)/(9), in position units.
+#[inline(always)]
+fn vel(scheme: Scheme, x: &[f64], k: usize) -> f64 {
+    match scheme {
+        Scheme::Lab => x[k] - x[k - 1],
+        Scheme::Central => 0.5 * (x[k + 1] - x[k - 1]),
+    }
+}
+
+/// The input the second difference at `k` sees.
+#[inline(always)]
+fn input(scheme: Scheme, u: &[f64], k: usize) -> f64 {
+    match scheme {
+        Scheme::Lab => u[k],
+        Scheme::Central => 0.5 * (u[k - 1] + u[k]),
+    }
+}
+
+/// Stage 2 (equations (9)–(11)): `[K, b2]` given the coupling spring `k2`.
+fn stage2(
+    p: &Prepared<'_>,
+    m2: f64,
+    k2: f64,
+    scheme: Scheme,
+    buf: &mut Vec<f64>,
+) -> Result<LeastSquaresFit, Error> {
+    let (x1, x2, u) = (&p.rec.x1[..], &p.rec.x2[..], &p.rec.u[..]);
+    let (t, m) = (p.dt, p.rows);
+    let t2 = t * t;
+    let ks = 1..=m;
+    buf.clear();
+    buf.reserve(3 * m);
+    buf.extend(ks.clone().map(|k| t2 * input(scheme, u, k)));
+    buf.extend(ks.clone().map(|k| -t * vel(scheme, x2, k)));
+    buf.extend(ks.map(|k| m2 * (x2[k + 1] - 2.0 * x2[k] + x2[k - 1]) + k2 * t2 * (x2[k] - x1[k])));
+    solve_augmented(buf, m, 2, DEFAULT_MAX_CONDITION)
+}
+
+fn estimates<const P: usize>(fit: &LeastSquaresFit) -> [Estimate; P] {
+    std::array::from_fn(|i| Estimate {
+        value: fit.theta[i],
+        std_error: fit.std_errors[i],
+    })
+}
+
+/// Identifies `k12 = k1 = k2`, `b1`, `K` and `b2` from a recording with
+/// known masses `m1`, `m2` (kg), by the lab's two-stage least squares.
+///
+/// # Errors
+///
+/// - [`Error::InvalidParameter`] for a mass that is not finite and > 0;
+/// - [`Error::TooFewSamples`] for fewer than [`MIN_ROWS`](crate::data::MIN_ROWS)
+///   samples;
+/// - [`Error::InvalidRecording`] for mismatched columns, non-finite values
+///   or an irregular time column;
+/// - [`Error::RankDeficient`] when the run does not excite the plant (e.g.
+///   the carts never move).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let lab = identify(&rec, 1.3, 0.7, Scheme::Lab)?;
+/// let central = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+/// // The true gain is 8.5 N/V: the lab's formula is biased low by 2 %.
+/// assert!((lab.gain.value / 8.5 - 1.0).abs() > 0.01);
+/// assert!((central.gain.value / 8.5 - 1.0).abs() < 0.003);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn identify(
+    recording: &Recording,
+    m1: f64,
+    m2: f64,
+    scheme: Scheme,
+) -> Result<MassSpringEstimate, Error> {
+    let p = prepare(recording, m1, m2)?;
+    let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
+    let (t, m) = (p.dt, p.rows);
+    let t2 = t * t;
+    // Column-major [Φ | λ], rows k = 1 … N − 2.
+    let ks = 1..=m;
+    let mut buf = Vec::with_capacity(3 * m);
+    buf.extend(ks.clone().map(|k| t2 * (2.0 * x1[k] - x2[k])));
+    buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
+    buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
+    let first = solve_augmented(&mut buf, m, 2, DEFAULT_MAX_CONDITION)?;
+    let [k12, b1] = estimates::<2>(&first);
+    let second = stage2(&p, m2, k12.value, scheme, &mut buf)?;
+    let [gain, b2] = estimates::<2>(&second);
+    Ok(MassSpringEstimate {
+        k12,
+        b1,
+        gain,
+        b2,
+        m1,
+        m2,
+        dt: t,
+        scheme,
+        first,
+        second,
+    })
+}
+
+/// Identifies unequal springs `k1`, `k2` with `b1` from cart 1's equation
+/// (three unknowns), then `K` and `b2` from cart 2's with that `k2`. Real
+/// springs are never exactly equal; this needs a run that moves the carts
+/// in both modes (a square wave does).
+///
+/// # Errors
+///
+/// As [`identify`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+/// assert!((est.k1.value / 950.0 - 1.0).abs() < 0.01);
+/// assert!((est.k2.value / 950.0 - 1.0).abs() < 0.01);
+/// assert_eq!(est.first.theta.len(), 3);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn identify_separate_springs(
+    recording: &Recording,
+    m1: f64,
+    m2: f64,
+    scheme: Scheme,
+) -> Result<SeparateSpringsEstimate, Error> {
+    let p = prepare(recording, m1, m2)?;
+    let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
+    let (t, m) = (p.dt, p.rows);
+    let t2 = t * t;
+    let ks = 1..=m;
+    let mut buf = Vec::with_capacity(4 * m);
+    buf.extend(ks.clone().map(|k| t2 * x1[k]));
+    buf.extend(ks.clone().map(|k| t2 * (x1[k] - x2[k])));
+    buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
+    buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
+    let first = solve_augmented(&mut buf, m, 3, DEFAULT_MAX_CONDITION)?;
+    let [k1, k2, b1] = estimates::<3>(&first);
+    let second = stage2(&p, m2, k2.value, scheme, &mut buf)?;
+    let [gain, b2] = estimates::<2>(&second);
+    Ok(SeparateSpringsEstimate {
+        k1,
+        k2,
+        b1,
+        gain,
+        b2,
+        m1,
+        m2,
+        dt: t,
+        scheme,
+        first,
+        second,
+    })
+}
+
+/// Mean and sample standard deviation (divisor `n − 1`) of one parameter
+/// over repeated runs.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::ident::mass_spring::Spread;
+/// let s = Spread { mean: 950.0, std_dev: 4.0 };
+/// assert_eq!(s.mean, 950.0);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spread {
+    /// Mean over the runs.
+    pub mean: f64,
+    /// Sample standard deviation over the runs (same unit).
+    pub std_dev: f64,
+}
+
+/// The averages of Tables 3 and 4: each parameter's mean and spread over
+/// repeated identification runs.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{Recording, ident::mass_spring::{average, identify, Scheme}};
+/// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+/// let avg = average(&[est.clone(), est.clone()])?;
+/// assert_eq!((avg.runs, avg.k12.mean, avg.k12.std_dev), (2, est.k12.value, 0.0));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MassSpringAverage {
+    /// Spring constant, N/m.
+    pub k12: Spread,
+    /// Friction of cart 1, N·s/m.
+    pub b1: Spread,
+    /// Motor gain, N per input unit.
+    pub gain: Spread,
+    /// Friction of cart 2, N·s/m.
+    pub b2: Spread,
+    /// Number of runs averaged.
+    pub runs: usize,
+}
+
+fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Spread {
+    let mean = values.clone().sum::<f64>() / n as f64;
+    let var = values.map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
+    Spread {
+        mean,
+        std_dev: var.sqrt(),
+    }
+}
+
+/// Mean and sample standard deviation of each parameter over repeated runs
+/// (the "average" rows of Tables 3 and 4).
+///
+/// # Errors
+///
+/// [`Error::TooFewSamples`] for fewer than two runs (a sample standard
+/// deviation needs two).
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{Error, ident::mass_spring::average};
+/// assert!(matches!(average(&[]), Err(Error::TooFewSamples { needed: 2, got: 0, .. })));
+/// ```
+pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Error> {
+    let n = runs.len();
+    if n < 2 {
+        return Err(Error::TooFewSamples {
+            what: "averaging identification runs",
+            needed: 2,
+            got: n,
+        });
+    }
+    Ok(MassSpringAverage {
+        k12: spread(runs.iter().map(|r| r.k12.value), n),
+        b1: spread(runs.iter().map(|r| r.b1.value), n),
+        gain: spread(runs.iter().map(|r| r.gain.value), n),
+        b2: spread(runs.iter().map(|r| r.b2.value), n),
+        runs: n,
+    })
+}

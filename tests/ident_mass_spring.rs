@@ -1,0 +1,480 @@
+//! The lab's identification (`ident::mass_spring`) against the NumPy
+//! fixture and against data simulated here from known parameters.
+
+mod common;
+
+use ctrlab::ident::mass_spring::{Scheme, average, identify, identify_separate_springs};
+use ctrlab::sim::{Solver, simulate, time_grid};
+use ctrlab::{Error, MassSpring, Output, Recording};
+use nalgebra::{SVector, vector};
+use proptest::prelude::*;
+use serde_json::Value;
+
+const DT: f64 = 0.002;
+/// 8192 encoder counts per 80 mm of travel.
+const COUNTS_PER_METRE: f64 = 8192.0 / 0.080;
+
+fn fixture() -> (Recording, Value) {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
+    let rec =
+        Recording::read_csv(format!("{dir}ident_square_wave.csv")).expect("fixture CSV reads");
+    let text =
+        std::fs::read_to_string(format!("{dir}ident_square_wave.json")).expect("fixture JSON");
+    (rec, serde_json::from_str(&text).expect("fixture is JSON"))
+}
+
+fn num(v: &Value, path: &[&str]) -> f64 {
+    let mut v = v;
+    for p in path {
+        v = &v[*p];
+    }
+    v.as_f64()
+        .unwrap_or_else(|| panic!("fixture has number at {path:?}"))
+}
+
+fn rel(got: f64, want: f64) -> f64 {
+    (got - want).abs() / want.abs()
+}
+
+/// ZOH simulation of `plant` driven by a ±`amp` square wave of half period
+/// `half` s, sampled every 2 ms for `t_end` s, positions quantised to the
+/// encoder's counts, plus `noise_counts` of uniform noise (seeded).
+fn simulated(
+    plant: &MassSpring,
+    amp: f64,
+    half: f64,
+    t_end: f64,
+    noise_counts: f64,
+    seed: u64,
+) -> Recording {
+    let sys = plant.state_space(Output::Cart2).unwrap();
+    let t = time_grid(t_end, DT).unwrap();
+    let square = |t: f64| {
+        if ((t / half + 1e-9).floor() as i64) % 2 == 0 {
+            amp
+        } else {
+            -amp
+        }
+    };
+    let r = simulate(
+        &sys,
+        &t,
+        SVector::zeros(),
+        |t| vector![square(t)],
+        Solver::Zoh,
+    )
+    .unwrap();
+    // xorshift64*: reproducible noise without another dependency.
+    let mut state = seed.max(1);
+    let mut uniform = move || {
+        state ^= state >> 12;
+        state ^= state << 25;
+        state ^= state >> 27;
+        (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut quantise = |x: f64| {
+        ((x * COUNTS_PER_METRE).round() + noise_counts * 2.0 * uniform()) / COUNTS_PER_METRE
+    };
+    let mut rec = Recording::with_capacity(t.len());
+    for (k, &tk) in t.iter().enumerate() {
+        let x = r.x[k];
+        rec.push(tk, square(tk), quantise(x[0]), quantise(x[2]));
+    }
+    rec
+}
+
+/// Double-double arithmetic (value = hi + lo), enough to evaluate the
+/// normal equations of a 2-parameter problem without losing digits: an
+/// independent reference for the exact least-squares solution.
+#[derive(Clone, Copy)]
+struct Dd(f64, f64);
+
+impl Dd {
+    fn prod(a: f64, b: f64) -> Dd {
+        let p = a * b;
+        Dd(p, a.mul_add(b, -p))
+    }
+    fn add(self, o: Dd) -> Dd {
+        let s = self.0 + o.0;
+        let bb = s - self.0;
+        let err = (self.0 - (s - bb)) + (o.0 - bb);
+        let lo = err + self.1 + o.1;
+        let hi = s + lo;
+        Dd(hi, lo - (hi - s))
+    }
+    fn mul(self, o: Dd) -> Dd {
+        let p = Dd::prod(self.0, o.0);
+        Dd(p.0, p.1 + self.0 * o.1 + self.1 * o.0).add(Dd(0.0, 0.0))
+    }
+    fn neg(self) -> Dd {
+        Dd(-self.0, -self.1)
+    }
+}
+
+/// Exact-to-f64 solution of the 2-column least-squares problem via the
+/// normal equations in double-double (Cramer's rule).
+fn reference_lstsq2(c0: &[f64], c1: &[f64], lam: &[f64]) -> [f64; 2] {
+    let dot = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .fold(Dd(0.0, 0.0), |s, (x, y)| s.add(Dd::prod(*x, *y)))
+    };
+    let (a, b, d) = (dot(c0, c0), dot(c0, c1), dot(c1, c1));
+    let (y0, y1) = (dot(c0, lam), dot(c1, lam));
+    let det = a.mul(d).add(b.mul(b).neg());
+    let n0 = d.mul(y0).add(b.mul(y1).neg());
+    let n1 = a.mul(y1).add(b.mul(y0).neg());
+    [
+        (n0.0 + n0.1) / (det.0 + det.1),
+        (n1.0 + n1.1) / (det.0 + det.1),
+    ]
+}
+
+/// The lab's MATLAB formulas (6)–(11), written out independently of the
+/// crate, solved by [`reference_lstsq2`]: `[k12, b1, K, b2]`.
+fn lab_formula_reference(rec: &Recording, m1: f64, m2: f64, t: f64) -> [f64; 4] {
+    let (x1, x2, u) = (&rec.x1, &rec.x2, &rec.u);
+    let n = x1.len();
+    let ks = 1..n - 1;
+    let a1: Vec<f64> = ks.clone().map(|k| t * t * (2.0 * x1[k] - x2[k])).collect();
+    let a2: Vec<f64> = ks.clone().map(|k| t * (x1[k] - x1[k - 1])).collect();
+    let lam: Vec<f64> = ks
+        .clone()
+        .map(|k| (2.0 * x1[k] - x1[k - 1] - x1[k + 1]) * m1)
+        .collect();
+    let [k12, b1] = reference_lstsq2(&a1, &a2, &lam);
+    let c1: Vec<f64> = ks.clone().map(|k| t * t * u[k]).collect();
+    let c2: Vec<f64> = ks.clone().map(|k| -t * (x2[k] - x2[k - 1])).collect();
+    let lam2: Vec<f64> = ks
+        .map(|k| m2 * (x2[k + 1] - 2.0 * x2[k] + x2[k - 1]) + k12 * t * t * (x2[k] - x1[k]))
+        .collect();
+    let [gain, b2] = reference_lstsq2(&c1, &c2, &lam2);
+    [k12, b1, gain, b2]
+}
+
+#[test]
+fn lab_scheme_is_the_exact_least_squares_solution_of_the_lab_formulas() {
+    let (rec, fx) = fixture();
+    let (m1, m2) = (num(&fx, &["true", "m1"]), num(&fx, &["true", "m2"]));
+    let est = identify(&rec, m1, m2, Scheme::Lab).unwrap();
+    let want = lab_formula_reference(&rec, m1, m2, num(&fx, &["dt"]));
+    let got = [est.k12.value, est.b1.value, est.gain.value, est.b2.value];
+    for (name, g, w) in [
+        ("k12", got[0], want[0]),
+        ("b1", got[1], want[1]),
+        ("K", got[2], want[2]),
+        ("b2", got[3], want[3]),
+    ] {
+        let e = rel(g, w);
+        println!("Lab {name}: {g} vs double-double reference {w}, rel {e:e}");
+        // QR is backward stable: the error is a small multiple of
+        // cond(Φ)·ε with cond(Φ) ≈ 10³ for these unscaled columns.
+        assert!(e < 1e-12, "{name}: {g} vs {w} (rel {e:e})");
+    }
+}
+
+#[test]
+fn lab_scheme_reproduces_the_numpy_formula() {
+    let (rec, fx) = fixture();
+    let (m1, m2) = (num(&fx, &["true", "m1"]), num(&fx, &["true", "m2"]));
+    let est = identify(&rec, m1, m2, Scheme::Lab).unwrap();
+    let want = &fx["lab_formula_estimate"];
+    for (name, got, key) in [
+        ("k12", est.k12.value, "k12"),
+        ("b1", est.b1.value, "b1"),
+        ("K", est.gain.value, "K"),
+        ("b2", est.b2.value, "b2"),
+    ] {
+        let e = rel(got, num(want, &[key]));
+        println!(
+            "Lab {name}: {got} vs NumPy {}, rel {e:e}",
+            num(want, &[key])
+        );
+        // The issue asks for 1e-9, but the fixture evaluates the lab's
+        // `inv(PHI'*PHI)*PHI'*lamda`: the normal equations square the
+        // condition number (≈ 10³ → 10⁶·ε), so the fixture itself is off the
+        // exact least-squares solution by up to 2e-8 (K). The test above
+        // pins the exact solution to 1e-12; here 1e-7 bounds the fixture's
+        // own rounding error.
+        assert!(
+            e < 1e-7,
+            "{name}: {got} vs {} (rel {e:e})",
+            num(want, &[key])
+        );
+    }
+    assert!((est.dt - num(&fx, &["dt"])).abs() < 1e-12);
+}
+
+#[test]
+fn central_scheme_is_within_0_3_percent_of_the_truth_on_the_fixture() {
+    let (rec, fx) = fixture();
+    let tr = |k: &str| num(&fx, &["true", k]);
+    assert_eq!(tr("k1"), tr("k2"), "fixture has equal springs");
+    let est = identify(&rec, tr("m1"), tr("m2"), Scheme::Central).unwrap();
+    for (name, got, want) in [
+        ("k12", est.k12, tr("k1")),
+        ("b1", est.b1, tr("b1")),
+        ("K", est.gain, tr("K")),
+        ("b2", est.b2, tr("b2")),
+    ] {
+        let e = rel(got.value, want);
+        println!(
+            "Central {name}: {} ± {} vs true {want}, rel {:.4} %",
+            got.value,
+            got.std_error,
+            e * 100.0
+        );
+        assert!(
+            e < 0.003,
+            "{name}: {} vs {want} ({:.3} %)",
+            got.value,
+            e * 100.0
+        );
+        // The truth is within a few standard errors (quantisation only).
+        assert!(got.std_error > 0.0 && got.std_error < 0.01 * want);
+    }
+    // Encoder quantisation dominates the second differences, so the fits
+    // are far from 100 % even on noise-free data (≈ 89 % and 92 %).
+    assert!(est.first.fit_percent > 80.0 && est.second.fit_percent > 80.0);
+}
+
+#[test]
+fn lab_scheme_shows_its_documented_bias_and_central_removes_it() {
+    let (rec, fx) = fixture();
+    let lab = identify(&rec, 1.3, 0.7, Scheme::Lab).unwrap();
+    let central = identify(&rec, 1.3, 0.7, Scheme::Central).unwrap();
+    let k = num(&fx, &["true", "K"]);
+    assert!(rel(lab.gain.value, k) > 0.01);
+    assert!(rel(central.gain.value, k) < rel(lab.gain.value, k) / 5.0);
+}
+
+#[test]
+fn state_space_holds_the_identified_parameters() {
+    let (rec, _) = fixture();
+    let est = identify(&rec, 1.3, 0.7, Scheme::Central).unwrap();
+    let sys = est.state_space().unwrap();
+    let want = MassSpring {
+        m1: 1.3,
+        m2: 0.7,
+        k1: est.k12.value,
+        k2: est.k12.value,
+        b1: est.b1.value,
+        b2: est.b2.value,
+        gain: est.gain.value,
+    }
+    .state_space(Output::Cart2)
+    .unwrap();
+    assert_eq!(sys, want);
+    assert_eq!(sys.a()[(1, 1)], -est.b1.value / 1.3);
+}
+
+#[test]
+fn simulated_fixture_plant_central_within_0_3_percent_lab_biased() {
+    // LAB.md says "within 0.1 %" on exact quantised data; on this run b2
+    // comes out at 0.105 %, so the bar is the issue's 0.3 % for the fixture.
+    let plant = MassSpring {
+        k1: 950.0,
+        k2: 950.0,
+        b1: 12.3,
+        b2: 6.1,
+        gain: 8.5,
+        ..MassSpring::nominal()
+    };
+    let rec = simulated(&plant, 2.0, 0.2, 5.0, 0.0, 1);
+    let c = identify(&rec, plant.m1, plant.m2, Scheme::Central).unwrap();
+    for (got, want) in [
+        (c.k12.value, 950.0),
+        (c.b1.value, 12.3),
+        (c.gain.value, 8.5),
+        (c.b2.value, 6.1),
+    ] {
+        assert!(rel(got, want) < 0.003, "{got} vs {want}");
+    }
+    let l = identify(&rec, plant.m1, plant.m2, Scheme::Lab).unwrap();
+    assert!(rel(l.gain.value, 8.5) > 0.01);
+}
+
+#[test]
+fn seeded_noise_still_identifies_within_half_a_percent() {
+    // Two counts (about 20 µm) of uniform noise on top of quantisation.
+    let plant = MassSpring {
+        k1: 950.0,
+        k2: 950.0,
+        b1: 12.3,
+        b2: 6.1,
+        gain: 8.5,
+        ..MassSpring::nominal()
+    };
+    let rec = simulated(&plant, 2.0, 0.2, 10.0, 2.0, 42);
+    let c = identify(&rec, plant.m1, plant.m2, Scheme::Central).unwrap();
+    for (got, want) in [(c.k12, 950.0), (c.b1, 12.3), (c.gain, 8.5), (c.b2, 6.1)] {
+        println!("noisy: {} ± {} vs {want}", got.value, got.std_error);
+        assert!(rel(got.value, want) < 0.005, "{} vs {want}", got.value);
+    }
+}
+
+#[test]
+fn separate_springs_on_the_fixture_find_equal_springs() {
+    let (rec, _) = fixture();
+    let s = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central).unwrap();
+    assert!(rel(s.k1.value, 950.0) < 0.01 && rel(s.k2.value, 950.0) < 0.01);
+    assert!(
+        rel(s.gain.value, 8.5) < 0.01
+            && rel(s.b2.value, 6.1) < 0.01
+            && rel(s.b1.value, 12.3) < 0.01
+    );
+    assert_eq!(
+        s.state_space().unwrap().a()[(1, 0)],
+        -(s.k1.value + s.k2.value) / 1.3
+    );
+}
+
+#[test]
+fn no_excitation_is_rank_deficient() {
+    let plant = MassSpring::nominal();
+    let rec = simulated(&plant, 0.0, 0.2, 1.0, 0.0, 1);
+    let err = identify(&rec, 1.3, 0.7, Scheme::Central).unwrap_err();
+    assert!(
+        matches!(err, Error::RankDeficient { rank: 0, .. }),
+        "{err:?}"
+    );
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    let (rec, _) = fixture();
+    assert!(matches!(
+        identify(&rec, 0.0, 0.7, Scheme::Lab),
+        Err(Error::InvalidParameter { name: "m1", .. })
+    ));
+    assert!(matches!(
+        identify(&rec, 1.3, f64::NAN, Scheme::Lab),
+        Err(Error::InvalidParameter { name: "m2", .. })
+    ));
+    let mut short = Recording::new();
+    for k in 0..5 {
+        short.push(k as f64 * DT, 1.0, 0.0, 0.0);
+    }
+    assert!(matches!(
+        identify(&short, 1.3, 0.7, Scheme::Lab),
+        Err(Error::TooFewSamples {
+            needed: 6,
+            got: 5,
+            ..
+        })
+    ));
+    let mut ragged = rec.clone();
+    ragged.u.pop();
+    assert!(matches!(
+        identify(&ragged, 1.3, 0.7, Scheme::Lab),
+        Err(Error::InvalidRecording { index: 2499, .. })
+    ));
+    let mut nan = rec.clone();
+    nan.x2[7] = f64::NAN;
+    assert!(matches!(
+        identify(&nan, 1.3, 0.7, Scheme::Central),
+        Err(Error::InvalidRecording { index: 7, .. })
+    ));
+    let mut jitter = rec;
+    jitter.t[100] += 0.1 * DT;
+    assert!(matches!(
+        identify(&jitter, 1.3, 0.7, Scheme::Central),
+        Err(Error::InvalidRecording { index: 100, .. })
+    ));
+}
+
+#[test]
+fn average_gives_mean_and_sample_std_dev() {
+    let plants = [900.0, 950.0, 1000.0].map(|k| MassSpring {
+        k1: k,
+        k2: k,
+        b1: 12.0,
+        b2: 6.0,
+        gain: 8.0,
+        ..MassSpring::nominal()
+    });
+    let runs: Vec<_> = plants
+        .iter()
+        .map(|p| {
+            identify(
+                &simulated(p, 2.0, 0.2, 3.0, 0.0, 1),
+                p.m1,
+                p.m2,
+                Scheme::Central,
+            )
+            .unwrap()
+        })
+        .collect();
+    let avg = average(&runs).unwrap();
+    let ks: Vec<f64> = runs.iter().map(|r| r.k12.value).collect();
+    let mean = ks.iter().sum::<f64>() / 3.0;
+    // Sample standard deviation, n − 1 = 2: independent two-pass formula.
+    let sd = (ks.iter().map(|k| (k - mean).powi(2)).sum::<f64>() / 2.0).sqrt();
+    assert!((avg.k12.mean - mean).abs() < 1e-9 && (avg.k12.std_dev - sd).abs() < 1e-9);
+    assert!((avg.k12.mean - 950.0).abs() < 2.0 && (avg.k12.std_dev - 50.0).abs() < 1.0);
+    assert_eq!(avg.runs, 3);
+    assert!(matches!(
+        average(&runs[..1]),
+        Err(Error::TooFewSamples {
+            needed: 2,
+            got: 1,
+            ..
+        })
+    ));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn central_recovers_plausible_plants_within_half_a_percent(
+        m1 in 1.0f64..1.6, m2 in 0.5f64..0.9, k in 700.0f64..1200.0,
+        b1 in 8.0f64..16.0, b2 in 4.0f64..8.0, gain in 6.0f64..10.0,
+        half in 0.15f64..0.3,
+    ) {
+        let plant = MassSpring { m1, m2, k1: k, k2: k, b1, b2, gain };
+        let rec = simulated(&plant, 2.0, half, 5.0, 0.0, 1);
+        let c = identify(&rec, m1, m2, Scheme::Central).unwrap();
+        for (name, got, want) in [("k12", c.k12.value, k), ("b1", c.b1.value, b1), ("K", c.gain.value, gain), ("b2", c.b2.value, b2)] {
+            prop_assert!(rel(got, want) < 0.005, "{name}: {got} vs {want} ({:.3} %)", rel(got, want) * 100.0);
+        }
+    }
+
+    #[test]
+    fn separate_springs_recover_unequal_springs_within_1_percent(
+        m1 in 1.0f64..1.6, m2 in 0.5f64..0.9, k1 in 700.0f64..1200.0, k2 in 700.0f64..1200.0,
+        b1 in 8.0f64..16.0, b2 in 4.0f64..8.0, gain in 6.0f64..10.0,
+    ) {
+        let plant = MassSpring { m1, m2, k1, k2, b1, b2, gain };
+        let rec = simulated(&plant, 2.0, 0.2, 5.0, 0.0, 1);
+        let s = identify_separate_springs(&rec, m1, m2, Scheme::Central).unwrap();
+        prop_assert!(rel(s.k1.value, k1) < 0.01, "k1 {} vs {k1}", s.k1.value);
+        prop_assert!(rel(s.k2.value, k2) < 0.01, "k2 {} vs {k2}", s.k2.value);
+        prop_assert!(rel(s.gain.value, gain) < 0.01 && rel(s.b2.value, b2) < 0.01 && rel(s.b1.value, b1) < 0.01);
+    }
+}
+
+#[test]
+fn rls_on_the_lab_regressors_agrees_with_the_batch_estimate() {
+    // Stage 1 of Scheme::Central, row by row through Rls<2> (factor 1).
+    let (rec, _) = fixture();
+    let batch = identify(&rec, 1.3, 0.7, Scheme::Central).unwrap();
+    let (x1, x2, t) = (&rec.x1, &rec.x2, DT);
+    // Rows are ~1e-8 in size, so ΦᵀΦ ~ 1e-13: P₀ = 1e22 makes the prior's
+    // pull (1/P₀ against ΦᵀΦ) about 1e-9 relative.
+    let mut rls = ctrlab::Rls::<2>::new(1.0, 1e22).unwrap();
+    for k in 1..rec.len() - 1 {
+        let phi = vector![
+            t * t * (2.0 * x1[k] - x2[k]),
+            t * 0.5 * (x1[k + 1] - x1[k - 1])
+        ];
+        rls.update(&phi, 1.3 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1]))
+            .unwrap();
+    }
+    let (k12, b1) = (rls.theta()[0], rls.theta()[1]);
+    println!(
+        "RLS k12 {k12} vs batch {}, b1 {b1} vs {}",
+        batch.k12.value, batch.b1.value
+    );
+    assert!(rel(k12, batch.k12.value) < 1e-8 && rel(b1, batch.b1.value) < 1e-8);
+}
