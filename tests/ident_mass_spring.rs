@@ -463,9 +463,11 @@ fn rls_on_the_lab_regressors_agrees_with_the_batch_estimate() {
     // Rows are ~1e-8 in size, so ΦᵀΦ ~ 1e-13: P₀ = 1e22 makes the prior's
     // pull (1/P₀ against ΦᵀΦ) about 1e-9 relative.
     let mut rls = ctrlab::Rls::<2>::new(1.0, 1e22).unwrap();
+    // Central's spring terms use the Numerov-weighted position.
+    let pos = |x: &[f64], k: usize| (x[k - 1] + 10.0 * x[k] + x[k + 1]) / 12.0;
     for k in 1..rec.len() - 1 {
         let phi = vector![
-            t * t * (2.0 * x1[k] - x2[k]),
+            t * t * (2.0 * pos(x1, k) - pos(x2, k)),
             t * 0.5 * (x1[k + 1] - x1[k - 1])
         ];
         rls.update(&phi, 1.3 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1]))
