@@ -66,7 +66,7 @@ pub mod sim;
 
 pub use analysis::Damping;
 pub use data::Recording;
-pub use design::{Controller, Lqr, StateFeedback, acker, dlqr, lqr};
+pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr};
 pub use discretize::Method;
 pub use error::Error;
 pub use ident::{LeastSquares, LeastSquaresFit, Rls};

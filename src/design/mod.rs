@@ -103,3 +103,31 @@ impl<T: Controller<N, M> + ?Sized, const N: usize, const M: usize> Controller<N,
         (**self).reset()
     }
 }
+
+/// The open-loop "controller": passes the reference through as the input,
+/// `u = reference` on every input channel, ignoring the state.
+///
+/// It lets open-loop experiments (an identification run's square wave, a
+/// constant push) go through the same loop, recording and safety as the
+/// closed-loop ones: the reference function *is* the input signal (V on the
+/// rig, N in simulation).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Controller, design::OpenLoop};
+/// use nalgebra::{SVector, vector};
+///
+/// let mut open = OpenLoop;
+/// let u: SVector<f64, 1> = open.update(2.0, &vector![0.1, 0.0, 0.2, 0.0]);
+/// assert_eq!(u, vector![2.0]);
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OpenLoop;
+
+impl<const N: usize, const M: usize> Controller<N, M> for OpenLoop {
+    #[inline]
+    fn update(&mut self, reference: f64, _state: &SVector<f64, N>) -> SVector<f64, M> {
+        SVector::from_element(reference)
+    }
+}

@@ -47,6 +47,7 @@ mod pc104;
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 mod ppdev;
 mod rig;
+mod run;
 mod sim_card;
 mod sim_config;
 pub mod testing;
@@ -61,5 +62,6 @@ pub use pc104::{
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 pub use ppdev::{Ppdev, ioctl};
 pub use rig::{Calibration, MassSpringRig, Rig};
+pub use run::{Clock, LoopConfig, LoopStats, RunError, RunOutcome, run};
 pub use sim_card::{SimulatedCard, TimeBase};
 pub use sim_config::{SIMULATED_CARD_ID, SimulatedCardConfig};
