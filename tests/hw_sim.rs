@@ -477,7 +477,9 @@ fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
         rig.apply_voltage(6.0).unwrap();
         assert_eq!(rig.card().port().attempts(), CYCLES);
         clock.advance_nanos(PERIOD_NS);
-        let result = rig.read_state().and_then(|_| rig.apply_voltage(3.0).map(drop));
+        let result = rig
+            .read_state()
+            .and_then(|_| rig.apply_voltage(3.0).map(drop));
         let err = result.expect_err("the injected fault surfaces");
         assert_eq!(err.kind(), HwErrorKind::Timeout, "cycle {k}");
         // Cut in the read (k < 18) the new command is never sent; cut in the

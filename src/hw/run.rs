@@ -18,6 +18,16 @@ use crate::design::Controller;
 use crate::hw::{HwError, Rig, VirtualClock};
 
 /// Where the loop's time comes from.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{Clock, VirtualClock};
+/// let time = VirtualClock::new();
+/// let clock = Clock::Virtual(time.clone()); // the card gets the same handle
+/// assert!(matches!(clock, Clock::Virtual(_)));
+/// assert_eq!(time.now(), 0.0);
+/// ```
 #[derive(Debug, Clone)]
 pub enum Clock {
     /// Wall-clock time: the loop sleeps until each deadline (the last
@@ -32,6 +42,14 @@ pub enum Clock {
 }
 
 /// Settings of a [`run`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::LoopConfig;
+/// let config = LoopConfig { duration: 3.0, ..LoopConfig::default() };
+/// assert_eq!((config.period, config.max_consecutive_overruns), (0.002, 5));
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoopConfig {
     /// Sampling period `T`, s (default 0.002).
@@ -54,7 +72,15 @@ impl Default for LoopConfig {
 }
 
 /// Timing statistics of a run. Lateness is how long after its deadline a tick
-/// started, s.
+/// started, s (always 0 on the virtual clock).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::LoopStats;
+/// let s = LoopStats::default();
+/// assert_eq!((s.ticks, s.overruns, s.lateness_max), (0, 0, 0.0));
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LoopStats {
     /// Ticks executed.
@@ -72,6 +98,22 @@ pub struct LoopStats {
 }
 
 /// A run that ended in an error: the error, with what was recorded before it.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{run, Calibration, Clock, HwErrorKind, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
+/// use ctrlab::OpenLoop;
+///
+/// let clock = VirtualClock::new();
+/// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
+/// let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+/// // Full drive on the default truth (8.5 N/V) runs cart 2 into its travel limit.
+/// let err = run(rig, OpenLoop, |_| 24.0, &Clock::Virtual(clock), &LoopConfig::default()).unwrap_err();
+/// assert_eq!(err.error.kind(), HwErrorKind::TravelLimit);
+/// assert!(!err.recording.is_empty()); // everything before the breach
+/// # Ok::<(), ctrlab::hw::HwError>(())
+/// ```
 #[derive(Debug)]
 pub struct RunError {
     /// What went wrong.
@@ -103,6 +145,22 @@ impl std::error::Error for RunError {
 }
 
 /// A run that completed: everything recorded, and the timing statistics.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{run, Calibration, Clock, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
+/// use ctrlab::OpenLoop;
+///
+/// let clock = VirtualClock::new();
+/// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
+/// let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+/// let config = LoopConfig { duration: 0.1, ..LoopConfig::default() };
+/// let out = run(rig, OpenLoop, |_| 1.2, &Clock::Virtual(clock), &config)?;
+/// assert_eq!(out.recording.len(), 50);
+/// assert!((out.recording.u[0] - 1.2).abs() < 1e-12); // 50 duty steps of 24 mV
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutcome {
     /// One sample per tick: time (s, from the start of the run), the voltage

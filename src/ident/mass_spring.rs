@@ -328,7 +328,10 @@ fn stage2(
     buf.reserve(3 * m);
     buf.extend(ks.clone().map(|k| t2 * input(scheme, u, k)));
     buf.extend(ks.clone().map(|k| -t * vel(scheme, x2, k)));
-    buf.extend(ks.map(|k| m2 * (x2[k + 1] - 2.0 * x2[k] + x2[k - 1]) + k2 * t2 * (pos(scheme, x2, k) - pos(scheme, x1, k))));
+    buf.extend(ks.map(|k| {
+        m2 * (x2[k + 1] - 2.0 * x2[k] + x2[k - 1])
+            + k2 * t2 * (pos(scheme, x2, k) - pos(scheme, x1, k))
+    }));
     solve_augmented(buf, m, 2, DEFAULT_MAX_CONDITION)
 }
 
@@ -378,7 +381,10 @@ pub fn identify(
     // Column-major [Φ | λ], rows k = 1 … N − 2.
     let ks = 1..=m;
     let mut buf = Vec::with_capacity(3 * m);
-    buf.extend(ks.clone().map(|k| t2 * (2.0 * pos(scheme, x1, k) - pos(scheme, x2, k))));
+    buf.extend(
+        ks.clone()
+            .map(|k| t2 * (2.0 * pos(scheme, x1, k) - pos(scheme, x2, k))),
+    );
     buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
     buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
     let first = solve_augmented(&mut buf, m, 2, DEFAULT_MAX_CONDITION)?;
@@ -433,7 +439,10 @@ pub fn identify_separate_springs(
     let ks = 1..=m;
     let mut buf = Vec::with_capacity(4 * m);
     buf.extend(ks.clone().map(|k| t2 * pos(scheme, x1, k)));
-    buf.extend(ks.clone().map(|k| t2 * (pos(scheme, x1, k) - pos(scheme, x2, k))));
+    buf.extend(
+        ks.clone()
+            .map(|k| t2 * (pos(scheme, x1, k) - pos(scheme, x2, k))),
+    );
     buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
     buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
     let first = solve_augmented(&mut buf, m, 3, DEFAULT_MAX_CONDITION)?;
@@ -498,6 +507,35 @@ pub struct MassSpringAverage {
     pub b2: Spread,
     /// Number of runs averaged.
     pub runs: usize,
+}
+
+impl Spread {
+    /// Mean and sample standard deviation of `values` (e.g. one parameter of
+    /// [`SeparateSpringsEstimate`] over several runs).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::TooFewSamples`] for fewer than two values.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::ident::mass_spring::Spread;
+    /// let s = Spread::of(&[948.0, 950.0, 952.0])?;
+    /// assert_eq!((s.mean, s.std_dev), (950.0, 2.0));
+    /// assert!(Spread::of(&[1.0]).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn of(values: &[f64]) -> Result<Self, Error> {
+        if values.len() < 2 {
+            return Err(Error::TooFewSamples {
+                what: "mean and sample standard deviation",
+                needed: 2,
+                got: values.len(),
+            });
+        }
+        Ok(spread(values.iter().copied(), values.len()))
+    }
 }
 
 fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Spread {

@@ -1,0 +1,113 @@
+//! Checks the report written by `cargo run --release --example lab5 -- --out DIR`.
+//!
+//! `.ci/run` runs the example, then this test with `--ignored` and
+//! `LAB5_REPORT=DIR/report.md`: every table of the lab must be present, with a
+//! number (or an explicit "unstable…" verdict) in every result cell.
+
+use std::collections::HashMap;
+
+/// Markdown tables under each heading containing "Table N".
+fn tables(report: &str) -> HashMap<u32, Vec<Vec<String>>> {
+    let mut out = HashMap::new();
+    let mut current: Option<u32> = None;
+    for line in report.lines() {
+        if line.starts_with('#') {
+            current = line
+                .split("Table ")
+                .nth(1)
+                .and_then(|rest| rest.split(':').next())
+                .and_then(|n| n.trim().parse().ok());
+        } else if let Some(n) = current
+            && line.starts_with('|')
+            && !line.starts_with("|---")
+        {
+            let cells = line
+                .trim_matches('|')
+                .split(" | ")
+                .map(|c| c.trim().to_string())
+                .collect();
+            out.entry(n).or_insert_with(Vec::new).push(cells);
+        }
+    }
+    out
+}
+
+fn number(cell: &str) -> Option<f64> {
+    cell.trim_matches('*').parse().ok()
+}
+
+#[test]
+#[ignore = "run by .ci/run after the lab5 example, with LAB5_REPORT set"]
+fn the_lab5_report_has_every_table_with_numbers() {
+    let path = std::env::var("LAB5_REPORT").expect("LAB5_REPORT names the report to check");
+    let report = std::fs::read_to_string(&path).expect("the report is readable");
+    let tables = tables(&report);
+    for n in 1..=6 {
+        let rows = tables
+            .get(&n)
+            .unwrap_or_else(|| panic!("Table {n} missing"));
+        assert!(rows.len() >= 2, "Table {n} has no rows");
+    }
+
+    // Table 1: every cell a number; F = 10 N gives 10 mm and 20 mm.
+    for row in &tables[&1][1..] {
+        assert!(
+            row.iter().all(|c| number(c).is_some()),
+            "Table 1 row {row:?}"
+        );
+    }
+    let f10 = &tables[&1][1];
+    assert_eq!(number(&f10[0]), Some(10.0));
+    assert!((number(&f10[1]).unwrap() - 10.0).abs() < 1e-3);
+    assert!((number(&f10[3]).unwrap() - 20.0).abs() < 1e-3);
+
+    // Tables 2, 5, 6: POT, settling time, error are numbers, or the row says
+    // it is unstable.
+    for n in [2, 5, 6] {
+        let header = &tables[&n][0];
+        let pot = header
+            .iter()
+            .position(|h| h.starts_with("POT"))
+            .expect("POT column");
+        let mut measured = 0;
+        for row in &tables[&n][1..] {
+            if row[pot].starts_with("unstable") {
+                continue;
+            }
+            for cell in &row[pot..pot + 3] {
+                assert!(number(cell).is_some(), "Table {n}: `{cell}` in {row:?}");
+            }
+            measured += 1;
+        }
+        if n != 6 {
+            assert!(measured > 0, "Table {n} has no measured row");
+        }
+    }
+    // Table 2's row [0 0 10 0.1]: the python-control reference says 5.03 %.
+    let row = tables[&2]
+        .iter()
+        .find(|r| r[0] == "[0 0 10 0.1]")
+        .expect("row [0 0 10 0.1]");
+    assert!((number(&row[2]).unwrap() - 5.03).abs() < 0.5);
+
+    // Tables 3 and 4: five numeric runs and a mean ± sd row.
+    for n in [3, 4] {
+        let rows = &tables[&n];
+        let runs: Vec<_> = rows.iter().filter(|r| number(&r[0]).is_some()).collect();
+        assert_eq!(runs.len(), 5, "Table {n} runs");
+        for r in runs {
+            assert!(
+                r[1..].iter().all(|c| number(c).is_some()),
+                "Table {n} {r:?}"
+            );
+        }
+        let mean = rows
+            .iter()
+            .find(|r| r[0].contains("mean"))
+            .expect("mean row");
+        for cell in &mean[1..] {
+            let (m, sd) = cell.split_once(" ± ").expect("mean ± sd");
+            assert!(number(m).is_some() && number(sd).is_some(), "{cell}");
+        }
+    }
+}
