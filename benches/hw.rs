@@ -1,13 +1,12 @@
 //! One iteration of the 2 ms control loop on the simulated card: latch and
-//! kick, read both counters, a state-feedback update `u = -k·x` with constant
-//! gains, PWM write. Target: under 2 µs (a thousandth of the period).
+//! kick, read both counters, the lab's `StateFeedback` update, PWM write.
+//! Target: under 2 µs (a thousandth of the period).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ctrlab::MassSpring;
 use ctrlab::hw::{
     Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock,
 };
-use nalgebra::SMatrix;
+use ctrlab::{Controller, MassSpring, Output, StateFeedback};
 use std::hint::black_box;
 
 fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard> {
@@ -22,16 +21,16 @@ fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard> {
 }
 
 fn benches(c: &mut Criterion) {
-    // The lab's gain [0 0 10 0.1] per mm, in SI (V per m, V per m/s).
-    let k = SMatrix::<f64, 1, 4>::new(0.0, 0.0, 10_000.0, 100.0);
+    // The lab's gain [0 0 10 0.1] per mm on cart 2, setpoint 30 mm.
+    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Output::Cart2).unwrap();
 
     c.bench_function("loop iteration, simulated card, clock held", |b| {
         let clock = VirtualClock::new();
         let mut rig = rig(&clock);
         b.iter(|| {
             let x = rig.read_state().unwrap();
-            let u = -(k * x)[0];
-            rig.apply_voltage(black_box(u)).unwrap();
+            let u = ctrl.update(black_box(0.030), &x)[0];
+            rig.apply_voltage(u).unwrap();
         })
     });
 
@@ -41,8 +40,8 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             clock.advance_nanos(2_000_000);
             let x = rig.read_state().unwrap();
-            let u = -(k * x)[0];
-            rig.apply_voltage(black_box(u)).unwrap();
+            let u = ctrl.update(black_box(0.030), &x)[0];
+            rig.apply_voltage(u).unwrap();
         })
     });
 }
