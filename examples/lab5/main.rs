@@ -248,7 +248,6 @@ fn answers(
             pct(lab_b2, t.b2),
             pct(cen_k, t.gain),
         );
-        let _ = &ident.separate;
     }
     report.add(&format!("{s}\n"));
 

@@ -1,7 +1,6 @@
 //! The Markdown report: sections and tables, echoed to stdout as they are
 //! written, and SVG figures (feature `plot`).
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use nalgebra::Complex;
@@ -33,15 +32,13 @@ impl Report {
 
     /// A Markdown table: header cells, alignment row, body rows.
     pub fn table(&mut self, header: &[&str], rows: &[Vec<String>]) {
-        let mut s = String::new();
-        let _ = writeln!(s, "| {} |", header.join(" | "));
-        let _ = writeln!(
-            s,
-            "|{}|",
-            header.iter().map(|_| "---").collect::<Vec<_>>().join("|")
+        let mut s = format!(
+            "| {} |\n|{}|\n",
+            header.join(" | "),
+            vec!["---"; header.len()].join("|")
         );
         for row in rows {
-            let _ = writeln!(s, "| {} |", row.join(" | "));
+            s += &format!("| {} |\n", row.join(" | "));
         }
         self.add(&s);
     }
@@ -68,7 +65,8 @@ impl Report {
         }
         #[cfg(not(feature = "plot"))]
         {
-            let _ = (title, x_label, y_label, series);
+            // Without plotters there is nothing to draw these with.
+            let (_, _, _, _) = (title, x_label, y_label, series);
             self.add(&format!(
                 "(figure `{file}` needs the `plot` feature, on by default)\n"
             ));
@@ -114,9 +112,8 @@ pub fn fmt_state_equations(
     for r in 0..4 {
         let label = if r == 1 { "A = " } else { "    " };
         let blabel = if r == 1 { "B = " } else { "    " };
-        let _ = writeln!(
-            s,
-            "{label}[ {:11.4} {:11.4} {:11.4} {:11.4} ]   {blabel}[ {:9.4} ]",
+        s += &format!(
+            "{label}[ {:11.4} {:11.4} {:11.4} {:11.4} ]   {blabel}[ {:9.4} ]\n",
             a[(r, 0)],
             a[(r, 1)],
             a[(r, 2)],

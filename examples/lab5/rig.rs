@@ -6,8 +6,7 @@ use ctrlab::hw::{
     SimulatedCard, SimulatedCardConfig, VirtualClock, run,
 };
 use ctrlab::ident::mass_spring::{
-    MassSpringEstimate, Scheme, SeparateSpringsEstimate, Spread, average, identify,
-    identify_separate_springs,
+    MassSpringEstimate, Scheme, Spread, average, identify, identify_separate_springs,
 };
 use ctrlab::{
     Controller, Error, MassSpring, OpenLoop, Output, StateFeedback, StepInfo, StepInfoOptions,
@@ -139,7 +138,6 @@ fn square(t: f64) -> f64 {
 pub struct Identification {
     pub lab: Vec<MassSpringEstimate>,
     pub central: Vec<MassSpringEstimate>,
-    pub separate: Vec<SeparateSpringsEstimate>,
     /// The identified model: averages of the separate-springs central
     /// estimates.
     pub model: MassSpring,
@@ -264,6 +262,20 @@ pub fn identification(
         ],
         &rows3,
     );
+    let run_axis: Vec<f64> = (1..=lab.len()).map(|r| r as f64).collect();
+    let per_run = |label: &str, values: Vec<f64>| (label.to_string(), run_axis.clone(), values);
+    report.figure(
+        "table3.svg",
+        "Table 3: spring estimates per run",
+        "run",
+        "spring (N/m)",
+        &[
+            per_run("k12 Lab", lab.iter().map(|e| e.k12.value).collect()),
+            per_run("k12 Central", central.iter().map(|e| e.k12.value).collect()),
+            per_run("k1 separate", separate.iter().map(|e| e.k1.value).collect()),
+            per_run("k2 separate", separate.iter().map(|e| e.k2.value).collect()),
+        ],
+    )?;
     report.heading(3, "Table 4: motor gain and friction of cart 2");
     report.table(
         &[
@@ -277,6 +289,20 @@ pub fn identification(
         ],
         &rows4,
     );
+    report.figure(
+        "table4.svg",
+        "Table 4: motor gain estimates per run",
+        "run",
+        "K (N/V)",
+        &[
+            per_run("K Lab", lab.iter().map(|e| e.gain.value).collect()),
+            per_run("K Central", central.iter().map(|e| e.gain.value).collect()),
+            per_run(
+                "K separate",
+                separate.iter().map(|e| e.gain.value).collect(),
+            ),
+        ],
+    )?;
     if let Some(rec) = first {
         let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<_>>();
         report.figure(
@@ -310,7 +336,6 @@ pub fn identification(
     Ok(Identification {
         lab,
         central,
-        separate,
         model,
     })
 }
