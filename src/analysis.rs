@@ -22,7 +22,7 @@
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::Error;
-use crate::linalg::Lu;
+use crate::linalg::{Lu, boundary_tolerance};
 use crate::model::{Continuous, Discrete, Domain, StateSpace};
 
 /// Iteration cap for the Schur and SVD iterations, per matrix dimension.
@@ -327,8 +327,9 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
 impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continuous> {
     /// True when every pole has a strictly negative real part.
     ///
-    /// A pole exactly on the imaginary axis (an integrator, an undamped
-    /// oscillator) is not stable.
+    /// A pole on the imaginary axis (an integrator, an undamped oscillator)
+    /// is not stable; so is one within rounding of it (`Re ≥ −100 N ε ‖A‖₁`),
+    /// such as a rigid-body mode computed from physical parameters.
     ///
     /// # Errors
     ///
@@ -346,7 +347,8 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_stable(&self) -> Result<bool, Error> {
-        Ok(self.poles()?.iter().all(|p| p.re < 0.0))
+        let tol = boundary_tolerance(self.a());
+        Ok(self.poles()?.iter().all(|p| p.re < -tol))
     }
 
     /// The steady-state gain `−C A⁻¹ B + D` (output units per input unit;
@@ -356,7 +358,8 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     ///
     /// [`Error::Singular`] when `A` is singular to working precision, i.e.
     /// a pole at `s = 0`: the gain is infinite or undefined, and is reported
-    /// instead of returned as inf/NaN.
+    /// instead of returned as inf/NaN. "To working precision" means a
+    /// condition number of `A` above `1 / (10⁴ ε)`.
     ///
     /// # Examples
     ///
@@ -371,7 +374,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn dc_gain(&self) -> Result<SMatrix<f64, P, M>, Error> {
-        let x = Lu::new(self.a(), "DC gain (pole at s = 0)")?.solve(self.b());
+        let x = gain_solve(self.a(), self.b(), "DC gain (pole at s = 0)")?;
         finite_gain(self.d() - self.c() * x)
     }
 
@@ -398,7 +401,8 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
 }
 
 impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discrete> {
-    /// True when every pole lies strictly inside the unit circle, `|z| < 1`.
+    /// True when every pole lies strictly inside the unit circle, `|z| < 1`,
+    /// by more than rounding (`|z| < 1 − 100 N ε ‖A‖₁`).
     ///
     /// # Errors
     ///
@@ -417,7 +421,8 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_stable(&self) -> Result<bool, Error> {
-        Ok(self.poles()?.iter().all(|p| p.norm() < 1.0))
+        let tol = boundary_tolerance(self.a());
+        Ok(self.poles()?.iter().all(|p| p.norm() < 1.0 - tol))
     }
 
     /// The steady-state gain `C (I − A)⁻¹ B + D`.
@@ -425,7 +430,10 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     /// # Errors
     ///
     /// [`Error::Singular`] when `I − A` is singular to working precision (a
-    /// pole at `z = 1`).
+    /// pole at `z = 1`, also one that discretisation moved off 1 by
+    /// rounding: refused when the condition number of `I − A` exceeds
+    /// `1 / (10⁴ ε)`, i.e. fewer than about four digits of the gain would be
+    /// right).
     ///
     /// # Examples
     ///
@@ -439,7 +447,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     /// ```
     pub fn dc_gain(&self) -> Result<SMatrix<f64, P, M>, Error> {
         let i_minus_a = SMatrix::<f64, N, N>::identity() - self.a();
-        let x = Lu::new(&i_minus_a, "DC gain (pole at z = 1)")?.solve(self.b());
+        let x = gain_solve(&i_minus_a, self.b(), "DC gain (pole at z = 1)")?;
         finite_gain(self.c() * x + self.d())
     }
 
@@ -478,6 +486,22 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
             }
         }))
     }
+}
+
+/// Solves `m x = b` for a DC gain, refusing an `m` so ill-conditioned that
+/// the gain would have fewer than about four correct digits: a pole at
+/// s = 0 / z = 1 that rounding moved slightly off it must be reported, not
+/// turned into a huge, meaningless number.
+fn gain_solve<const N: usize, const M: usize>(
+    m: &SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, M>,
+    operation: &'static str,
+) -> Result<SMatrix<f64, N, M>, Error> {
+    let lu = Lu::new(m, operation)?;
+    if lu.condition(m) * f64::EPSILON > 1e-4 {
+        return Err(Error::Singular { operation });
+    }
+    Ok(lu.solve(b))
 }
 
 fn finite_gain<const P: usize, const M: usize>(

@@ -82,6 +82,13 @@ impl<const N: usize> Lu<N> {
         x
     }
 
+    /// The 1-norm condition number `‖A‖₁ ‖A⁻¹‖₁` of the factored matrix `a`
+    /// (computed exactly from the inverse: N is small).
+    pub(crate) fn condition(&self, a: &SMatrix<f64, N, N>) -> f64 {
+        let inv = self.solve(&SMatrix::<f64, N, N>::identity());
+        norm1(a) * norm1(&inv)
+    }
+
     /// Solves `X A = B` for `X` (a row-vector system), via `Aᵀ Xᵀ = Bᵀ`.
     pub(crate) fn solve_right<const K: usize>(
         a: &SMatrix<f64, N, N>,
@@ -92,6 +99,21 @@ impl<const N: usize> Lu<N> {
             .solve(&b.transpose())
             .transpose())
     }
+}
+
+/// The 1-norm (largest column sum of magnitudes).
+pub(crate) fn norm1<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> f64 {
+    m.column_iter()
+        .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// How close to the stability boundary a computed pole of `a` must be to
+/// count as *on* it: eigenvalues are computed to about `ε ‖A‖`, so a pole
+/// within `100 N ε max(1, ‖A‖₁)` of the boundary (a rigid-body mode whose
+/// exact value is 0, say) is marginal, not stable.
+pub(crate) fn boundary_tolerance<const N: usize>(a: &SMatrix<f64, N, N>) -> f64 {
+    100.0 * N as f64 * f64::EPSILON * norm1(a).max(1.0)
 }
 
 #[cfg(test)]

@@ -328,7 +328,8 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
         settling_min: s_min,
         settling_max: s_max,
         overshoot: (100.0 * (peak_p - 1.0)).max(0.0),
-        undershoot: (-100.0 * min_p).max(0.0),
+        // Written out so that no undershoot is +0, never -0 (printed "-0").
+        undershoot: if min_p < 0.0 { -100.0 * min_p } else { 0.0 },
         peak,
         peak_time: t[peak_i] - t0,
         steady_state_value: yf,
@@ -402,7 +403,8 @@ pub fn step_info_of<const N: usize>(
     options: &StepInfoOptions,
 ) -> Result<StepInfo, Error> {
     options.validate()?;
-    if let Some(p) = sys.poles()?.iter().find(|p| p.re >= 0.0) {
+    let tol = crate::linalg::boundary_tolerance(sys.a());
+    if let Some(p) = sys.poles()?.iter().find(|p| p.re >= -tol) {
         return Err(Error::Unstable {
             operation: "step metrics of a model",
             re: p.re,

@@ -13,10 +13,10 @@ use crate::error::{Error, check_dt};
 use crate::integrate::{Integrator, Rk4};
 use crate::model::{Continuous, Discrete, StateSpace};
 
-/// Largest number of samples a simulation will allocate for (10⁸); a longer
-/// request is almost certainly a unit mistake (ms for s) and is refused
-/// rather than exhausting memory.
-pub const MAX_SAMPLES: usize = 100_000_000;
+/// Largest number of samples a simulation will allocate for (10⁷, about
+/// 0.5 GB for the lab's 4-state plant); a longer request is almost certainly
+/// a unit mistake (ms for s) and is refused rather than exhausting memory.
+pub const MAX_SAMPLES: usize = 10_000_000;
 
 /// A simulated time response: sample times (s), states and outputs, in the
 /// model's units (SI for the crate's own models). All three have one entry
@@ -244,7 +244,8 @@ fn check_grid(t: &[f64]) -> Result<(), Error> {
 }
 
 /// Simulates a discrete model open loop: one sample per input, `t[k] = k dt`,
-/// `y[k] = C x[k] + D u[k]`, then `x[k+1] = A x[k] + B u[k]`.
+/// `y[k] = C x[k] + D u[k]`, then `x[k+1] = A x[k] + B u[k]` (at most
+/// [`MAX_SAMPLES`] samples).
 ///
 /// # Examples
 ///
@@ -267,7 +268,9 @@ pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
 
 /// Simulates a discrete model for `steps` samples with the input computed
 /// from the current sample index and state, `u[k] = control(k, &x[k])`: a
-/// closed loop around any controller.
+/// closed loop around any controller. At most [`MAX_SAMPLES`] samples are
+/// simulated (a longer request is cut there, and the response is shorter:
+/// check `len()`).
 ///
 /// # Examples
 ///

@@ -221,3 +221,37 @@ proptest! {
         prop_assert_eq!(sys.is_stable().unwrap(), sigma.iter().all(|s| *s < 0.0));
     }
 }
+
+#[test]
+fn a_rigid_body_mode_is_neither_stable_nor_given_a_dc_gain() {
+    // k1 = 0: both carts can drift together. The pole at 0 (z = 1) comes
+    // out of the arithmetic a few ε off the boundary; it must still count
+    // as on it, before and after discretisation.
+    for k2 in [1000.0, 777.7] {
+        let plant = MassSpring {
+            k1: 0.0,
+            k2,
+            ..MassSpring::nominal()
+        };
+        let sys = plant.state_space(Output::Cart2).unwrap();
+        assert!(!sys.is_stable().unwrap(), "k2 = {k2}");
+        assert!(
+            matches!(sys.dc_gain(), Err(Error::Singular { .. })),
+            "k2 = {k2}"
+        );
+        let d = sys.discretize(0.002, Method::Zoh).unwrap();
+        assert!(!d.is_stable().unwrap(), "k2 = {k2}");
+        assert!(
+            matches!(d.dc_gain(), Err(Error::Singular { .. })),
+            "k2 = {k2}: {:?}",
+            d.dc_gain()
+        );
+    }
+    // A slow but genuine pole keeps its stability and its gain.
+    let slow =
+        StateSpace::continuous(matrix![-1e-6], matrix![1e-6], matrix![1.0], matrix![0.0]).unwrap();
+    let d = slow.discretize(0.002, Method::Zoh).unwrap();
+    assert!(slow.is_stable().unwrap() && d.is_stable().unwrap());
+    assert!((slow.dc_gain().unwrap()[(0, 0)] - 1.0).abs() < 1e-12);
+    assert!((d.dc_gain().unwrap()[(0, 0)] - 1.0).abs() < 1e-6);
+}

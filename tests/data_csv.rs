@@ -235,3 +235,18 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_time_column_whose_span_overflows_is_refused() {
+    // Alternating ±1e308 overflows the mean period to inf; it must still be
+    // reported as a non-increasing column, not accepted.
+    let mut text = String::from("t_s,u,x1_m,x2_m\n");
+    for k in 0..8 {
+        let t = if k % 2 == 0 { -1e308 } else { 1e308 };
+        text += &format!("{t:e},0,0,0\n");
+    }
+    assert!(matches!(
+        Recording::from_reader(text.as_bytes()),
+        Err(Error::Csv { line: 4, .. })
+    ));
+}

@@ -303,7 +303,9 @@ fn check_time(t: &[f64]) -> Result<f64, (usize, String)> {
     // implies a strictly increasing column. The loops below find and
     // describe the culprit otherwise.
     let worst = crate::reduce::max_step_deviation(t, dt);
-    if dt > 0.0 && worst <= limit {
+    // A finite period only: alternating ±1e308 overflows the mean to inf,
+    // and every step then looks within the (infinite) jitter limit.
+    if dt.is_finite() && dt > 0.0 && worst <= limit {
         return Ok(dt);
     }
     for k in 1..t.len() {
@@ -320,7 +322,8 @@ fn check_time(t: &[f64]) -> Result<f64, (usize, String)> {
     }
     for k in 1..t.len() {
         let jitter = (t[k] - t[k - 1] - dt) / dt;
-        if jitter.abs() > MAX_JITTER {
+        // NaN comes from a span that overflows to inf: irregular too.
+        if jitter.is_nan() || jitter.abs() > MAX_JITTER {
             return Err((
                 k,
                 format!(

@@ -51,9 +51,10 @@ const REFINE_STEPS: usize = 3;
 /// case, a Stein equation for the discrete one, solved in Kronecker form),
 /// each kept only if it lowers the residual.
 ///
-/// Every solution is checked: the relative residual of its Riccati equation
-/// is returned in [`Lqr::residual`], and a solution whose closed loop is not
-/// stable is refused with [`Error::Unstable`].
+/// Every solution's closed loop is checked: one that is not stable is
+/// refused with [`Error::Unstable`]. The relative residual of the Riccati
+/// equation is returned in [`Lqr::residual`] and is not a refusal criterion:
+/// callers that need a bound check it (the tests require < 1e-9).
 ///
 /// # Examples
 ///
