@@ -270,20 +270,95 @@ fn overruns_stop_the_loop_safely() {
 }
 
 #[test]
-fn a_real_time_run_reports_its_lateness() {
+fn a_stall_is_skipped_not_caught_up() {
+    /// Stalls 7 ms (3.5 periods) once, at tick 5.
+    struct Stall(usize);
+    impl Controller<4, 1> for Stall {
+        fn update(&mut self, _r: f64, _x: &SVector<f64, 4>) -> SVector<f64, 1> {
+            self.0 += 1;
+            if self.0 == 6 {
+                std::thread::sleep(std::time::Duration::from_millis(7));
+            }
+            vector![1.0]
+        }
+    }
     let card = SimulatedCard::real_time(SimulatedCardConfig::default()).unwrap();
     let out = run(
         rig(card),
-        OpenLoop,
-        |_| 1.0,
+        Stall(0),
+        |_| 0.0,
         &Clock::RealTime,
         &config(0.05),
     )
     .unwrap();
-    assert_eq!(out.stats.ticks, 25);
     let s = &out.stats;
-    assert!(0.0 <= s.lateness_p50 && s.lateness_p50 <= s.lateness_p99);
-    assert!(s.lateness_p99 <= s.lateness_max && s.lateness_max.is_finite());
+    // Tick 5's work ends at least 7 ms after its deadline (10 ms), past
+    // deadlines 12 and 14 ms at least: two or more are skipped, not run late.
+    assert!(s.skipped >= 2, "{s:?}");
+    assert!(s.overruns >= 1, "{s:?}");
+    assert_eq!(s.ticks + s.skipped, 25, "{s:?}");
+    let rec = &out.recording;
+    assert_eq!(rec.len(), s.ticks);
+    let gap = rec.t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    assert!(
+        gap >= 3.0 * PERIOD - 1e-12,
+        "the recording shows the gap: {gap}"
+    );
+    // The first sample after the gap has its speed estimate restarted.
+    let after = rec
+        .t
+        .windows(2)
+        .position(|w| w[1] - w[0] > 1.5 * PERIOD)
+        .unwrap()
+        + 1;
+    let v2 = rec.v2.as_ref().unwrap();
+    assert_eq!(v2[after], 0.0);
+    assert!(s.lateness_p50 <= s.lateness_p99 && s.lateness_p99 <= s.lateness_max);
+}
+
+#[test]
+fn a_reused_rig_starts_each_run_with_a_fresh_speed_estimate() {
+    let (clock, card) = card(SimulatedCardConfig::default());
+    let mut rig = rig(card);
+    let push = run(
+        &mut rig,
+        OpenLoop,
+        |_| 6.0,
+        &Clock::Virtual(clock.clone()),
+        &config(0.5),
+    )
+    .unwrap();
+    assert!(push.recording.x2.last().unwrap() > &0.005);
+    clock.advance(1.0).unwrap(); // carts swing back while nobody looks
+    let again = run(
+        &mut rig,
+        OpenLoop,
+        |_| 0.0,
+        &Clock::Virtual(clock),
+        &config(0.1),
+    )
+    .unwrap();
+    let v = again.recording.v2.as_ref().unwrap();
+    // Not (x now − x at the end of the last run) / T.
+    assert_eq!(v[0], 0.0);
+    assert!(again.recording.v1.as_ref().unwrap()[0] == 0.0);
+}
+
+#[test]
+fn a_loop_at_another_period_than_the_rig_is_refused() {
+    let (clock, card) = card(SimulatedCardConfig::default());
+    let mut rig = rig(card);
+    let cfg = LoopConfig {
+        period: 0.001,
+        duration: 0.1,
+        ..LoopConfig::default()
+    };
+    let err = run(&mut rig, OpenLoop, |_| 1.0, &Clock::Virtual(clock), &cfg).unwrap_err();
+    assert!(matches!(
+        err.error,
+        ctrlab::hw::HwError::InvalidConfig { name: "period", .. }
+    ));
+    assert!(err.recording.is_empty());
 }
 
 #[test]

@@ -79,6 +79,10 @@ fn the_lab5_report_has_every_table_with_numbers() {
             }
             measured += 1;
         }
+        // Table 6 may legitimately have no measured row: on the simulated
+        // card's default truth (8.5 N/V) every cart-1 gain of the lab is
+        // unstable in the sampled loop, and the report must say so rather
+        // than print metrics. Tables 2 and 5 always have stable rows.
         if n != 6 {
             assert!(measured > 0, "Table {n} has no measured row");
         }

@@ -68,6 +68,7 @@ impl Backend {
     pub fn experiment(
         &self,
         seed: u64,
+        truth: Option<MassSpring>,
         controller: impl Controller<4, 1>,
         reference: impl FnMut(f64) -> f64,
         duration: f64,
@@ -82,6 +83,7 @@ impl Backend {
                 let config = SimulatedCardConfig {
                     encoder_noise: NOISE_COUNTS,
                     seed,
+                    truth: truth.unwrap_or_else(SimulatedCardConfig::default_truth),
                     ..Default::default()
                 };
                 if *real_time {
@@ -109,6 +111,7 @@ impl Backend {
             }
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
             Backend::Card(path) => {
+                let _ = truth; // the real rig has its own
                 // Let the carts come to rest, then make it the zero position.
                 std::thread::sleep(std::time::Duration::from_secs(3));
                 let mut card = Pc104::new(ctrlab::hw::Ppdev::open(path)?);
@@ -138,9 +141,17 @@ fn square(t: f64) -> f64 {
 pub struct Identification {
     pub lab: Vec<MassSpringEstimate>,
     pub central: Vec<MassSpringEstimate>,
+    /// Lab and Central on one run of an equal-springs truth (simulated rig
+    /// only): the schemes' own bias, free of the k1 ≠ k2 model error.
+    pub equal_springs: Option<(MassSpring, MassSpringEstimate, MassSpringEstimate)>,
     /// The identified model: averages of the separate-springs central
     /// estimates.
     pub model: MassSpring,
+}
+
+/// Relative error in percent, signed.
+pub fn pct(got: f64, want: f64) -> String {
+    format!("{:+.2} %", (got / want - 1.0) * 100.0)
 }
 
 fn pm(s: &Spread, digits: usize) -> String {
@@ -166,7 +177,7 @@ pub fn identification(
     let mut first = None;
     for seed in 1..=RUNS {
         let out = backend
-            .experiment(seed, OpenLoop, square, IDENT_DURATION)?
+            .experiment(seed, None, OpenLoop, square, IDENT_DURATION)?
             .map_err(|e| format!("identification run {seed}: {e}"))?;
         let rec = out.recording;
         lab.push(identify(&rec, M1, M2, Scheme::Lab)?);
@@ -333,9 +344,39 @@ pub fn identification(
     let sys = model.state_space(Output::Cart2)?;
     report.add(&fmt_state_equations(sys.a(), sys.b()));
     report.add(&format!("Open-loop poles: {}.\n", fmt_poles(&sys.poles()?)));
+    // The lab's formulas assume k1 = k2. On an equal-springs truth the only
+    // difference between the schemes is the finite differences themselves.
+    let equal_springs = match backend.truth() {
+        Some(t) => {
+            let truth = MassSpring { k2: t.k1, ..t };
+            let out = backend
+                .experiment(99, Some(truth), OpenLoop, square, IDENT_DURATION)?
+                .map_err(|e| format!("equal-springs run: {e}"))?;
+            let rec = out.recording;
+            let (l, c) = (
+                identify(&rec, M1, M2, Scheme::Lab)?,
+                identify(&rec, M1, M2, Scheme::Central)?,
+            );
+            report.add(&format!(
+                "One more run on a card whose springs are equal (k1 = k2 = {:.0} N/m), where the lab's model is exact, isolates the schemes' own bias: Lab k12 {}, b1 {}, K {}, b2 {}; Central k12 {}, b1 {}, K {}, b2 {}.\n",
+                truth.k1,
+                pct(l.k12.value, truth.k1),
+                pct(l.b1.value, truth.b1),
+                pct(l.gain.value, truth.gain),
+                pct(l.b2.value, truth.b2),
+                pct(c.k12.value, truth.k1),
+                pct(c.b1.value, truth.b1),
+                pct(c.gain.value, truth.gain),
+                pct(c.b2.value, truth.b2),
+            ));
+            Some((truth, l, c))
+        }
+        None => None,
+    };
     Ok(Identification {
         lab,
         central,
+        equal_springs,
         model,
     })
 }
@@ -345,6 +386,13 @@ pub enum RigRow {
     Measured(StepInfo),
     /// The run ended early (a travel limit, …) or never settled.
     Failed(String),
+}
+
+/// A rig row with what the identified model predicted for it.
+pub struct RigResult {
+    pub row: RigRow,
+    /// The sampled identified loop's spectral radius (< 1: stable).
+    pub radius: f64,
 }
 
 /// One table of rig runs.
@@ -393,7 +441,7 @@ pub fn rig_table(
     model: &MassSpring,
     table: &RigTable,
     report: &mut Report,
-) -> Result<Vec<RigRow>, Box<dyn std::error::Error>> {
+) -> Result<Vec<RigResult>, Box<dyn std::error::Error>> {
     report.heading(2, table.name);
     report.add(&format!(
         "u = Kf (G r − x_mm) in volts per mm, saturated at ±24 V, {STEP_DURATION} s per run on {}; metrics of the measured position (2 % band over the last 5 % of the run; steady state = mean of that window). The prediction is the identified model's closed loop sampled at 2 ms (ZOH, no saturation): stable when its spectral radius ρ = max |z| < 1; the continuous poles are shown for reference.\n",
@@ -421,7 +469,8 @@ pub fn rig_table(
             "{} (ρ = {radius:.3})",
             if radius < 1.0 { "stable" } else { "unstable" }
         );
-        let outcome = backend.experiment(100 + i as u64, ctrl, |_| setpoint, STEP_DURATION)?;
+        let outcome =
+            backend.experiment(100 + i as u64, None, ctrl, |_| setpoint, STEP_DURATION)?;
         let row = match outcome {
             Ok(out) => {
                 let rec = out.recording;
@@ -479,7 +528,7 @@ pub fn rig_table(
                 String::new(),
             ],
         });
-        results.push(row);
+        results.push(RigResult { row, radius });
     }
     report.table(
         &[

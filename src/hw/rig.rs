@@ -53,6 +53,45 @@ pub trait Rig {
     /// Port errors.
     fn halt(&mut self) -> Result<(), HwError>;
 
+    /// Forgets the previous sample, so the next [`read_state`](Self::read_state)
+    /// starts its speed estimate afresh (reporting zero speed) instead of
+    /// differencing against a sample from long ago. The control loop calls
+    /// it at the start of every run and after skipped deadlines. The default
+    /// does nothing (for rigs that measure speed directly).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock};
+    ///
+    /// let clock = VirtualClock::new();
+    /// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
+    /// let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+    /// rig.read_state()?;
+    /// rig.apply_voltage(6.0)?;
+    /// clock.advance(0.5)?; // a long pause, as between two runs
+    /// rig.restart();
+    /// let x = rig.read_state()?;
+    /// assert!(x[2] > 0.0 && x[3] == 0.0); // moved, but no speed from a 0.5 s gap
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    fn restart(&mut self) {}
+
+    /// The sampling period the rig's speed estimates assume, s, if it has
+    /// one. The control loop refuses to run at another period.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, Rig, SimulatedCard};
+    /// let rig = MassSpringRig::new(Pc104::new(SimulatedCard::default()), Calibration::default(), 0.002)?;
+    /// assert_eq!(Rig::period(&rig), Some(0.002));
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    fn period(&self) -> Option<f64> {
+        None
+    }
+
     /// Tells the card's watchdog the controller is alive. The default does
     /// nothing (for rigs without a watchdog, or whose
     /// [`read_state`](Self::read_state) already kicks it).
@@ -95,6 +134,14 @@ impl<R: Rig + ?Sized> Rig for &mut R {
     #[inline]
     fn kick_watchdog(&mut self) -> Result<(), HwError> {
         (**self).kick_watchdog()
+    }
+    #[inline]
+    fn restart(&mut self) {
+        (**self).restart()
+    }
+    #[inline]
+    fn period(&self) -> Option<f64> {
+        (**self).period()
     }
 }
 
@@ -398,6 +445,14 @@ impl<P: EppPort> Rig for MassSpringRig<P> {
 
     fn kick_watchdog(&mut self) -> Result<(), HwError> {
         self.card.kick_watchdog()
+    }
+
+    fn restart(&mut self) {
+        self.previous = None;
+    }
+
+    fn period(&self) -> Option<f64> {
+        Some(self.period)
     }
 }
 

@@ -87,6 +87,9 @@ pub struct LoopStats {
     pub ticks: usize,
     /// Ticks whose work ended after the next deadline.
     pub overruns: usize,
+    /// Deadlines skipped because the loop fell a whole period or more
+    /// behind (real-time clock only); nothing is recorded for them.
+    pub skipped: usize,
     /// Longest run of consecutive overruns.
     pub max_consecutive_overruns: usize,
     /// Median lateness, s.
@@ -181,7 +184,9 @@ const SPIN: Duration = Duration::from_micros(200);
 /// [`MassSpringRig`](crate::hw::MassSpringRig) this latches the counters and
 /// kicks the card's watchdog), evaluate the reference, update the controller,
 /// apply its voltage, and record `(t, applied volts, state)`. At the end the
-/// rig is halted.
+/// rig is halted. The loop does not call [`Rig::kick_watchdog`] on its own: a
+/// rig with a watchdog kicks it in `read_state`, as `MassSpringRig` does
+/// (one control write latches and kicks).
 ///
 /// # Errors
 ///
@@ -228,7 +233,15 @@ where
     R: Rig,
     C: Controller<4, 1>,
 {
-    let ticks = match check_config(config) {
+    let checked = check_config(config).and_then(|ticks| match rig.period() {
+        Some(p) if (p - config.period).abs() > 1e-9 * p => Err(HwError::InvalidConfig {
+            name: "period",
+            value: config.period,
+            reason: "differs from the period the rig's speed estimates assume",
+        }),
+        _ => Ok(ticks),
+    });
+    let ticks = match checked {
         Ok(ticks) => ticks,
         Err(error) => {
             return Err(Box::new(RunError {
@@ -245,6 +258,8 @@ where
     let mut stats = LoopStats::default();
     let mut consecutive = 0usize;
     controller.reset();
+    // The rig may have been used before: its last sample is not this run's.
+    rig.restart();
 
     let wall_start = Instant::now();
     let virtual_start = match clock {
@@ -253,19 +268,36 @@ where
     };
     let period_ns = (period * 1e9).round() as u64;
 
-    for k in 0..ticks {
-        let t = k as f64 * period;
-        // Wait for the absolute deadline k·T.
-        let late = match clock {
+    let mut k = 0usize;
+    while k < ticks {
+        // Wait for the absolute deadline k·T. On the virtual clock time is
+        // kept in whole nanoseconds, and so is the recorded time.
+        let (t, late) = match clock {
             Clock::Virtual(c) => {
-                let target = virtual_start + k as u64 * period_ns;
+                let offset = (k as u64).saturating_mul(period_ns);
+                let target = virtual_start.saturating_add(offset);
                 c.advance_nanos(target.saturating_sub(c.now_nanos()));
-                0.0
+                (offset as f64 * 1e-9, 0.0)
             }
             Clock::RealTime => {
+                let elapsed = wall_start.elapsed().as_secs_f64();
+                if elapsed > (k + 1) as f64 * period {
+                    // A whole period or more behind (the OS took the CPU):
+                    // skip the missed deadlines rather than run them back
+                    // to back on stale time, and restart the speed estimate,
+                    // which would otherwise span the gap.
+                    let behind = ((elapsed / period) as usize).min(ticks);
+                    stats.skipped += behind - k;
+                    k = behind;
+                    rig.restart();
+                    if k >= ticks {
+                        break;
+                    }
+                }
+                let t = k as f64 * period;
                 let deadline = wall_start + Duration::from_secs_f64(t);
                 sleep_until(deadline);
-                (Instant::now() - deadline).as_secs_f64()
+                (t, (Instant::now() - deadline).as_secs_f64())
             }
         };
         lateness.push(late);
@@ -302,6 +334,7 @@ where
                 consecutive = 0;
             }
         }
+        k += 1;
     }
     if let Err(error) = rig.halt() {
         return Err(stop(rig, error, recording, None, stats, lateness));
