@@ -279,59 +279,103 @@ fn prepare<'a>(rec: &'a Recording, m1: f64, m2: f64) -> Result<Prepared<'a>, Err
     })
 }
 
-/// `T ·` (velocity `· T`) at row `k` of position `x`: the velocity
-/// regressor of equations (6)/(9), in position units.
+/// The finite differences of a [`Scheme`], as monomorphised kernels: a
+/// runtime `match` on the scheme inside the per-sample column loops keeps
+/// them from vectorising (measured: 50 µs → 80 µs for 5000 samples).
+trait Differences {
+    /// `T ·` velocity at a row from `[x(k−1), x(k), x(k+1)]`: the velocity
+    /// regressor of equations (6)/(9), in position units.
+    fn vel(x: [f64; 3]) -> f64;
+    /// The position the spring terms use, from `[x(k−1), x(k), x(k+1)]`.
+    fn pos(x: [f64; 3]) -> f64;
+    /// The input the second difference at `k` sees, from `u(k−1)`, `u(k)`.
+    fn input(previous: f64, current: f64) -> f64;
+}
+
+/// `[x(k−1), x(k), x(k+1)]` for the rows `k = 1 … len − 2`, from shifted
+/// slices: no bounds check per sample, so the column loops vectorise.
+fn triples(x: &[f64]) -> impl Iterator<Item = [f64; 3]> + '_ {
+    let m = x.len().saturating_sub(2);
+    x[..m]
+        .iter()
+        .zip(&x[1..m + 1])
+        .zip(&x[2..m + 2])
+        .map(|((&a, &b), &c)| [a, b, c])
+}
+
+/// `(u(k−1), u(k))` for the same rows.
+fn input_pairs(u: &[f64]) -> impl Iterator<Item = (f64, f64)> + '_ {
+    let m = u.len().saturating_sub(2);
+    u[..m].iter().zip(&u[1..m + 1]).map(|(&a, &b)| (a, b))
+}
+
+/// `x(k+1) − 2 x(k) + x(k−1)`.
 #[inline(always)]
-fn vel(scheme: Scheme, x: &[f64], k: usize) -> f64 {
-    match scheme {
-        Scheme::Lab => x[k] - x[k - 1],
-        Scheme::Central => 0.5 * (x[k + 1] - x[k - 1]),
+fn second_difference(x: [f64; 3]) -> f64 {
+    x[2] - 2.0 * x[1] + x[0]
+}
+
+/// [`Scheme::Lab`]: equations (6)–(11) as written.
+struct LabDifferences;
+
+impl Differences for LabDifferences {
+    #[inline(always)]
+    fn vel(x: [f64; 3]) -> f64 {
+        x[1] - x[0]
+    }
+    #[inline(always)]
+    fn pos(x: [f64; 3]) -> f64 {
+        x[1]
+    }
+    #[inline(always)]
+    fn input(_previous: f64, current: f64) -> f64 {
+        current
     }
 }
 
-/// The position the spring terms use at row `k`. The central second
-/// difference is exactly the triangle-weighted mean of `x''` over
-/// `[t(k−1), t(k+1)]`, so the spring forces it balances are that mean of `x`
-/// too, `(x(k−1) + 10 x(k) + x(k+1)) / 12` to O(T⁴); the plain `x(k)` is off
-/// by `T² x''/12`, an error in phase with the springs that otherwise leaks
-/// into the small damping `b2` (0.5 % seen on plausible plants).
-#[inline(always)]
-fn pos(scheme: Scheme, x: &[f64], k: usize) -> f64 {
-    match scheme {
-        Scheme::Lab => x[k],
-        Scheme::Central => (x[k - 1] + 10.0 * x[k] + x[k + 1]) / 12.0,
-    }
-}
+/// [`Scheme::Central`].
+struct CentralDifferences;
 
-/// The input the second difference at `k` sees.
-#[inline(always)]
-fn input(scheme: Scheme, u: &[f64], k: usize) -> f64 {
-    match scheme {
-        Scheme::Lab => u[k],
-        Scheme::Central => 0.5 * (u[k - 1] + u[k]),
+impl Differences for CentralDifferences {
+    #[inline(always)]
+    fn vel(x: [f64; 3]) -> f64 {
+        0.5 * (x[2] - x[0])
+    }
+    /// The central second difference is exactly the triangle-weighted mean
+    /// of `x''` over `[t(k−1), t(k+1)]`, so the spring forces it balances are
+    /// that mean of `x` too, `(x(k−1) + 10 x(k) + x(k+1)) / 12` to O(T⁴); the
+    /// plain `x(k)` is off by `T² x''/12`, an error in phase with the springs
+    /// that otherwise leaks into the small damping `b2` (0.5 % seen on
+    /// plausible plants).
+    #[inline(always)]
+    fn pos(x: [f64; 3]) -> f64 {
+        (x[0] + 10.0 * x[1] + x[2]) / 12.0
+    }
+    #[inline(always)]
+    fn input(previous: f64, current: f64) -> f64 {
+        0.5 * (previous + current)
     }
 }
 
 /// Stage 2 (equations (9)–(11)): `[K, b2]` given the coupling spring `k2`.
-fn stage2(
+fn stage2<D: Differences>(
     p: &Prepared<'_>,
     m2: f64,
     k2: f64,
-    scheme: Scheme,
     buf: &mut Vec<f64>,
 ) -> Result<LeastSquaresFit, Error> {
     let (x1, x2, u) = (&p.rec.x1[..], &p.rec.x2[..], &p.rec.u[..]);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
-    let ks = 1..=m;
     buf.clear();
     buf.reserve(3 * m);
-    buf.extend(ks.clone().map(|k| t2 * input(scheme, u, k)));
-    buf.extend(ks.clone().map(|k| -t * vel(scheme, x2, k)));
-    buf.extend(ks.map(|k| {
-        m2 * (x2[k + 1] - 2.0 * x2[k] + x2[k - 1])
-            + k2 * t2 * (pos(scheme, x2, k) - pos(scheme, x1, k))
-    }));
+    buf.extend(input_pairs(u).map(|(a, b)| t2 * D::input(a, b)));
+    buf.extend(triples(x2).map(|x| -t * D::vel(x)));
+    buf.extend(
+        triples(x2)
+            .zip(triples(x1))
+            .map(|(x2, x1)| m2 * second_difference(x2) + k2 * t2 * (D::pos(x2) - D::pos(x1))),
+    );
     solve_augmented(buf, m, 2, DEFAULT_MAX_CONDITION)
 }
 
@@ -374,22 +418,35 @@ pub fn identify(
     m2: f64,
     scheme: Scheme,
 ) -> Result<MassSpringEstimate, Error> {
+    match scheme {
+        Scheme::Lab => identify_with::<LabDifferences>(recording, m1, m2, scheme),
+        Scheme::Central => identify_with::<CentralDifferences>(recording, m1, m2, scheme),
+    }
+}
+
+fn identify_with<D: Differences>(
+    recording: &Recording,
+    m1: f64,
+    m2: f64,
+    scheme: Scheme,
+) -> Result<MassSpringEstimate, Error> {
     let p = prepare(recording, m1, m2)?;
     let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
     // Column-major [Φ | λ], rows k = 1 … N − 2.
-    let ks = 1..=m;
     let mut buf = Vec::with_capacity(3 * m);
     buf.extend(
-        ks.clone()
-            .map(|k| t2 * (2.0 * pos(scheme, x1, k) - pos(scheme, x2, k))),
+        triples(x1)
+            .zip(triples(x2))
+            .map(|(x1, x2)| t2 * (2.0 * D::pos(x1) - D::pos(x2))),
     );
-    buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
-    buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
+    buf.extend(triples(x1).map(|x| t * D::vel(x)));
+    // The lab's own order of operations, as its MATLAB `lamda`.
+    buf.extend(triples(x1).map(|x| m1 * (2.0 * x[1] - x[0] - x[2])));
     let first = solve_augmented(&mut buf, m, 2, DEFAULT_MAX_CONDITION)?;
     let [k12, b1] = estimates::<2>(&first);
-    let second = stage2(&p, m2, k12.value, scheme, &mut buf)?;
+    let second = stage2::<D>(&p, m2, k12.value, &mut buf)?;
     let [gain, b2] = estimates::<2>(&second);
     Ok(MassSpringEstimate {
         k12,
@@ -432,22 +489,35 @@ pub fn identify_separate_springs(
     m2: f64,
     scheme: Scheme,
 ) -> Result<SeparateSpringsEstimate, Error> {
+    match scheme {
+        Scheme::Lab => separate_with::<LabDifferences>(recording, m1, m2, scheme),
+        Scheme::Central => separate_with::<CentralDifferences>(recording, m1, m2, scheme),
+    }
+}
+
+fn separate_with<D: Differences>(
+    recording: &Recording,
+    m1: f64,
+    m2: f64,
+    scheme: Scheme,
+) -> Result<SeparateSpringsEstimate, Error> {
     let p = prepare(recording, m1, m2)?;
     let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
-    let ks = 1..=m;
     let mut buf = Vec::with_capacity(4 * m);
-    buf.extend(ks.clone().map(|k| t2 * pos(scheme, x1, k)));
+    buf.extend(triples(x1).map(|x| t2 * D::pos(x)));
     buf.extend(
-        ks.clone()
-            .map(|k| t2 * (pos(scheme, x1, k) - pos(scheme, x2, k))),
+        triples(x1)
+            .zip(triples(x2))
+            .map(|(x1, x2)| t2 * (D::pos(x1) - D::pos(x2))),
     );
-    buf.extend(ks.clone().map(|k| t * vel(scheme, x1, k)));
-    buf.extend(ks.map(|k| m1 * (2.0 * x1[k] - x1[k - 1] - x1[k + 1])));
+    buf.extend(triples(x1).map(|x| t * D::vel(x)));
+    // The lab's own order of operations, as its MATLAB `lamda`.
+    buf.extend(triples(x1).map(|x| m1 * (2.0 * x[1] - x[0] - x[2])));
     let first = solve_augmented(&mut buf, m, 3, DEFAULT_MAX_CONDITION)?;
     let [k1, k2, b1] = estimates::<3>(&first);
-    let second = stage2(&p, m2, k2.value, scheme, &mut buf)?;
+    let second = stage2::<D>(&p, m2, k2.value, &mut buf)?;
     let [gain, b2] = estimates::<2>(&second);
     Ok(SeparateSpringsEstimate {
         k1,
