@@ -21,8 +21,12 @@
 //! With the `plot` feature, one SVG per table (every stable row's response)
 //! is written to `target/state_feedback/`.
 
+#[path = "common/lab_tables.rs"]
+mod lab_tables;
+
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{Error, MassSpring, Output, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use lab_tables::{fmt_kf, fmt_poles};
 use nalgebra::{Complex, SVector, vector};
 
 /// Grid of the responses, s.
@@ -55,45 +59,27 @@ enum Row {
 }
 
 fn tables() -> Vec<Table> {
-    let cart2 = |kf3: f64, kf4: f64| [0.0, 0.0, kf3, kf4];
-    let cart1 = |kf1: f64, kf2: f64, kf4: f64| [kf1, kf2, 0.0, kf4];
     vec![
         Table {
             name: "Table 2: cart 2, setpoint 30 mm",
             file: "table2.svg",
             output: Output::Cart2,
             setpoint_mm: 30.0,
-            rows: vec![
-                cart2(0.1, 0.0),
-                cart2(1.0, 0.0),
-                cart2(10.0, 0.0),
-                cart2(10.0, 0.1),
-                cart2(10.0, 0.3),
-                cart2(10.0, 0.5),
-            ],
+            rows: lab_tables::table2(),
         },
         Table {
             name: "Table 5: cart 2, setpoint 30 mm (nominal plant, gain 1)",
             file: "table5.svg",
             output: Output::Cart2,
             setpoint_mm: 30.0,
-            rows: [0.1, 0.5, 1.0, 5.0, 10.0]
-                .map(|k| cart2(k, 0.0))
-                .into_iter()
-                .chain([0.02, 0.05, 0.1, 0.2].map(|k| cart2(10.0, k)))
-                .collect(),
+            rows: lab_tables::table5(),
         },
         Table {
             name: "Table 6: cart 1, setpoint 15 mm (nominal plant, gain 1)",
             file: "table6.svg",
             output: Output::Cart1,
             setpoint_mm: 15.0,
-            rows: [0.2, 0.5, 1.0, 1.5, 2.0]
-                .map(|k| cart1(k, 0.0, 0.0))
-                .into_iter()
-                .chain([0.001, 0.002, 0.005, 0.008, 0.01].map(|k| cart1(1.0, k, 0.0)))
-                .chain([0.01, 0.02, 0.05, 0.1, 0.2].map(|k| cart1(1.0, 0.0, k)))
-                .collect(),
+            rows: lab_tables::table6(),
         },
     ]
 }
@@ -136,26 +122,6 @@ fn run_row(plant: &MassSpring, table: &Table, kf: [f64; 4]) -> Result<Row, Error
         Err(Error::NotSettled { .. }) => Ok(Row::NotSettled { poles, horizon }),
         Err(e) => Err(e),
     }
-}
-
-/// Poles as `a ± bj` pairs and real values, most damped first.
-fn fmt_poles(poles: &[Complex<f64>]) -> String {
-    poles
-        .iter()
-        .filter(|p| p.im >= 0.0)
-        .map(|p| {
-            if p.im > 0.0 {
-                format!("{:.2} ± {:.2}j", p.re, p.im)
-            } else {
-                format!("{:.2}", p.re)
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-fn fmt_kf(kf: &[f64; 4]) -> String {
-    format!("[{} {} {} {}]", kf[0], kf[1], kf[2], kf[3])
 }
 
 fn main() -> Result<(), Error> {

@@ -19,6 +19,8 @@
 //! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0   # the real card
 //! ```
 
+#[path = "../common/lab_tables.rs"]
+mod lab_tables;
 mod report;
 mod rig;
 mod simulation;

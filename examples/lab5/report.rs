@@ -3,8 +3,6 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::Complex;
-
 /// The report being written: Markdown text plus the figures' file names.
 pub struct Report {
     text: String,
@@ -79,26 +77,6 @@ impl Report {
         std::fs::write(&path, &self.text)?;
         Ok(path)
     }
-}
-
-/// Poles as `a ± bj` pairs and real values.
-pub fn fmt_poles(poles: &[Complex<f64>]) -> String {
-    poles
-        .iter()
-        .filter(|p| p.im >= 0.0)
-        .map(|p| {
-            if p.im > 0.0 {
-                format!("{:.2} ± {:.2}j", p.re, p.im)
-            } else {
-                format!("{:.2}", p.re)
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-pub fn fmt_kf(kf: &[f64; 4]) -> String {
-    format!("[{} {} {} {}]", kf[0], kf[1], kf[2], kf[3])
 }
 
 /// A 4×4 and a 4×1 matrix side by side, as the state equations.

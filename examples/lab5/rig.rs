@@ -13,7 +13,8 @@ use ctrlab::{
     step_info,
 };
 
-use crate::report::{Report, fmt_kf, fmt_poles, fmt_state_equations};
+use crate::lab_tables::{self, fmt_kf, fmt_poles};
+use crate::report::{Report, fmt_state_equations};
 
 /// The loop period, s.
 pub const PERIOD: f64 = 0.002;
@@ -405,31 +406,20 @@ pub struct RigTable {
 }
 
 pub fn rig_tables() -> [RigTable; 2] {
-    let cart2 = |kf3: f64, kf4: f64| [0.0, 0.0, kf3, kf4];
-    let cart1 = |kf1: f64, kf2: f64, kf4: f64| [kf1, kf2, 0.0, kf4];
     [
         RigTable {
             name: "Table 5: cart 2, setpoint 30 mm (rig)",
             file: "table5.svg",
             output: Output::Cart2,
             setpoint_mm: 30.0,
-            rows: [0.1, 0.5, 1.0, 5.0, 10.0]
-                .map(|k| cart2(k, 0.0))
-                .into_iter()
-                .chain([0.02, 0.05, 0.1, 0.2].map(|k| cart2(10.0, k)))
-                .collect(),
+            rows: lab_tables::table5(),
         },
         RigTable {
             name: "Table 6: cart 1, setpoint 15 mm (rig)",
             file: "table6.svg",
             output: Output::Cart1,
             setpoint_mm: 15.0,
-            rows: [0.2, 0.5, 1.0, 1.5, 2.0]
-                .map(|k| cart1(k, 0.0, 0.0))
-                .into_iter()
-                .chain([0.001, 0.002, 0.005, 0.008, 0.01].map(|k| cart1(1.0, k, 0.0)))
-                .chain([0.01, 0.02, 0.05, 0.1, 0.2].map(|k| cart1(1.0, 0.0, k)))
-                .collect(),
+            rows: lab_tables::table6(),
         },
     ]
 }

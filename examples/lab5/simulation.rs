@@ -4,17 +4,8 @@ use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{Error, MassSpring, Output, StateFeedback, StepInfo, StepInfoOptions, step_info};
 use nalgebra::{SVector, vector};
 
-use crate::report::{Report, fmt_kf, fmt_poles};
-
-/// Table 2's gains (per mm), cart 2, setpoint 30 mm.
-pub const TABLE2: [[f64; 4]; 6] = [
-    [0.0, 0.0, 0.1, 0.0],
-    [0.0, 0.0, 1.0, 0.0],
-    [0.0, 0.0, 10.0, 0.0],
-    [0.0, 0.0, 10.0, 0.1],
-    [0.0, 0.0, 10.0, 0.3],
-    [0.0, 0.0, 10.0, 0.5],
-];
+use crate::lab_tables::{self, fmt_kf, fmt_poles};
+use crate::report::Report;
 
 /// Table 1: static deflection under F = 10…50 N, simulated to rest.
 pub fn table1(report: &mut Report) -> Result<(), Error> {
@@ -81,7 +72,7 @@ pub fn table2(report: &mut Report) -> Result<Vec<Measured>, Error> {
     let mut rows = Vec::new();
     let mut curves = Vec::new();
     let mut measured = Vec::new();
-    for kf in TABLE2 {
+    for kf in lab_tables::table2() {
         let cl = StateFeedback::from_lab_gains(kf, Output::Cart2)?.closed_loop(&plant)?;
         let poles = cl.poles()?;
         if !cl.is_stable()? {
