@@ -1,9 +1,13 @@
 //! # ctrlab
 //!
 //! Control engineering for a real lab, in Rust: typed state-space models,
-//! discretisation, simulation, and (as the crate grows) identification,
-//! state-feedback design, step metrics and hardware I/O, built around the
-//! two-cart mass-spring rig of a university control lab.
+//! discretisation and simulation, identification from recorded data,
+//! state-feedback design and step metrics, and a hardware layer that runs
+//! the same controller on the rig at 2 ms; built around the two-cart
+//! mass-spring rig of a university control lab (`cargo run --release
+//! --example lab5` reproduces the whole lab on the simulated rig).
+//!
+//! Modelling and simulation:
 //!
 //! - [`model`]: [`StateSpace`] with its sizes and time domain in the type, and
 //!   the lab's plant [`MassSpring`].
@@ -12,20 +16,31 @@
 //! - [`integrate`]: the [`Dynamics`] trait and the [`Rk4`] and [`Euler`]
 //!   steppers.
 //! - [`sim`]: continuous and discrete simulation and step responses.
-//! - [`hw`]: the lab's card over the parallel port (EPP), its register-level
-//!   simulation, and the [`Rig`](hw::Rig) a controller runs against.
+//!
+//! Analysis and design:
+//!
 //! - [`analysis`]: poles, stability, DC gain, damping, controllability and
 //!   observability.
 //! - [`design`]: the [`Controller`] trait, [`StateFeedback`] (the lab's
-//!   per-millimetre form and the textbook form), [`acker`], [`lqr`], [`dlqr`].
+//!   per-millimetre form and the textbook form), [`OpenLoop`], [`acker`],
+//!   [`lqr`], [`dlqr`].
 //! - [`metrics`]: [`step_info`] / [`step_info_of`] (rise and settling time,
 //!   overshoot, steady state) with interpolated crossing times.
-//! - `plot` (feature `plot`): SVG figures of time responses.
+//! - `plot` (feature `plot`, on by default): SVG figures of time responses.
+//!
+//! Data and identification:
+//!
 //! - [`data`]: [`Recording`]s of a run (time, input, cart states) and their
 //!   CSV form, units in the header.
 //! - [`ident`]: least squares by QR ([`LeastSquares`]), recursive least
 //!   squares ([`Rls`]) and the lab's two-cart identification
 //!   ([`ident::mass_spring`]).
+//!
+//! Hardware:
+//!
+//! - [`hw`]: the lab's card over the parallel port (EPP), its register-level
+//!   simulation, the [`Rig`](hw::Rig) a controller runs against, and the
+//!   fixed-period control loop [`run`](hw::run).
 //!
 //! Units are SI throughout (m, m/s, N, V, s); the lab's millimetres appear
 //! only in printed tables and at named conversions.
