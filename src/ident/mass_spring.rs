@@ -357,6 +357,14 @@ impl Differences for CentralDifferences {
     }
 }
 
+/// The columns of equation (6) that do not depend on the spring model:
+/// cart 1's velocity regressor (for `b1`) and `λ`, appended to `buf`.
+fn push_cart1_friction_and_lambda<D: Differences>(x1: &[f64], t: f64, m1: f64, buf: &mut Vec<f64>) {
+    buf.extend(triples(x1).map(|x| t * D::vel(x)));
+    // The lab's own order of operations, as its MATLAB `lamda`.
+    buf.extend(triples(x1).map(|x| m1 * (2.0 * x[1] - x[0] - x[2])));
+}
+
 /// Stage 2 (equations (9)–(11)): `[K, b2]` given the coupling spring `k2`.
 fn stage2<D: Differences>(
     p: &Prepared<'_>,
@@ -441,9 +449,7 @@ fn identify_with<D: Differences>(
             .zip(triples(x2))
             .map(|(x1, x2)| t2 * (2.0 * D::pos(x1) - D::pos(x2))),
     );
-    buf.extend(triples(x1).map(|x| t * D::vel(x)));
-    // The lab's own order of operations, as its MATLAB `lamda`.
-    buf.extend(triples(x1).map(|x| m1 * (2.0 * x[1] - x[0] - x[2])));
+    push_cart1_friction_and_lambda::<D>(x1, t, m1, &mut buf);
     let first = solve_augmented(&mut buf, m, 2, DEFAULT_MAX_CONDITION)?;
     let [k12, b1] = estimates::<2>(&first);
     let second = stage2::<D>(&p, m2, k12.value, &mut buf)?;
@@ -512,9 +518,7 @@ fn separate_with<D: Differences>(
             .zip(triples(x2))
             .map(|(x1, x2)| t2 * (D::pos(x1) - D::pos(x2))),
     );
-    buf.extend(triples(x1).map(|x| t * D::vel(x)));
-    // The lab's own order of operations, as its MATLAB `lamda`.
-    buf.extend(triples(x1).map(|x| m1 * (2.0 * x[1] - x[0] - x[2])));
+    push_cart1_friction_and_lambda::<D>(x1, t, m1, &mut buf);
     let first = solve_augmented(&mut buf, m, 3, DEFAULT_MAX_CONDITION)?;
     let [k1, k2, b1] = estimates::<3>(&first);
     let second = stage2::<D>(&p, m2, k2.value, &mut buf)?;
