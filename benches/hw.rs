@@ -6,7 +6,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::hw::{
     Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock,
 };
-use ctrlab::{Controller, MassSpring, Output, StateFeedback};
+use ctrlab::{Controller, MassSpring, Cart, StateFeedback};
 use std::hint::black_box;
 
 fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard> {
@@ -22,7 +22,7 @@ fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard> {
 
 fn benches(c: &mut Criterion) {
     // The lab's gain [0 0 10 0.1] per mm on cart 2, setpoint 30 mm.
-    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Output::Cart2).unwrap();
+    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
 
     c.bench_function("loop iteration, simulated card, clock held", |b| {
         let clock = VirtualClock::new();

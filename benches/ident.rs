@@ -5,7 +5,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::ident::mass_spring::{Scheme, identify};
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{MassSpring, Output, Recording, Rls};
+use ctrlab::{MassSpring, Cart, Recording, Rls};
 use nalgebra::{SVector, vector};
 use std::hint::black_box;
 
@@ -22,7 +22,7 @@ fn recording() -> Recording {
         gain: 8.5,
         ..MassSpring::nominal()
     };
-    let sys = plant.state_space(Output::Cart2).unwrap();
+    let sys = plant.state_space(Cart::Two).unwrap();
     let t = time_grid((SAMPLES - 1) as f64 * 0.002, 0.002).unwrap();
     let square = |t: f64| {
         if (t / 0.2).floor() as i64 % 2 == 0 {

@@ -4,15 +4,15 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{MassSpring, Method, Output, StateFeedback, StepInfoOptions, acker, dlqr, step_info};
+use ctrlab::{MassSpring, Method, Cart, StateFeedback, StepInfoOptions, acker, dlqr, step_info};
 use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 use std::hint::black_box;
 
 fn benches(c: &mut Criterion) {
-    let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
 
     // Table 2, row [0 0 10 0.1]: 5000 samples at 0.5 ms (2.5 s).
-    let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Output::Cart2)
+    let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)
         .unwrap()
         .closed_loop(&plant)
         .unwrap();

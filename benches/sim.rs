@@ -3,14 +3,14 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::sim::simulate_discrete_feedback;
-use ctrlab::{Integrator, MassSpring, Method, Output, Rk4};
+use ctrlab::{Integrator, MassSpring, Method, Cart, Rk4};
 use nalgebra::{SMatrix, SVector, vector};
 use std::hint::black_box;
 
 const STEPS: usize = 5000;
 
 fn benches(c: &mut Criterion) {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let d = sys.discretize(0.002, Method::Zoh).unwrap();
     // The lab's gain [0 0 10 0.1] per mm, in SI: u = K (G r - x).
     let k = SMatrix::<f64, 1, 4>::new(0.0, 0.0, 10_000.0, 100.0);
@@ -19,7 +19,7 @@ fn benches(c: &mut Criterion) {
     c.bench_function("discrete step (4 states)", |b| {
         let mut x = vector![0.001, 0.0, 0.002, 0.0];
         b.iter(|| {
-            d.step_mut(black_box(&mut x), black_box(&vector![1.0]));
+            d.advance_mut(black_box(&mut x), black_box(&vector![1.0]));
         })
     });
 

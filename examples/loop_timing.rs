@@ -14,7 +14,7 @@
 use ctrlab::hw::{
     Calibration, Clock, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig, run,
 };
-use ctrlab::{Output, StateFeedback};
+use ctrlab::{Cart, StateFeedback};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let seconds: f64 = match std::env::args().nth(1) {
@@ -25,7 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let card = SimulatedCard::real_time(SimulatedCardConfig::default())?;
     let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
-    let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.05], Output::Cart2)?;
+    let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.05], Cart::Two)?;
     let config = LoopConfig {
         duration: seconds,
         ..LoopConfig::default()

@@ -10,12 +10,12 @@
 //! ```
 
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{MassSpring, Output};
+use ctrlab::{MassSpring, Cart};
 use nalgebra::{SVector, vector};
 
 fn main() -> Result<(), ctrlab::Error> {
     let plant = MassSpring::nominal();
-    let sys = plant.state_space(Output::Cart2)?;
+    let sys = plant.state_space(Cart::Two)?;
     // The slowest pole decays at 3.70 /s: after 10 s what is left is e^-37.
     let t = time_grid(10.0, 0.002)?;
 

@@ -25,7 +25,7 @@
 mod lab_tables;
 
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Error, MassSpring, Output, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Error, MassSpring, Cart, StateFeedback, StepInfo, StepInfoOptions, step_info};
 use lab_tables::{fmt_kf, fmt_poles};
 use nalgebra::{Complex, SVector, vector};
 
@@ -35,7 +35,7 @@ const DT: f64 = 0.0005;
 struct Table {
     name: &'static str,
     file: &'static str,
-    output: Output,
+    cart: Cart,
     setpoint_mm: f64,
     rows: Vec<[f64; 4]>,
 }
@@ -63,21 +63,21 @@ fn tables() -> Vec<Table> {
         Table {
             name: "Table 2: cart 2, setpoint 30 mm",
             file: "table2.svg",
-            output: Output::Cart2,
+            output: Cart::Two,
             setpoint_mm: 30.0,
             rows: lab_tables::table2(),
         },
         Table {
             name: "Table 5: cart 2, setpoint 30 mm (nominal plant, gain 1)",
             file: "table5.svg",
-            output: Output::Cart2,
+            output: Cart::Two,
             setpoint_mm: 30.0,
             rows: lab_tables::table5(),
         },
         Table {
             name: "Table 6: cart 1, setpoint 15 mm (nominal plant, gain 1)",
             file: "table6.svg",
-            output: Output::Cart1,
+            output: Cart::One,
             setpoint_mm: 15.0,
             rows: lab_tables::table6(),
         },
@@ -215,8 +215,8 @@ fn plot(
         table.name.to_string()
     };
     let y_label = match table.output {
-        Output::Cart1 => "x1 (mm)",
-        Output::Cart2 => "x2 (mm)",
+        Cart::One => "x1 (mm)",
+        Cart::Two => "x2 (mm)",
     };
     responses_svg(&path, &title, "t (s)", y_label, &series)?;
     println!("wrote {}", path.display());

@@ -9,9 +9,9 @@
 //! # Examples
 //!
 //! ```
-//! use ctrlab::{MassSpring, Output};
+//! use ctrlab::{MassSpring, Cart};
 //!
-//! let plant = MassSpring::nominal().state_space(Output::Cart2)?;
+//! let plant = MassSpring::nominal().state_space(Cart::Two)?;
 //! assert!(plant.is_stable()?);
 //! assert!(plant.is_controllable()? && plant.is_observable()?);
 //! // 1 N on cart 2 moves it 2 mm at rest.
@@ -22,8 +22,8 @@
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::Error;
-use crate::linalg::{Lu, boundary_tolerance};
-use crate::model::{Continuous, Discrete, Domain, StateSpace};
+use crate::kernels::linalg::{Lu, boundary_tolerance};
+use crate::model::{Domain, StateSpace, period_of};
 
 /// Iteration cap for the Schur and SVD iterations, per matrix dimension.
 const ITERATIONS_PER_DIM: usize = 200;
@@ -220,9 +220,9 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{MassSpring, Output};
+    /// use ctrlab::{MassSpring, Cart};
     ///
-    /// let p = MassSpring::nominal().state_space(Output::Cart2)?.poles()?;
+    /// let p = MassSpring::nominal().state_space(Cart::Two)?.poles()?;
     /// // Two lightly damped pairs, about 20 rad/s and 50 rad/s.
     /// assert!(p.iter().all(|p| p.re < 0.0 && p.im.abs() > 20.0));
     /// assert_eq!(p[0].conj(), p[1]);
@@ -313,10 +313,10 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{MassSpring, Output};
+    /// use ctrlab::{MassSpring, Cart};
     ///
     /// // Either cart's position alone reveals the whole state.
-    /// assert!(MassSpring::nominal().state_space(Output::Cart1)?.is_observable()?);
+    /// assert!(MassSpring::nominal().state_space(Cart::One)?.is_observable()?);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_observable(&self) -> Result<bool, Error> {
@@ -324,12 +324,14 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     }
 }
 
-impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continuous> {
-    /// True when every pole has a strictly negative real part.
+impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M, P, D> {
+    /// True when every pole is strictly inside the stability region by more
+    /// than rounding: `Re s < −tol` in continuous time, `|z| < 1 − tol` in
+    /// discrete time, with `tol = 100 N ε max(1, ‖A‖₁)` (see
+    /// [`unstable_pole`](Self::unstable_pole)).
     ///
-    /// A pole on the imaginary axis (an integrator, an undamped oscillator)
-    /// is not stable; so is one within rounding of it (`Re ≥ −100 N ε ‖A‖₁`),
-    /// such as a rigid-body mode computed from physical parameters.
+    /// A pole on the boundary (an integrator, an undamped oscillator, a
+    /// rigid-body mode computed from physical parameters) is not stable.
     ///
     /// # Errors
     ///
@@ -344,115 +346,91 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     /// let lag = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
     /// let integrator = StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
     /// assert!(lag.is_stable()? && !integrator.is_stable()?);
+    ///
+    /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
+    /// let acc = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
+    /// assert!(sys.is_stable()? && !acc.is_stable()?);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_stable(&self) -> Result<bool, Error> {
-        let tol = boundary_tolerance(self.a());
-        Ok(self.poles()?.iter().all(|p| p.re < -tol))
+        Ok(self.unstable_pole()?.is_none())
     }
 
-    /// The steady-state gain `−C A⁻¹ B + D` (output units per input unit;
-    /// m/N for the lab plant).
+    /// The first pole, in the order of [`poles`](Self::poles), on or outside
+    /// the stability boundary, or `None` for a stable model. This is the
+    /// crate's one stability test: [`is_stable`](Self::is_stable), step
+    /// metrics and the LQR checks all use it.
+    ///
+    /// "On" the boundary means within `tol = 100 N ε max(1, ‖A‖₁)` of it
+    /// (eigenvalues are computed to about `ε ‖A‖`): `Re s ≥ −tol` in
+    /// continuous time, `|z| ≥ 1 − tol` in discrete time.
     ///
     /// # Errors
     ///
-    /// [`Error::Singular`] when `A` is singular to working precision, i.e.
-    /// a pole at `s = 0`: the gain is infinite or undefined, and is reported
-    /// instead of returned as inf/NaN. "To working precision" means a
-    /// condition number of `A` above `1 / (10⁴ ε)`.
+    /// As [`poles`](Self::poles).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{StateSpace, Error};
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::matrix;
+    ///
+    /// let sys = StateSpace::continuous(matrix![-1.0, 0.0; 0.0, 2.0], matrix![1.0; 1.0], matrix![1.0, 1.0], matrix![0.0])?;
+    /// assert_eq!(sys.unstable_pole()?.map(|p| p.re), Some(2.0));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn unstable_pole(&self) -> Result<Option<Complex<f64>>, Error> {
+        let poles = self.poles()?;
+        Ok(first_unstable(&poles, self.a(), period_of(&self.domain())))
+    }
+
+    /// The steady-state gain (output units per input unit; m/N for the lab
+    /// plant): `−C A⁻¹ B + D` in continuous time, `C (I − A)⁻¹ B + D` in
+    /// discrete time. MATLAB's and python-control's `dcgain`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Singular`] for a pole at `s = 0` / `z = 1` to working
+    /// precision (the gain is infinite or undefined, and is reported instead
+    /// of returned as inf/NaN): refused when the condition number of `A`
+    /// (or `I − A`) exceeds `1 / (10⁴ ε)`, i.e. fewer than about four digits
+    /// of the gain would be right; [`Error::Overflow`] for a gain that
+    /// overflows.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Cart, Error, MassSpring, Method, StateSpace};
     /// use nalgebra::matrix;
     ///
     /// let lag = StateSpace::continuous(matrix![-2.0], matrix![4.0], matrix![1.0], matrix![0.0])?;
     /// assert_eq!(lag.dc_gain()?, matrix![2.0]);
     /// let integrator = StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
     /// assert!(matches!(integrator.dc_gain(), Err(Error::Singular { .. })));
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn dc_gain(&self) -> Result<SMatrix<f64, P, M>, Error> {
-        let x = gain_solve(self.a(), self.b(), "DC gain (pole at s = 0)")?;
-        finite_gain(self.d() - self.c() * x)
-    }
-
-    /// [`Damping`] (natural frequency, damping ratio, time constant) of each
-    /// pole, in the order of [`poles`](Self::poles).
-    ///
-    /// # Errors
-    ///
-    /// As [`poles`](Self::poles).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{MassSpring, Output};
-    ///
-    /// let d = MassSpring::nominal().state_space(Output::Cart2)?.damping()?;
-    /// // Both modes of the rig are lightly damped.
-    /// assert!(d.iter().all(|d| d.damping_ratio > 0.0 && d.damping_ratio < 0.2));
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn damping(&self) -> Result<[Damping; N], Error> {
-        Ok(self.poles()?.map(|p| Damping::of_s(p, p)))
-    }
-}
-
-impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discrete> {
-    /// True when every pole lies strictly inside the unit circle, `|z| < 1`,
-    /// by more than rounding (`|z| < 1 − 100 N ε ‖A‖₁`).
-    ///
-    /// # Errors
-    ///
-    /// As [`poles`](Self::poles).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::StateSpace;
-    /// use nalgebra::matrix;
-    ///
-    /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
-    /// assert!(sys.is_stable()?);
-    /// let acc = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
-    /// assert!(!acc.is_stable()?);
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn is_stable(&self) -> Result<bool, Error> {
-        let tol = boundary_tolerance(self.a());
-        Ok(self.poles()?.iter().all(|p| p.norm() < 1.0 - tol))
-    }
-
-    /// The steady-state gain `C (I − A)⁻¹ B + D`.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::Singular`] when `I − A` is singular to working precision (a
-    /// pole at `z = 1`, also one that discretisation moved off 1 by
-    /// rounding: refused when the condition number of `I − A` exceeds
-    /// `1 / (10⁴ ε)`, i.e. fewer than about four digits of the gain would be
-    /// right).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{MassSpring, Method, Output};
     ///
     /// // ZOH keeps the DC gain: 2 mm per newton on cart 2.
-    /// let d = MassSpring::nominal().state_space(Output::Cart2)?.discretize(0.002, Method::Zoh)?;
+    /// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
     /// assert!((d.dc_gain()?[(0, 0)] - 0.002).abs() < 1e-12);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
+    #[doc(alias = "dcgain")]
     pub fn dc_gain(&self) -> Result<SMatrix<f64, P, M>, Error> {
-        let i_minus_a = SMatrix::<f64, N, N>::identity() - self.a();
-        let x = gain_solve(&i_minus_a, self.b(), "DC gain (pole at z = 1)")?;
-        finite_gain(self.c() * x + self.d())
+        match period_of(&self.domain()) {
+            None => {
+                let x = gain_solve(self.a(), self.b(), "DC gain (pole at s = 0)")?;
+                finite_gain(self.d() - self.c() * x)
+            }
+            Some(_) => {
+                let i_minus_a = SMatrix::<f64, N, N>::identity() - self.a();
+                let x = gain_solve(&i_minus_a, self.b(), "DC gain (pole at z = 1)")?;
+                finite_gain(self.c() * x + self.d())
+            }
+        }
     }
 
-    /// [`Damping`] of each pole, after mapping `z` to `s = ln(z) / dt` as
-    /// MATLAB's `damp` does, in the order of [`poles`](Self::poles).
+    /// [`Damping`] (natural frequency, damping ratio, time constant) of each
+    /// pole, in the order of [`poles`](Self::poles). A discrete pole `z` is
+    /// first mapped to `s = ln(z) / dt`, as MATLAB's `damp` does.
     ///
     /// # Errors
     ///
@@ -461,8 +439,12 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::StateSpace;
+    /// use ctrlab::{Cart, MassSpring, StateSpace};
     /// use nalgebra::matrix;
+    ///
+    /// let d = MassSpring::nominal().state_space(Cart::Two)?.damping()?;
+    /// // Both modes of the rig are lightly damped.
+    /// assert!(d.iter().all(|d| d.damping_ratio > 0.0 && d.damping_ratio < 0.2));
     ///
     /// // z = e^(−2 · 0.1): the discrete image of s = −2.
     /// let sys = StateSpace::discrete(matrix![(-0.2f64).exp()], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
@@ -471,21 +453,40 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     /// assert!((d.damping_ratio - 1.0).abs() < 1e-12);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
+    #[doc(alias = "damp")]
     pub fn damping(&self) -> Result<[Damping; N], Error> {
-        let dt = self.dt();
-        Ok(self.poles()?.map(|z| {
-            if z.norm() == 0.0 {
-                Damping {
-                    pole: z,
-                    natural_frequency: f64::INFINITY,
-                    damping_ratio: 1.0,
-                    time_constant: 0.0,
+        let poles = self.poles()?;
+        Ok(match period_of(&self.domain()) {
+            None => poles.map(|p| Damping::of_s(p, p)),
+            Some(dt) => poles.map(|z| {
+                if z.norm() == 0.0 {
+                    Damping {
+                        pole: z,
+                        natural_frequency: f64::INFINITY,
+                        damping_ratio: 1.0,
+                        time_constant: 0.0,
+                    }
+                } else {
+                    Damping::of_s(z, z.ln() / dt)
                 }
-            } else {
-                Damping::of_s(z, z.ln() / dt)
-            }
-        }))
+            }),
+        })
     }
+}
+
+/// The crate's one stability test: the first of `poles` (eigenvalues of `a`)
+/// on or outside the stability boundary of the domain with sampling period
+/// `period` (`None`: continuous), within rounding of `a`.
+pub(crate) fn first_unstable<const N: usize>(
+    poles: &[Complex<f64>; N],
+    a: &SMatrix<f64, N, N>,
+    period: Option<f64>,
+) -> Option<Complex<f64>> {
+    let tol = boundary_tolerance(a);
+    poles.iter().copied().find(|p| match period {
+        None => p.re >= -tol,
+        Some(_) => p.norm() >= 1.0 - tol,
+    })
 }
 
 /// Solves `m x = b` for a DC gain, refusing an `m` so ill-conditioned that

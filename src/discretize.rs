@@ -10,7 +10,7 @@
 use nalgebra::SMatrix;
 
 use crate::error::{Error, check_dt};
-use crate::linalg::Lu;
+use crate::kernels::linalg::Lu;
 use crate::model::{Continuous, Discrete, StateSpace};
 
 /// How to turn a continuous model into a discrete one with period `h`.

@@ -180,6 +180,16 @@ pub enum Error {
         /// What is wrong.
         reason: String,
     },
+    /// A recording has no channel of that name, or a channel's name or unit
+    /// cannot be used (empty, duplicated, or with characters a CSV header
+    /// cannot hold).
+    #[error("channel `{name}`: {reason}")]
+    Channel {
+        /// The channel's name as asked for or given.
+        name: String,
+        /// What is wrong; for a missing channel, the channels there are.
+        reason: String,
+    },
     /// Reading or writing a file failed. Holds the error kind and message
     /// rather than `std::io::Error` so that `Error` stays `Clone + PartialEq`.
     #[error("{context}: {message}")]

@@ -1,5 +1,6 @@
-//! Fixed-step ODE integration: the [`Dynamics`] trait any plant implements,
-//! and the [`Rk4`] and [`Euler`] steppers.
+//! Fixed-step ODE integration: the [`Rk4`] and [`Euler`] steppers for any
+//! [`Dynamics`] (the plant trait lives in [`model`](crate::model) and is
+//! re-exported here).
 //!
 //! Steppers hold the input constant over a step (a zero-order hold, as a
 //! sampled-data controller applies it). Stage vectors live on the stack, so a
@@ -7,51 +8,7 @@
 
 use nalgebra::SVector;
 
-use crate::model::{Continuous, StateSpace};
-
-/// A continuous-time plant `x' = f(t, x, u)` with `N` states and `M` inputs.
-///
-/// Linear models ([`StateSpace`] in [`Continuous`] time), the lab's
-/// [`MassSpring`](crate::MassSpring) and any nonlinear plant (Coulomb
-/// friction, saturation, …) implement it; so do closures of the right shape.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::integrate::{Dynamics, Rk4, Integrator};
-/// use nalgebra::{SVector, vector};
-///
-/// // A pendulum, x = [angle (rad), rate (rad/s)], u = torque/inertia (rad/s²).
-/// let pendulum = |_t: f64, x: &SVector<f64, 2>, u: &SVector<f64, 1>| {
-///     vector![x[1], -9.81 * x[0].sin() + u[0]]
-/// };
-/// let mut x = vector![0.1, 0.0];
-/// Rk4.step_mut(&pendulum, 0.0, 1e-3, &mut x, &vector![0.0]);
-/// assert!(x[0] < 0.1 && x[1] < 0.0);
-/// ```
-pub trait Dynamics<const N: usize, const M: usize> {
-    /// The state derivative at time `t` (s), state `x`, input `u`.
-    fn derivative(&self, t: f64, x: &SVector<f64, N>, u: &SVector<f64, M>) -> SVector<f64, N>;
-}
-
-impl<const N: usize, const M: usize, const P: usize> Dynamics<N, M>
-    for StateSpace<N, M, P, Continuous>
-{
-    #[inline]
-    fn derivative(&self, _t: f64, x: &SVector<f64, N>, u: &SVector<f64, M>) -> SVector<f64, N> {
-        StateSpace::derivative(self, x, u)
-    }
-}
-
-impl<const N: usize, const M: usize, F> Dynamics<N, M> for F
-where
-    F: Fn(f64, &SVector<f64, N>, &SVector<f64, M>) -> SVector<f64, N>,
-{
-    #[inline]
-    fn derivative(&self, t: f64, x: &SVector<f64, N>, u: &SVector<f64, M>) -> SVector<f64, N> {
-        self(t, x, u)
-    }
-}
+pub use crate::model::Dynamics;
 
 /// A fixed-step integrator. The input `u` is held constant over the step.
 ///
@@ -80,6 +37,7 @@ pub trait Integrator {
     /// assert_eq!(Euler.step(&decay, 0.0, 0.1, &vector![1.0], &vector![0.0]), vector![0.9]);
     /// ```
     #[inline]
+    #[must_use]
     fn step<const N: usize, const M: usize, F: Dynamics<N, M> + ?Sized>(
         &self,
         f: &F,

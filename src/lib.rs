@@ -3,65 +3,83 @@
 //! Control engineering for a real lab, in Rust: typed state-space models,
 //! discretisation and simulation, identification from recorded data,
 //! state-feedback design and step metrics, and a hardware layer that runs
-//! the same controller on the rig at 2 ms; built around the two-cart
-//! mass-spring rig of a university control lab (`cargo run --release
-//! --example lab5` reproduces the whole lab on the simulated rig).
+//! the same controller on the rig; built around the two-cart mass-spring
+//! rig of a university control lab (`cargo run --release --example lab5`
+//! reproduces the whole lab on the simulated rig), and generic everywhere
+//! else.
 //!
 //! Modelling and simulation:
 //!
-//! - [`model`]: [`StateSpace`] with its sizes and time domain in the type, and
-//!   the lab's plant [`MassSpring`].
+//! - [`model`]: [`StateSpace`] with its sizes and time domain in the type,
+//!   and the [`Dynamics`] trait any plant implements.
 //! - [`discretize`]: ZOH (exact), Tustin, forward and backward Euler, and
 //!   [`expm`](discretize::expm).
-//! - [`integrate`]: the [`Dynamics`] trait and the [`Rk4`] and [`Euler`]
-//!   steppers.
-//! - [`sim`]: continuous and discrete simulation and step responses.
+//! - [`integrate`]: the [`Rk4`] and [`Euler`] steppers.
+//! - [`sim`]: continuous and discrete simulation, step responses, and the
+//!   sampled-data simulator [`run_sampled`] (a continuous plant under a
+//!   discrete controller, with hold, delay, saturation, quantisation and
+//!   noise).
+//! - [`signal`]: test inputs (step, square wave, PRBS) and the crate's
+//!   seeded random generator.
 //!
 //! Analysis and design:
 //!
 //! - [`analysis`]: poles, stability, DC gain, damping, controllability and
 //!   observability.
-//! - [`design`]: the [`Controller`] trait, [`StateFeedback`] (the lab's
-//!   per-millimetre form and the textbook form), [`OpenLoop`], [`acker`],
-//!   [`lqr`], [`dlqr`].
+//! - [`design`]: the [`Controller`] trait (measurements and reference in,
+//!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
+//!   [`acker`], [`lqr`], [`dlqr`].
 //! - [`metrics`]: [`step_info`] / [`step_info_of`] (rise and settling time,
 //!   overshoot, steady state) with interpolated crossing times.
 //! - `plot` (feature `plot`, on by default): SVG figures of time responses.
 //!
 //! Data and identification:
 //!
-//! - [`data`]: [`Recording`]s of a run (time, input, cart states) and their
-//!   CSV form, units in the header.
-//! - [`ident`]: least squares by QR ([`LeastSquares`]), recursive least
-//!   squares ([`Rls`]) and the lab's two-cart identification
-//!   ([`ident::mass_spring`]).
+//! - [`data`]: [`Recording`]s (time stamps, inputs as applied, measurements,
+//!   each a named [`Channel`] with its unit) and their CSV form.
+//! - [`ident`]: least squares by QR ([`LeastSquares`]) and recursive least
+//!   squares ([`Rls`]).
 //!
 //! Hardware:
 //!
-//! - [`hw`]: the lab's card over the parallel port (EPP), its register-level
-//!   simulation, the [`Rig`](hw::Rig) a controller runs against, and the
-//!   fixed-period control loop [`run`](hw::run).
+//! - [`hw`]: the [`Rig`](hw::Rig) trait, the fixed-period control loop
+//!   [`run`](hw::run), the lab's card over the parallel port (EPP) and its
+//!   register-level simulation.
 //!
-//! Units are SI throughout (m, m/s, N, V, s); the lab's millimetres appear
-//! only in printed tables and at named conversions.
+//! The lab:
+//!
+//! - [`lab`]: the two-cart plant [`MassSpring`] and [`Cart`], the lab's
+//!   per-millimetre gains, its identification (equations (4)–(11)), the
+//!   rig on the card and the simulated rig in one call.
+//!
+//! Layers point one way: private kernels and [`model`] at the bottom;
+//! [`discretize`], [`integrate`], [`analysis`] on them; [`design`],
+//! [`sim`], [`metrics`], [`data`], [`ident`], [`signal`] above; [`hw`]
+//! above those; [`lab`] on top. Units are SI throughout (m, m/s, N, V, s);
+//! the lab's millimetres appear only in printed tables and at named
+//! conversions. Names follow MATLAB and python-control where one exists
+//! (search docs.rs for `c2d`, `ctrb`, `dcgain`, `lsim`, …).
 //!
 //! ## Example
 //!
 //! ```
-//! use ctrlab::{MassSpring, Method, Output, sim::step_response};
+//! use ctrlab::{Cart, MassSpring, Method, sim::step_response};
 //!
-//! let plant = MassSpring::nominal().state_space(Output::Cart2)?;
+//! let plant = MassSpring::nominal().state_space(Cart::Two)?;
 //! // The discrete model the 2 ms control loop sees.
 //! let discrete = plant.discretize(0.002, Method::Zoh)?;
 //! assert_eq!(discrete.dt(), 0.002);
 //!
 //! // A 1 N step on cart 2 settles at 2 mm (two 1000 N/m springs in series).
-//! let r = step_response(&plant, 10.0, 0.002)?;
+//! let (t_end, dt) = (10.0, 0.002); // s
+//! let r = step_response(&plant, t_end, dt)?;
 //! assert!((r.y.last().unwrap()[0] - 0.002).abs() < 1e-9);
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
+
+#![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod analysis;
 pub mod data;
@@ -71,24 +89,31 @@ mod error;
 pub mod hw;
 pub mod ident;
 pub mod integrate;
-mod linalg;
+mod kernels;
+pub mod lab;
 pub mod metrics;
 pub mod model;
 #[cfg(feature = "plot")]
+#[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
 pub mod plot;
-mod reduce;
+pub mod signal;
 pub mod sim;
 
+/// The nalgebra this crate's matrices and vectors are, re-exported so that a
+/// user need not match its version: `ctrlab::nalgebra::vector![…]`.
+pub use nalgebra;
+
 pub use analysis::Damping;
-pub use data::Recording;
+pub use data::{Channel, Recording, Schema};
 pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr};
 pub use discretize::Method;
 pub use error::Error;
 pub use ident::{LeastSquares, LeastSquaresFit, Rls};
-pub use integrate::{Dynamics, Euler, Integrator, Rk4};
+pub use integrate::{Euler, Integrator, Rk4};
+pub use lab::{Cart, MassSpring};
 pub use metrics::{StepInfo, StepInfoOptions, step_info, step_info_of};
-pub use model::{Continuous, Discrete, Domain, MassSpring, Output, StateSpace};
-pub use sim::{Response, step_response};
+pub use model::{Continuous, Discrete, Domain, Dynamics, StateSpace};
+pub use sim::{Response, run_sampled, step_response};
 
 // The README's code blocks are compiled and run as doctests.
 #[cfg(doctest)]

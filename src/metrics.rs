@@ -51,6 +51,7 @@
 //!   there: the means of the window's two halves must agree to a quarter of
 //!   the band.
 
+use crate::data::Recording;
 use crate::error::Error;
 use crate::model::{Continuous, StateSpace};
 use crate::sim::step_response;
@@ -387,10 +388,10 @@ fn crossing(ta: f64, ya: f64, tb: f64, yb: f64, level: f64) -> f64 {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Output, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
+/// use ctrlab::{MassSpring, Cart, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
 ///
-/// let plant = MassSpring::nominal().state_space(Output::Cart2)?;
-/// let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Output::Cart2)?.closed_loop(&plant)?;
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+/// let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?.closed_loop(&plant)?;
 /// let info = step_info_of(&cl, 2.0, 0.0005, &StepInfoOptions { reference: Some(1.0), ..Default::default() })?;
 /// // Table 2, row [0 0 10 0.1]: about 5 % overshoot, settled in about 0.2 s.
 /// assert!((info.overshoot - 5.03).abs() < 0.5 && (info.settling_time - 0.2).abs() < 0.01);
@@ -403,8 +404,7 @@ pub fn step_info_of<const N: usize>(
     options: &StepInfoOptions,
 ) -> Result<StepInfo, Error> {
     options.validate()?;
-    let tol = crate::linalg::boundary_tolerance(sys.a());
-    if let Some(p) = sys.poles()?.iter().find(|p| p.re >= -tol) {
+    if let Some(p) = sys.unstable_pole()? {
         return Err(Error::Unstable {
             operation: "step metrics of a model",
             re: p.re,
@@ -425,4 +425,37 @@ pub fn step_info_of<const N: usize>(
             ..*options
         },
     )
+}
+
+/// [`step_info`] of channel `channel` of a recording (from the rig's loop or
+/// the sampled-data simulator), against its time stamps.
+///
+/// # Errors
+///
+/// [`Error::Channel`] when the recording has no such channel (the message
+/// lists those it has); the errors of [`step_info`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::data::{Recording, Schema};
+/// use ctrlab::metrics::{StepInfoOptions, step_info_channel};
+///
+/// // A first-order rise to 1 with τ = 0.1 s, sampled every 10 ms.
+/// let mut rec = Recording::new(Schema::numbered(1, 1));
+/// for k in 0..300 {
+///     let t = k as f64 * 0.01;
+///     rec.push(t, &[1.0], &[1.0 - (-t / 0.1).exp()])?;
+/// }
+/// let info = step_info_channel(&rec, "y", &StepInfoOptions::default())?;
+/// assert!((info.rise_time - 0.1 * 9f64.ln()).abs() < 1e-3);
+/// assert!(step_info_channel(&rec, "x2", &StepInfoOptions::default()).is_err());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn step_info_channel(
+    recording: &Recording,
+    channel: &str,
+    options: &StepInfoOptions,
+) -> Result<StepInfo, Error> {
+    step_info(recording.time(), recording.channel(channel)?, options)
 }

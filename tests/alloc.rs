@@ -6,7 +6,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use ctrlab::{Integrator, MassSpring, Method, Output, Rk4};
+use ctrlab::{Integrator, MassSpring, Method, Cart, Rk4};
 use nalgebra::{SVector, vector};
 
 struct Counting;
@@ -54,15 +54,15 @@ fn the_counter_sees_allocations() {
 #[test]
 fn discrete_step_allocates_nothing() {
     let d = MassSpring::nominal()
-        .state_space(Output::Cart2)
+        .state_space(Cart::Two)
         .unwrap()
         .discretize(0.002, Method::Zoh)
         .unwrap();
     let mut x = SVector::<f64, 4>::zeros();
     let n = allocations(|| {
         for _ in 0..1000 {
-            d.step_mut(&mut x, &vector![1.0]);
-            x = d.step(&x, &vector![-1.0]);
+            d.advance_mut(&mut x, &vector![1.0]);
+            x = d.advance(&x, &vector![-1.0]);
         }
     });
     assert_eq!(n, 0);
@@ -72,7 +72,7 @@ fn discrete_step_allocates_nothing() {
 #[test]
 fn rk4_step_allocates_nothing() {
     let plant = MassSpring::nominal();
-    let sys = plant.state_space(Output::Cart2).unwrap();
+    let sys = plant.state_space(Cart::Two).unwrap();
     let mut x = SVector::<f64, 4>::zeros();
     let n = allocations(|| {
         for k in 0..1000 {
@@ -86,7 +86,7 @@ fn rk4_step_allocates_nothing() {
 
 #[test]
 fn zoh_discretisation_allocates_nothing() {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let mut ad00 = 0.0;
     let n = allocations(|| {
         let d = sys.discretize(0.002, Method::Zoh).unwrap();
@@ -158,9 +158,9 @@ fn step_info_allocates_nothing() {
 #[test]
 fn state_feedback_update_allocates_nothing() {
     use ctrlab::{Controller, StateFeedback};
-    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Output::Cart2).unwrap();
+    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
     let d = MassSpring::nominal()
-        .state_space(Output::Cart2)
+        .state_space(Cart::Two)
         .unwrap()
         .discretize(0.002, Method::Zoh)
         .unwrap();
@@ -170,7 +170,7 @@ fn state_feedback_update_allocates_nothing() {
         let dynamic: &mut dyn Controller<4, 1> = &mut ctrl;
         for _ in 0..1000 {
             let u = dynamic.update(0.030, &x);
-            d.step_mut(&mut x, &u);
+            d.advance_mut(&mut x, &u);
         }
         dynamic.reset();
     });

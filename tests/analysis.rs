@@ -4,14 +4,14 @@
 mod common;
 
 use ctrlab::analysis::rank;
-use ctrlab::{Error, MassSpring, Method, Output, StateSpace};
+use ctrlab::{Error, MassSpring, Method, Cart, StateSpace};
 use nalgebra::{Complex, DMatrix, SMatrix, dmatrix, matrix};
 use proptest::prelude::*;
 
 #[test]
 fn poles_match_the_fixture_sorted() {
     let fx = common::nominal_fixture();
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let got = sys.poles().unwrap();
     let mut want: Vec<Complex<f64>> = fx["poles"]
         .as_array()
@@ -32,7 +32,7 @@ fn poles_match_the_fixture_sorted() {
 #[test]
 fn dc_gain_is_the_static_deflection() {
     let plant = MassSpring::nominal();
-    for (output, want) in [(Output::Cart1, 1.0 / 1000.0), (Output::Cart2, 2.0 / 1000.0)] {
+    for (output, want) in [(Cart::One, 1.0 / 1000.0), (Cart::Two, 2.0 / 1000.0)] {
         let sys = plant.state_space(output).unwrap();
         let g = sys.dc_gain().unwrap()[(0, 0)];
         assert!((g - want).abs() <= 1e-14 * want, "{output:?}");
@@ -66,7 +66,7 @@ fn dc_gain_includes_feedthrough() {
 
 #[test]
 fn stability_in_both_domains() {
-    let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
     assert!(plant.is_stable().unwrap());
     assert!(
         plant
@@ -137,7 +137,7 @@ fn damping_of_a_second_order_system_and_its_discretisation() {
 
 #[test]
 fn controllability_and_observability_of_the_lab_plant() {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let c = sys.controllability().unwrap();
     assert_eq!((c.nrows(), c.ncols()), (4, 4));
     // Column j is A^j B.
@@ -158,7 +158,7 @@ fn controllability_and_observability_of_the_lab_plant() {
         k2: 0.0,
         ..MassSpring::nominal()
     };
-    let s = cut.state_space(Output::Cart2).unwrap();
+    let s = cut.state_space(Cart::Two).unwrap();
     assert!(!s.is_controllable().unwrap());
     assert!(!s.is_observable().unwrap());
     assert_eq!(rank(&s.controllability().unwrap(), None).unwrap(), 2);
@@ -233,7 +233,7 @@ fn a_rigid_body_mode_is_neither_stable_nor_given_a_dc_gain() {
             k2,
             ..MassSpring::nominal()
         };
-        let sys = plant.state_space(Output::Cart2).unwrap();
+        let sys = plant.state_space(Cart::Two).unwrap();
         assert!(!sys.is_stable().unwrap(), "k2 = {k2}");
         assert!(
             matches!(sys.dc_gain(), Err(Error::Singular { .. })),

@@ -5,7 +5,7 @@
 mod common;
 
 use ctrlab::{
-    Controller, Error, MassSpring, Method, Output, StateFeedback, StateSpace, acker, dlqr, lqr,
+    Controller, Error, MassSpring, Method, Cart, StateFeedback, StateSpace, acker, dlqr, lqr,
 };
 use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 use proptest::prelude::*;
@@ -21,18 +21,18 @@ fn fixture_poles(row: &serde_json::Value) -> Vec<Complex<f64>> {
 
 #[test]
 fn lab_gains_are_converted_to_si_once() {
-    let c = StateFeedback::from_lab_gains([1.0, 0.005, 10.0, 0.1], Output::Cart2).unwrap();
+    let c = StateFeedback::from_lab_gains([1.0, 0.005, 10.0, 0.1], Cart::Two).unwrap();
     assert_eq!(*c.gain(), matrix![1000.0, 5.0, 10_000.0, 100.0]);
     // N = K G: G selects cart 2's position.
     assert_eq!(*c.reference_gain(), vector![10_000.0]);
-    let c1 = StateFeedback::from_lab_gains([1.0, 0.005, 10.0, 0.1], Output::Cart1).unwrap();
+    let c1 = StateFeedback::from_lab_gains([1.0, 0.005, 10.0, 0.1], Cart::One).unwrap();
     assert_eq!(*c1.reference_gain(), vector![1000.0]);
 }
 
 #[test]
 fn lab_law_in_si_equals_the_lab_law_in_millimetres() {
     let kf = [0.7, 0.003, 4.0, 0.2];
-    let mut c = StateFeedback::from_lab_gains(kf, Output::Cart2).unwrap();
+    let mut c = StateFeedback::from_lab_gains(kf, Cart::Two).unwrap();
     let x_m = vector![0.004, -0.02, 0.011, 0.05];
     let r_m = 0.030;
     // u = Kf (G r_mm − x_mm), evaluated in millimetres by hand.
@@ -45,7 +45,7 @@ fn lab_law_in_si_equals_the_lab_law_in_millimetres() {
 
 #[test]
 fn non_finite_lab_gain_is_an_error() {
-    let err = StateFeedback::from_lab_gains([0.0, f64::NAN, 1.0, 0.0], Output::Cart2).unwrap_err();
+    let err = StateFeedback::from_lab_gains([0.0, f64::NAN, 1.0, 0.0], Cart::Two).unwrap_err();
     assert!(matches!(
         err,
         Error::NonFinite {
@@ -69,8 +69,8 @@ fn closed_loop_poles_match_the_fixture_rows() {
             .map(|v| v.as_f64().unwrap())
             .collect();
         let output = match row["cart"].as_u64().unwrap() {
-            1 => Output::Cart1,
-            _ => Output::Cart2,
+            1 => Cart::One,
+            _ => Cart::Two,
         };
         let plant = MassSpring::nominal().state_space(output).unwrap();
         let c = StateFeedback::from_lab_gains([kf[0], kf[1], kf[2], kf[3]], output).unwrap();
@@ -94,8 +94,8 @@ fn closed_loop_of_the_lab_law_has_the_lab_steady_state() {
     // x' = (A − B K) x + B K G r: at rest k3·(r − x2) balances the springs,
     // x2 = r·K3/(K3 + k_series) with k_series = 500 N/m; for Kf3 = 0.1/mm
     // (100 N/m) that is r/6.
-    let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
-    let cl = StateFeedback::from_lab_gains([0.0, 0.0, 0.1, 0.0], Output::Cart2)
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
+    let cl = StateFeedback::from_lab_gains([0.0, 0.0, 0.1, 0.0], Cart::Two)
         .unwrap()
         .closed_loop(&plant)
         .unwrap();
@@ -104,7 +104,7 @@ fn closed_loop_of_the_lab_law_has_the_lab_steady_state() {
 
 #[test]
 fn prefilter_removes_the_steady_state_error() {
-    let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let k = matrix![0.0, 0.0, 10_000.0, 100.0];
     let c = StateFeedback::with_prefilter(&plant, k).unwrap();
     assert_eq!(*c.gain(), k);
@@ -144,7 +144,7 @@ fn controller_through_mut_reference_and_reset() {
 
 #[test]
 fn acker_places_the_lab_plant_poles() {
-    let plant = MassSpring::nominal().state_space(Output::Cart1).unwrap();
+    let plant = MassSpring::nominal().state_space(Cart::One).unwrap();
     let targets = [
         Complex::new(-20.0, 15.0),
         Complex::new(-25.0, 0.0),
@@ -175,7 +175,7 @@ fn acker_refuses_uncontrollable_plants_and_unpaired_targets() {
         acker(&sys, &targets).unwrap_err(),
         Error::Uncontrollable { rank: 1, states: 2 }
     );
-    let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let unpaired = [
         Complex::new(-1.0, 1.0),
         Complex::new(-1.0, 1.0),
@@ -266,7 +266,7 @@ fn scalar_dare_matches_the_closed_form() {
 
 #[test]
 fn lqr_on_the_lab_plant_satisfies_the_riccati_equation() {
-    let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e6, 10.0, 1e8, 10.0]);
     let r = matrix![0.01];
     let sol = lqr(&plant, &q, &r).unwrap();

@@ -3,7 +3,7 @@
 mod common;
 
 use ctrlab::discretize::expm;
-use ctrlab::{Error, MassSpring, Method, Output, StateSpace};
+use ctrlab::{Error, MassSpring, Method, Cart, StateSpace};
 use nalgebra::{SMatrix, matrix};
 use proptest::prelude::*;
 
@@ -12,7 +12,7 @@ const DT: f64 = 0.002;
 #[test]
 fn all_four_methods_match_scipy_to_1e10() {
     let fx = common::nominal_fixture();
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let table = &fx["discretised_dt_0_002"];
     for (key, method) in [
         ("zoh", Method::Zoh),
@@ -82,7 +82,7 @@ fn tustin_and_backward_euler_refuse_a_singular_inverse() {
 
 #[test]
 fn bad_time_steps_and_overflow_are_errors() {
-    let sys = MassSpring::nominal().state_space(Output::Cart1).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::One).unwrap();
     for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         for method in [
             Method::Zoh,
@@ -116,7 +116,7 @@ fn bad_time_steps_and_overflow_are_errors() {
 fn tustin_and_backward_euler_transform_c_and_d_like_scipy() {
     // SciPy gbt: Cd = C (I - αhA)^-1, Dd = D + α C Bd. Check the identities
     // directly on the nominal plant.
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     for (method, alpha) in [(Method::Tustin, 0.5), (Method::BackwardEuler, 1.0)] {
         let d = sys.discretize(DT, method).unwrap();
         let ima = SMatrix::<f64, 4, 4>::identity() - sys.a() * (alpha * DT);

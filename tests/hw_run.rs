@@ -8,7 +8,7 @@ use ctrlab::hw::{
     SimulatedCardConfig, VirtualClock, run,
 };
 use ctrlab::{
-    Controller, MassSpring, Method, OpenLoop, Output, StateFeedback, StepInfoOptions, step_info,
+    Controller, MassSpring, Method, OpenLoop, Cart, StateFeedback, StepInfoOptions, step_info,
 };
 use nalgebra::{SVector, vector};
 use proptest::prelude::*;
@@ -45,7 +45,7 @@ fn sampled_simulation(
     ticks: usize,
 ) -> Vec<f64> {
     let d = plant
-        .state_space(Output::Cart2)
+        .state_space(Cart::Two)
         .unwrap()
         .discretize(PERIOD, Method::Zoh)
         .unwrap();
@@ -62,7 +62,7 @@ fn sampled_simulation(
         previous = x;
         let u = controller.update(setpoint, &measured);
         x2.push(x[2]);
-        d.step_mut(&mut x, &u);
+        d.advance_mut(&mut x, &u);
     }
     x2
 }
@@ -83,7 +83,7 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
         ..Default::default()
     });
     let gains = [0.0, 0.0, 10.0, 0.1];
-    let ctrl = StateFeedback::from_lab_gains(gains, Output::Cart2).unwrap();
+    let ctrl = StateFeedback::from_lab_gains(gains, Cart::Two).unwrap();
     let setpoint = 0.030;
     let calibration = Calibration {
         volts_full_scale: supply,
@@ -118,7 +118,7 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
 
     // And the sampled loop is close to the continuous design: the 2 ms
     // sampling costs a few points of overshoot at most for these poles.
-    let plant = truth.state_space(Output::Cart2).unwrap();
+    let plant = truth.state_space(Cart::Two).unwrap();
     let cl = ctrl.closed_loop(&plant).unwrap();
     let continuous = ctrlab::step_info_of(&cl, 2.0, PERIOD, &StepInfoOptions::default()).unwrap();
     println!("continuous design {continuous:?}");

@@ -7,7 +7,7 @@ use ctrlab::hw::{
     Calibration, CycleKind, EppPort, HwError, HwErrorKind, MassSpringRig, Pc104, Rig,
     SIMULATED_CARD_ID, SimulatedCard, SimulatedCardConfig, VirtualClock,
 };
-use ctrlab::{MassSpring, Method, Output};
+use ctrlab::{MassSpring, Method, Cart};
 use nalgebra::{SVector, vector};
 
 /// 80 mm per 8192 counts.
@@ -54,7 +54,7 @@ fn plant_matches_the_exact_zoh_discretisation() {
     });
     let mut pc104 = Pc104::new(card);
     let d = truth
-        .state_space(Output::Cart2)
+        .state_space(Cart::Two)
         .unwrap()
         .discretize(0.002, Method::Zoh)
         .unwrap();
@@ -65,7 +65,7 @@ fn plant_matches_the_exact_zoh_discretisation() {
         let duty = ((k % 50) as i16 - 25) * 8;
         pc104.set_pwm(0, duty).unwrap();
         let volts = 24.0 * f64::from(duty) / 1000.0;
-        x = d.step(&x, &vector![volts]);
+        x = d.advance(&x, &vector![volts]);
         clock.advance_nanos(PERIOD_NS);
         pc104.latch().unwrap();
         let got = pc104.port().true_state();

@@ -5,7 +5,7 @@ mod common;
 
 use ctrlab::ident::mass_spring::{Scheme, average, identify, identify_separate_springs};
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Error, MassSpring, Output, Recording};
+use ctrlab::{Error, MassSpring, Cart, Recording};
 use nalgebra::{SVector, vector};
 use proptest::prelude::*;
 use serde_json::Value;
@@ -47,7 +47,7 @@ fn simulated(
     noise_counts: f64,
     seed: u64,
 ) -> Recording {
-    let sys = plant.state_space(Output::Cart2).unwrap();
+    let sys = plant.state_space(Cart::Two).unwrap();
     let t = time_grid(t_end, DT).unwrap();
     let square = |t: f64| {
         if ((t / half + 1e-9).floor() as i64) % 2 == 0 {
@@ -266,7 +266,7 @@ fn state_space_holds_the_identified_parameters() {
         b2: est.b2.value,
         gain: est.gain.value,
     }
-    .state_space(Output::Cart2)
+    .state_space(Cart::Two)
     .unwrap();
     assert_eq!(sys, want);
     assert_eq!(sys.a()[(1, 1)], -est.b1.value / 1.3);

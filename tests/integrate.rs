@@ -1,16 +1,16 @@
 //! RK4's order of accuracy against the exact (ZOH) solution.
 
-use ctrlab::{Dynamics, Euler, Integrator, MassSpring, Method, Output, Rk4};
+use ctrlab::{Dynamics, Euler, Integrator, MassSpring, Method, Cart, Rk4};
 use nalgebra::{SVector, vector};
 
 /// Max-norm error of `steps` steps of `integrator` over [0, t_end] from rest
 /// under a constant 10 N, against the exact solution.
 fn error<I: Integrator>(integrator: I, f: &impl Dynamics<4, 1>, t_end: f64, steps: usize) -> f64 {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let exact = sys
         .discretize(t_end, Method::Zoh)
         .unwrap()
-        .step(&SVector::zeros(), &vector![10.0]);
+        .advance(&SVector::zeros(), &vector![10.0]);
     let h = t_end / steps as f64;
     let mut x = SVector::<f64, 4>::zeros();
     for k in 0..steps {
@@ -21,7 +21,7 @@ fn error<I: Integrator>(integrator: I, f: &impl Dynamics<4, 1>, t_end: f64, step
 
 #[test]
 fn rk4_is_fourth_order() {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     for steps in [50, 100, 200] {
         let coarse = error(Rk4, &sys, 0.5, steps);
         let fine = error(Rk4, &sys, 0.5, 2 * steps);
@@ -35,7 +35,7 @@ fn rk4_is_fourth_order() {
 
 #[test]
 fn euler_is_first_order() {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let ratio = error(Euler, &sys, 0.5, 20_000) / error(Euler, &sys, 0.5, 40_000);
     assert!((1.8..2.2).contains(&ratio), "ratio {ratio}");
 }
@@ -48,7 +48,7 @@ fn the_plant_and_its_linear_model_have_the_same_dynamics() {
         gain: 8.5,
         ..MassSpring::nominal()
     };
-    let sys = plant.state_space(Output::Cart1).unwrap();
+    let sys = plant.state_space(Cart::One).unwrap();
     let x = vector![0.01, -0.2, 0.03, 0.4];
     let u = vector![2.0];
     let via_plant = plant.derivative(0.0, &x, &u);

@@ -5,7 +5,7 @@ mod common;
 
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{
-    Error, MassSpring, Output, StateFeedback, StateSpace, StepInfoOptions, step_info, step_info_of,
+    Error, MassSpring, Cart, StateFeedback, StateSpace, StepInfoOptions, step_info, step_info_of,
 };
 use nalgebra::{SVector, matrix, vector};
 use proptest::prelude::*;
@@ -24,9 +24,9 @@ fn table_2_rows_match_python_control() {
             .map(|v| v.as_f64().unwrap())
             .collect();
         assert_eq!(row["cart"].as_u64(), Some(2));
-        let plant = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+        let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
         let ctrl =
-            StateFeedback::from_lab_gains([kf[0], kf[1], kf[2], kf[3]], Output::Cart2).unwrap();
+            StateFeedback::from_lab_gains([kf[0], kf[1], kf[2], kf[3]], Cart::Two).unwrap();
         let cl = ctrl.closed_loop(&plant).unwrap();
         let setpoint = f("setpoint_mm") / 1000.0;
         // The fixture's grid: 0.5 ms out to 20 s.

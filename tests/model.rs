@@ -2,19 +2,19 @@
 
 mod common;
 
-use ctrlab::{Error, MassSpring, Output, StateSpace};
+use ctrlab::{Error, MassSpring, Cart, StateSpace};
 use nalgebra::{SMatrix, matrix};
 use proptest::prelude::*;
 
 #[test]
 fn nominal_a_and_b_equal_the_fixture_exactly() {
     let fx = common::nominal_fixture();
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     assert_eq!(*sys.a(), common::matrix::<4, 4>(&fx["a"]));
     assert_eq!(*sys.b(), common::matrix::<4, 1>(&fx["b"]));
     assert_eq!(*sys.c(), matrix![0.0, 0.0, 1.0, 0.0]);
     assert_eq!(*sys.d(), matrix![0.0]);
-    let cart1 = MassSpring::nominal().state_space(Output::Cart1).unwrap();
+    let cart1 = MassSpring::nominal().state_space(Cart::One).unwrap();
     assert_eq!(*cart1.c(), matrix![1.0, 0.0, 0.0, 0.0]);
     assert_eq!(cart1.a(), sys.a());
 }
@@ -22,7 +22,7 @@ fn nominal_a_and_b_equal_the_fixture_exactly() {
 #[test]
 fn open_loop_poles_match_the_fixture() {
     let fx = common::nominal_fixture();
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let mut got: Vec<(f64, f64)> = sys
         .a()
         .complex_eigenvalues()
@@ -116,7 +116,7 @@ fn every_bad_parameter_is_named() {
     for (plant, field) in cases {
         for err in [
             plant.validate().unwrap_err(),
-            plant.state_space(Output::Cart1).unwrap_err(),
+            plant.state_space(Cart::One).unwrap_err(),
             plant.static_deflection(1.0).unwrap_err(),
         ] {
             match err {
@@ -133,7 +133,7 @@ fn zero_spring_has_no_static_deflection_but_is_a_valid_model() {
         k1: 0.0,
         ..MassSpring::nominal()
     };
-    assert!(plant.state_space(Output::Cart2).is_ok());
+    assert!(plant.state_space(Cart::Two).is_ok());
     assert!(matches!(
         plant.static_deflection(10.0),
         Err(Error::InvalidParameter { name: "k1", .. })
@@ -235,7 +235,7 @@ proptest! {
         prop_assert_eq!(plant.validate().is_ok(), valid);
         // Valid but extreme parameters may still overflow A (e.g. k / tiny m):
         // that must be an error, not a panic or a NaN-filled model.
-        if let Ok(sys) = plant.state_space(Output::Cart1) {
+        if let Ok(sys) = plant.state_space(Cart::One) {
             prop_assert!(sys.a().iter().all(|v| v.is_finite()));
         }
     }

@@ -4,12 +4,12 @@
 use ctrlab::sim::{
     Solver, simulate, simulate_discrete, simulate_discrete_feedback, step_response, time_grid,
 };
-use ctrlab::{Error, MassSpring, Method, Output, StateSpace};
+use ctrlab::{Error, MassSpring, Method, Cart, StateSpace};
 use nalgebra::{SVector, matrix, vector};
 
 #[test]
 fn rk4_and_zoh_simulations_agree() {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let t = time_grid(2.0, 0.002).unwrap();
     let square = |t: f64| {
         vector![if ((t / 0.2) as u64).is_multiple_of(2) {
@@ -58,7 +58,7 @@ fn first_order_step_response_is_analytic() {
 
 #[test]
 fn discrete_simulation_matches_the_continuous_one_at_the_samples() {
-    let sys = MassSpring::nominal().state_space(Output::Cart1).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::One).unwrap();
     let d = sys.discretize(0.002, Method::Zoh).unwrap();
     let inputs = vec![vector![5.0]; 500];
     let disc = simulate_discrete(&d, SVector::zeros(), &inputs);
@@ -83,7 +83,7 @@ fn closed_loop_feedback_sees_the_current_state() {
 
 #[test]
 fn bad_grids_and_inputs_are_errors() {
-    let sys = MassSpring::nominal().state_space(Output::Cart2).unwrap();
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let run = |t: &[f64]| simulate(&sys, t, SVector::zeros(), |_| vector![1.0], Solver::Zoh);
     for t in [
         &[][..],

@@ -9,7 +9,7 @@ use ctrlab::ident::mass_spring::{
     MassSpringEstimate, Scheme, Spread, average, identify, identify_separate_springs,
 };
 use ctrlab::{
-    Controller, Error, MassSpring, OpenLoop, Output, StateFeedback, StepInfo, StepInfoOptions,
+    Controller, Error, MassSpring, OpenLoop, Cart, StateFeedback, StepInfo, StepInfoOptions,
     step_info,
 };
 
@@ -342,7 +342,7 @@ pub fn identification(
     report.add(
         "From the averages of the separate-springs (Central) estimates, equations (3)/(14):\n",
     );
-    let sys = model.state_space(Output::Cart2)?;
+    let sys = model.state_space(Cart::Two)?;
     report.add(&fmt_state_equations(sys.a(), sys.b()));
     report.add(&format!("Open-loop poles: {}.\n", fmt_poles(&sys.poles()?)));
     // The lab's formulas assume k1 = k2. On an equal-springs truth the only
@@ -400,7 +400,7 @@ pub struct RigResult {
 pub struct RigTable {
     pub name: &'static str,
     pub file: &'static str,
-    pub output: Output,
+    pub cart: Cart,
     pub setpoint_mm: f64,
     pub rows: Vec<[f64; 4]>,
 }
@@ -410,14 +410,14 @@ pub fn rig_tables() -> [RigTable; 2] {
         RigTable {
             name: "Table 5: cart 2, setpoint 30 mm (rig)",
             file: "table5.svg",
-            output: Output::Cart2,
+            output: Cart::Two,
             setpoint_mm: 30.0,
             rows: lab_tables::table5(),
         },
         RigTable {
             name: "Table 6: cart 1, setpoint 15 mm (rig)",
             file: "table6.svg",
-            output: Output::Cart1,
+            output: Cart::One,
             setpoint_mm: 15.0,
             rows: lab_tables::table6(),
         },

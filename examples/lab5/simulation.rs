@@ -1,7 +1,7 @@
 //! Tables 1 and 2: the nominal model in simulation.
 
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Error, MassSpring, Output, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Error, MassSpring, Cart, StateFeedback, StepInfo, StepInfoOptions, step_info};
 use nalgebra::{SVector, vector};
 
 use crate::lab_tables::{self, fmt_kf, fmt_poles};
@@ -10,7 +10,7 @@ use crate::report::Report;
 /// Table 1: static deflection under F = 10…50 N, simulated to rest.
 pub fn table1(report: &mut Report) -> Result<(), Error> {
     let plant = MassSpring::nominal();
-    let sys = plant.state_space(Output::Cart2)?;
+    let sys = plant.state_space(Cart::Two)?;
     // The slowest pole decays at 3.70 /s: after 10 s what is left is e^-37.
     let t = time_grid(10.0, 0.002)?;
     report.heading(2, "Table 1: open loop, nominal model (simulation)");
@@ -62,7 +62,7 @@ pub struct Measured {
 
 /// Table 2: state feedback on the nominal model, continuous closed loop.
 pub fn table2(report: &mut Report) -> Result<Vec<Measured>, Error> {
-    let plant = MassSpring::nominal().state_space(Output::Cart2)?;
+    let plant = MassSpring::nominal().state_space(Cart::Two)?;
     let setpoint_mm = 30.0;
     report.heading(
         2,
@@ -73,7 +73,7 @@ pub fn table2(report: &mut Report) -> Result<Vec<Measured>, Error> {
     let mut curves = Vec::new();
     let mut measured = Vec::new();
     for kf in lab_tables::table2() {
-        let cl = StateFeedback::from_lab_gains(kf, Output::Cart2)?.closed_loop(&plant)?;
+        let cl = StateFeedback::from_lab_gains(kf, Cart::Two)?.closed_loop(&plant)?;
         let poles = cl.poles()?;
         if !cl.is_stable()? {
             rows.push(vec![

@@ -3,42 +3,83 @@
 use std::io::{Read, Write};
 use std::path::Path;
 
-use super::{MIN_ROWS, Recording, check_time};
+use super::{Channel, Recording, Schema, check_time};
 use crate::error::Error;
 
-/// A recognised column: which field, and the factor from the file's unit to SI.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Field {
-    T,
-    U,
-    X1,
-    X2,
-    V1,
-    V2,
+/// The units the CSV reader recognises as a header suffix, with the SI unit
+/// they stand for and the factor to it: `(suffix, SI unit, factor)`. A
+/// header `x1_mm` is channel `x1` in `m`, read values × 0.001; `v1_m_s` is
+/// `v1` in `m/s`. The writer uses the SI suffixes, so every recording whose
+/// units are in this table reads back identical.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::data::KNOWN_UNITS;
+/// assert!(KNOWN_UNITS.contains(&("mm_s", "m/s", 1e-3)));
+/// ```
+pub const KNOWN_UNITS: [(&str, &str, f64); 10] = [
+    ("mm_s", "m/s", 1e-3),
+    ("m_s", "m/s", 1.0),
+    ("rad_s", "rad/s", 1.0),
+    ("mm", "m", 1e-3),
+    ("ms", "s", 1e-3),
+    ("m", "m", 1.0),
+    ("s", "s", 1.0),
+    ("V", "V", 1.0),
+    ("N", "N", 1.0),
+    ("rad", "rad", 1.0),
+];
+
+/// Splits a header into a channel (SI unit) and the factor to SI: the
+/// bracket form `name [unit]` / `name (unit)` or a known suffix `name_unit`;
+/// otherwise the whole header is the name, without a unit.
+fn parse_header(header: &str) -> (Channel, f64) {
+    let bracketed = header
+        .strip_suffix(']')
+        .and_then(|h| h.rsplit_once('['))
+        .or_else(|| header.strip_suffix(')').and_then(|h| h.rsplit_once('(')));
+    if let Some((name, unit)) = bracketed {
+        let (name, unit) = (name.trim(), unit.trim());
+        let suffix = unit.replace('/', "_");
+        return match KNOWN_UNITS.iter().find(|k| k.0 == suffix) {
+            Some(&(_, si, factor)) => (Channel::new(name, si), factor),
+            None => (Channel::new(name, unit), 1.0),
+        };
+    }
+    for &(suffix, si, factor) in &KNOWN_UNITS {
+        if let Some(name) = header
+            .strip_suffix(suffix)
+            .and_then(|h| h.strip_suffix('_'))
+            .filter(|n| !n.is_empty())
+        {
+            return (Channel::new(name, si), factor);
+        }
+    }
+    (Channel::new(header, ""), 1.0)
 }
 
-/// `(header name, field, divisor to SI)`.
-const COLUMNS: [(&str, Field, f64); 10] = [
-    ("t_s", Field::T, 1.0),
-    ("u", Field::U, 1.0),
-    ("x1_m", Field::X1, 1.0),
-    ("x1_mm", Field::X1, 1000.0),
-    ("x2_m", Field::X2, 1.0),
-    ("x2_mm", Field::X2, 1000.0),
-    ("v1_m_s", Field::V1, 1.0),
-    ("v1_mm_s", Field::V1, 1000.0),
-    ("v2_m_s", Field::V2, 1.0),
-    ("v2_mm_s", Field::V2, 1000.0),
-];
+/// The header the writer uses for `channel`: `name_unit` for a unit in
+/// [`KNOWN_UNITS`] (`/` written as `_`), `name [unit]` for any other unit,
+/// `name` alone without one.
+fn header_of(channel: &Channel) -> String {
+    if channel.unit.is_empty() {
+        return channel.name.clone();
+    }
+    let suffix = channel.unit.replace('/', "_");
+    if KNOWN_UNITS.iter().any(|k| k.0 == suffix && k.2 == 1.0) {
+        format!("{}_{suffix}", channel.name)
+    } else {
+        format!("{} [{}]", channel.name, channel.unit)
+    }
+}
 
-/// Names that are a known quantity written without a unit.
-const UNITLESS: [(&str, &str); 5] = [
-    ("t", "t_s"),
-    ("x1", "x1_m or x1_mm"),
-    ("x2", "x2_m or x2_mm"),
-    ("v1", "v1_m_s or v1_mm_s"),
-    ("v2", "v2_m_s or v2_mm_s"),
-];
+/// Input channels in a file are those named `u` or `u` followed by digits
+/// (python-control's and MATLAB's convention for inputs).
+fn is_input_name(name: &str) -> bool {
+    name.strip_prefix('u')
+        .is_some_and(|rest| rest.chars().all(|c| c.is_ascii_digit()))
+}
 
 fn csv_error(line: u64, reason: impl Into<String>) -> Error {
     Error::Csv {
@@ -84,39 +125,43 @@ impl Recording {
 
     /// Reads a recording from CSV text.
     ///
-    /// The first line is a header; the name of each column carries its unit,
-    /// and values are converted to SI on reading:
+    /// The first line is a header. One column is time: `t_s` (or `t_ms`,
+    /// `t [s]`, `time_s`, …: a channel named `t` or `time` in a time unit).
+    /// Every other column is a channel; its header carries its unit, and
+    /// values are converted to SI on reading:
     ///
-    /// | quantity | accepted headers |
-    /// |---|---|
-    /// | time (required) | `t_s` |
-    /// | input (required) | `u` (V on the rig, N in simulation; stored as is) |
-    /// | cart positions (required) | `x1_m` or `x1_mm`, `x2_m` or `x2_mm` |
-    /// | cart velocities (optional, both or neither) | `v1_m_s` or `v1_mm_s`, `v2_m_s` or `v2_mm_s` |
+    /// - `name_unit` with a unit from [`KNOWN_UNITS`] (`x1_mm`, `v1_m_s`,
+    ///   `u_V`), or `name [unit]` / `name (unit)` with any unit;
+    /// - `name` alone: a channel without a unit (the lab's `u`).
     ///
-    /// Columns may come in any order; other columns are ignored. Surrounding
-    /// whitespace is trimmed. The time column must increase strictly and be
-    /// uniformly sampled (each interval within [`MAX_JITTER`](super::MAX_JITTER)
-    /// of the mean), and there must be at least [`MIN_ROWS`] data rows.
+    /// Channels named `u` or `u1`, `u2`, … are the inputs, the others the
+    /// measurements, in file order. Surrounding whitespace is trimmed. The
+    /// time column must increase strictly and be uniformly sampled (each
+    /// interval within [`MAX_JITTER`](super::MAX_JITTER) of the mean), with
+    /// at least two rows; what a file must hold beyond that is for its user
+    /// to check (the lab's identification asks for its own channels and
+    /// rows).
     ///
     /// # Errors
     ///
     /// [`Error::Csv`] with the one-based line (header = line 1) for: empty
-    /// input, a missing, duplicated or unit-less column, a row with the wrong
+    /// input, a missing or duplicated time column (the message shows the
+    /// header found), two columns for one channel, a row with the wrong
     /// number of fields, a value that is not a finite number, a time that
     /// does not increase, irregular sampling (the jitter is in the message),
-    /// fewer than [`MIN_ROWS`] rows (reported on the last line), or bytes the
-    /// CSV parser rejects (invalid UTF-8). [`Error::Io`] for a failing reader.
+    /// fewer than two rows, or bytes the CSV parser rejects (invalid
+    /// UTF-8). [`Error::Io`] for a failing reader.
     ///
     /// # Examples
     ///
     /// ```
     /// # use ctrlab::{Error, Recording};
     /// let text = "t_s,u,x1_mm,x2_mm\n\
-    ///             0.000,2,0,0\n0.002,2,0,0.05\n0.004,2,0.01,0.2\n\
-    ///             0.006,2,0.05,0.43\n0.008,2,0.12,0.75\n0.010,2,0.24,1.15\n";
+    ///             0.000,2,0,0\n0.002,2,0,0.05\n0.004,2,0.01,0.2\n";
     /// let rec = Recording::from_reader(text.as_bytes())?;
-    /// assert_eq!(rec.x2[2], 0.2 / 1000.0); // millimetres are converted to metres
+    /// assert_eq!(rec.channel("x2")?[2], 0.2 / 1000.0); // millimetres are converted to metres
+    /// assert_eq!(rec.schema().inputs()[0].name, "u");
+    /// assert_eq!(rec.schema().measurements()[0].unit, "m");
     ///
     /// let bad = text.replace("0.01,0.2", "0.01,oops");
     /// let err = Recording::from_reader(bad.as_bytes()).unwrap_err();
@@ -132,46 +177,51 @@ impl Recording {
         if headers.is_empty() || headers.iter().all(str::is_empty) {
             return Err(csv_error(1, "empty input: expected a header line"));
         }
+        let found = || headers.iter().collect::<Vec<_>>().join(",");
 
-        // Map each recognised header to (column index, divisor).
-        let mut slots: [Option<(usize, f64, &str)>; 6] = [None; 6];
-        for (i, name) in headers.iter().enumerate() {
-            if let Some(&(canonical, field, div)) = COLUMNS.iter().find(|c| c.0 == name) {
-                let slot = &mut slots[field as usize];
-                if let Some((_, _, first)) = slot {
-                    return Err(csv_error(
-                        1,
-                        format!("column `{name}` duplicates column `{first}`"),
-                    ));
+        // (column index, factor) of time, and of each channel in order.
+        let mut time: Option<(usize, f64)> = None;
+        let mut inputs: Vec<(Channel, usize, f64)> = Vec::new();
+        let mut measurements: Vec<(Channel, usize, f64)> = Vec::new();
+        for (i, header) in headers.iter().enumerate() {
+            let (channel, factor) = parse_header(header);
+            if matches!(channel.name.as_str(), "t" | "time") && channel.unit == "s" {
+                if time.is_some() {
+                    return Err(csv_error(1, format!("two time columns in header `{}`", found())));
                 }
-                *slot = Some((i, div, canonical));
-            } else if let Some((_, want)) = UNITLESS.iter().find(|c| c.0 == name) {
+                time = Some((i, factor));
+            } else if matches!(channel.name.as_str(), "t" | "time") {
                 return Err(csv_error(
                     1,
-                    format!("column `{name}` has no unit: name it {want}"),
+                    format!("column `{header}` has no time unit: name it t_s or t_ms (header `{}`)", found()),
                 ));
+            } else if is_input_name(&channel.name) {
+                inputs.push((channel, i, factor));
+            } else {
+                measurements.push((channel, i, factor));
             }
         }
-        for (field, want) in [
-            (Field::T, "t_s"),
-            (Field::U, "u"),
-            (Field::X1, "x1_m or x1_mm"),
-            (Field::X2, "x2_m or x2_mm"),
-        ] {
-            if slots[field as usize].is_none() {
-                return Err(csv_error(1, format!("missing column {want}")));
-            }
-        }
-        let has_v1 = slots[Field::V1 as usize].is_some();
-        if has_v1 != slots[Field::V2 as usize].is_some() {
-            let missing = if has_v1 { "v2" } else { "v1" };
+        let Some((time_index, time_factor)) = time else {
             return Err(csv_error(
                 1,
-                format!("velocity columns come in pairs: missing {missing}_m_s or {missing}_mm_s"),
+                format!("missing a time column t_s (or t_ms, t [s]); the header is `{}`", found()),
             ));
-        }
+        };
+        let schema = Schema::new(
+            inputs.iter().map(|c| c.0.clone()).collect(),
+            measurements.iter().map(|c| c.0.clone()).collect(),
+        )
+        .map_err(|e| csv_error(1, format!("{e} (header `{}`)", found())))?;
+        let slots: Vec<(usize, f64, &str)> = std::iter::once((time_index, time_factor, "t"))
+            .chain(
+                inputs
+                    .iter()
+                    .chain(&measurements)
+                    .map(|(c, i, f)| (*i, *f, c.name.as_str())),
+            )
+            .collect();
 
-        let mut cols: [Vec<f64>; 6] = Default::default();
+        let mut cols: Vec<Vec<f64>> = vec![Vec::new(); slots.len()];
         let mut lines: Vec<u64> = Vec::new();
         let mut record = csv::StringRecord::new();
         let mut last_line = 1u64;
@@ -183,43 +233,36 @@ impl Recording {
             }
             let line = record.position().map_or(last_line + 1, |p| p.line());
             last_line = line;
-            for (slot, col) in slots.iter().zip(cols.iter_mut()) {
-                let Some((i, div, name)) = *slot else {
-                    continue;
-                };
+            for (&(i, factor, name), col) in slots.iter().zip(cols.iter_mut()) {
                 let text = record.get(i).unwrap_or("");
                 let value: f64 = text.parse().map_err(|_| {
                     csv_error(line, format!("column {name}: `{text}` is not a number"))
                 })?;
+                let value = value * factor;
                 if !value.is_finite() {
                     return Err(csv_error(
                         line,
                         format!("column {name}: `{text}` is not a finite number"),
                     ));
                 }
-                col.push(value / div);
+                col.push(value);
             }
             lines.push(line);
         }
 
-        if lines.len() < MIN_ROWS {
+        if lines.len() < 2 {
             return Err(csv_error(
                 last_line,
-                format!(
-                    "only {} data rows: at least {MIN_ROWS} are needed",
-                    lines.len()
-                ),
+                format!("only {} data rows: at least 2 are needed", lines.len()),
             ));
         }
-        let [t, u, x1, x2, v1, v2] = cols;
+        let mut cols = cols.into_iter();
+        let t = cols.next().unwrap_or_default();
         check_time(&t).map_err(|(k, reason)| csv_error(lines[k], reason))?;
         Ok(Recording {
+            schema,
             t,
-            u,
-            x1,
-            x2,
-            v1: has_v1.then_some(v1),
-            v2: has_v1.then_some(v2),
+            columns: cols.collect(),
         })
     }
 
@@ -235,9 +278,10 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::Recording;
-    /// let mut rec = Recording::new();
+    /// # use ctrlab::data::Schema;
+    /// let mut rec = Recording::new(Schema::numbered(1, 2));
     /// for k in 0..6 {
-    ///     rec.push(k as f64 * 0.002, 1.0, 1e-4 * k as f64, 2e-4 * k as f64);
+    ///     rec.push(k as f64 * 0.002, &[1.0], &[1e-4 * k as f64, 2e-4 * k as f64])?;
     /// }
     /// let path = std::env::temp_dir().join("ctrlab_doc_write_csv.csv");
     /// rec.write_csv(&path)?;
@@ -262,62 +306,45 @@ impl Recording {
             .map_err(|e| Error::io(format!("writing {}", path.display()), &e))
     }
 
-    /// Writes the recording as CSV in SI units: header
-    /// `t_s,u,x1_m,x2_m` plus `v1_m_s,v2_m_s` when the recording has
-    /// velocities. Values are written in Rust's shortest round-trip form, so
-    /// reading the output back gives the identical recording (metres are
-    /// chosen over millimetres because the conversion would round).
+    /// Writes the recording as CSV in SI units: header `t_s` and one column
+    /// per channel (inputs, then measurements), each header the channel's
+    /// name and unit (`x1_m`, `v1_m_s`, `u_V`; see [`KNOWN_UNITS`]). Values
+    /// are written in Rust's shortest round-trip form, so reading the output
+    /// back gives the identical recording.
     ///
     /// # Errors
     ///
-    /// [`Error::InvalidRecording`] for columns of different lengths or a
-    /// non-finite value (the reader would refuse them); [`Error::Io`] when
-    /// the writer fails.
+    /// [`Error::InvalidRecording`] for a non-finite value (the reader would
+    /// refuse it); [`Error::Io`] when the writer fails.
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::Recording;
-    /// let mut rec = Recording::new();
-    /// rec.push(0.0, 2.0, 0.001, 0.0025);
+    /// # use ctrlab::data::{Channel, Recording, Schema};
+    /// let schema = Schema::new(vec![Channel::new("u", "V")], vec![Channel::new("x1", "m"), Channel::new("v1", "m/s")])?;
+    /// let mut rec = Recording::new(schema);
+    /// rec.push(0.0, &[2.0], &[0.001, 0.0025])?;
     /// let mut out = Vec::new();
     /// rec.to_writer(&mut out)?;
-    /// assert_eq!(String::from_utf8(out).unwrap(), "t_s,u,x1_m,x2_m\n0.0,2.0,0.001,0.0025\n");
+    /// assert_eq!(String::from_utf8(out).unwrap(), "t_s,u_V,x1_m,v1_m_s\n0.0,2.0,0.001,0.0025\n");
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn to_writer(&self, writer: impl Write) -> Result<(), Error> {
-        let n = self.len();
-        let mut columns: Vec<&[f64]> = vec![&self.t, &self.u, &self.x1, &self.x2];
-        let mut header = vec!["t_s", "u", "x1_m", "x2_m"];
-        if let (Some(v1), Some(v2)) = (&self.v1, &self.v2) {
-            columns.push(v1);
-            columns.push(v2);
-            header.extend(["v1_m_s", "v2_m_s"]);
-        }
-        for (name, col) in header.iter().zip(&columns) {
-            if col.len() != n {
-                return Err(Error::InvalidRecording {
-                    index: col.len().min(n),
-                    reason: format!("column {name} has {} samples, t has {n}", col.len()),
-                });
-            }
-            if let Some(k) = col.iter().position(|v| !v.is_finite()) {
-                return Err(Error::InvalidRecording {
-                    index: k,
-                    reason: format!("{name} = {} is not finite", col[k]),
-                });
-            }
-        }
+        self.check_values()?;
         let io = |e: csv::Error| match e.into_kind() {
             csv::ErrorKind::Io(e) => Error::io("writing CSV", &e),
             other => Error::io("writing CSV", &std::io::Error::other(format!("{other:?}"))),
         };
         let mut w = csv::Writer::from_writer(writer);
+        let header: Vec<String> = std::iter::once("t_s".to_string())
+            .chain(self.schema.channels().map(header_of))
+            .collect();
         w.write_record(&header).map_err(io)?;
-        let mut fields: Vec<String> = Vec::with_capacity(columns.len());
-        for k in 0..n {
+        let mut fields: Vec<String> = Vec::with_capacity(header.len());
+        for k in 0..self.len() {
             fields.clear();
-            fields.extend(columns.iter().map(|c| format!("{:?}", c[k])));
+            fields.push(format!("{:?}", self.t[k]));
+            fields.extend(self.columns.iter().map(|c| format!("{:?}", c[k])));
             w.write_record(&fields).map_err(io)?;
         }
         w.flush().map_err(|e| Error::io("writing CSV", &e))

@@ -3,9 +3,9 @@
 
 use nalgebra::{Complex, DMatrix, SMatrix};
 
-use crate::analysis::eigenvalues;
+use crate::analysis::{eigenvalues, first_unstable};
 use crate::error::{Error, check_finite};
-use crate::linalg::Lu;
+use crate::kernels::linalg::Lu;
 use crate::model::{Continuous, Discrete, StateSpace};
 
 /// Doubling steps allowed; quadratic convergence needs far fewer (about
@@ -105,10 +105,10 @@ pub struct Lqr<const N: usize, const M: usize> {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Output, design::lqr};
+/// use ctrlab::{MassSpring, Cart, design::lqr};
 /// use nalgebra::{SMatrix, matrix};
 ///
-/// let plant = MassSpring::nominal().state_space(Output::Cart2)?;
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let q = SMatrix::<f64, 4, 4>::from_diagonal(&nalgebra::vector![0.0, 0.0, 1e6, 0.0]);
 /// let sol = lqr(&plant, &q, &matrix![1.0])?;
 /// assert!(sol.poles.iter().all(|p| p.re < 0.0));
@@ -183,9 +183,7 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
         },
     );
     let gain = r_inv_bt * x;
-    finish(gain, x, &(a - b * gain), residual, iterations, |p| {
-        p.re < 0.0
-    })
+    finish(gain, x, &(a - b * gain), residual, iterations, None)
 }
 
 /// Discrete-time LQR: the gain `K = (R + Bᵀ X B)⁻¹ Bᵀ X A` minimising
@@ -201,10 +199,10 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Method, Output, design::dlqr};
+/// use ctrlab::{MassSpring, Method, Cart, design::dlqr};
 /// use nalgebra::{SMatrix, matrix, vector};
 ///
-/// let d = MassSpring::nominal().state_space(Output::Cart2)?.discretize(0.002, Method::Zoh)?;
+/// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
 /// let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e4, 0.0, 1e6, 0.0]);
 /// let sol = dlqr(&d, &q, &matrix![1.0])?;
 /// assert!(sol.poles.iter().all(|z| z.norm() < 1.0));
@@ -237,9 +235,7 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
         )
     });
     let gain = dare_gain(&a, &b, r, &x)?;
-    finish(gain, x, &(a - b * gain), residual, iterations, |z| {
-        z.norm() < 1.0
-    })
+    finish(gain, x, &(a - b * gain), residual, iterations, Some(sys.dt()))
 }
 
 /// The doubling iteration on `(E, G, H)`; returns `H` at convergence.
@@ -280,7 +276,7 @@ fn finish<const N: usize, const M: usize>(
     a_cl: &SMatrix<f64, N, N>,
     residual: f64,
     iterations: usize,
-    stable: impl Fn(&Complex<f64>) -> bool,
+    period: Option<f64>,
 ) -> Result<Lqr<N, M>, Error> {
     if gain.iter().any(|v| !v.is_finite()) {
         return Err(Error::Overflow {
@@ -288,7 +284,7 @@ fn finish<const N: usize, const M: usize>(
         });
     }
     let poles = eigenvalues(a_cl)?;
-    if let Some(p) = poles.iter().find(|p| !stable(p)) {
+    if let Some(p) = first_unstable(&poles, a_cl, period) {
         return Err(Error::Unstable {
             operation: "LQR: the Riccati solution does not stabilise the loop \
                         (is (A, B) stabilisable and (A, Q) detectable?)",

@@ -4,7 +4,7 @@ use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::analysis::rank;
 use crate::error::Error;
-use crate::linalg::Lu;
+use crate::kernels::linalg::Lu;
 use crate::model::{Domain, StateSpace};
 
 /// Relative distance within which two targets count as a conjugate pair.
@@ -31,10 +31,10 @@ const CONJUGATE_RTOL: f64 = 1e-10;
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Output, design::{StateFeedback, acker}};
+/// use ctrlab::{MassSpring, Cart, design::{StateFeedback, acker}};
 /// use nalgebra::Complex;
 ///
-/// let plant = MassSpring::nominal().state_space(Output::Cart2)?;
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let targets = [
 ///     Complex::new(-30.0, 30.0), Complex::new(-30.0, -30.0),
 ///     Complex::new(-40.0, 0.0), Complex::new(-50.0, 0.0),

@@ -1,10 +1,36 @@
-//! [`VirtualClock`]: shared simulated time for the simulated card and the
+//! Where time comes from: [`Clock`] (wall-clock or virtual) and
+//! [`VirtualClock`], shared simulated time for the simulated card and the
 //! control loop.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::HwError;
+
+/// Where the control loop and the simulated card take their time from.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{Clock, VirtualClock};
+/// let time = VirtualClock::new();
+/// let clock = Clock::Virtual(time.clone()); // the card gets the same handle
+/// assert!(matches!(clock, Clock::Virtual(_)));
+/// assert_eq!(time.now(), 0.0);
+/// ```
+#[derive(Debug, Clone)]
+pub enum Clock {
+    /// Wall-clock time (`std::time::Instant`). The loop sleeps until each
+    /// deadline (the last 200 µs are spun for precision); a simulated card
+    /// integrates its plant to the time of each access. Not a real-time
+    /// kernel: expect occasional lateness of tens of µs or more under load.
+    RealTime,
+    /// Simulated time: each tick of the loop advances the [`VirtualClock`]
+    /// by exactly one period and never sleeps, so a 5 s experiment on a
+    /// [`SimulatedCard`](super::SimulatedCard) sharing the same clock runs
+    /// as fast as the CPU allows and is exactly reproducible.
+    Virtual(VirtualClock),
+}
 
 /// A cheap, cloneable handle to shared simulated time, counted in whole
 /// nanoseconds from zero.

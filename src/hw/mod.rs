@@ -1,5 +1,6 @@
-//! Hardware: the lab's FPGA card over the parallel port, a register-level
-//! simulation of it, and the two-cart rig on top.
+//! Hardware: the [`Rig`] trait any controller runs against, the
+//! fixed-period control loop [`run`], and the lab's FPGA card over the
+//! parallel port with a register-level simulation of it.
 //!
 //! The layers, bottom up:
 //!
@@ -10,11 +11,16 @@
 //! - [`Pc104`]: the card driver (PWM duty, counters latched together and
 //!   unwrapped, counter clear, ID probe, watchdog kick) over a documented,
 //!   replaceable [`RegisterMap`].
-//! - [`SimulatedCard`]: the card emulated register by register, with a
-//!   two-cart plant inside that follows a [`VirtualClock`] or real time.
-//! - [`Rig`] and [`MassSpringRig`]: the state `[x1, v1, x2, v2]` in m and
-//!   m/s and the motor in volts, with [`Calibration`], saturation, travel
-//!   limits and halt on drop.
+//! - [`SimulatedCard`]: the card emulated register by register, with any
+//!   plant ([`Dynamics`](crate::Dynamics), input in volts) inside that
+//!   follows a [`Clock`]: a [`VirtualClock`] or real time.
+//! - [`Rig`]: measurements in, inputs out, at a fixed period; [`run`]
+//!   drives one with any [`Controller`](crate::Controller) and returns a
+//!   [`Recording`](crate::Recording).
+//!
+//! This module names no cart: the lab's two-cart rig on the card is
+//! [`lab::MassSpringRig`](crate::lab::MassSpringRig), and the simulated one
+//! in one call is [`lab::SimulatedRig`](crate::lab::SimulatedRig).
 //!
 //! # Examples
 //!
@@ -22,13 +28,12 @@
 //! and watch cart 2 settle at its static deflection.
 //!
 //! ```
-//! use ctrlab::MassSpring;
-//! use ctrlab::hw::{Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock};
+//! use ctrlab::hw::{Clock, Rig, VirtualClock};
+//! use ctrlab::lab::{MassSpring, SimulatedRig};
 //!
 //! let clock = VirtualClock::new();
-//! let config = SimulatedCardConfig { truth: MassSpring::nominal(), ..Default::default() };
-//! let card = SimulatedCard::virtual_time(config, &clock)?;
-//! let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+//! let mut rig = SimulatedRig { truth: MassSpring::nominal(), ..Default::default() }
+//!     .rig(&Clock::Virtual(clock.clone()))?;
 //! let mut x = rig.read_state()?;
 //! for _ in 0..5000 {
 //!     rig.apply_voltage(12.0)?; // 12 N with the nominal 1 N/V
@@ -45,6 +50,7 @@ mod epp;
 mod error;
 mod pc104;
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
+#[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 mod ppdev;
 mod rig;
 mod run;
@@ -52,7 +58,7 @@ mod sim_card;
 mod sim_config;
 pub mod testing;
 
-pub use clock::VirtualClock;
+pub use clock::{Clock, VirtualClock};
 pub use epp::EppPort;
 pub use error::{CycleKind, HwError, HwErrorKind};
 pub use pc104::{
@@ -60,8 +66,9 @@ pub use pc104::{
     duty_from_bytes, pwm_bytes,
 };
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
+#[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 pub use ppdev::{Ppdev, ioctl};
-pub use rig::{Calibration, MassSpringRig, Rig};
-pub use run::{Clock, LoopConfig, LoopStats, RunError, RunOutcome, run};
-pub use sim_card::{SimulatedCard, TimeBase};
+pub use rig::Rig;
+pub use run::{LoopConfig, LoopStats, RunError, RunOutcome, run};
+pub use sim_card::SimulatedCard;
 pub use sim_config::{SIMULATED_CARD_ID, SimulatedCardConfig};

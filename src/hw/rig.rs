@@ -1,72 +1,109 @@
-//! The [`Rig`] trait and the lab's two-cart rig on the card,
-//! [`MassSpringRig`].
+//! The [`Rig`] trait: a plant a controller can run against.
 
 use nalgebra::SVector;
 
-use super::pc104::{ENCODER_CHANNELS, MAX_DUTY, PWM_CHANNELS};
-use super::{EppPort, HwError, Pc104};
+use super::HwError;
+use crate::data::Schema;
 
-/// A plant a controller can run against: read the state, apply a voltage,
-/// halt. The state is `[x1, v1, x2, v2]` in m and m/s, the input in V.
+/// A plant a controller can run against, with `M` inputs and `P`
+/// measurements, sampled at a fixed period: read the measurements, apply
+/// the inputs, halt.
 ///
-/// Implemented by [`MassSpringRig`] over any [`EppPort`] (the real card, the
-/// [`SimulatedCard`](super::SimulatedCard), a fake), and by `&mut R` for any
+/// [`run`](super::run) drives any `Rig` with any
+/// [`Controller`](crate::Controller) of matching sizes. The lab's two-cart
+/// rig on the PC104 card is [`lab::MassSpringRig`](crate::lab::MassSpringRig)
+/// (`M = 1` volt, `P = 4`: `[x1, v1, x2, v2]`); `&mut R` is a rig for any
 /// rig `R`.
 ///
 /// # Examples
 ///
-/// ```
-/// use ctrlab::hw::{Pc104, Rig, MassSpringRig, Calibration, SimulatedCard};
+/// A rig written outside the crate: a heater whose temperature rises with
+/// the power applied.
 ///
-/// fn push<R: Rig>(rig: &mut R) -> Result<f64, ctrlab::hw::HwError> {
-///     rig.apply_voltage(6.0)?;
-///     Ok(rig.read_state()?[2])
-/// }
-/// let mut rig = MassSpringRig::new(Pc104::new(SimulatedCard::default()), Calibration::default(), 0.002)?;
-/// assert_eq!(push(&mut rig)?, 0.0); // no time has passed
-/// rig.halt()?;
-/// # Ok::<(), ctrlab::hw::HwError>(())
 /// ```
-pub trait Rig {
-    /// Samples the state `[x1, v1, x2, v2]` (m, m/s).
+/// use ctrlab::hw::{HwError, Rig};
+/// use nalgebra::{SVector, vector};
+///
+/// struct Heater { temperature: f64, power: f64 }
+/// impl Rig<1, 1> for Heater {
+///     fn read(&mut self) -> Result<SVector<f64, 1>, HwError> {
+///         self.temperature += 0.1 * self.power; // one period of heating
+///         Ok(vector![self.temperature])
+///     }
+///     fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HwError> {
+///         self.power = u[0].clamp(0.0, 100.0);
+///         Ok(vector![self.power])
+///     }
+///     fn halt(&mut self) -> Result<(), HwError> { self.power = 0.0; Ok(()) }
+///     fn period(&self) -> f64 { 1.0 }
+/// }
+///
+/// let mut heater = Heater { temperature: 20.0, power: 0.0 };
+/// assert_eq!(heater.apply(&vector![150.0])?, vector![100.0]); // saturated
+/// assert_eq!(heater.read()?, vector![30.0]);
+/// # Ok::<(), HwError>(())
+/// ```
+pub trait Rig<const M: usize, const P: usize> {
+    /// Samples the measurements now, in the units of
+    /// [`schema`](Self::schema) (SI). Called once per period.
     ///
     /// # Errors
     ///
-    /// Port errors; [`HwError::TravelLimit`] (after halting) when a cart is
-    /// beyond its limit.
-    fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError>;
+    /// Port errors, and whatever the rig checks (travel limits, …), after
+    /// halting.
+    fn read(&mut self) -> Result<SVector<f64, P>, HwError>;
 
-    /// Applies `volts` to the motor (saturated to the rig's range) and
-    /// returns the voltage actually applied, V (after saturation and the
-    /// card's quantisation), which is what a recording should hold.
+    /// Applies the inputs `u` (saturated and quantised to what the rig can
+    /// do) and returns the inputs actually applied, which is what a
+    /// recording and the controller's anti-windup should see.
     ///
     /// # Errors
     ///
     /// Port errors; [`HwError::InvalidCommand`] (after halting) for a
-    /// non-finite voltage.
-    fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError>;
+    /// non-finite input.
+    fn apply(&mut self, u: &SVector<f64, M>) -> Result<SVector<f64, M>, HwError>;
 
-    /// Stops the motor (zero voltage).
+    /// Stops the actuators (zero input).
     ///
     /// # Errors
     ///
     /// Port errors.
     fn halt(&mut self) -> Result<(), HwError>;
 
-    /// Forgets the previous sample, so the next [`read_state`](Self::read_state)
-    /// starts its speed estimate afresh (reporting zero speed) instead of
-    /// differencing against a sample from long ago. The control loop calls
-    /// it at the start of every run and after skipped deadlines. The default
-    /// does nothing (for rigs that measure speed directly).
+    /// The sampling period the rig runs at, s: the loop runs at this
+    /// period (it is given once, to the rig).
+    fn period(&self) -> f64;
+
+    /// Names and units of the inputs and measurements, for the recording.
+    /// The default numbers them without units ([`Schema::numbered`]).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock};
+    /// use ctrlab::hw::{Clock, Rig};
+    /// use ctrlab::lab::SimulatedRig;
+    /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
+    /// assert_eq!(rig.schema().measurements()[2].name, "x2");
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    fn schema(&self) -> Schema {
+        Schema::numbered(M, P)
+    }
+
+    /// Forgets the previous sample, so the next [`read`](Self::read) starts
+    /// any differenced estimate (a speed from counts) afresh instead of
+    /// differencing against a sample from long ago. The control loop calls
+    /// it at the start of every run and after skipped deadlines. The default
+    /// does nothing.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Clock, Rig, VirtualClock};
+    /// use ctrlab::lab::SimulatedRig;
     ///
     /// let clock = VirtualClock::new();
-    /// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
-    /// let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+    /// let mut rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
     /// rig.read_state()?;
     /// rig.apply_voltage(6.0)?;
     /// clock.advance(0.5)?; // a long pause, as between two runs
@@ -77,389 +114,44 @@ pub trait Rig {
     /// ```
     fn restart(&mut self) {}
 
-    /// The sampling period the rig's speed estimates assume, s, if it has
-    /// one. The control loop refuses to run at another period.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, Rig, SimulatedCard};
-    /// let rig = MassSpringRig::new(Pc104::new(SimulatedCard::default()), Calibration::default(), 0.002)?;
-    /// assert_eq!(Rig::period(&rig), Some(0.002));
-    /// # Ok::<(), ctrlab::hw::HwError>(())
-    /// ```
-    fn period(&self) -> Option<f64> {
-        None
-    }
-
-    /// Tells the card's watchdog the controller is alive. The default does
+    /// Tells the rig's watchdog the controller is alive. The default does
     /// nothing (for rigs without a watchdog, or whose
-    /// [`read_state`](Self::read_state) already kicks it).
+    /// [`read`](Self::read) already kicks it).
     ///
     /// # Errors
     ///
     /// Port errors.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{HwError, Rig};
-    /// use nalgebra::SVector;
-    /// struct Still;
-    /// impl Rig for Still {
-    ///     fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError> { Ok(SVector::zeros()) }
-    ///     fn apply_voltage(&mut self, _: f64) -> Result<f64, HwError> { Ok(0.0) }
-    ///     fn halt(&mut self) -> Result<(), HwError> { Ok(()) }
-    /// }
-    /// assert!(Still.kick_watchdog().is_ok());
-    /// ```
     fn kick_watchdog(&mut self) -> Result<(), HwError> {
         Ok(())
     }
 }
 
-impl<R: Rig + ?Sized> Rig for &mut R {
+impl<R: Rig<M, P> + ?Sized, const M: usize, const P: usize> Rig<M, P> for &mut R {
     #[inline]
-    fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError> {
-        (**self).read_state()
+    fn read(&mut self) -> Result<SVector<f64, P>, HwError> {
+        (**self).read()
     }
     #[inline]
-    fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError> {
-        (**self).apply_voltage(volts)
+    fn apply(&mut self, u: &SVector<f64, M>) -> Result<SVector<f64, M>, HwError> {
+        (**self).apply(u)
     }
     #[inline]
     fn halt(&mut self) -> Result<(), HwError> {
         (**self).halt()
     }
     #[inline]
-    fn kick_watchdog(&mut self) -> Result<(), HwError> {
-        (**self).kick_watchdog()
+    fn period(&self) -> f64 {
+        (**self).period()
+    }
+    fn schema(&self) -> Schema {
+        (**self).schema()
     }
     #[inline]
     fn restart(&mut self) {
         (**self).restart()
     }
     #[inline]
-    fn period(&self) -> Option<f64> {
-        (**self).period()
-    }
-}
-
-/// How the rig's counts and volts map to SI, and which channels are wired
-/// where.
-///
-/// The default is the lab's rig as the [`SimulatedCard`](super::SimulatedCard)
-/// models it: 80 mm per 8192 counts (9.765625 µm per count), both encoders
-/// counting up when the carts move away from the wall, 24 V full scale, the
-/// motor on PWM channel 0, cart 1 on encoder 0, cart 2 on encoder 1, travel
-/// limits ±0.15 m on both carts.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::hw::Calibration;
-/// let cal = Calibration::default();
-/// assert_eq!(cal.metres_per_count * 8192.0, 0.080);
-/// let flipped = Calibration { sign: [1.0, -1.0], ..cal };
-/// assert!(flipped.validate().is_ok());
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Calibration {
-    /// Cart travel per encoder count, m (> 0).
-    pub metres_per_count: f64,
-    /// Sign of each encoder (cart 1, cart 2): +1 when counting up means the
-    /// cart moves away from the wall, −1 otherwise.
-    pub sign: [f64; 2],
-    /// Motor voltage at 100 % duty, V (> 0); commands saturate at ±this.
-    pub volts_full_scale: f64,
-    /// The PWM channel driving the motor (0–3).
-    pub pwm_channel: usize,
-    /// The encoder channels of cart 1 and cart 2 (0–3, distinct).
-    pub encoder_channels: [usize; 2],
-    /// Software travel limits of cart 1 and cart 2, m (> 0, symmetric about
-    /// the position where the counters were cleared).
-    pub travel_limits: [f64; 2],
-}
-
-impl Default for Calibration {
-    fn default() -> Self {
-        Self {
-            metres_per_count: 0.080 / 8192.0,
-            sign: [1.0, 1.0],
-            volts_full_scale: 24.0,
-            pwm_channel: 0,
-            encoder_channels: [0, 1],
-            travel_limits: [0.15, 0.15],
-        }
-    }
-}
-
-impl Calibration {
-    /// Checks every field.
-    ///
-    /// # Errors
-    ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{Calibration, HwError};
-    /// let bad = Calibration { sign: [1.0, 0.5], ..Calibration::default() };
-    /// assert!(matches!(bad.validate(), Err(HwError::InvalidConfig { name: "sign", .. })));
-    /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        let positive = [
-            ("metres_per_count", self.metres_per_count),
-            ("volts_full_scale", self.volts_full_scale),
-            ("travel_limits", self.travel_limits[0]),
-            ("travel_limits", self.travel_limits[1]),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(invalid(name, value, "must be finite and > 0"));
-            }
-        }
-        for s in self.sign {
-            if s != 1.0 && s != -1.0 {
-                return Err(invalid("sign", s, "must be +1 or -1"));
-            }
-        }
-        if self.pwm_channel >= PWM_CHANNELS {
-            return Err(invalid(
-                "pwm_channel",
-                self.pwm_channel as f64,
-                "must be 0–3",
-            ));
-        }
-        let [e1, e2] = self.encoder_channels;
-        if e1 >= ENCODER_CHANNELS || e2 >= ENCODER_CHANNELS || e1 == e2 {
-            return Err(invalid(
-                "encoder_channels",
-                e2 as f64,
-                "must be two distinct channels 0–3",
-            ));
-        }
-        Ok(())
-    }
-}
-
-fn invalid(name: &'static str, value: f64, reason: &'static str) -> HwError {
-    HwError::InvalidConfig {
-        name,
-        value,
-        reason,
-    }
-}
-
-/// The lab's two-cart rig on a [`Pc104`] card: counts to metres, volts to
-/// PWM duty, with the safety the rig needs.
-///
-/// - [`read_state`](Rig::read_state) latches both counters **and kicks the
-///   watchdog** in one control write, reads cart 1's and cart 2's counters,
-///   and returns `[x1, v1, x2, v2]`; speeds are backward differences of
-///   the counts over `period` (as the lab: "speeds come from counting pulses
-///   over the sampling period"), so read exactly once per period; the first
-///   read reports zero speeds. A cart beyond its travel limit halts the rig
-///   and returns [`HwError::TravelLimit`].
-/// - [`apply_voltage`](Rig::apply_voltage) saturates to
-///   ±`volts_full_scale` and quantises to the card's 0.1 % duty steps; a
-///   non-finite command halts the rig and returns
-///   [`HwError::InvalidCommand`].
-/// - Dropping the rig sets the PWM to zero (errors ignored: there is no one
-///   left to tell).
-///
-/// Nothing allocates in `read_state` or `apply_voltage`.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock};
-///
-/// let clock = VirtualClock::new();
-/// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
-/// let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
-/// assert_eq!(rig.apply_voltage(100.0)?, 24.0); // saturates at 24 V
-/// assert_eq!(rig.card().port().pwm_duty(0), 1000);
-/// clock.advance(0.02)?;
-/// let x = rig.read_state()?;
-/// assert!(x[2] > 0.0 && x[2] < 0.15);
-/// assert!(rig.apply_voltage(f64::NAN).is_err());
-/// assert_eq!(rig.card().port().pwm_duty(0), 0); // halted
-/// # Ok::<(), ctrlab::hw::HwError>(())
-/// ```
-#[derive(Debug)]
-pub struct MassSpringRig<P: EppPort> {
-    card: Pc104<P>,
-    calibration: Calibration,
-    period: f64,
-    previous: Option<[i64; 2]>,
-}
-
-impl<P: EppPort> MassSpringRig<P> {
-    /// The rig on `card` with `calibration`, read every `period` seconds.
-    /// Talks to the card only when used.
-    ///
-    /// # Errors
-    ///
-    /// [`HwError::InvalidConfig`] for an invalid calibration or a period
-    /// that is not finite and > 0.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{Calibration, HwErrorKind, MassSpringRig, Pc104, testing::RegisterFile};
-    /// let rig = MassSpringRig::new(Pc104::new(RegisterFile::new()), Calibration::default(), 0.002)?;
-    /// assert_eq!(rig.period(), 0.002);
-    /// let bad = MassSpringRig::new(Pc104::new(RegisterFile::new()), Calibration::default(), 0.0);
-    /// assert_eq!(bad.unwrap_err().kind(), HwErrorKind::InvalidConfig);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
-    /// ```
-    pub fn new(card: Pc104<P>, calibration: Calibration, period: f64) -> Result<Self, HwError> {
-        calibration.validate()?;
-        if !(period.is_finite() && period > 0.0) {
-            return Err(invalid("period", period, "must be finite and > 0 s"));
-        }
-        Ok(Self {
-            card,
-            calibration,
-            period,
-            previous: None,
-        })
-    }
-
-    /// The card driver.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, SimulatedCard};
-    /// let rig = MassSpringRig::new(Pc104::new(SimulatedCard::default()), Calibration::default(), 0.002)?;
-    /// assert_eq!(rig.card().port().voltage(), 0.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
-    /// ```
-    pub fn card(&self) -> &Pc104<P> {
-        &self.card
-    }
-
-    /// The card driver, mutably (to clear counters, probe the ID, …).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, SimulatedCard, SIMULATED_CARD_ID};
-    /// let mut rig = MassSpringRig::new(Pc104::new(SimulatedCard::default()), Calibration::default(), 0.002)?;
-    /// assert_eq!(rig.card_mut().probe_id(SIMULATED_CARD_ID)?, SIMULATED_CARD_ID);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
-    /// ```
-    pub fn card_mut(&mut self) -> &mut Pc104<P> {
-        &mut self.card
-    }
-
-    /// The calibration.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, SimulatedCard};
-    /// let rig = MassSpringRig::new(Pc104::new(SimulatedCard::default()), Calibration::default(), 0.002)?;
-    /// assert_eq!(rig.calibration().volts_full_scale, 24.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
-    /// ```
-    pub fn calibration(&self) -> &Calibration {
-        &self.calibration
-    }
-
-    /// The sampling period the speeds are computed over, s.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::{Calibration, MassSpringRig, Pc104, SimulatedCard};
-    /// let rig = MassSpringRig::new(Pc104::new(SimulatedCard::default()), Calibration::default(), 0.001)?;
-    /// assert_eq!(rig.period(), 0.001);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
-    /// ```
-    pub fn period(&self) -> f64 {
-        self.period
-    }
-
-    /// The duty for `volts` (finite): saturated, quantised to 0.1 %.
-    fn duty(&self, volts: f64) -> i16 {
-        let full = self.calibration.volts_full_scale;
-        let fraction = volts.clamp(-full, full) / full;
-        (fraction * f64::from(MAX_DUTY)).round() as i16
-    }
-}
-
-impl<P: EppPort> Rig for MassSpringRig<P> {
-    fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError> {
-        let cal = self.calibration;
-        self.card.latch_and_kick()?;
-        let counts = [
-            self.card.read_counter(cal.encoder_channels[0])?,
-            self.card.read_counter(cal.encoder_channels[1])?,
-        ];
-        let previous = self.previous.replace(counts).unwrap_or(counts);
-        let mut x = SVector::<f64, 4>::zeros();
-        for cart in 0..2 {
-            let scale = cal.sign[cart] * cal.metres_per_count;
-            x[2 * cart] = counts[cart] as f64 * scale;
-            x[2 * cart + 1] = (counts[cart] - previous[cart]) as f64 * scale / self.period;
-        }
-        for cart in 0..2 {
-            let (position, limit) = (x[2 * cart], cal.travel_limits[cart]);
-            if position.abs() > limit {
-                // The breach is the error to report; should the halt fail
-                // too, the caller's own halt or the card's watchdog follows.
-                self.halt().ok();
-                return Err(HwError::TravelLimit {
-                    cart: cart + 1,
-                    position,
-                    limit,
-                });
-            }
-        }
-        Ok(x)
-    }
-
-    fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError> {
-        if !volts.is_finite() {
-            // As for a travel-limit breach: report the cause.
-            self.halt().ok();
-            return Err(HwError::InvalidCommand {
-                what: "voltage",
-                channel: Some(self.calibration.pwm_channel),
-                value: volts,
-                limit: self.calibration.volts_full_scale,
-            });
-        }
-        let duty = self.duty(volts);
-        self.card.set_pwm(self.calibration.pwm_channel, duty)?;
-        Ok(f64::from(duty) / f64::from(MAX_DUTY) * self.calibration.volts_full_scale)
-    }
-
-    fn halt(&mut self) -> Result<(), HwError> {
-        self.card.set_pwm(self.calibration.pwm_channel, 0)
-    }
-
     fn kick_watchdog(&mut self) -> Result<(), HwError> {
-        self.card.kick_watchdog()
-    }
-
-    fn restart(&mut self) {
-        self.previous = None;
-    }
-
-    fn period(&self) -> Option<f64> {
-        Some(self.period)
-    }
-}
-
-impl<P: EppPort> Drop for MassSpringRig<P> {
-    fn drop(&mut self) {
-        // Best effort: a failing port cannot be reported from a destructor,
-        // and the card's watchdog zeroes the PWM anyway.
-        self.halt().ok();
+        (**self).kick_watchdog()
     }
 }

@@ -1,5 +1,5 @@
 //! The fixed-period control loop: drives any [`Controller`] against any
-//! [`Rig`] at period `T` (2 ms by default) on absolute deadlines, records every
+//! [`Rig`] at the rig's period `T` on absolute deadlines, records every
 //! sample, and stops safely.
 //!
 //! Deadlines are `t0 + k T`, never "now + T", so timing errors do not
@@ -15,31 +15,7 @@ use nalgebra::SVector;
 
 use crate::data::Recording;
 use crate::design::Controller;
-use crate::hw::{HwError, Rig, VirtualClock};
-
-/// Where the loop's time comes from.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::hw::{Clock, VirtualClock};
-/// let time = VirtualClock::new();
-/// let clock = Clock::Virtual(time.clone()); // the card gets the same handle
-/// assert!(matches!(clock, Clock::Virtual(_)));
-/// assert_eq!(time.now(), 0.0);
-/// ```
-#[derive(Debug, Clone)]
-pub enum Clock {
-    /// Wall-clock time: the loop sleeps until each deadline (the last
-    /// 200 µs are spun for precision). Not a real-time kernel: expect
-    /// occasional lateness of tens of µs or more under load.
-    RealTime,
-    /// Simulated time: each tick advances the [`VirtualClock`] by exactly one
-    /// period and never sleeps, so a 5 s experiment on the
-    /// [`SimulatedCard`](crate::hw::SimulatedCard) (sharing the same clock) runs
-    /// as fast as the CPU allows and is exactly reproducible.
-    Virtual(VirtualClock),
-}
+use crate::hw::{Clock, HwError, Rig};
 
 /// Settings of a [`run`].
 ///
@@ -48,14 +24,12 @@ pub enum Clock {
 /// ```
 /// use ctrlab::hw::LoopConfig;
 /// let config = LoopConfig { duration: 3.0, ..LoopConfig::default() };
-/// assert_eq!((config.period, config.max_consecutive_overruns), (0.002, 5));
+/// assert_eq!(config.max_consecutive_overruns, 5);
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoopConfig {
-    /// Sampling period `T`, s (default 0.002).
-    pub period: f64,
-    /// Length of the experiment, s; the loop runs `round(duration / period)`
-    /// ticks.
+    /// Length of the experiment, s; the loop runs `round(duration / T)`
+    /// ticks at the rig's period `T` ([`Rig::period`]).
     pub duration: f64,
     /// Consecutive overruns that stop the run (default 5).
     pub max_consecutive_overruns: usize,
@@ -64,7 +38,6 @@ pub struct LoopConfig {
 impl Default for LoopConfig {
     fn default() -> Self {
         Self {
-            period: 0.002,
             duration: 5.0,
             max_consecutive_overruns: 5,
         }
@@ -105,14 +78,14 @@ pub struct LoopStats {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::hw::{run, Calibration, Clock, HwErrorKind, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
-/// use ctrlab::OpenLoop;
+/// use ctrlab::hw::{Clock, HwErrorKind, LoopConfig, VirtualClock, run};
+/// use ctrlab::{OpenLoop, lab::SimulatedRig};
+/// use nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
-/// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
-/// let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+/// let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
 /// // Full drive on the default truth (8.5 N/V) runs cart 2 into its travel limit.
-/// let err = run(rig, OpenLoop, |_| 24.0, &Clock::Virtual(clock), &LoopConfig::default()).unwrap_err();
+/// let err = run(rig, OpenLoop, |_| vector![24.0], &Clock::Virtual(clock), &LoopConfig::default()).unwrap_err();
 /// assert_eq!(err.error.kind(), HwErrorKind::TravelLimit);
 /// assert!(!err.recording.is_empty()); // everything before the breach
 /// # Ok::<(), ctrlab::hw::HwError>(())
@@ -123,9 +96,10 @@ pub struct RunError {
     pub error: HwError,
     /// Every sample completed before the fault.
     pub recording: Recording,
-    /// The state read in the failing tick, when the fault came after the
-    /// read (its command never reached the rig, so it is not in `recording`).
-    pub last_state: Option<SVector<f64, 4>>,
+    /// The measurements read in the failing tick, when the fault came after
+    /// the read (its command never reached the rig, so it is not in
+    /// `recording`).
+    pub last_measurement: Option<Vec<f64>>,
     /// Timing statistics up to the fault.
     pub stats: LoopStats,
 }
@@ -152,22 +126,23 @@ impl std::error::Error for RunError {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::hw::{run, Calibration, Clock, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
-/// use ctrlab::OpenLoop;
+/// use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
+/// use ctrlab::{OpenLoop, lab::SimulatedRig};
+/// use nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
-/// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
-/// let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+/// let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
 /// let config = LoopConfig { duration: 0.1, ..LoopConfig::default() };
-/// let out = run(rig, OpenLoop, |_| 1.2, &Clock::Virtual(clock), &config)?;
+/// let out = run(rig, OpenLoop, |_| vector![1.2], &Clock::Virtual(clock), &config)?;
 /// assert_eq!(out.recording.len(), 50);
-/// assert!((out.recording.u[0] - 1.2).abs() < 1e-12); // 50 duty steps of 24 mV
+/// assert!((out.recording.channel("u")?[0] - 1.2).abs() < 1e-12); // 50 duty steps of 24 mV
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunOutcome {
-    /// One sample per tick: time (s, from the start of the run), the voltage
-    /// actually applied (V), and the state read at that tick (m, m/s).
+    /// One sample per tick: time (s, from the start of the run), the inputs
+    /// actually applied, and the measurements read at that tick, named by
+    /// the rig's [`schema`](Rig::schema).
     pub recording: Recording,
     /// Timing statistics.
     pub stats: LoopStats,
@@ -176,27 +151,36 @@ pub struct RunOutcome {
 /// How far the real-time clock sleeps before spinning to a deadline.
 const SPIN: Duration = Duration::from_micros(200);
 
-/// Runs `controller` against `rig` for `config.duration` seconds at period
-/// `config.period`, with reference `reference(t)` (SI, `t` in s from the
+/// Runs `controller` against `rig` for `config.duration` seconds at the
+/// rig's period `T`, with reference `reference(t)` (SI, `t` in s from the
 /// start), timed by `clock`.
 ///
-/// Each tick `k`, at the absolute deadline `k T`: read the state (on
-/// [`MassSpringRig`](crate::hw::MassSpringRig) this latches the counters and
-/// kicks the card's watchdog), evaluate the reference, update the controller,
-/// apply its voltage, and record `(t, applied volts, state)`. At the end the
-/// rig is halted. The loop does not call [`Rig::kick_watchdog`] on its own: a
-/// rig with a watchdog kicks it in `read_state`, as `MassSpringRig` does
-/// (one control write latches and kicks).
+/// Each tick `k`, at the absolute deadline `k T`: read the measurements (on
+/// [`MassSpringRig`](crate::lab::MassSpringRig) this latches the counters
+/// and kicks the card's watchdog), evaluate the reference, update the
+/// controller, apply its input, tell the controller what was applied
+/// ([`Controller::applied`]), and record `(t, applied input,
+/// measurements)`. At the end the rig is halted. The loop does not call
+/// [`Rig::kick_watchdog`] on its own: a rig with a watchdog kicks it in
+/// `read`, as `MassSpringRig` does (one control write latches and kicks).
+///
+/// The same controller object runs unchanged in the sampled-data simulator
+/// [`sim::run_sampled`](crate::sim::run_sampled), which follows the same
+/// order.
 ///
 /// # Errors
 ///
-/// A [`RunError`] (boxed: it carries the whole recording) holding the error, every sample recorded before it, the
-/// state read in the failing tick if there was one, and the statistics. The
-/// rig has been halted (best effort: a dead port cannot be told, but then the
-/// card's watchdog stops the motor). Causes: any rig error (port fault,
-/// travel limit, non-finite command), [`HwError::Overrun`] after
+/// A [`RunError`] (boxed: it carries the whole recording) holding the
+/// error, every sample recorded before it, the measurements read in the
+/// failing tick if there were any, and the statistics. The rig has been
+/// halted (best effort: a dead port cannot be told, but then the card's
+/// watchdog stops the motor). Causes: any rig error (port fault, travel
+/// limit, non-finite command), [`HwError::Overrun`] after
 /// `max_consecutive_overruns` overruns in a row, and
-/// [`HwError::InvalidConfig`] for a bad `config` (nothing is run then).
+/// [`HwError::InvalidConfig`] for a bad `config`, a rig whose period is
+/// not finite and > 0, a controller designed for another period, or a rig
+/// whose schema does not have `M` inputs and `P` measurements (nothing is
+/// run then).
 ///
 /// # Examples
 ///
@@ -204,56 +188,69 @@ const SPIN: Duration = Duration::from_micros(200);
 /// card with the nominal plant, 1 s of virtual time in a few milliseconds:
 ///
 /// ```
-/// use ctrlab::hw::{run, Calibration, Clock, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
-/// use ctrlab::{MassSpring, Output, StateFeedback};
+/// use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
+/// use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
+/// use ctrlab::StateFeedback;
+/// use nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
-/// let config = SimulatedCardConfig { truth: MassSpring::nominal(), ..Default::default() };
-/// let card = SimulatedCard::virtual_time(config, &clock)?;
-/// let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
-/// let controller = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Output::Cart2)?;
+/// let mut rig = SimulatedRig { truth: MassSpring::nominal(), ..Default::default() }
+///     .rig(&Clock::Virtual(clock.clone()))?;
+/// let controller = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
 /// let loop_config = LoopConfig { duration: 1.0, ..LoopConfig::default() };
 ///
-/// let out = run(&mut rig, controller, |_t| 0.030, &Clock::Virtual(clock), &loop_config)?;
+/// let out = run(&mut rig, controller, |_t| vector![0.030], &Clock::Virtual(clock), &loop_config)?;
 /// assert_eq!(out.recording.len(), 500);
 /// // Cart 2 ends near the closed loop's steady state, 28.57 mm for 30 mm.
-/// let x2 = *out.recording.x2.last().unwrap();
+/// let x2 = *out.recording.channel("x2")?.last().unwrap();
 /// assert!((x2 - 0.02857).abs() < 2e-4, "{x2}");
 /// assert_eq!(out.stats.overruns, 0);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn run<R, C>(
-    mut rig: R,
+pub fn run<G, C, const M: usize, const P: usize, const R: usize>(
+    mut rig: G,
     mut controller: C,
-    mut reference: impl FnMut(f64) -> f64,
+    mut reference: impl FnMut(f64) -> SVector<f64, R>,
     clock: &Clock,
     config: &LoopConfig,
 ) -> Result<RunOutcome, Box<RunError>>
 where
-    R: Rig,
-    C: Controller<4, 1>,
+    G: Rig<M, P>,
+    C: Controller<P, R, M>,
 {
-    let checked = check_config(config).and_then(|ticks| match rig.period() {
-        Some(p) if (p - config.period).abs() > 1e-9 * p => Err(HwError::InvalidConfig {
-            name: "period",
-            value: config.period,
-            reason: "differs from the period the rig's speed estimates assume",
-        }),
-        _ => Ok(ticks),
+    let period = rig.period();
+    let schema = rig.schema();
+    let checked = check_config(config, period).and_then(|ticks| {
+        if let Some(p) = controller.period()
+            && (p - period).abs() > 1e-9 * period
+        {
+            return Err(HwError::InvalidConfig {
+                name: "period",
+                value: period,
+                reason: "the rig's period differs from the one the controller was designed for",
+            });
+        }
+        if schema.inputs().len() != M || schema.measurements().len() != P {
+            return Err(HwError::InvalidConfig {
+                name: "schema",
+                value: schema.len() as f64,
+                reason: "the rig's schema does not have one channel per input and measurement",
+            });
+        }
+        Ok(ticks)
     });
     let ticks = match checked {
         Ok(ticks) => ticks,
         Err(error) => {
             return Err(Box::new(RunError {
                 error,
-                recording: Recording::new(),
-                last_state: None,
+                recording: Recording::new(schema),
+                last_measurement: None,
                 stats: LoopStats::default(),
             }));
         }
     };
-    let period = config.period;
-    let mut recording = Recording::with_capacity(ticks);
+    let mut recording = Recording::with_capacity(schema, ticks);
     let mut lateness = Vec::with_capacity(ticks);
     let mut stats = LoopStats::default();
     let mut consecutive = 0usize;
@@ -284,8 +281,8 @@ where
                 if elapsed > (k + 1) as f64 * period {
                     // A whole period or more behind (the OS took the CPU):
                     // skip the missed deadlines rather than run them back
-                    // to back on stale time, and restart the speed estimate,
-                    // which would otherwise span the gap.
+                    // to back on stale time, and restart differenced
+                    // estimates, which would otherwise span the gap.
                     let behind = ((elapsed / period) as usize).min(ticks);
                     stats.skipped += behind - k;
                     k = behind;
@@ -303,16 +300,21 @@ where
         lateness.push(late);
 
         let tick = Instant::now();
-        let state = match rig.read_state() {
-            Ok(state) => state,
+        let y = match rig.read() {
+            Ok(y) => y,
             Err(error) => return Err(stop(rig, error, recording, None, stats, lateness)),
         };
-        let u = controller.update(reference(t), &state)[0];
-        let applied = match rig.apply_voltage(u) {
+        let u = controller.update(&y, &reference(t));
+        let applied = match rig.apply(&u) {
             Ok(v) => v,
-            Err(error) => return Err(stop(rig, error, recording, Some(state), stats, lateness)),
+            Err(error) => {
+                let last = Some(y.as_slice().to_vec());
+                return Err(stop(rig, error, recording, last, stats, lateness));
+            }
         };
-        recording.push_state(t, applied, &state);
+        controller.applied(&applied);
+        // Cannot fail: the schema's sizes were checked above.
+        recording.push_vectors(t, &applied, &y).ok();
         stats.ticks += 1;
 
         // An overrun: this tick's work ended after the next deadline.
@@ -344,11 +346,11 @@ where
 }
 
 /// Halts the rig after `error` and packs up what was recorded.
-fn stop<R: Rig>(
-    mut rig: R,
+fn stop<G: Rig<M, P>, const M: usize, const P: usize>(
+    mut rig: G,
     error: HwError,
     recording: Recording,
-    last_state: Option<SVector<f64, 4>>,
+    last_measurement: Option<Vec<f64>>,
     mut stats: LoopStats,
     mut lateness: Vec<f64>,
 ) -> Box<RunError> {
@@ -359,7 +361,7 @@ fn stop<R: Rig>(
     Box::new(RunError {
         error,
         recording,
-        last_state,
+        last_measurement,
         stats,
     })
 }
@@ -375,19 +377,18 @@ fn finish_stats(stats: &mut LoopStats, lateness: &mut [f64]) {
     stats.lateness_max = at(1.0);
 }
 
-fn check_config(config: &LoopConfig) -> Result<usize, HwError> {
+fn check_config(config: &LoopConfig, period: f64) -> Result<usize, HwError> {
     let invalid = |name, value, reason| HwError::InvalidConfig {
         name,
         value,
         reason,
     };
     let LoopConfig {
-        period,
         duration,
         max_consecutive_overruns,
     } = *config;
     if !(period.is_finite() && period >= 1e-6) {
-        return Err(invalid("period", period, "must be finite and >= 1 µs"));
+        return Err(invalid("period", period, "the rig's period must be finite and >= 1 µs"));
     }
     if !(duration.is_finite() && duration >= period) {
         return Err(invalid(

@@ -6,7 +6,7 @@ use faer::{MatMut, Par};
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::Error;
-use crate::reduce::{first_non_finite, sum_by};
+use crate::kernels::reduce::{first_non_finite, sum_by};
 
 /// Default limit on the column-equilibrated condition number (10¹⁰, i.e.
 /// more than ten of the sixteen significant digits lost): above it a

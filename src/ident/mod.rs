@@ -1,29 +1,33 @@
-//! System identification from recorded data.
+//! System identification from recorded data, for any linear-in-parameters
+//! model.
 //!
 //! - [`LeastSquares`]: batch linear least squares by QR (faer inside, never
 //!   the normal equations), with covariance, standard errors, residual RMS,
 //!   R², fit % and condition number.
 //! - [`Rls`]: recursive least squares, fixed size and allocation-free, with
 //!   a forgetting factor, for identification inside the control loop.
-//! - [`mass_spring`]: the lab's regressors for the two-cart plant
-//!   (equations (6)–(11)), in the lab's form ([`Scheme::Lab`]) and without
-//!   its half-sample bias ([`Scheme::Central`]).
+//!
+//! The lab's two-cart regressors (equations (6)–(11)) build on these in
+//! [`lab::ident`](crate::lab::ident).
 //!
 //! # Examples
 //!
 //! ```
-//! use ctrlab::{Recording, ident::{identify, Scheme}};
+//! use ctrlab::ident::LeastSquares;
 //!
-//! let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-//! let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
-//! assert!((est.b2.value / 6.1 - 1.0).abs() < 0.003);
+//! // y = 2 a + 3 b from four noiseless rows.
+//! let mut ls = LeastSquares::new(2);
+//! for (a, b) in [(1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (2.0, -1.0)] {
+//!     ls.push_row(&[a, b], 2.0 * a + 3.0 * b)?;
+//! }
+//! let fit = ls.solve()?;
+//! assert!((fit.theta[0] - 2.0).abs() < 1e-12 && (fit.theta[1] - 3.0).abs() < 1e-12);
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
 mod least_squares;
-pub mod mass_spring;
 mod rls;
 
+pub(crate) use least_squares::solve_augmented;
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};
-pub use mass_spring::{MassSpringEstimate, Scheme, identify};
 pub use rls::Rls;

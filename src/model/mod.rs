@@ -1,11 +1,14 @@
-//! Typed linear models and the lab's two-cart plant.
+//! Typed models: linear [`StateSpace`] models with their sizes and time
+//! domain ([`Continuous`] or [`Discrete`]) in the type, and the
+//! [`Dynamics`] trait any plant (linear or not) implements for simulation.
 //!
-//! [`StateSpace`] carries its sizes and its time domain ([`Continuous`] or
-//! [`Discrete`]) in its type; [`MassSpring`] turns the rig's physical
-//! parameters into one.
+//! This is the bottom layer: it names no particular plant (the lab's
+//! two-cart plant is [`lab::MassSpring`](crate::lab::MassSpring)).
 
-mod mass_spring;
+mod display;
+mod dynamics;
 mod state_space;
 
-pub use mass_spring::{MassSpring, Output};
+pub use dynamics::Dynamics;
 pub use state_space::{Continuous, Discrete, Domain, StateSpace};
+pub(crate) use state_space::period_of;

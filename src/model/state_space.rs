@@ -6,9 +6,22 @@ use nalgebra::{SMatrix, SVector};
 use crate::error::{Error, check_dt, check_finite};
 
 mod sealed {
-    pub trait Sealed {}
-    impl Sealed for super::Continuous {}
-    impl Sealed for super::Discrete {}
+    /// Seals [`Domain`](super::Domain) and lets crate code ask a domain for
+    /// its period without a public method.
+    pub trait Sealed {
+        /// `None` in continuous time, `Some(dt)` in discrete time.
+        fn period(&self) -> Option<f64>;
+    }
+    impl Sealed for super::Continuous {
+        fn period(&self) -> Option<f64> {
+            None
+        }
+    }
+    impl Sealed for super::Discrete {
+        fn period(&self) -> Option<f64> {
+            Some(self.dt)
+        }
+    }
 }
 
 /// The time domain of a [`StateSpace`]: [`Continuous`] or [`Discrete`].
@@ -47,6 +60,12 @@ impl Discrete {
 impl Domain for Continuous {}
 impl Domain for Discrete {}
 
+/// The sampling period of a domain: `None` in continuous time (crate-wide
+/// helper for algorithms written once for both domains).
+pub(crate) fn period_of<D: Domain>(domain: &D) -> Option<f64> {
+    sealed::Sealed::period(domain)
+}
+
 /// A linear time-invariant state-space model with `N` states, `M` inputs and
 /// `P` outputs, in time domain `D`.
 ///
@@ -55,14 +74,14 @@ impl Domain for Discrete {}
 ///
 /// Matrices are nalgebra [`SMatrix`]es on the stack. The domain is in the
 /// type: [`discretize`](StateSpace::discretize) exists only on continuous
-/// models and [`step`](StateSpace::step) only on discrete ones, so mixing them
-/// up is a compile error:
+/// models and [`advance`](StateSpace::advance) only on discrete ones, so
+/// mixing them up is a compile error:
 ///
 /// ```compile_fail
 /// # use ctrlab::StateSpace;
 /// # use nalgebra::matrix;
 /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
-/// sys.step(&matrix![0.0], &matrix![1.0]); // no `step` on a continuous model
+/// sys.advance(&matrix![0.0], &matrix![1.0]); // no `advance` on a continuous model
 /// ```
 ///
 /// # Examples
@@ -204,7 +223,9 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     }
 
     /// Advances the state one sample in place: `x ← A x + B u`. Allocates
-    /// nothing; this is the inner loop of discrete simulation.
+    /// nothing; this is the inner loop of discrete simulation. (Not MATLAB's
+    /// `step`, the step response: that is
+    /// [`step_response`](crate::sim::step_response).)
     ///
     /// # Examples
     ///
@@ -213,17 +234,17 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     /// # use nalgebra::{matrix, vector};
     /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
     /// let mut x = vector![2.0];
-    /// sys.step_mut(&mut x, &vector![1.0]);
+    /// sys.advance_mut(&mut x, &vector![1.0]);
     /// assert_eq!(x, vector![2.0]);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     #[inline]
-    pub fn step_mut(&self, x: &mut SVector<f64, N>, u: &SVector<f64, M>) {
+    pub fn advance_mut(&self, x: &mut SVector<f64, N>, u: &SVector<f64, M>) {
         *x = self.a * *x + self.b * u;
     }
 
     /// The next state `A x + B u`; the returning twin of
-    /// [`step_mut`](Self::step_mut).
+    /// [`advance_mut`](Self::advance_mut).
     ///
     /// # Examples
     ///
@@ -231,11 +252,12 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     /// # use ctrlab::StateSpace;
     /// # use nalgebra::{matrix, vector};
     /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
-    /// assert_eq!(sys.step(&vector![4.0], &vector![0.0]), vector![2.0]);
+    /// assert_eq!(sys.advance(&vector![4.0], &vector![0.0]), vector![2.0]);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     #[inline]
-    pub fn step(&self, x: &SVector<f64, N>, u: &SVector<f64, M>) -> SVector<f64, N> {
+    #[must_use]
+    pub fn advance(&self, x: &SVector<f64, N>, u: &SVector<f64, M>) -> SVector<f64, N> {
         self.a * x + self.b * u
     }
 }
@@ -247,7 +269,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::MassSpring;
-    /// let sys = MassSpring::nominal().state_space(ctrlab::Output::Cart2)?;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::Two)?;
     /// assert_eq!(sys.a()[(0, 1)], 1.0);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -262,7 +284,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::MassSpring;
-    /// let sys = MassSpring::nominal().state_space(ctrlab::Output::Cart2)?;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::Two)?;
     /// assert_eq!(sys.b()[(3, 0)], 1.0 / 0.7);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -277,7 +299,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::MassSpring;
-    /// let sys = MassSpring::nominal().state_space(ctrlab::Output::Cart2)?;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::Two)?;
     /// assert_eq!(sys.c()[(0, 2)], 1.0);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -292,7 +314,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::MassSpring;
-    /// let sys = MassSpring::nominal().state_space(ctrlab::Output::Cart2)?;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::Two)?;
     /// assert_eq!(sys.d()[(0, 0)], 0.0);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -307,7 +329,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::{MassSpring, Continuous};
-    /// let sys = MassSpring::nominal().state_space(ctrlab::Output::Cart2)?;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::Two)?;
     /// assert_eq!(sys.domain(), Continuous);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -323,7 +345,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// ```
     /// # use ctrlab::MassSpring;
     /// # use nalgebra::vector;
-    /// let sys = MassSpring::nominal().state_space(ctrlab::Output::Cart1)?;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::One)?;
     /// let y = sys.output(&vector![0.01, 0.0, 0.02, 0.0], &vector![0.0]);
     /// assert_eq!(y[0], 0.01);
     /// # Ok::<(), ctrlab::Error>(())
@@ -345,7 +367,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// ```
     /// # use ctrlab::MassSpring;
     /// # use nalgebra::{SMatrix, matrix};
-    /// let sys = MassSpring::nominal().state_space(ctrlab::Output::Cart1)?;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::One)?;
     /// let full = sys.with_output(SMatrix::<f64, 4, 4>::identity(), SMatrix::<f64, 4, 1>::zeros())?;
     /// assert_eq!(full.c().nrows(), 4);
     /// # Ok::<(), ctrlab::Error>(())

@@ -1,12 +1,20 @@
 //! Time responses: continuous simulation on a time grid ([`simulate`]),
 //! discrete simulation open or closed loop ([`simulate_discrete`],
-//! [`simulate_discrete_feedback`]) and the unit [`step_response`].
+//! [`simulate_discrete_feedback`]), the unit [`step_response`], and the
+//! sampled-data simulator [`run_sampled`]: any continuous plant under a
+//! discrete [`Controller`](crate::Controller) with zero-order hold, input
+//! delay, saturation and measurement quantisation and noise, producing the
+//! same [`Recording`](crate::Recording) as the rig's loop.
 //!
-//! The inner loops are [`StateSpace::step_mut`] and
+//! The inner loops are [`StateSpace::advance_mut`] and
 //! [`Integrator::step_mut`], which allocate nothing; the functions here
 //! allocate only their output, once, up front.
 
 use nalgebra::SVector;
+
+mod sampled;
+
+pub use sampled::{SampledConfig, Sensor, run_sampled};
 
 use crate::discretize::zoh;
 use crate::error::{Error, check_dt};
@@ -45,8 +53,8 @@ impl<const N: usize, const P: usize> Response<N, P> {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{MassSpring, Output, sim::step_response};
-    /// let r = step_response(&MassSpring::nominal().state_space(Output::Cart2)?, 1.0, 0.01)?;
+    /// # use ctrlab::{MassSpring, Cart, sim::step_response};
+    /// let r = step_response(&MassSpring::nominal().state_space(Cart::Two)?, 1.0, 0.01)?;
     /// assert_eq!(r.len(), 101);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -59,8 +67,8 @@ impl<const N: usize, const P: usize> Response<N, P> {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{MassSpring, Output, sim::step_response};
-    /// let r = step_response(&MassSpring::nominal().state_space(Output::Cart2)?, 1.0, 0.01)?;
+    /// # use ctrlab::{MassSpring, Cart, sim::step_response};
+    /// let r = step_response(&MassSpring::nominal().state_space(Cart::Two)?, 1.0, 0.01)?;
     /// assert!(!r.is_empty());
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -73,8 +81,8 @@ impl<const N: usize, const P: usize> Response<N, P> {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{MassSpring, Output, sim::step_response};
-    /// let r = step_response(&MassSpring::nominal().state_space(Output::Cart2)?, 1.0, 0.01)?;
+    /// # use ctrlab::{MassSpring, Cart, sim::step_response};
+    /// let r = step_response(&MassSpring::nominal().state_space(Cart::Two)?, 1.0, 0.01)?;
     /// assert_eq!(r.output(0).len(), r.len());
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -151,16 +159,17 @@ pub fn time_grid(t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Output, sim::{simulate, time_grid, Solver}};
+/// use ctrlab::{MassSpring, Cart, sim::{simulate, time_grid, Solver}};
 /// use nalgebra::vector;
 ///
-/// let sys = MassSpring::nominal().state_space(Output::Cart2)?;
+/// let sys = MassSpring::nominal().state_space(Cart::Two)?;
 /// let t = time_grid(10.0, 0.002)?;
 /// let r = simulate(&sys, &t, vector![0.0, 0.0, 0.0, 0.0], |_t| vector![10.0], Solver::Zoh)?;
 /// // 10 N on cart 2 settles at 20 mm.
 /// assert!((r.y.last().unwrap()[0] - 0.020).abs() < 1e-9);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
+#[doc(alias = "lsim")]
 pub fn simulate<const N: usize, const M: usize, const P: usize>(
     sys: &StateSpace<N, M, P, Continuous>,
     t: &[f64],
@@ -208,7 +217,7 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
                     cached = Some((h, d));
                 }
                 if let Some((_, d)) = &cached {
-                    d.step_mut(&mut x, &u);
+                    d.advance_mut(&mut x, &u);
                 }
             }
             Solver::Rk4 { substeps } => {
@@ -299,7 +308,7 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
         out.t.push(k as f64 * dt);
         out.x.push(x);
         out.y.push(sys.output(&x, &u));
-        sys.step_mut(&mut x, &u);
+        sys.advance_mut(&mut x, &u);
     }
     out
 }
@@ -324,6 +333,7 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
 /// assert!((r.y[1][0] - (1.0 - (-1.0f64).exp())).abs() < 1e-14);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
+#[doc(alias = "step")]
 pub fn step_response<const N: usize, const P: usize>(
     sys: &StateSpace<N, 1, P, Continuous>,
     t_end: f64,

@@ -9,14 +9,19 @@
 //! 2. cart 2, `m2 x2'' + b2 x2' + k2 (x2 − x1) = K u`, with `k2` from stage
 //!    1, gives the motor gain `K` and `b2`.
 //!
+//! The recording must hold the channels `u` (the input), `x1` and `x2`
+//! (positions, m), uniformly sampled: the lab's [`schema`](super::schema),
+//! or the lab's own CSV logs (`t_s,u,x1_mm,x2_mm`).
+//!
 //! Every row is multiplied by `T²` as in the lab's code (equations (6), (9));
 //! that scaling does not change the estimate. The standard errors of stage
 //! 2 treat `k2` as exact.
 
 use crate::data::Recording;
 use crate::error::Error;
-use crate::ident::least_squares::{DEFAULT_MAX_CONDITION, LeastSquaresFit, solve_augmented};
-use crate::model::{Continuous, MassSpring, Output, StateSpace};
+use crate::ident::{DEFAULT_MAX_CONDITION, LeastSquaresFit, solve_augmented};
+use super::{Cart, MassSpring};
+use crate::model::{Continuous, StateSpace};
 
 /// How derivatives and the input are taken from the samples.
 ///
@@ -27,7 +32,7 @@ use crate::model::{Continuous, MassSpring, Output, StateSpace};
 /// # Examples
 ///
 /// ```
-/// use ctrlab::ident::mass_spring::Scheme;
+/// use ctrlab::lab::ident::Scheme;
 /// assert_ne!(Scheme::Lab, Scheme::Central);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -53,7 +58,7 @@ pub enum Scheme {
 /// # Examples
 ///
 /// ```
-/// # use ctrlab::ident::mass_spring::Estimate;
+/// # use ctrlab::lab::ident::Estimate;
 /// let k = Estimate { value: 950.0, std_error: 1.9 };
 /// assert!((k.relative_error() - 0.002).abs() < 1e-15);
 /// ```
@@ -71,7 +76,7 @@ impl Estimate {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::ident::mass_spring::Estimate;
+    /// # use ctrlab::lab::ident::Estimate;
     /// assert_eq!(Estimate { value: -2.0, std_error: 0.5 }.relative_error(), 0.25);
     /// ```
     pub fn relative_error(&self) -> f64 {
@@ -84,7 +89,7 @@ impl Estimate {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+/// use ctrlab::{Recording, lab::ident::{identify, Scheme}};
 ///
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
 /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
@@ -123,7 +128,7 @@ impl MassSpringEstimate {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+    /// # use ctrlab::{Recording, lab::ident::{identify, Scheme}};
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let p = identify(&rec, 1.3, 0.7, Scheme::Lab)?.plant();
     /// assert_eq!(p.k1, p.k2);
@@ -152,7 +157,7 @@ impl MassSpringEstimate {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+    /// # use ctrlab::{Recording, lab::ident::{identify, Scheme}};
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
     /// let a = *est.state_space()?.a();
@@ -160,7 +165,7 @@ impl MassSpringEstimate {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
-        self.plant().state_space(Output::Cart2)
+        self.plant().state_space(Cart::Two)
     }
 }
 
@@ -169,7 +174,7 @@ impl MassSpringEstimate {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+/// use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
 ///
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
 /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
@@ -209,7 +214,7 @@ impl SeparateSpringsEstimate {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+    /// # use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
     /// assert_eq!(est.plant().k2, est.k2.value);
@@ -236,20 +241,39 @@ impl SeparateSpringsEstimate {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+    /// # use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
     /// assert_eq!(est.state_space()?.a()[(3, 0)], est.k2.value / 0.7);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
-        self.plant().state_space(Output::Cart2)
+        self.plant().state_space(Cart::Two)
     }
 }
 
-/// Validated inputs shared by both identifiers.
+/// Fewest samples the identifiers can use: three unknowns, one residual
+/// degree of freedom, and the two samples the finite differences consume.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, data::{Recording, Schema}, lab::ident::{MIN_SAMPLES, Scheme, identify}};
+/// let mut rec = Recording::new(ctrlab::lab::schema());
+/// for k in 0..MIN_SAMPLES - 1 {
+///     rec.push(k as f64 * 0.002, &[1.0], &[0.0, 0.0, 0.0, 0.0])?;
+/// }
+/// assert!(matches!(identify(&rec, 1.3, 0.7, Scheme::Lab), Err(Error::TooFewSamples { needed: 6, .. })));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub const MIN_SAMPLES: usize = 6;
+
+/// Validated inputs shared by both identifiers: the channels `u`, `x1`,
+/// `x2` of the recording.
 struct Prepared<'a> {
-    rec: &'a Recording,
+    u: &'a [f64],
+    x1: &'a [f64],
+    x2: &'a [f64],
     dt: f64,
     rows: usize,
 }
@@ -264,16 +288,19 @@ fn prepare<'a>(rec: &'a Recording, m1: f64, m2: f64) -> Result<Prepared<'a>, Err
             });
         }
     }
-    if rec.len() < crate::data::MIN_ROWS {
+    let (u, x1, x2) = (rec.channel("u")?, rec.channel("x1")?, rec.channel("x2")?);
+    if rec.len() < MIN_SAMPLES {
         return Err(Error::TooFewSamples {
             what: "mass-spring identification",
-            needed: crate::data::MIN_ROWS,
+            needed: MIN_SAMPLES,
             got: rec.len(),
         });
     }
     let dt = rec.sample_period()?;
     Ok(Prepared {
-        rec,
+        u,
+        x1,
+        x2,
         dt,
         rows: rec.len() - 2,
     })
@@ -372,7 +399,7 @@ fn stage2<D: Differences>(
     k2: f64,
     buf: &mut Vec<f64>,
 ) -> Result<LeastSquaresFit, Error> {
-    let (x1, x2, u) = (&p.rec.x1[..], &p.rec.x2[..], &p.rec.u[..]);
+    let (x1, x2, u) = (p.x1, p.x2, p.u);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
     buf.clear();
@@ -400,7 +427,7 @@ fn estimates<const P: usize>(fit: &LeastSquaresFit) -> [Estimate; P] {
 /// # Errors
 ///
 /// - [`Error::InvalidParameter`] for a mass that is not finite and > 0;
-/// - [`Error::TooFewSamples`] for fewer than [`MIN_ROWS`](crate::data::MIN_ROWS)
+/// - [`Error::TooFewSamples`] for fewer than [`MIN_SAMPLES`]
 ///   samples;
 /// - [`Error::InvalidRecording`] for mismatched columns, non-finite values
 ///   or an irregular time column;
@@ -410,7 +437,7 @@ fn estimates<const P: usize>(fit: &LeastSquaresFit) -> [Estimate; P] {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Recording, ident::mass_spring::{identify, Scheme}};
+/// use ctrlab::{Recording, lab::ident::{identify, Scheme}};
 ///
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
 /// let lab = identify(&rec, 1.3, 0.7, Scheme::Lab)?;
@@ -439,7 +466,7 @@ fn identify_with<D: Differences>(
     scheme: Scheme,
 ) -> Result<MassSpringEstimate, Error> {
     let p = prepare(recording, m1, m2)?;
-    let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
+    let (x1, x2) = (p.x1, p.x2);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
     // Column-major [Φ | λ], rows k = 1 … N − 2.
@@ -480,7 +507,7 @@ fn identify_with<D: Differences>(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Recording, ident::mass_spring::{identify_separate_springs, Scheme}};
+/// use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
 ///
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
 /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
@@ -508,7 +535,7 @@ fn separate_with<D: Differences>(
     scheme: Scheme,
 ) -> Result<SeparateSpringsEstimate, Error> {
     let p = prepare(recording, m1, m2)?;
-    let (x1, x2) = (&recording.x1[..], &recording.x2[..]);
+    let (x1, x2) = (p.x1, p.x2);
     let (t, m) = (p.dt, p.rows);
     let t2 = t * t;
     let mut buf = Vec::with_capacity(4 * m);
@@ -544,7 +571,7 @@ fn separate_with<D: Differences>(
 /// # Examples
 ///
 /// ```
-/// # use ctrlab::ident::mass_spring::Spread;
+/// # use ctrlab::lab::ident::Spread;
 /// let s = Spread { mean: 950.0, std_dev: 4.0 };
 /// assert_eq!(s.mean, 950.0);
 /// ```
@@ -562,7 +589,7 @@ pub struct Spread {
 /// # Examples
 ///
 /// ```
-/// # use ctrlab::{Recording, ident::mass_spring::{average, identify, Scheme}};
+/// # use ctrlab::{Recording, lab::ident::{average, identify, Scheme}};
 /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
 /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
 /// let avg = average(&[est.clone(), est.clone()])?;
@@ -594,7 +621,7 @@ impl Spread {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::ident::mass_spring::Spread;
+    /// # use ctrlab::lab::ident::Spread;
     /// let s = Spread::of(&[948.0, 950.0, 952.0])?;
     /// assert_eq!((s.mean, s.std_dev), (950.0, 2.0));
     /// assert!(Spread::of(&[1.0]).is_err());
@@ -632,7 +659,7 @@ fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Spread {
 /// # Examples
 ///
 /// ```
-/// # use ctrlab::{Error, ident::mass_spring::average};
+/// # use ctrlab::{Error, lab::ident::average};
 /// assert!(matches!(average(&[]), Err(Error::TooFewSamples { needed: 2, got: 0, .. })));
 /// ```
 pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Error> {

@@ -4,32 +4,47 @@
 use nalgebra::{SMatrix, SVector, matrix};
 
 use crate::error::Error;
-use crate::integrate::Dynamics;
-use crate::model::{Continuous, StateSpace};
+use crate::model::{Continuous, Dynamics, StateSpace};
 
-/// Which cart's position is the model's output `y`.
+/// One of the rig's two carts: which cart's position a model outputs, a
+/// controller moves, or a report talks about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Output {
-    /// `y = x1`, position of cart 1 (the one tied to the wall), m.
-    Cart1,
-    /// `y = x2`, position of cart 2 (the driven one), m.
-    Cart2,
+pub enum Cart {
+    /// Cart 1, the one tied to the wall; position `x1`, m.
+    One,
+    /// Cart 2, the one the motor drives; position `x2`, m.
+    Two,
 }
 
-impl Output {
-    /// Index of this output's position in the state `[x1, v1, x2, v2]`.
+impl Cart {
+    /// Index of this cart's position in the state `[x1, v1, x2, v2]`.
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::Output;
-    /// assert_eq!(Output::Cart1.state_index(), 0);
-    /// assert_eq!(Output::Cart2.state_index(), 2);
+    /// # use ctrlab::Cart;
+    /// assert_eq!(Cart::One.state_index(), 0);
+    /// assert_eq!(Cart::Two.state_index(), 2);
     /// ```
     pub fn state_index(self) -> usize {
         match self {
-            Output::Cart1 => 0,
-            Output::Cart2 => 2,
+            Cart::One => 0,
+            Cart::Two => 2,
+        }
+    }
+
+    /// The cart's number as the lab writes it (1 or 2).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::Cart;
+    /// assert_eq!(Cart::One.number(), 1);
+    /// ```
+    pub fn number(self) -> usize {
+        match self {
+            Cart::One => 1,
+            Cart::Two => 2,
         }
     }
 
@@ -38,9 +53,9 @@ impl Output {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::Output;
+    /// # use ctrlab::Cart;
     /// # use nalgebra::matrix;
-    /// assert_eq!(Output::Cart2.selection(), matrix![0.0, 0.0, 1.0, 0.0]);
+    /// assert_eq!(Cart::Two.selection(), matrix![0.0, 0.0, 1.0, 0.0]);
     /// ```
     pub fn selection(self) -> SMatrix<f64, 1, 4> {
         let mut c = SMatrix::<f64, 1, 4>::zeros();
@@ -63,10 +78,10 @@ impl Output {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Output};
+/// use ctrlab::{MassSpring, Cart};
 ///
 /// let plant = MassSpring::nominal();
-/// let sys = plant.state_space(Output::Cart2)?;
+/// let sys = plant.state_space(Cart::Two)?;
 /// assert_eq!(sys.a()[(1, 0)], -(1000.0 + 1000.0) / 1.3);
 /// // A 10 N push deflects the carts 10 mm and 20 mm at rest.
 /// let (x1, x2) = plant.static_deflection(10.0)?;
@@ -186,16 +201,16 @@ impl MassSpring {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{MassSpring, Output};
-    /// let sys = MassSpring::nominal().state_space(Output::Cart1)?;
+    /// # use ctrlab::{MassSpring, Cart};
+    /// let sys = MassSpring::nominal().state_space(Cart::One)?;
     /// assert_eq!(sys.c()[(0, 0)], 1.0);
     /// assert_eq!(sys.b()[(3, 0)], 1.0 / 0.7);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
-    pub fn state_space(&self, output: Output) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
+    pub fn state_space(&self, cart: Cart) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.validate()?;
         let b = matrix![0.0; 0.0; 0.0; self.gain / self.m2];
-        StateSpace::continuous(self.a_matrix(), b, output.selection(), SMatrix::zeros())
+        StateSpace::continuous(self.a_matrix(), b, cart.selection(), SMatrix::zeros())
     }
 
     /// Rest positions `(x1, x2)` in metres under a constant force `force` (N) on
