@@ -3,21 +3,21 @@
 //! Target: under 2 µs (a thousandth of the period).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ctrlab::hw::{
-    Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock,
-};
-use ctrlab::{Controller, MassSpring, Cart, StateFeedback};
+use ctrlab::hw::{Clock, SimulatedCard, VirtualClock};
+use ctrlab::lab::{FrictionPlant, MassSpringRig, SimulatedRig};
+use ctrlab::{Cart, Controller, MassSpring, StateFeedback};
+use nalgebra::vector;
 use std::hint::black_box;
 
-fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard> {
-    let config = SimulatedCardConfig {
+fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard<FrictionPlant, 4>> {
+    SimulatedRig {
         truth: MassSpring::nominal(),
         watchdog_timeout: None,
-        initial_state: nalgebra::vector![0.001, 0.0, 0.002, 0.0],
+        initial_state: vector![0.001, 0.0, 0.002, 0.0],
         ..Default::default()
-    };
-    let card = SimulatedCard::virtual_time(config, clock).unwrap();
-    MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002).unwrap()
+    }
+    .rig(&Clock::Virtual(clock.clone()))
+    .unwrap()
 }
 
 fn benches(c: &mut Criterion) {
@@ -29,7 +29,7 @@ fn benches(c: &mut Criterion) {
         let mut rig = rig(&clock);
         b.iter(|| {
             let x = rig.read_state().unwrap();
-            let u = ctrl.update(black_box(0.030), &x)[0];
+            let u = ctrl.update(&x, &black_box(vector![0.030]))[0];
             rig.apply_voltage(u).unwrap();
         })
     });
@@ -40,7 +40,7 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             clock.advance_nanos(2_000_000);
             let x = rig.read_state().unwrap();
-            let u = ctrl.update(black_box(0.030), &x)[0];
+            let u = ctrl.update(&x, &black_box(vector![0.030]))[0];
             rig.apply_voltage(u).unwrap();
         })
     });

@@ -4,7 +4,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{MassSpring, Method, Cart, StateFeedback, StepInfoOptions, acker, dlqr, step_info};
+use ctrlab::{Cart, MassSpring, Method, StateFeedback, StepInfoOptions, acker, dlqr, step_info};
 use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 use std::hint::black_box;
 

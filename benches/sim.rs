@@ -3,7 +3,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::sim::simulate_discrete_feedback;
-use ctrlab::{Integrator, MassSpring, Method, Cart, Rk4};
+use ctrlab::{Cart, Integrator, MassSpring, Method, Rk4};
 use nalgebra::{SMatrix, SVector, vector};
 use std::hint::black_box;
 

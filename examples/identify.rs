@@ -16,7 +16,7 @@ use std::io::Write as _;
 use std::process::ExitCode;
 
 use ctrlab::Recording;
-use ctrlab::ident::mass_spring::{MassSpringEstimate, Scheme, identify};
+use ctrlab::lab::ident::{MassSpringEstimate, Scheme, identify};
 
 const USAGE: &str = "usage: identify [LOG.csv] [--m1 KG] [--m2 KG]
   LOG.csv   recording with columns t_s, u, x1_mm|x1_m, x2_mm|x2_m
@@ -119,20 +119,11 @@ fn run(args: &Args) -> Result<String, ctrlab::Error> {
     writeln!(w).unwrap_or_default();
     writeln!(
         w,
-        "Identified state equations (Central), x = [x1 m, x1' m/s, x2 m, x2' m/s], u in V:\n  x' = A x + B u,  y = x2"
+        "Identified state equations (Central), x = [x1 m, x1' m/s, x2 m, x2' m/s], u in V, y = x2:"
     )
     .unwrap_or_default();
     let sys = central.state_space()?;
-    let (a, b) = (sys.a(), sys.b());
-    for r in 0..4 {
-        let row: Vec<String> = (0..4).map(|c| format!("{:>11.4}", a[(r, c)])).collect();
-        let (al, bl) = if r == 1 {
-            ("A = ", "B = ")
-        } else {
-            ("    ", "    ")
-        };
-        writeln!(w, "  {al}[{} ]   {bl}[{:>9.4} ]", row.join(""), b[(r, 0)]).unwrap_or_default();
-    }
+    write!(w, "{sys:.4}").unwrap_or_default();
     Ok(out)
 }
 

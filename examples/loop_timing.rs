@@ -11,10 +11,10 @@
 //! occasional millisecond outliers under load. The numbers say how much of
 //! the 2 ms period is left on a given PC.
 
-use ctrlab::hw::{
-    Calibration, Clock, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig, run,
-};
-use ctrlab::{Cart, StateFeedback};
+use ctrlab::StateFeedback;
+use ctrlab::hw::{Clock, LoopConfig, run};
+use ctrlab::lab::{Cart, SimulatedRig};
+use ctrlab::nalgebra::vector;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let seconds: f64 = match std::env::args().nth(1) {
@@ -23,15 +23,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map_err(|_| format!("not a duration in s: `{s}`"))?,
         None => 10.0,
     };
-    let card = SimulatedCard::real_time(SimulatedCardConfig::default())?;
-    let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002)?;
+    let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.05], Cart::Two)?;
     let config = LoopConfig {
         duration: seconds,
         ..LoopConfig::default()
     };
     println!("running {seconds} s of the 2 ms loop on the wall clock…");
-    let out = run(rig, ctrl, |_| 0.030, &Clock::RealTime, &config)?;
+    let out = run(rig, ctrl, |_| vector![0.030], &Clock::RealTime, &config)?;
     let s = out.stats;
     println!(
         "ticks {}, overruns {} (longest run {}), lateness p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs",

@@ -10,7 +10,7 @@
 //! ```
 
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{MassSpring, Cart};
+use ctrlab::{Cart, MassSpring};
 use nalgebra::{SVector, vector};
 
 fn main() -> Result<(), ctrlab::Error> {

@@ -25,7 +25,7 @@
 mod lab_tables;
 
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Error, MassSpring, Cart, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Cart, Error, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
 use lab_tables::{fmt_kf, fmt_poles};
 use nalgebra::{Complex, SVector, vector};
 
@@ -63,21 +63,21 @@ fn tables() -> Vec<Table> {
         Table {
             name: "Table 2: cart 2, setpoint 30 mm",
             file: "table2.svg",
-            output: Cart::Two,
+            cart: Cart::Two,
             setpoint_mm: 30.0,
             rows: lab_tables::table2(),
         },
         Table {
             name: "Table 5: cart 2, setpoint 30 mm (nominal plant, gain 1)",
             file: "table5.svg",
-            output: Cart::Two,
+            cart: Cart::Two,
             setpoint_mm: 30.0,
             rows: lab_tables::table5(),
         },
         Table {
             name: "Table 6: cart 1, setpoint 15 mm (nominal plant, gain 1)",
             file: "table6.svg",
-            output: Cart::One,
+            cart: Cart::One,
             setpoint_mm: 15.0,
             rows: lab_tables::table6(),
         },
@@ -86,8 +86,8 @@ fn tables() -> Vec<Table> {
 
 /// Simulates one row and measures it.
 fn run_row(plant: &MassSpring, table: &Table, kf: [f64; 4]) -> Result<Row, Error> {
-    let sys = plant.state_space(table.output)?;
-    let cl = StateFeedback::from_lab_gains(kf, table.output)?.closed_loop(&sys)?;
+    let sys = plant.state_space(table.cart)?;
+    let cl = StateFeedback::from_lab_gains(kf, table.cart)?.closed_loop(&sys)?;
     let poles = cl.poles()?;
     if !cl.is_stable()? {
         return Ok(Row::Unstable { poles });
@@ -214,7 +214,7 @@ fn plot(
     } else {
         table.name.to_string()
     };
-    let y_label = match table.output {
+    let y_label = match table.cart {
         Cart::One => "x1 (mm)",
         Cart::Two => "x2 (mm)",
     };

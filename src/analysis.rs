@@ -249,6 +249,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// assert_eq!(sys.controllability()?, dmatrix![0.0, 1.0; 1.0, 0.0]);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
+    #[doc(alias = "ctrb")]
     pub fn controllability(&self) -> Result<DMatrix<f64>, Error> {
         krylov(self.a(), self.b(), "controllability matrix")
     }
@@ -270,6 +271,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// assert_eq!(sys.observability()?, dmatrix![1.0, 0.0; 0.0, 1.0]);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
+    #[doc(alias = "obsv")]
     pub fn observability(&self) -> Result<DMatrix<f64>, Error> {
         // Observability of (A, C) is controllability of (Aᵀ, Cᵀ), transposed.
         Ok(krylov(

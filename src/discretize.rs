@@ -64,6 +64,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     /// assert_eq!(d.dt(), 0.1);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
+    #[doc(alias = "c2d")]
     pub fn discretize(
         &self,
         dt: f64,

@@ -78,7 +78,6 @@
 //! ```
 #![deny(missing_docs)]
 #![deny(unsafe_code)]
-
 #![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod analysis;

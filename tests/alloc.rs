@@ -6,7 +6,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use ctrlab::{Integrator, MassSpring, Method, Cart, Rk4};
+use ctrlab::{Cart, Integrator, MassSpring, Method, Rk4};
 use nalgebra::{SVector, vector};
 
 struct Counting;
@@ -98,17 +98,16 @@ fn zoh_discretisation_allocates_nothing() {
 
 #[test]
 fn rig_loop_iteration_on_the_simulated_card_allocates_nothing() {
-    use ctrlab::hw::{
-        Calibration, MassSpringRig, Pc104, Rig, SimulatedCard, SimulatedCardConfig, VirtualClock,
-    };
+    use ctrlab::hw::{Clock, VirtualClock};
+    use ctrlab::lab::SimulatedRig;
     let clock = VirtualClock::new();
-    let config = SimulatedCardConfig {
+    let mut rig = SimulatedRig {
         coulomb_friction: [0.5, 0.5],
         encoder_noise: 0.5,
         ..Default::default()
-    };
-    let card = SimulatedCard::virtual_time(config, &clock).unwrap();
-    let mut rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002).unwrap();
+    }
+    .rig(&Clock::Virtual(clock.clone()))
+    .unwrap();
     // The lab's gain [0 0 10 0.1] per mm in SI, toward x2 = 10 mm.
     let k = nalgebra::SMatrix::<f64, 1, 4>::new(0.0, 0.0, 10_000.0, 100.0);
     let target = vector![0.0, 0.0, 0.010, 0.0];
@@ -167,9 +166,12 @@ fn state_feedback_update_allocates_nothing() {
     let mut x = SVector::<f64, 4>::zeros();
     let n = allocations(|| {
         // Through the trait object too, as a hardware loop would hold it.
-        let dynamic: &mut dyn Controller<4, 1> = &mut ctrl;
+        let dynamic: &mut dyn Controller<4, 1, 1> = &mut ctrl;
+        let r = vector![0.030];
         for _ in 0..1000 {
-            let u = dynamic.update(0.030, &x);
+            let u = dynamic.update(&x, &r);
+            // What the drive applied is reported back, as both loops do.
+            dynamic.applied(&u);
             d.advance_mut(&mut x, &u);
         }
         dynamic.reset();
@@ -195,31 +197,132 @@ fn rls_update_allocates_nothing() {
 }
 
 #[test]
-fn recording_push_state_allocates_nothing_within_capacity() {
-    let mut rec = ctrlab::Recording::with_capacity(1000);
+fn recording_push_vectors_allocates_nothing_within_capacity() {
+    // The lab's layout (u; x1, v1, x2, v2), one sample per state read.
+    let mut rec = ctrlab::Recording::with_capacity(ctrlab::lab::schema(), 1000);
     let n = allocations(|| {
         for k in 0..1000 {
             let t = k as f64 * 0.002;
-            rec.push_state(t, 1.0, &vector![t, 1.0, 2.0 * t, 2.0]);
+            rec.push_vectors(t, &vector![1.0], &vector![t, 1.0, 2.0 * t, 2.0])
+                .unwrap();
         }
     });
     assert_eq!(n, 0);
     assert_eq!(rec.len(), 1000);
-    assert_eq!(rec.v2.as_ref().map(Vec::len), Some(1000));
+    assert_eq!(rec.channel("v2").map(<[f64]>::len).unwrap(), 1000);
     // Past capacity it does allocate: the counter would see it.
-    assert!(allocations(|| rec.push_state(2.0, 1.0, &vector![0.0, 0.0, 0.0, 0.0])) > 0);
+    assert!(
+        allocations(|| rec
+            .push_vectors(2.0, &vector![1.0], &vector![0.0, 0.0, 0.0, 0.0])
+            .unwrap())
+            > 0
+    );
 }
 
 #[test]
 fn recording_push_allocates_nothing_within_capacity() {
-    let mut rec = ctrlab::Recording::with_capacity(1000);
+    use ctrlab::data::{Channel, Schema};
+    // Positions only, as the lab's own logs are.
+    let schema = Schema::new(
+        vec![Channel::new("u", "V")],
+        vec![Channel::new("x1", "m"), Channel::new("x2", "m")],
+    )
+    .unwrap();
+    let mut rec = ctrlab::Recording::with_capacity(schema, 1000);
     let n = allocations(|| {
         for k in 0..1000 {
-            rec.push(k as f64 * 0.002, 1.0, 0.001, 0.002);
+            rec.push(k as f64 * 0.002, &[1.0], &[0.001, 0.002]).unwrap();
         }
     });
     assert_eq!(n, 0);
-    assert_eq!(rec.x1.len(), 1000);
+    assert_eq!(rec.channel("x1").unwrap().len(), 1000);
+}
+
+#[test]
+fn hw_run_on_the_simulated_rig_allocates_nothing_per_tick() {
+    use ctrlab::StateFeedback;
+    use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
+    use ctrlab::lab::SimulatedRig;
+    let clock = VirtualClock::new();
+    let virtual_clock = Clock::Virtual(clock.clone());
+    let mut rig = SimulatedRig {
+        truth: MassSpring::nominal(),
+        coulomb_friction: [0.5, 0.5],
+        encoder_noise: 0.5,
+        ..Default::default()
+    }
+    .rig(&virtual_clock)
+    .unwrap();
+    let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let mut counted = |ticks: usize| {
+        let config = LoopConfig {
+            duration: ticks as f64 * 0.002,
+            ..LoopConfig::default()
+        };
+        let mut out = None;
+        let n = allocations(|| {
+            out = Some(run(
+                &mut rig,
+                ctrl,
+                |_| vector![0.030],
+                &virtual_clock,
+                &config,
+            ));
+        });
+        let out = out.unwrap().unwrap();
+        assert_eq!(out.recording.len(), ticks);
+        (n, out)
+    };
+    let (short, _) = counted(100);
+    let (long, out) = counted(1000);
+    println!("hw::run: {short} allocations for 100 ticks, {long} for 1000");
+    // Only the up-front buffers (the recording's columns, its schema, the
+    // lateness statistics): the same for 100 ticks as for 1000.
+    assert_eq!(short, long, "allocations grow with the number of ticks");
+    assert!(long > 0, "the counter sees the run's buffers");
+    // The loop did something: cart 2 moved towards the setpoint.
+    let x2 = *out.recording.channel("x2").unwrap().last().unwrap();
+    assert!(x2 > 0.02 && x2 < 0.035, "{x2}");
+}
+
+#[test]
+fn run_sampled_allocates_nothing_per_sample() {
+    use ctrlab::StateFeedback;
+    use ctrlab::lab::SimulatedRig;
+    use ctrlab::sim::run_sampled;
+    let sim = SimulatedRig {
+        truth: MassSpring::nominal(),
+        coulomb_friction: [0.5, 0.5],
+        encoder_noise: 0.5,
+        ..Default::default()
+    };
+    let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let counted = |samples: usize| {
+        let config = sim.sampled_config(samples as f64 * 0.002);
+        let (plant, sensor) = (sim.plant(), sim.sensor());
+        let mut out = None;
+        let n = allocations(|| {
+            out = Some(run_sampled(
+                plant,
+                sensor,
+                ctrl,
+                |_| vector![0.030],
+                SVector::zeros(),
+                &config,
+            ));
+        });
+        let rec = out.unwrap().unwrap();
+        assert_eq!(rec.len(), samples);
+        (n, rec)
+    };
+    let (short, _) = counted(100);
+    let (long, rec) = counted(1000);
+    println!("run_sampled: {short} allocations for 100 samples, {long} for 1000");
+    // Only the recording (its columns and a copy of the schema), up front.
+    assert_eq!(short, long, "allocations grow with the number of samples");
+    assert!(long > 0, "the counter sees the recording");
+    let x2 = *rec.channel("x2").unwrap().last().unwrap();
+    assert!(x2 > 0.02 && x2 < 0.035, "{x2}");
 }
 
 #[test]

@@ -4,7 +4,7 @@
 mod common;
 
 use ctrlab::analysis::rank;
-use ctrlab::{Error, MassSpring, Method, Cart, StateSpace};
+use ctrlab::{Cart, Error, MassSpring, Method, StateSpace, dlqr, lqr};
 use nalgebra::{Complex, DMatrix, SMatrix, dmatrix, matrix};
 use proptest::prelude::*;
 
@@ -254,4 +254,133 @@ fn a_rigid_body_mode_is_neither_stable_nor_given_a_dc_gain() {
     assert!(slow.is_stable().unwrap() && d.is_stable().unwrap());
     assert!((slow.dc_gain().unwrap()[(0, 0)] - 1.0).abs() < 1e-12);
     assert!((d.dc_gain().unwrap()[(0, 0)] - 1.0).abs() < 1e-6);
+}
+
+#[test]
+fn unstable_pole_is_the_first_pole_on_or_outside_the_boundary() {
+    // Continuous: poles sorted by real part, then imaginary part; the first
+    // with Re s ≥ 0 (to rounding) is returned.
+    let two_unstable = StateSpace::continuous(
+        matrix![-1.0, 0.0, 0.0; 0.0, 3.0, 0.0; 0.0, 0.0, 2.0],
+        matrix![1.0; 1.0; 1.0],
+        matrix![1.0, 1.0, 1.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    assert_eq!(
+        two_unstable.unstable_pole().unwrap(),
+        Some(Complex::new(2.0, 0.0))
+    );
+    assert!(!two_unstable.is_stable().unwrap());
+    // A growing oscillation 0.5 ± i next to a stable real pole: the pair's
+    // lower half comes first.
+    let spiral = StateSpace::continuous(
+        matrix![0.5, 1.0, 0.0; -1.0, 0.5, 0.0; 0.0, 0.0, -3.0],
+        matrix![0.0; 1.0; 1.0],
+        matrix![1.0, 0.0, 1.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    let p = spiral.unstable_pole().unwrap().unwrap();
+    assert!((p - Complex::new(0.5, -1.0)).norm() < 1e-12, "{p}");
+    // On the boundary counts: an integrator.
+    let integrator =
+        StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
+    assert_eq!(
+        integrator.unstable_pole().unwrap(),
+        Some(Complex::new(0.0, 0.0))
+    );
+    // Stable models have none.
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
+    assert_eq!(plant.unstable_pole().unwrap(), None);
+    let lag =
+        StateSpace::continuous(matrix![-1e-3], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
+    assert_eq!(lag.unstable_pole().unwrap(), None);
+
+    // Discrete: the first pole with |z| ≥ 1 (to rounding), in the same order.
+    let outside = StateSpace::discrete(
+        matrix![0.5, 0.0, 0.0; 0.0, 1.1, 0.0; 0.0, 0.0, -1.2],
+        matrix![1.0; 1.0; 1.0],
+        matrix![1.0, 1.0, 1.0],
+        matrix![0.0],
+        0.1,
+    )
+    .unwrap();
+    assert_eq!(
+        outside.unstable_pole().unwrap(),
+        Some(Complex::new(-1.2, 0.0))
+    );
+    assert!(!outside.is_stable().unwrap());
+    // |z| = 1.2 > 1 although Re z = 0.6 < 1: the test is on the modulus.
+    let rotating = StateSpace::discrete(
+        matrix![0.6, 0.96; -0.96, 0.6],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+        0.1,
+    )
+    .unwrap();
+    let z = rotating.unstable_pole().unwrap().unwrap();
+    assert!((z - Complex::new(0.6, -0.96)).norm() < 1e-12, "{z}");
+    let accumulator =
+        StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    assert_eq!(
+        accumulator.unstable_pole().unwrap(),
+        Some(Complex::new(1.0, 0.0))
+    );
+    let d = plant.discretize(0.002, Method::Zoh).unwrap();
+    assert_eq!(d.unstable_pole().unwrap(), None);
+    let halving =
+        StateSpace::discrete(matrix![-0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    assert_eq!(halving.unstable_pole().unwrap(), None);
+}
+
+#[test]
+fn lqr_and_dlqr_refuse_a_solution_that_does_not_stabilise() {
+    // x' = x + u with Q = 0: the unstable mode costs nothing, the Riccati
+    // solution found is X = 0, and its loop keeps the pole at s = 1.
+    let sys =
+        StateSpace::continuous(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
+    match lqr(&sys, &matrix![0.0], &matrix![1.0]) {
+        Err(Error::Unstable { re, im, .. }) => assert_eq!((re, im), (1.0, 0.0)),
+        other => panic!("expected Error::Unstable, got {other:?}"),
+    }
+    // The same in discrete time: x[k+1] = 2 x[k] + u[k] keeps z = 2.
+    let d =
+        StateSpace::discrete(matrix![2.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    match dlqr(&d, &matrix![0.0], &matrix![1.0]) {
+        Err(Error::Unstable { re, im, .. }) => assert_eq!((re, im), (2.0, 0.0)),
+        other => panic!("expected Error::Unstable, got {other:?}"),
+    }
+    // An unstable mode the input cannot reach (not stabilisable), in both
+    // domains.
+    let unreachable = StateSpace::continuous(
+        matrix![1.0, 0.0; 0.0, -1.0],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    let q = SMatrix::<f64, 2, 2>::identity();
+    match lqr(&unreachable, &q, &matrix![1.0]) {
+        Err(Error::Unstable { re, .. }) => assert!(re >= 0.0, "{re}"),
+        other => panic!("expected Error::Unstable, got {other:?}"),
+    }
+    let unreachable_d = StateSpace::discrete(
+        matrix![1.5, 0.0; 0.0, 0.5],
+        matrix![0.0; 1.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+        0.1,
+    )
+    .unwrap();
+    match dlqr(&unreachable_d, &q, &matrix![1.0]) {
+        Err(Error::Unstable { re, im, .. }) => {
+            assert!(Complex::new(re, im).norm() >= 1.0, "{re} + {im}i")
+        }
+        other => panic!("expected Error::Unstable, got {other:?}"),
+    }
+    // With Q > 0 the same plants are stabilised.
+    assert!(lqr(&sys, &matrix![1.0], &matrix![1.0]).is_ok());
+    assert!(dlqr(&d, &matrix![1.0], &matrix![1.0]).is_ok());
 }

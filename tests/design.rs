@@ -5,7 +5,7 @@
 mod common;
 
 use ctrlab::{
-    Controller, Error, MassSpring, Method, Cart, StateFeedback, StateSpace, acker, dlqr, lqr,
+    Cart, Controller, Error, MassSpring, Method, StateFeedback, StateSpace, acker, dlqr, lqr,
 };
 use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 use proptest::prelude::*;
@@ -39,7 +39,8 @@ fn lab_law_in_si_equals_the_lab_law_in_millimetres() {
     let x_mm = x_m * 1000.0;
     let g_r_mm = vector![0.0, 0.0, r_m * 1000.0, 0.0];
     let want: f64 = (0..4).map(|i| kf[i] * (g_r_mm[i] - x_mm[i])).sum();
-    let got = c.update(r_m, &x_m)[0];
+    // Measurements first, then the reference as a vector.
+    let got = c.update(&x_m, &vector![r_m])[0];
     assert!((got - want).abs() <= 1e-12 * want.abs(), "{got} vs {want}");
 }
 
@@ -113,8 +114,10 @@ fn prefilter_removes_the_steady_state_error() {
     // Analytic: N = K3 + k_series = 10 000 + 500 N/m.
     assert!((c.reference_gain()[0] - 10_500.0).abs() < 1e-8);
 
+    // The same constructor on the discrete plant (`with_prefilter` takes
+    // either domain; `with_prefilter_discrete` was merged into it).
     let d = plant.discretize(0.002, Method::Zoh).unwrap();
-    let cd = StateFeedback::with_prefilter_discrete(&d, k).unwrap();
+    let cd = StateFeedback::with_prefilter(&d, k).unwrap();
     let dcd = cd.closed_loop(&d).unwrap().dc_gain().unwrap()[(0, 0)];
     assert!((dcd - 1.0).abs() < 1e-12);
 }
@@ -133,13 +136,40 @@ fn prefilter_refuses_a_closed_loop_without_dc_gain() {
 #[test]
 fn controller_through_mut_reference_and_reset() {
     let mut c = StateFeedback::new(matrix![1.0, 2.0], vector![3.0]).unwrap();
-    fn run(mut c: impl Controller<2, 1>) -> f64 {
+    // Controller<P = 2 measurements, R = 1 reference, M = 1 input>.
+    fn run(mut c: impl Controller<2, 1, 1>) -> f64 {
         c.reset();
-        c.update(2.0, &vector![1.0, 1.0])[0]
+        c.update(&vector![1.0, 1.0], &vector![2.0])[0]
     }
     assert_eq!(run(&mut c), 6.0 - 3.0);
-    let dynamic: &mut dyn Controller<2, 1> = &mut c;
+    let dynamic: &mut dyn Controller<2, 1, 1> = &mut c;
     assert_eq!(run(dynamic), 3.0);
+}
+
+#[test]
+fn open_loop_and_multi_reference_feedback_through_the_trait() {
+    use ctrlab::OpenLoop;
+    // OpenLoop: u = r, whatever is measured; a static law has no period.
+    let mut open = OpenLoop;
+    let u = Controller::<4, 1, 1>::update(&mut open, &vector![1.0, 2.0, 3.0, 4.0], &vector![2.5]);
+    assert_eq!(u, vector![2.5]);
+    Controller::<4, 1, 1>::applied(&mut open, &vector![2.0]);
+    assert_eq!(Controller::<4, 1, 1>::period(&open), None);
+    // Two references (each cart's position), one input: u = N r − K x.
+    let mut c = StateFeedback::<4, 1, 2>::new(
+        matrix![1000.0, 5.0, 10_000.0, 100.0],
+        matrix![1000.0, 10_000.0],
+    )
+    .unwrap();
+    let x = vector![0.001, 0.0, 0.002, -0.01];
+    let u = c.update(&x, &vector![0.010, 0.030]);
+    let want = 1000.0 * 0.010 + 10_000.0 * 0.030 - (1.0 + 20.0 - 1.0);
+    assert!((u[0] - want).abs() <= 1e-12 * want, "{} vs {want}", u[0]);
+    assert_eq!(c.period(), None);
+    // Its closed loop has one input per reference.
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
+    let cl = c.closed_loop(&plant).unwrap();
+    assert_eq!(*cl.b(), plant.b() * matrix![1000.0, 10_000.0]);
 }
 
 #[test]

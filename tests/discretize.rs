@@ -3,7 +3,7 @@
 mod common;
 
 use ctrlab::discretize::expm;
-use ctrlab::{Error, MassSpring, Method, Cart, StateSpace};
+use ctrlab::{Cart, Error, MassSpring, Method, StateSpace};
 use nalgebra::{SMatrix, matrix};
 use proptest::prelude::*;
 

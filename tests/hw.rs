@@ -3,10 +3,8 @@
 //! card and the rig are in `hw_sim.rs`.
 
 use ctrlab::hw::testing::{Cycle, RecordingPort, RegisterFile};
-use ctrlab::hw::{
-    Calibration, CycleKind, HwError, MassSpringRig, Pc104, RegisterMap, Rig, duty_from_bytes,
-    pwm_bytes,
-};
+use ctrlab::hw::{CycleKind, HwError, Pc104, RegisterMap, duty_from_bytes, pwm_bytes};
+use ctrlab::lab::{Calibration, MassSpringRig};
 use nalgebra::vector;
 use proptest::prelude::*;
 

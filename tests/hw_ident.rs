@@ -2,43 +2,45 @@
 //! stack: five runs with different noise seeds recover the card's truth.
 
 use ctrlab::OpenLoop;
-use ctrlab::hw::{
-    Calibration, Clock, LoopConfig, MassSpringRig, Pc104, SimulatedCard, SimulatedCardConfig,
-    VirtualClock, run,
-};
-use ctrlab::ident::mass_spring::{Scheme, Spread, identify_separate_springs};
+use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
+use ctrlab::lab::SimulatedRig;
+use ctrlab::lab::ident::{Scheme, SeparateSpringsEstimate, Spread, identify_separate_springs};
+use ctrlab::signal::{Signal, SquareWave};
+use nalgebra::vector;
 
 #[test]
 fn five_simulated_runs_recover_the_truth_within_one_percent() {
-    let truth = SimulatedCardConfig::default_truth();
+    let truth = SimulatedRig::default_truth();
     assert_ne!(truth.k1, truth.k2, "the default truth has unequal springs");
+    // The lab's identification input: ±2 V, switching every 0.2 s.
+    let square = SquareWave::new(2.0, 0.2).unwrap();
     let mut estimates = Vec::new();
     for seed in 1..=5 {
         let clock = VirtualClock::new();
-        let config = SimulatedCardConfig {
+        let rig = SimulatedRig {
             encoder_noise: 0.5,
             seed,
             ..Default::default()
-        };
-        let card = SimulatedCard::virtual_time(config, &clock).unwrap();
-        let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002).unwrap();
-        let square = |t: f64| {
-            if ((t / 0.2) as u64).is_multiple_of(2) {
-                2.0
-            } else {
-                -2.0
-            }
-        };
+        }
+        .rig(&Clock::Virtual(clock.clone()))
+        .unwrap();
         let loop_config = LoopConfig {
             duration: 5.0,
             ..LoopConfig::default()
         };
-        let out = run(rig, OpenLoop, square, &Clock::Virtual(clock), &loop_config).unwrap();
+        let out = run(
+            rig,
+            OpenLoop,
+            |t| vector![square.value(t)],
+            &Clock::Virtual(clock),
+            &loop_config,
+        )
+        .unwrap();
         estimates.push(
             identify_separate_springs(&out.recording, truth.m1, truth.m2, Scheme::Central).unwrap(),
         );
     }
-    let mean = |f: fn(&ctrlab::ident::mass_spring::SeparateSpringsEstimate) -> f64| {
+    let mean = |f: fn(&SeparateSpringsEstimate) -> f64| {
         Spread::of(&estimates.iter().map(f).collect::<Vec<_>>())
             .unwrap()
             .mean

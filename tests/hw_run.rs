@@ -4,11 +4,12 @@
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
-    Calibration, Clock, EppPort, HwErrorKind, LoopConfig, MassSpringRig, Pc104, SimulatedCard,
-    SimulatedCardConfig, VirtualClock, run,
+    Clock, EppPort, HwError, HwErrorKind, LoopConfig, Pc104, Rig, SimulatedCard, VirtualClock, run,
 };
+use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
+use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::{
-    Controller, MassSpring, Method, OpenLoop, Cart, StateFeedback, StepInfoOptions, step_info,
+    Cart, Controller, MassSpring, Method, OpenLoop, StateFeedback, StepInfoOptions, step_info,
 };
 use nalgebra::{SVector, vector};
 use proptest::prelude::*;
@@ -17,12 +18,23 @@ const PERIOD: f64 = 0.002;
 /// EPP cycles of one tick: latch+kick (2), two 4-byte counters (16), PWM (4).
 const CYCLES_PER_TICK: usize = 22;
 
-fn card(config: SimulatedCardConfig) -> (VirtualClock, SimulatedCard) {
+/// The lab's simulated card (the two carts with friction inside).
+type Card = SimulatedCard<FrictionPlant, 4>;
+
+fn card(config: SimulatedRig) -> (VirtualClock, Card) {
     let clock = VirtualClock::new();
-    let card = SimulatedCard::virtual_time(config, &clock).unwrap();
+    let card = config.card(&Clock::Virtual(clock.clone())).unwrap();
     (clock, card)
 }
 
+/// The simulated rig in one call, over a fresh virtual clock.
+fn sim_rig(config: SimulatedRig) -> (VirtualClock, MassSpringRig<Card>) {
+    let clock = VirtualClock::new();
+    let rig = config.rig(&Clock::Virtual(clock.clone())).unwrap();
+    (clock, rig)
+}
+
+/// The lab's rig on any port (a card behind a fault-injecting port).
 fn rig<P: EppPort>(port: P) -> MassSpringRig<P> {
     MassSpringRig::new(Pc104::new(port), Calibration::default(), PERIOD).unwrap()
 }
@@ -40,7 +52,7 @@ fn config(duration: f64) -> LoopConfig {
 /// velocities by backward difference over one period).
 fn sampled_simulation(
     plant: &MassSpring,
-    mut controller: impl Controller<4, 1>,
+    mut controller: impl Controller<4, 1, 1>,
     setpoint: f64,
     ticks: usize,
 ) -> Vec<f64> {
@@ -60,7 +72,7 @@ fn sampled_simulation(
             (x[2] - previous[2]) / PERIOD
         ];
         previous = x;
-        let u = controller.update(setpoint, &measured);
+        let u = controller.update(&measured, &vector![setpoint]);
         x2.push(x[2]);
         d.advance_mut(&mut x, &u);
     }
@@ -77,30 +89,31 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
     // like with like. Saturation itself is exercised by the lab5 rig runs.
     let truth = MassSpring::nominal();
     let supply = 400.0;
-    let (clock, card) = card(SimulatedCardConfig {
+    let clock = VirtualClock::new();
+    let sim = SimulatedRig {
         truth,
         supply_voltage: supply,
         ..Default::default()
-    });
+    };
     let gains = [0.0, 0.0, 10.0, 0.1];
     let ctrl = StateFeedback::from_lab_gains(gains, Cart::Two).unwrap();
     let setpoint = 0.030;
-    let calibration = Calibration {
-        volts_full_scale: supply,
-        ..Calibration::default()
-    };
-    let rig = MassSpringRig::new(Pc104::new(card), calibration, PERIOD).unwrap();
+    // The simulated rig's calibration has the card's supply as full scale.
+    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
+    assert_eq!(rig.calibration().volts_full_scale, supply);
     let out = run(
         rig,
         ctrl,
-        |_| setpoint,
+        |_| vector![setpoint],
         &Clock::Virtual(clock),
         &config(2.0),
     )
     .unwrap();
     let rec = out.recording;
     assert_eq!(rec.len(), 1000);
-    assert!(rec.u.iter().all(|u| u.abs() < supply), "no saturation");
+    let u = rec.channel("u").unwrap();
+    assert!(u.iter().all(|u| u.abs() < supply), "no saturation");
+    let (t, x2) = (rec.time(), rec.channel("x2").unwrap());
 
     let sim = sampled_simulation(&truth, ctrl, setpoint, rec.len());
     let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<_>>();
@@ -108,8 +121,8 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
         reference: Some(setpoint * 1e3),
         ..Default::default()
     };
-    let on_rig = step_info(&rec.t, &mm(&rec.x2), &options).unwrap();
-    let simulated = step_info(&rec.t, &mm(&sim), &options).unwrap();
+    let on_rig = step_info(t, &mm(x2), &options).unwrap();
+    let simulated = step_info(t, &mm(&sim), &options).unwrap();
     println!("rig {on_rig:?}\nsim {simulated:?}");
     assert!((on_rig.overshoot - simulated.overshoot).abs() < 1.0);
     assert!((on_rig.settling_time - simulated.settling_time).abs() < 0.010);
@@ -128,22 +141,16 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
 #[test]
 fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
     let make = || {
-        let (clock, card) = card(SimulatedCardConfig {
+        let (clock, rig) = sim_rig(SimulatedRig {
             encoder_noise: 0.5,
             seed: 7,
             ..Default::default()
         });
-        let square = |t: f64| {
-            if ((t / 0.2) as u64).is_multiple_of(2) {
-                2.0
-            } else {
-                -2.0
-            }
-        };
+        let square = SquareWave::new(2.0, 0.2).unwrap();
         run(
-            rig(card),
+            rig,
             OpenLoop,
-            square,
+            |t| vector![square.value(t)],
             &Clock::Virtual(clock),
             &config(1.0),
         )
@@ -155,11 +162,12 @@ fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
     // applies 83 steps = 1.992 V, and that is what is recorded.
     assert!(
         a.recording
-            .u
+            .channel("u")
+            .unwrap()
             .iter()
             .all(|u| (u.abs() - 1.992).abs() < 1e-12)
     );
-    let t = &a.recording.t;
+    let t = a.recording.time();
     assert!(t.windows(2).all(|w| ((w[1] - w[0]) - PERIOD).abs() < 1e-12));
     assert_eq!(a.stats.ticks, 500);
     assert_eq!(a.stats.overruns, 0);
@@ -168,46 +176,56 @@ fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
 #[test]
 fn a_travel_limit_breach_halts_and_keeps_the_recording() {
     // +24 V on the default truth (8.5 N/V) would push cart 2 to ~0.4 m.
-    let (clock, card) = card(SimulatedCardConfig::default());
-    let mut rig = rig(card);
+    let (clock, mut rig) = sim_rig(SimulatedRig::default());
     let err = run(
         &mut rig,
         OpenLoop,
-        |_| 24.0,
+        |_| vector![24.0],
         &Clock::Virtual(clock),
         &config(5.0),
     )
     .unwrap_err();
     assert_eq!(err.error.kind(), HwErrorKind::TravelLimit);
-    assert!(err.last_state.is_none(), "the breach is found in the read");
+    assert!(
+        err.last_measurement.is_none(),
+        "the breach is found in the read"
+    );
     let n = err.recording.len();
     assert!(n > 10 && n < 2500, "{n} samples before the breach");
-    assert!(err.recording.x2.iter().all(|x| x.abs() <= 0.15));
+    assert!(
+        err.recording
+            .channel("x2")
+            .unwrap()
+            .iter()
+            .all(|x| x.abs() <= 0.15)
+    );
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
 
 #[test]
 fn a_non_finite_command_halts_the_same_way() {
     struct NanAfter(usize);
-    impl Controller<4, 1> for NanAfter {
-        fn update(&mut self, _r: f64, _x: &SVector<f64, 4>) -> SVector<f64, 1> {
+    impl Controller<4, 1, 1> for NanAfter {
+        fn update(&mut self, _y: &SVector<f64, 4>, _r: &SVector<f64, 1>) -> SVector<f64, 1> {
             self.0 = self.0.saturating_sub(1);
             vector![if self.0 == 0 { f64::NAN } else { 3.0 }]
         }
     }
-    let (clock, card) = card(SimulatedCardConfig::default());
-    let mut rig = rig(card);
+    let (clock, mut rig) = sim_rig(SimulatedRig::default());
     let err = run(
         &mut rig,
         NanAfter(11),
-        |_| 0.0,
+        |_| vector![0.0],
         &Clock::Virtual(clock),
         &config(1.0),
     )
     .unwrap_err();
     assert_eq!(err.error.kind(), HwErrorKind::InvalidCommand);
     assert_eq!(err.recording.len(), 10);
-    assert!(err.last_state.is_some(), "the failing tick's state is kept");
+    assert!(
+        err.last_measurement.is_some(),
+        "the failing tick's state is kept"
+    );
     assert_eq!(rig.card().port().pwm_duty(0), 0);
     assert!(err.to_string().contains("10 samples"));
 }
@@ -216,13 +234,13 @@ fn a_non_finite_command_halts_the_same_way() {
 fn a_dead_port_leaves_the_motor_to_the_watchdog() {
     // Every cycle fails from tick 50 on, so even the halt cannot reach the
     // card: the last duty stays until the card's watchdog (100 ms) trips.
-    let (clock, card) = card(SimulatedCardConfig::default());
+    let (clock, card) = card(SimulatedRig::default());
     let port = RecordingPort::new(card).fail_from(50 * CYCLES_PER_TICK);
     let mut rig = rig(port);
     let err = run(
         &mut rig,
         OpenLoop,
-        |_| 6.0,
+        |_| vector![6.0],
         &Clock::Virtual(clock.clone()),
         &config(1.0),
     )
@@ -249,20 +267,18 @@ fn a_dead_port_leaves_the_motor_to_the_watchdog() {
 fn overruns_stop_the_loop_safely() {
     /// A controller that takes longer than the period, every time.
     struct Slow;
-    impl Controller<4, 1> for Slow {
-        fn update(&mut self, _r: f64, _x: &SVector<f64, 4>) -> SVector<f64, 1> {
+    impl Controller<4, 1, 1> for Slow {
+        fn update(&mut self, _y: &SVector<f64, 4>, _r: &SVector<f64, 1>) -> SVector<f64, 1> {
             std::thread::sleep(std::time::Duration::from_millis(3));
             vector![1.0]
         }
     }
-    let card = SimulatedCard::real_time(SimulatedCardConfig::default()).unwrap();
-    let mut rig = rig(card);
+    let mut rig = SimulatedRig::default().rig(&Clock::RealTime).unwrap();
     let cfg = LoopConfig {
         duration: 1.0,
         max_consecutive_overruns: 3,
-        ..LoopConfig::default()
     };
-    let err = run(&mut rig, Slow, |_| 0.0, &Clock::RealTime, &cfg).unwrap_err();
+    let err = run(&mut rig, Slow, |_| vector![0.0], &Clock::RealTime, &cfg).unwrap_err();
     assert_eq!(err.error.kind(), HwErrorKind::Overrun);
     assert_eq!(err.recording.len(), 3);
     assert_eq!(err.stats.overruns, 3);
@@ -273,8 +289,8 @@ fn overruns_stop_the_loop_safely() {
 fn a_stall_is_skipped_not_caught_up() {
     /// Stalls 7 ms (3.5 periods) once, at tick 5.
     struct Stall(usize);
-    impl Controller<4, 1> for Stall {
-        fn update(&mut self, _r: f64, _x: &SVector<f64, 4>) -> SVector<f64, 1> {
+    impl Controller<4, 1, 1> for Stall {
+        fn update(&mut self, _y: &SVector<f64, 4>, _r: &SVector<f64, 1>) -> SVector<f64, 1> {
             self.0 += 1;
             if self.0 == 6 {
                 std::thread::sleep(std::time::Duration::from_millis(7));
@@ -282,11 +298,11 @@ fn a_stall_is_skipped_not_caught_up() {
             vector![1.0]
         }
     }
-    let card = SimulatedCard::real_time(SimulatedCardConfig::default()).unwrap();
+    let rig = SimulatedRig::default().rig(&Clock::RealTime).unwrap();
     let out = run(
-        rig(card),
+        rig,
         Stall(0),
-        |_| 0.0,
+        |_| vector![0.0],
         &Clock::RealTime,
         &config(0.05),
     )
@@ -299,90 +315,127 @@ fn a_stall_is_skipped_not_caught_up() {
     assert_eq!(s.ticks + s.skipped, 25, "{s:?}");
     let rec = &out.recording;
     assert_eq!(rec.len(), s.ticks);
-    let gap = rec.t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+    let t = rec.time();
+    let gap = t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
     assert!(
         gap >= 3.0 * PERIOD - 1e-12,
         "the recording shows the gap: {gap}"
     );
     // The first sample after the gap has its speed estimate restarted.
-    let after = rec
-        .t
+    let after = t
         .windows(2)
         .position(|w| w[1] - w[0] > 1.5 * PERIOD)
         .unwrap()
         + 1;
-    let v2 = rec.v2.as_ref().unwrap();
+    let v2 = rec.channel("v2").unwrap();
     assert_eq!(v2[after], 0.0);
     assert!(s.lateness_p50 <= s.lateness_p99 && s.lateness_p99 <= s.lateness_max);
 }
 
 #[test]
 fn a_reused_rig_starts_each_run_with_a_fresh_speed_estimate() {
-    let (clock, card) = card(SimulatedCardConfig::default());
-    let mut rig = rig(card);
+    let (clock, mut rig) = sim_rig(SimulatedRig::default());
     let push = run(
         &mut rig,
         OpenLoop,
-        |_| 6.0,
+        |_| vector![6.0],
         &Clock::Virtual(clock.clone()),
         &config(0.5),
     )
     .unwrap();
-    assert!(push.recording.x2.last().unwrap() > &0.005);
+    assert!(push.recording.channel("x2").unwrap().last().unwrap() > &0.005);
     clock.advance(1.0).unwrap(); // carts swing back while nobody looks
     let again = run(
         &mut rig,
         OpenLoop,
-        |_| 0.0,
+        |_| vector![0.0],
         &Clock::Virtual(clock),
         &config(0.1),
     )
     .unwrap();
-    let v = again.recording.v2.as_ref().unwrap();
+    let v = again.recording.channel("v2").unwrap();
     // Not (x now − x at the end of the last run) / T.
     assert_eq!(v[0], 0.0);
-    assert!(again.recording.v1.as_ref().unwrap()[0] == 0.0);
+    assert!(again.recording.channel("v1").unwrap()[0] == 0.0);
+}
+
+/// A controller designed for sampling period `.0` (s) that outputs nothing.
+struct DesignedFor(f64);
+impl Controller<4, 1, 1> for DesignedFor {
+    fn update(&mut self, _y: &SVector<f64, 4>, _r: &SVector<f64, 1>) -> SVector<f64, 1> {
+        vector![0.0]
+    }
+    fn period(&self) -> Option<f64> {
+        Some(self.0)
+    }
+}
+
+/// A rig that reports period `.1` and is otherwise rig `.0`: the loop has no
+/// period of its own any more, it takes the rig's.
+struct ClaimsPeriod<R>(R, f64);
+impl<R: Rig<1, 4>> Rig<1, 4> for ClaimsPeriod<R> {
+    fn read(&mut self) -> Result<SVector<f64, 4>, HwError> {
+        self.0.read()
+    }
+    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HwError> {
+        self.0.apply(u)
+    }
+    fn halt(&mut self) -> Result<(), HwError> {
+        self.0.halt()
+    }
+    fn period(&self) -> f64 {
+        self.1
+    }
+    fn schema(&self) -> ctrlab::Schema {
+        self.0.schema()
+    }
 }
 
 #[test]
 fn a_loop_at_another_period_than_the_rig_is_refused() {
-    let (clock, card) = card(SimulatedCardConfig::default());
-    let mut rig = rig(card);
-    let cfg = LoopConfig {
-        period: 0.001,
-        duration: 0.1,
-        ..LoopConfig::default()
-    };
-    let err = run(&mut rig, OpenLoop, |_| 1.0, &Clock::Virtual(clock), &cfg).unwrap_err();
+    // The loop runs at the rig's period; a controller designed for another
+    // one (here 1 ms on the 2 ms rig) is refused before anything runs.
+    let (clock, mut rig) = sim_rig(SimulatedRig::default());
+    let cfg = config(0.1);
+    let err = run(
+        &mut rig,
+        DesignedFor(0.001),
+        |_| vector![1.0],
+        &Clock::Virtual(clock.clone()),
+        &cfg,
+    )
+    .unwrap_err();
     assert!(matches!(
         err.error,
         ctrlab::hw::HwError::InvalidConfig { name: "period", .. }
     ));
     assert!(err.recording.is_empty());
+    assert_eq!(rig.card().port().pwm_duty(0), 0);
+    // The same controller designed for the rig's 2 ms runs.
+    let out = run(
+        &mut rig,
+        DesignedFor(PERIOD),
+        |_| vector![1.0],
+        &Clock::Virtual(clock),
+        &cfg,
+    )
+    .unwrap();
+    assert_eq!(out.recording.len(), 50);
 }
 
 #[test]
 fn bad_loop_settings_are_refused_before_anything_runs() {
-    for (cfg, name) in [
-        (
-            LoopConfig {
-                period: 0.0,
-                ..LoopConfig::default()
-            },
-            "period",
-        ),
-        (
-            LoopConfig {
-                period: f64::NAN,
-                ..LoopConfig::default()
-            },
-            "period",
-        ),
+    let default = LoopConfig::default();
+    // (loop settings, the period the rig reports, the field refused)
+    for (cfg, period, name) in [
+        (default.clone(), 0.0, "period"),
+        (default.clone(), f64::NAN, "period"),
         (
             LoopConfig {
                 duration: 0.001,
                 ..LoopConfig::default()
             },
+            PERIOD,
             "duration",
         ),
         (
@@ -390,6 +443,7 @@ fn bad_loop_settings_are_refused_before_anything_runs() {
                 duration: f64::INFINITY,
                 ..LoopConfig::default()
             },
+            PERIOD,
             "duration",
         ),
         (
@@ -397,18 +451,36 @@ fn bad_loop_settings_are_refused_before_anything_runs() {
                 max_consecutive_overruns: 0,
                 ..LoopConfig::default()
             },
+            PERIOD,
             "max_consecutive_overruns",
         ),
     ] {
-        let (clock, card) = card(SimulatedCardConfig::default());
-        let mut rig = rig(card);
-        let err = run(&mut rig, OpenLoop, |_| 1.0, &Clock::Virtual(clock), &cfg).unwrap_err();
+        let (clock, mut rig) = sim_rig(SimulatedRig::default());
+        let err = run(
+            ClaimsPeriod(&mut rig, period),
+            OpenLoop,
+            |_| vector![1.0],
+            &Clock::Virtual(clock),
+            &cfg,
+        )
+        .unwrap_err();
         match err.error {
             ctrlab::hw::HwError::InvalidConfig { name: got, .. } => assert_eq!(got, name),
             other => panic!("{name}: {other}"),
         }
         assert!(err.recording.is_empty());
         assert_eq!(rig.card().port().pwm_duty(0), 0);
+    }
+    // The lab's rig itself refuses a period that is not finite and > 0.
+    for period in [0.0, f64::NAN] {
+        let bad = SimulatedRig {
+            period,
+            ..Default::default()
+        };
+        match bad.rig(&Clock::Virtual(VirtualClock::new())) {
+            Err(ctrlab::hw::HwError::InvalidConfig { name, .. }) => assert_eq!(name, "period"),
+            other => panic!("period {period}: {other:?}"),
+        }
     }
 }
 
@@ -417,18 +489,18 @@ proptest! {
 
     #[test]
     fn a_fault_at_any_cycle_ends_the_run_with_everything_before_it(k in 0usize..(40 * CYCLES_PER_TICK)) {
-        let (clock, card) = card(SimulatedCardConfig::default());
+        let (clock, card) = card(SimulatedRig::default());
         let port = RecordingPort::new(card).fail_at(k);
         let mut rig = rig(port);
-        let result = run(&mut rig, OpenLoop, |_| 3.0, &Clock::Virtual(clock), &config(0.1));
+        let result = run(&mut rig, OpenLoop, |_| vector![3.0], &Clock::Virtual(clock), &config(0.1));
         let err = result.expect_err("cycle k is inside the 50-tick run");
         prop_assert_eq!(err.error.kind(), HwErrorKind::Timeout);
         let tick = k / CYCLES_PER_TICK;
         prop_assert_eq!(err.recording.len(), tick);
         // Cut in the read (first 18 cycles) there is no state of that tick;
         // cut in the PWM write there is.
-        prop_assert_eq!(err.last_state.is_some(), k % CYCLES_PER_TICK >= 18);
-        prop_assert!(err.recording.u.iter().all(|u| (u - 3.0).abs() < 0.012));
+        prop_assert_eq!(err.last_measurement.is_some(), k % CYCLES_PER_TICK >= 18);
+        prop_assert!(err.recording.channel("u").unwrap().iter().all(|u| (u - 3.0).abs() < 0.012));
         prop_assert_eq!(rig.card().port().inner().pwm_duty(0), 0);
     }
 }

@@ -4,24 +4,28 @@
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
-    Calibration, CycleKind, EppPort, HwError, HwErrorKind, MassSpringRig, Pc104, Rig,
-    SIMULATED_CARD_ID, SimulatedCard, SimulatedCardConfig, VirtualClock,
+    Clock, CycleKind, EppPort, HwError, HwErrorKind, Pc104, Rig, SIMULATED_CARD_ID, SimulatedCard,
+    VirtualClock,
 };
-use ctrlab::{MassSpring, Method, Cart};
+use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
+use ctrlab::{Cart, MassSpring, Method};
 use nalgebra::{SVector, vector};
 
 /// 80 mm per 8192 counts.
 const MPC: f64 = 0.080 / 8192.0;
 const PERIOD_NS: u64 = 2_000_000;
 
-fn sim(config: SimulatedCardConfig) -> (VirtualClock, SimulatedCard) {
+/// The lab's simulated card (two carts, friction model inside).
+type Card = SimulatedCard<FrictionPlant, 4>;
+
+fn sim(config: SimulatedRig) -> (VirtualClock, Card) {
     let clock = VirtualClock::new();
-    let card = SimulatedCard::virtual_time(config, &clock).unwrap();
+    let card = config.card(&Clock::Virtual(clock.clone())).unwrap();
     (clock, card)
 }
 
-fn nominal_config() -> SimulatedCardConfig {
-    SimulatedCardConfig {
+fn nominal_config() -> SimulatedRig {
+    SimulatedRig {
         truth: MassSpring::nominal(),
         ..Default::default()
     }
@@ -31,7 +35,8 @@ fn nominal_config() -> SimulatedCardConfig {
 
 #[test]
 fn card_id_and_probe() {
-    let mut pc104 = Pc104::new(SimulatedCard::default());
+    let (_clock, card) = sim(SimulatedRig::default());
+    let mut pc104 = Pc104::new(card);
     assert_eq!(
         pc104.probe_id(SIMULATED_CARD_ID).unwrap(),
         SIMULATED_CARD_ID
@@ -47,8 +52,8 @@ fn card_id_and_probe() {
 fn plant_matches_the_exact_zoh_discretisation() {
     // The card's RK4 sub-steps against the crate's exact ZOH model: the
     // voltage is held between accesses, so the two agree to RK4's error.
-    let truth = SimulatedCardConfig::default_truth();
-    let (clock, card) = sim(SimulatedCardConfig {
+    let truth = SimulatedRig::default_truth();
+    let (clock, card) = sim(SimulatedRig {
         watchdog_timeout: None,
         ..Default::default()
     });
@@ -80,7 +85,7 @@ fn plant_matches_the_exact_zoh_discretisation() {
 
 #[test]
 fn a_latch_captures_the_counts_of_the_state_at_that_instant() {
-    let (clock, card) = sim(SimulatedCardConfig {
+    let (clock, card) = sim(SimulatedRig {
         initial_state: vector![0.004, 0.0, -0.013, 0.0],
         watchdog_timeout: None,
         ..Default::default()
@@ -102,7 +107,7 @@ fn a_latch_captures_the_counts_of_the_state_at_that_instant() {
 
 #[test]
 fn clearing_zeroes_the_counters_where_the_carts_are() {
-    let (clock, card) = sim(SimulatedCardConfig {
+    let (clock, card) = sim(SimulatedRig {
         initial_state: vector![0.004, 0.0, 0.013, 0.0],
         ..Default::default()
     });
@@ -124,7 +129,7 @@ fn clearing_zeroes_the_counters_where_the_carts_are() {
 
 #[test]
 fn watchdog_zeroes_the_pwm_when_not_kicked() {
-    let config = SimulatedCardConfig {
+    let config = SimulatedRig {
         initial_state: vector![0.0, 0.0, 0.0, 0.0],
         ..Default::default()
     };
@@ -153,7 +158,7 @@ fn watchdog_zeroes_the_pwm_when_not_kicked() {
 
     // The trip happened at exactly 150 ms of card time: the same card with no
     // watchdog, switched off by hand at 150 ms, ends in the same state.
-    let (clock2, card2) = sim(SimulatedCardConfig {
+    let (clock2, card2) = sim(SimulatedRig {
         watchdog_timeout: None,
         ..config
     });
@@ -171,7 +176,7 @@ fn watchdog_zeroes_the_pwm_when_not_kicked() {
 #[test]
 fn noise_is_seeded_and_of_the_configured_size() {
     let run = |seed: u64| {
-        let (_clock, card) = sim(SimulatedCardConfig {
+        let (_clock, card) = sim(SimulatedRig {
             encoder_noise: 3.0,
             seed,
             ..Default::default()
@@ -204,7 +209,7 @@ fn noise_is_seeded_and_of_the_configured_size() {
 #[test]
 fn coulomb_friction_sticks_below_breakaway_and_stops_in_the_dead_band() {
     let truth = MassSpring::nominal();
-    let (clock, card) = sim(SimulatedCardConfig {
+    let (clock, card) = sim(SimulatedRig {
         truth,
         coulomb_friction: [0.0, 2.0],
         watchdog_timeout: None,
@@ -235,38 +240,38 @@ fn coulomb_friction_sticks_below_breakaway_and_stops_in_the_dead_band() {
 
 #[test]
 fn invalid_configurations_are_refused() {
-    let default = SimulatedCardConfig::default();
+    let default = SimulatedRig::default();
     for (bad, name) in [
         (
-            SimulatedCardConfig {
+            SimulatedRig {
                 max_substep: 0.0,
                 ..default.clone()
             },
             "max_substep",
         ),
         (
-            SimulatedCardConfig {
+            SimulatedRig {
                 encoder_noise: -1.0,
                 ..default.clone()
             },
             "encoder_noise",
         ),
         (
-            SimulatedCardConfig {
+            SimulatedRig {
                 encoder_channels: [1, 1],
                 ..default.clone()
             },
             "encoder_channels",
         ),
         (
-            SimulatedCardConfig {
+            SimulatedRig {
                 watchdog_timeout: Some(f64::NAN),
                 ..default.clone()
             },
             "watchdog_timeout",
         ),
         (
-            SimulatedCardConfig {
+            SimulatedRig {
                 truth: MassSpring {
                     m2: 0.0,
                     ..MassSpring::nominal()
@@ -276,7 +281,7 @@ fn invalid_configurations_are_refused() {
             "m2",
         ),
     ] {
-        match SimulatedCard::real_time(bad) {
+        match bad.card(&Clock::RealTime) {
             Err(HwError::InvalidConfig { name: got, .. }) => assert_eq!(got, name),
             other => panic!("expected InvalidConfig for {name}, got {other:?}"),
         }
@@ -285,14 +290,19 @@ fn invalid_configurations_are_refused() {
 
 // ---- the rig ---------------------------------------------------------------
 
-fn rig_on(config: SimulatedCardConfig) -> (VirtualClock, MassSpringRig<SimulatedCard>) {
-    let (clock, card) = sim(config);
-    let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), 0.002).unwrap();
+fn rig_on(config: SimulatedRig) -> (VirtualClock, MassSpringRig<Card>) {
+    let clock = VirtualClock::new();
+    let rig = config.rig(&Clock::Virtual(clock.clone())).unwrap();
     (clock, rig)
 }
 
 /// Holds `volts` for `seconds`, reading every 2 ms; returns the last state.
-fn hold(clock: &VirtualClock, rig: &mut impl Rig, volts: f64, seconds: f64) -> SVector<f64, 4> {
+fn hold<P: EppPort>(
+    clock: &VirtualClock,
+    rig: &mut MassSpringRig<P>,
+    volts: f64,
+    seconds: f64,
+) -> SVector<f64, 4> {
     let mut x = rig.read_state().unwrap();
     for _ in 0..(seconds / 0.002).round() as usize {
         rig.apply_voltage(volts).unwrap();
@@ -306,8 +316,8 @@ fn hold(clock: &VirtualClock, rig: &mut impl Rig, volts: f64, seconds: f64) -> S
 fn open_loop_reaches_the_static_deflection_of_the_truth() {
     for (config, volts) in [
         (nominal_config(), 12.0),
-        (SimulatedCardConfig::default(), 3.0),
-        (SimulatedCardConfig::default(), -4.8),
+        (SimulatedRig::default(), 3.0),
+        (SimulatedRig::default(), -4.8),
     ] {
         let truth = config.truth;
         let (clock, mut rig) = rig_on(config);
@@ -351,7 +361,7 @@ fn speeds_are_count_differences_over_the_period() {
 
 #[test]
 fn voltages_saturate_and_quantise() {
-    let (_clock, mut rig) = rig_on(SimulatedCardConfig::default());
+    let (_clock, mut rig) = rig_on(SimulatedRig::default());
     for (volts, duty) in [
         (100.0, 1000),
         (-1e9, -1000),
@@ -370,7 +380,7 @@ fn voltages_saturate_and_quantise() {
 #[test]
 fn non_finite_voltage_halts_the_rig() {
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        let (_clock, mut rig) = rig_on(SimulatedCardConfig::default());
+        let (_clock, mut rig) = rig_on(SimulatedRig::default());
         rig.apply_voltage(10.0).unwrap();
         let err = rig.apply_voltage(bad).unwrap_err();
         assert_eq!(err.kind(), HwErrorKind::InvalidCommand, "{bad}");
@@ -380,7 +390,7 @@ fn non_finite_voltage_halts_the_rig() {
 
 #[test]
 fn travel_limit_breach_halts_the_rig() {
-    let (clock, mut rig) = rig_on(SimulatedCardConfig::default());
+    let (clock, mut rig) = rig_on(SimulatedRig::default());
     let mut err = None;
     // 24 V on the default truth would deflect cart 2 by 0.41 m.
     for _ in 0..5000 {
@@ -392,8 +402,9 @@ fn travel_limit_breach_halts_the_rig() {
         }
     }
     match err {
+        // Axis 2 is cart 2.
         Some(HwError::TravelLimit {
-            cart: 2,
+            axis: 2,
             position,
             limit,
         }) => {
@@ -407,7 +418,7 @@ fn travel_limit_breach_halts_the_rig() {
 
 #[test]
 fn dropping_the_rig_zeroes_the_pwm() {
-    let (_clock, mut card) = sim(SimulatedCardConfig::default());
+    let (_clock, mut card) = sim(SimulatedRig::default());
     {
         let mut rig =
             MassSpringRig::new(Pc104::new(&mut card), Calibration::default(), 0.002).unwrap();
@@ -419,7 +430,7 @@ fn dropping_the_rig_zeroes_the_pwm() {
 
 #[test]
 fn read_state_kicks_the_watchdog_and_stopping_trips_it() {
-    let (clock, mut rig) = rig_on(SimulatedCardConfig::default());
+    let (clock, mut rig) = rig_on(SimulatedRig::default());
     // A 1 s run of a loop that reads and writes every period: never trips.
     let x = hold(&clock, &mut rig, 1.2, 1.0);
     assert!(x[2] > 0.0);
@@ -432,7 +443,7 @@ fn read_state_kicks_the_watchdog_and_stopping_trips_it() {
 
 #[test]
 fn encoder_signs_and_channels_follow_the_calibration() {
-    let (clock, card) = sim(SimulatedCardConfig {
+    let (clock, card) = sim(SimulatedRig {
         initial_state: vector![0.002, 0.0, 0.005, 0.0],
         encoder_channels: [3, 2],
         ..Default::default()
@@ -452,7 +463,7 @@ fn encoder_signs_and_channels_follow_the_calibration() {
 #[test]
 fn a_dead_port_surfaces_as_an_error_from_the_rig() {
     // Cycle 0 is the latch's address write.
-    let (_clock, card) = sim(SimulatedCardConfig::default());
+    let (_clock, card) = sim(SimulatedRig::default());
     let port = RecordingPort::new(card).fail_from(0);
     let mut rig = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap();
     let err = rig.read_state().unwrap_err();
@@ -470,7 +481,7 @@ fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
     // An iteration is 22 cycles: latch+kick (2), two counters (2 × 8), PWM (4).
     const CYCLES: usize = 22;
     for k in 0..CYCLES {
-        let (clock, card) = sim(SimulatedCardConfig::default());
+        let (clock, card) = sim(SimulatedRig::default());
         let port = RecordingPort::new(card).fail_at(CYCLES + k);
         let mut rig = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap();
         rig.read_state().unwrap();

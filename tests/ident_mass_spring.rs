@@ -1,11 +1,13 @@
-//! The lab's identification (`ident::mass_spring`) against the NumPy
-//! fixture and against data simulated here from known parameters.
+//! The lab's identification (`lab::ident`) against the NumPy fixture and
+//! against data simulated here from known parameters.
 
 mod common;
 
-use ctrlab::ident::mass_spring::{Scheme, average, identify, identify_separate_springs};
+use ctrlab::data::{Channel, Schema};
+use ctrlab::lab::ident::{MIN_SAMPLES, Scheme, average, identify, identify_separate_springs};
+use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Error, MassSpring, Cart, Recording};
+use ctrlab::{Cart, Error, MassSpring, Recording};
 use nalgebra::{SVector, vector};
 use proptest::prelude::*;
 use serde_json::Value;
@@ -36,9 +38,27 @@ fn rel(got: f64, want: f64) -> f64 {
     (got - want).abs() / want.abs()
 }
 
+/// The channels of the lab's own logs (`t_s,u,x1_mm,x2_mm`), in SI: what
+/// the identification reads.
+fn log_schema() -> Schema {
+    Schema::new(
+        vec![Channel::new("u", "V")],
+        vec![Channel::new("x1", "m"), Channel::new("x2", "m")],
+    )
+    .unwrap()
+}
+
 /// ZOH simulation of `plant` driven by a ±`amp` square wave of half period
 /// `half` s, sampled every 2 ms for `t_end` s, positions quantised to the
 /// encoder's counts, plus `noise_counts` of uniform noise (seeded).
+///
+/// The wave held over each sample interval `[t, t + DT)` is its value in
+/// the middle of the interval, `t + DT / 2`: a switch at an exact multiple
+/// of the half period then falls on the sample the grid puts there, as in
+/// the fixture (every 100 samples for 0.2 s), and not one sample late when
+/// `k·DT / half` rounds just below an integer (0.6 s, 1.2 s, 2.4 s, … on
+/// this grid). For `half = 0.2` this is, sample for sample, the input of
+/// the hand-written `⌊t / half + 1e-9⌋` wave these tests used before.
 fn simulated(
     plant: &MassSpring,
     amp: f64,
@@ -49,13 +69,8 @@ fn simulated(
 ) -> Recording {
     let sys = plant.state_space(Cart::Two).unwrap();
     let t = time_grid(t_end, DT).unwrap();
-    let square = |t: f64| {
-        if ((t / half + 1e-9).floor() as i64) % 2 == 0 {
-            amp
-        } else {
-            -amp
-        }
-    };
+    let wave = SquareWave::new(amp, half).unwrap();
+    let square = |t: f64| wave.value(t + 0.5 * DT);
     let r = simulate(
         &sys,
         &t,
@@ -75,10 +90,11 @@ fn simulated(
     let mut quantise = |x: f64| {
         ((x * COUNTS_PER_METRE).round() + noise_counts * 2.0 * uniform()) / COUNTS_PER_METRE
     };
-    let mut rec = Recording::with_capacity(t.len());
+    let mut rec = Recording::with_capacity(log_schema(), t.len());
     for (k, &tk) in t.iter().enumerate() {
         let x = r.x[k];
-        rec.push(tk, square(tk), quantise(x[0]), quantise(x[2]));
+        rec.push(tk, &[square(tk)], &[quantise(x[0]), quantise(x[2])])
+            .unwrap();
     }
     rec
 }
@@ -133,7 +149,11 @@ fn reference_lstsq2(c0: &[f64], c1: &[f64], lam: &[f64]) -> [f64; 2] {
 /// The lab's MATLAB formulas (6)–(11), written out independently of the
 /// crate, solved by [`reference_lstsq2`]: `[k12, b1, K, b2]`.
 fn lab_formula_reference(rec: &Recording, m1: f64, m2: f64, t: f64) -> [f64; 4] {
-    let (x1, x2, u) = (&rec.x1, &rec.x2, &rec.u);
+    let (x1, x2, u) = (
+        rec.channel("x1").unwrap(),
+        rec.channel("x2").unwrap(),
+        rec.channel("u").unwrap(),
+    );
     let n = x1.len();
     let ks = 1..n - 1;
     let a1: Vec<f64> = ks.clone().map(|k| t * t * (2.0 * x1[k] - x2[k])).collect();
@@ -183,8 +203,10 @@ fn lab_scheme_reproduces_the_numpy_formula() {
     // moves K and b2 by 2e-8 and 3e-8 through the second differences.
     let per_metre = num(&fx, &["counts_per_metre"]);
     assert_eq!(per_metre, COUNTS_PER_METRE);
-    for x in rec.x1.iter_mut().chain(rec.x2.iter_mut()) {
-        *x = (*x * per_metre).round() / per_metre;
+    for name in ["x1", "x2"] {
+        for x in rec.channel_mut(name).unwrap() {
+            *x = (*x * per_metre).round() / per_metre;
+        }
     }
     let (m1, m2) = (num(&fx, &["true", "m1"]), num(&fx, &["true", "m2"]));
     let est = identify(&rec, m1, m2, Scheme::Lab).unwrap();
@@ -285,6 +307,13 @@ fn simulated_fixture_plant_central_within_0_3_percent_lab_biased() {
         ..MassSpring::nominal()
     };
     let rec = simulated(&plant, 2.0, 0.2, 5.0, 0.0, 1);
+    // The input switches every 100 samples (0.2 s), as the fixture's does
+    // (5 s at 2 ms is 2501 samples here, the fixture's 2500 and one more).
+    let u = rec.channel("u").unwrap();
+    let switches: Vec<usize> = (1..u.len()).filter(|&k| u[k] != u[k - 1]).collect();
+    assert_eq!(switches, (1..=25).map(|j| 100 * j).collect::<Vec<_>>());
+    let (fixture, _) = fixture();
+    assert_eq!(&u[..2500], fixture.channel("u").unwrap());
     let c = identify(&rec, plant.m1, plant.m2, Scheme::Central).unwrap();
     for (got, want) in [
         (c.k12.value, 950.0),
@@ -355,9 +384,10 @@ fn bad_inputs_are_typed_errors() {
         identify(&rec, 1.3, f64::NAN, Scheme::Lab),
         Err(Error::InvalidParameter { name: "m2", .. })
     ));
-    let mut short = Recording::new();
+    assert_eq!(MIN_SAMPLES, 6);
+    let mut short = Recording::new(log_schema());
     for k in 0..5 {
-        short.push(k as f64 * DT, 1.0, 0.0, 0.0);
+        short.push(k as f64 * DT, &[1.0], &[0.0, 0.0]).unwrap();
     }
     assert!(matches!(
         identify(&short, 1.3, 0.7, Scheme::Lab),
@@ -367,20 +397,53 @@ fn bad_inputs_are_typed_errors() {
             ..
         })
     ));
-    let mut ragged = rec.clone();
-    ragged.u.pop();
+    // A ragged recording (one input sample short) can no longer be built:
+    // `from_columns` refuses it, so identification never sees one.
+    let mut u = rec.channel("u").unwrap().to_vec();
+    u.pop();
+    let ragged = Recording::from_columns(
+        rec.schema().clone(),
+        rec.time().to_vec(),
+        vec![
+            u,
+            rec.channel("x1").unwrap().to_vec(),
+            rec.channel("x2").unwrap().to_vec(),
+        ],
+    );
     assert!(matches!(
-        identify(&ragged, 1.3, 0.7, Scheme::Lab),
-        Err(Error::InvalidRecording { index: 2499, .. })
+        ragged,
+        Err(Error::LengthMismatch {
+            expected: 2500,
+            found: 2499,
+            ..
+        })
     ));
     let mut nan = rec.clone();
-    nan.x2[7] = f64::NAN;
+    nan.channel_mut("x2").unwrap()[7] = f64::NAN;
     assert!(matches!(
         identify(&nan, 1.3, 0.7, Scheme::Central),
         Err(Error::InvalidRecording { index: 7, .. })
     ));
+    // The channels are read by name: a recording without x1 is refused,
+    // with the channels it has.
+    let no_x1 = Recording::from_columns(
+        Schema::new(vec![Channel::new("u", "V")], vec![Channel::new("x2", "m")]).unwrap(),
+        rec.time().to_vec(),
+        vec![
+            rec.channel("u").unwrap().to_vec(),
+            rec.channel("x2").unwrap().to_vec(),
+        ],
+    )
+    .unwrap();
+    match identify(&no_x1, 1.3, 0.7, Scheme::Central) {
+        Err(Error::Channel { name, reason }) => {
+            assert_eq!(name, "x1");
+            assert!(reason.contains("t, u, x2"), "{reason}");
+        }
+        other => panic!("expected Error::Channel, got {other:?}"),
+    }
     let mut jitter = rec;
-    jitter.t[100] += 0.1 * DT;
+    jitter.time_mut()[100] += 0.1 * DT;
     assert!(matches!(
         identify(&jitter, 1.3, 0.7, Scheme::Central),
         Err(Error::InvalidRecording { index: 100, .. })
@@ -463,7 +526,7 @@ fn rls_on_the_lab_regressors_agrees_with_the_batch_estimate() {
     // Stage 1 of Scheme::Central, row by row through Rls<2> (factor 1).
     let (rec, _) = fixture();
     let batch = identify(&rec, 1.3, 0.7, Scheme::Central).unwrap();
-    let (x1, x2, t) = (&rec.x1, &rec.x2, DT);
+    let (x1, x2, t) = (rec.channel("x1").unwrap(), rec.channel("x2").unwrap(), DT);
     // Rows are ~1e-8 in size, so ΦᵀΦ ~ 1e-13: P₀ = 1e22 makes the prior's
     // pull (1/P₀ against ΦᵀΦ) about 1e-9 relative.
     let mut rls = ctrlab::Rls::<2>::new(1.0, 1e22).unwrap();

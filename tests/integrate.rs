@@ -1,6 +1,6 @@
 //! RK4's order of accuracy against the exact (ZOH) solution.
 
-use ctrlab::{Dynamics, Euler, Integrator, MassSpring, Method, Cart, Rk4};
+use ctrlab::{Cart, Dynamics, Euler, Integrator, MassSpring, Method, Rk4};
 use nalgebra::{SVector, vector};
 
 /// Max-norm error of `steps` steps of `integrator` over [0, t_end] from rest

@@ -3,9 +3,11 @@
 
 mod common;
 
+use ctrlab::metrics::step_info_channel;
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{
-    Error, MassSpring, Cart, StateFeedback, StateSpace, StepInfoOptions, step_info, step_info_of,
+    Cart, Controller, Error, MassSpring, Recording, StateFeedback, StateSpace, StepInfoOptions,
+    step_info, step_info_of,
 };
 use nalgebra::{SVector, matrix, vector};
 use proptest::prelude::*;
@@ -25,8 +27,7 @@ fn table_2_rows_match_python_control() {
             .collect();
         assert_eq!(row["cart"].as_u64(), Some(2));
         let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
-        let ctrl =
-            StateFeedback::from_lab_gains([kf[0], kf[1], kf[2], kf[3]], Cart::Two).unwrap();
+        let ctrl = StateFeedback::from_lab_gains([kf[0], kf[1], kf[2], kf[3]], Cart::Two).unwrap();
         let cl = ctrl.closed_loop(&plant).unwrap();
         let setpoint = f("setpoint_mm") / 1000.0;
         // The fixture's grid: 0.5 ms out to 20 s.
@@ -86,6 +87,46 @@ fn table_2_rows_match_python_control() {
             (err - f("steady_state_error_mm")).abs() <= 1e-6,
             "{kf:?} ess {err}"
         );
+    }
+}
+
+#[test]
+fn step_info_of_a_recorded_channel() {
+    // Table 2, row [0 0 10 0.1], recorded in the lab's schema (u, x1, v1,
+    // x2, v2) as the rig's loop records it; the input is the controller's.
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
+    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let cl = ctrl.closed_loop(&plant).unwrap();
+    let setpoint = 0.030;
+    let t = time_grid(2.0, 0.0005).unwrap();
+    let r = simulate(
+        &cl,
+        &t,
+        SVector::zeros(),
+        |_| vector![setpoint],
+        Solver::Zoh,
+    )
+    .unwrap();
+    let mut rec = Recording::with_capacity(ctrlab::lab::schema(), t.len());
+    for (tk, x) in t.iter().zip(&r.x) {
+        let u = ctrl.update(x, &vector![setpoint]);
+        rec.push_vectors(*tk, &u, x).unwrap();
+    }
+    let opts = StepInfoOptions {
+        reference: Some(setpoint),
+        ..Default::default()
+    };
+    let x2: Vec<f64> = r.x.iter().map(|x| x[2]).collect();
+    let info = step_info_channel(&rec, "x2", &opts).unwrap();
+    assert_eq!(info, step_info(&t, &x2, &opts).unwrap());
+    // About 5 % overshoot, as in the fixture's row.
+    assert!((info.overshoot - 5.03).abs() < 0.5, "{}", info.overshoot);
+    match step_info_channel(&rec, "y", &opts) {
+        Err(Error::Channel { name, reason }) => {
+            assert_eq!(name, "y");
+            assert!(reason.contains("t, u, x1, v1, x2, v2"), "{reason}");
+        }
+        other => panic!("expected Error::Channel, got {other:?}"),
     }
 }
 

@@ -2,7 +2,7 @@
 
 mod common;
 
-use ctrlab::{Error, MassSpring, Cart, StateSpace};
+use ctrlab::{Cart, Error, MassSpring, StateSpace};
 use nalgebra::{SMatrix, matrix};
 use proptest::prelude::*;
 

@@ -1,23 +1,21 @@
 //! Simulation: solvers agree with each other and with analytic responses;
 //! bad grids and inputs are errors.
 
+use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{
     Solver, simulate, simulate_discrete, simulate_discrete_feedback, step_response, time_grid,
 };
-use ctrlab::{Error, MassSpring, Method, Cart, StateSpace};
+use ctrlab::{Cart, Error, MassSpring, Method, StateSpace};
 use nalgebra::{SVector, matrix, vector};
 
 #[test]
 fn rk4_and_zoh_simulations_agree() {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let t = time_grid(2.0, 0.002).unwrap();
-    let square = |t: f64| {
-        vector![if ((t / 0.2) as u64).is_multiple_of(2) {
-            10.0
-        } else {
-            -10.0
-        }]
-    };
+    // ±10 N every 0.2 s: `SquareWave` is exactly the hand-written
+    // `((t / 0.2) as u64).is_multiple_of(2)` wave this test used.
+    let wave = SquareWave::new(10.0, 0.2).unwrap();
+    let square = |t: f64| vector![wave.value(t)];
     let zoh = simulate(&sys, &t, SVector::zeros(), square, Solver::Zoh).unwrap();
     assert_eq!(zoh.len(), 1001);
     let worst = |substeps| {

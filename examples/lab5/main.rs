@@ -1,6 +1,6 @@
 //! The whole of Lab 5 ("State feedback control" of the two-cart rig), end to
 //! end, on the simulated rig through the full driver stack
-//! (`MassSpringRig` → `Pc104` → `SimulatedCard`) with a virtual clock:
+//! (`lab::MassSpringRig` → `Pc104` → `SimulatedCard`) with a virtual clock:
 //!
 //! - Tables 1 and 2 in simulation (nominal model);
 //! - five identification runs on the rig, Tables 3 and 4 with averages, by

@@ -79,26 +79,7 @@ impl Report {
     }
 }
 
-/// A 4×4 and a 4×1 matrix side by side, as the state equations.
-pub fn fmt_state_equations(
-    a: &nalgebra::SMatrix<f64, 4, 4>,
-    b: &nalgebra::SMatrix<f64, 4, 1>,
-) -> String {
-    let mut s = String::from(
-        "```text\nx' = A x + B u,   x = [x1 (m), x1' (m/s), x2 (m), x2' (m/s)],   u in V\n\n",
-    );
-    for r in 0..4 {
-        let label = if r == 1 { "A = " } else { "    " };
-        let blabel = if r == 1 { "B = " } else { "    " };
-        s += &format!(
-            "{label}[ {:11.4} {:11.4} {:11.4} {:11.4} ]   {blabel}[ {:9.4} ]\n",
-            a[(r, 0)],
-            a[(r, 1)],
-            a[(r, 2)],
-            a[(r, 3)],
-            b[(r, 0)]
-        );
-    }
-    s.push_str("```\n");
-    s
+/// The identified model as the report shows it: its `Display`, in a text block.
+pub fn fmt_state_equations<D: ctrlab::Domain>(sys: &ctrlab::StateSpace<4, 1, 1, D>) -> String {
+    format!("```text\nx = [x1 (m), x1' (m/s), x2 (m), x2' (m/s)],   u in V\n{sys:.4}```\n")
 }

@@ -1,17 +1,14 @@
 //! The rig sections: identification runs (Tables 3 and 4) and state feedback
 //! on the rig (Tables 5 and 6), through the full driver stack.
 
-use ctrlab::hw::{
-    Calibration, Clock, HwError, LoopConfig, MassSpringRig, Pc104, RunError, RunOutcome,
-    SimulatedCard, SimulatedCardConfig, VirtualClock, run,
-};
-use ctrlab::ident::mass_spring::{
+use ctrlab::hw::{Clock, HwError, LoopConfig, RunError, RunOutcome, VirtualClock, run};
+use ctrlab::lab::ident::{
     MassSpringEstimate, Scheme, Spread, average, identify, identify_separate_springs,
 };
-use ctrlab::{
-    Controller, Error, MassSpring, OpenLoop, Cart, StateFeedback, StepInfo, StepInfoOptions,
-    step_info,
-};
+use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
+use ctrlab::nalgebra::{SVector, vector};
+use ctrlab::signal::{Signal, SquareWave};
+use ctrlab::{Controller, Error, OpenLoop, StateFeedback, StepInfo, StepInfoOptions, step_info};
 
 use crate::lab_tables::{self, fmt_kf, fmt_poles};
 use crate::report::{Report, fmt_state_equations};
@@ -34,7 +31,7 @@ pub const RUNS: u64 = 5;
 /// Where the rig sections run.
 pub enum Backend {
     /// The register-level simulated card (default truth, see
-    /// `SimulatedCardConfig::default_truth`), virtual or real time.
+    /// `SimulatedRig::default_truth`), virtual or real time.
     Simulated { real_time: bool },
     /// The real PC104 card on a parallel port.
     #[cfg(all(feature = "ppdev", target_os = "linux"))]
@@ -44,11 +41,20 @@ pub enum Backend {
 impl Backend {
     pub fn describe(&self) -> String {
         match self {
-            Backend::Simulated { real_time } => format!(
-                "simulated PC104 card ({} clock), truth {:?}, encoder noise σ = {NOISE_COUNTS} counts",
-                if *real_time { "real-time" } else { "virtual" },
-                SimulatedCardConfig::default_truth()
-            ),
+            Backend::Simulated { real_time } => {
+                let t = SimulatedRig::default_truth();
+                format!(
+                    "simulated PC104 card ({} clock), truth m1 = {} kg, m2 = {} kg, k1 = {} N/m, k2 = {} N/m, b1 = {} N·s/m, b2 = {} N·s/m, K = {} N/V, encoder noise σ = {NOISE_COUNTS} counts",
+                    if *real_time { "real-time" } else { "virtual" },
+                    t.m1,
+                    t.m2,
+                    t.k1,
+                    t.k2,
+                    t.b1,
+                    t.b2,
+                    t.gain
+                )
+            }
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
             Backend::Card(path) => format!("the PC104 card on {}", path.display()),
         }
@@ -57,7 +63,7 @@ impl Backend {
     /// The truth behind a simulated rig, when there is one.
     pub fn truth(&self) -> Option<MassSpring> {
         match self {
-            Backend::Simulated { .. } => Some(SimulatedCardConfig::default_truth()),
+            Backend::Simulated { .. } => Some(SimulatedRig::default_truth()),
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
             Backend::Card(_) => None,
         }
@@ -70,54 +76,43 @@ impl Backend {
         &self,
         seed: u64,
         truth: Option<MassSpring>,
-        controller: impl Controller<4, 1>,
-        reference: impl FnMut(f64) -> f64,
+        controller: impl Controller<4, 1, 1>,
+        reference: impl FnMut(f64) -> SVector<f64, 1>,
         duration: f64,
     ) -> Result<Result<RunOutcome, Box<RunError>>, HwError> {
         let loop_config = LoopConfig {
-            period: PERIOD,
             duration,
             ..LoopConfig::default()
         };
         match self {
             Backend::Simulated { real_time } => {
-                let config = SimulatedCardConfig {
+                let sim = SimulatedRig {
                     encoder_noise: NOISE_COUNTS,
                     seed,
-                    truth: truth.unwrap_or_else(SimulatedCardConfig::default_truth),
+                    truth: truth.unwrap_or_else(SimulatedRig::default_truth),
+                    period: PERIOD,
                     ..Default::default()
                 };
-                if *real_time {
-                    let card = SimulatedCard::real_time(config)?;
-                    let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), PERIOD)?;
-                    Ok(run(
-                        rig,
-                        controller,
-                        reference,
-                        &Clock::RealTime,
-                        &loop_config,
-                    ))
+                let clock = if *real_time {
+                    Clock::RealTime
                 } else {
-                    let clock = VirtualClock::new();
-                    let card = SimulatedCard::virtual_time(config, &clock)?;
-                    let rig = MassSpringRig::new(Pc104::new(card), Calibration::default(), PERIOD)?;
-                    Ok(run(
-                        rig,
-                        controller,
-                        reference,
-                        &Clock::Virtual(clock),
-                        &loop_config,
-                    ))
-                }
+                    Clock::Virtual(VirtualClock::new())
+                };
+                let rig = sim.rig(&clock)?;
+                Ok(run(rig, controller, reference, &clock, &loop_config))
             }
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
             Backend::Card(path) => {
                 let _ = truth; // the real rig has its own
                 // Let the carts come to rest, then make it the zero position.
                 std::thread::sleep(std::time::Duration::from_secs(3));
-                let mut card = Pc104::new(ctrlab::hw::Ppdev::open(path)?);
+                let mut card = ctrlab::hw::Pc104::new(ctrlab::hw::Ppdev::open(path)?);
                 card.clear_counters()?;
-                let rig = MassSpringRig::new(card, Calibration::default(), PERIOD)?;
+                let rig = ctrlab::lab::MassSpringRig::new(
+                    card,
+                    ctrlab::lab::Calibration::default(),
+                    PERIOD,
+                )?;
                 Ok(run(
                     rig,
                     controller,
@@ -130,12 +125,9 @@ impl Backend {
     }
 }
 
-fn square(t: f64) -> f64 {
-    if ((t / IDENT_HALF_PERIOD) as u64).is_multiple_of(2) {
-        IDENT_VOLTS
-    } else {
-        -IDENT_VOLTS
-    }
+/// The identification input: the lab's square wave, V.
+fn square() -> SquareWave {
+    SquareWave::new(IDENT_VOLTS, IDENT_HALF_PERIOD).expect("valid constants")
 }
 
 /// All estimates of the identification runs.
@@ -176,9 +168,16 @@ pub fn identification(
     ));
     let (mut lab, mut central, mut separate) = (Vec::new(), Vec::new(), Vec::new());
     let mut first = None;
+    let wave = square();
     for seed in 1..=RUNS {
         let out = backend
-            .experiment(seed, None, OpenLoop, square, IDENT_DURATION)?
+            .experiment(
+                seed,
+                None,
+                OpenLoop,
+                |t| vector![wave.value(t)],
+                IDENT_DURATION,
+            )?
             .map_err(|e| format!("identification run {seed}: {e}"))?;
         let rec = out.recording;
         lab.push(identify(&rec, M1, M2, Scheme::Lab)?);
@@ -323,8 +322,8 @@ pub fn identification(
             "t (s)",
             "position (mm)",
             &[
-                ("x1".into(), rec.t.clone(), mm(&rec.x1)),
-                ("x2".into(), rec.t.clone(), mm(&rec.x2)),
+                ("x1".into(), rec.time().to_vec(), mm(rec.channel("x1")?)),
+                ("x2".into(), rec.time().to_vec(), mm(rec.channel("x2")?)),
             ],
         )?;
     }
@@ -343,7 +342,7 @@ pub fn identification(
         "From the averages of the separate-springs (Central) estimates, equations (3)/(14):\n",
     );
     let sys = model.state_space(Cart::Two)?;
-    report.add(&fmt_state_equations(sys.a(), sys.b()));
+    report.add(&fmt_state_equations(&sys));
     report.add(&format!("Open-loop poles: {}.\n", fmt_poles(&sys.poles()?)));
     // The lab's formulas assume k1 = k2. On an equal-springs truth the only
     // difference between the schemes is the finite differences themselves.
@@ -351,7 +350,13 @@ pub fn identification(
         Some(t) => {
             let truth = MassSpring { k2: t.k1, ..t };
             let out = backend
-                .experiment(99, Some(truth), OpenLoop, square, IDENT_DURATION)?
+                .experiment(
+                    99,
+                    Some(truth),
+                    OpenLoop,
+                    |t| vector![square().value(t)],
+                    IDENT_DURATION,
+                )?
                 .map_err(|e| format!("equal-springs run: {e}"))?;
             let rec = out.recording;
             let (l, c) = (
@@ -410,14 +415,14 @@ pub fn rig_tables() -> [RigTable; 2] {
         RigTable {
             name: "Table 5: cart 2, setpoint 30 mm (rig)",
             file: "table5.svg",
-            output: Cart::Two,
+            cart: Cart::Two,
             setpoint_mm: 30.0,
             rows: lab_tables::table5(),
         },
         RigTable {
             name: "Table 6: cart 1, setpoint 15 mm (rig)",
             file: "table6.svg",
-            output: Cart::One,
+            cart: Cart::One,
             setpoint_mm: 15.0,
             rows: lab_tables::table6(),
         },
@@ -437,17 +442,17 @@ pub fn rig_table(
         "u = Kf (G r − x_mm) in volts per mm, saturated at ±24 V, {STEP_DURATION} s per run on {}; metrics of the measured position (2 % band over the last 5 % of the run; steady state = mean of that window). The prediction is the identified model's closed loop sampled at 2 ms (ZOH, no saturation): stable when its spectral radius ρ = max |z| < 1; the continuous poles are shown for reference.\n",
         backend.describe()
     ));
-    let sys = model.state_space(table.output)?;
+    let sys = model.state_space(table.cart)?;
     // The rig samples every 2 ms: the loop that can be stable or not is the
     // sampled one, so predict with the ZOH-discretised model.
     let sampled = sys.discretize(PERIOD, ctrlab::Method::Zoh)?;
-    let idx = table.output.state_index();
+    let idx = table.cart.state_index();
     let setpoint = table.setpoint_mm / 1e3;
     let mut rows = Vec::new();
     let mut curves = Vec::new();
     let mut results = Vec::new();
     for (i, kf) in table.rows.iter().enumerate() {
-        let ctrl = StateFeedback::from_lab_gains(*kf, table.output)?;
+        let ctrl = StateFeedback::from_lab_gains(*kf, table.cart)?;
         let poles = fmt_poles(&ctrl.closed_loop(&sys)?.poles()?);
         let radius = ctrl
             .closed_loop(&sampled)?
@@ -459,18 +464,23 @@ pub fn rig_table(
             "{} (ρ = {radius:.3})",
             if radius < 1.0 { "stable" } else { "unstable" }
         );
-        let outcome =
-            backend.experiment(100 + i as u64, None, ctrl, |_| setpoint, STEP_DURATION)?;
+        let outcome = backend.experiment(
+            100 + i as u64,
+            None,
+            ctrl,
+            |_| vector![setpoint],
+            STEP_DURATION,
+        )?;
         let row = match outcome {
             Ok(out) => {
                 let rec = out.recording;
-                let x = if idx == 0 { &rec.x1 } else { &rec.x2 };
+                let x = rec.channel(if idx == 0 { "x1" } else { "x2" })?;
                 let y: Vec<f64> = x.iter().map(|v| v * 1e3).collect();
                 let options = StepInfoOptions {
                     reference: Some(table.setpoint_mm),
                     ..Default::default()
                 };
-                let row = match step_info(&rec.t, &y, &options) {
+                let row = match step_info(rec.time(), &y, &options) {
                     Ok(info) => RigRow::Measured(info),
                     Err(Error::NotSettled { .. }) => {
                         let tail = &y[y.len() * 3 / 4..];
@@ -482,20 +492,20 @@ pub fn rig_table(
                     }
                     Err(e) => RigRow::Failed(format!("no metrics: {e}")),
                 };
-                curves.push((format!("Kf = {}", fmt_kf(kf)), rec.t, y));
+                curves.push((format!("Kf = {}", fmt_kf(kf)), rec.time().to_vec(), y));
                 row
             }
             Err(e) => {
                 let rec = &e.recording;
-                let x = if idx == 0 { &rec.x1 } else { &rec.x2 };
+                let x = rec.channel(if idx == 0 { "x1" } else { "x2" })?;
                 curves.push((
                     format!("Kf = {} (halted)", fmt_kf(kf)),
-                    rec.t.clone(),
+                    rec.time().to_vec(),
                     x.iter().map(|v| v * 1e3).collect(),
                 ));
                 RigRow::Failed(format!(
                     "unstable/halted at t = {:.3} s: {}",
-                    rec.t.last().copied().unwrap_or(0.0),
+                    rec.time().last().copied().unwrap_or(0.0),
                     e.error
                 ))
             }

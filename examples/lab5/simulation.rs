@@ -1,7 +1,7 @@
 //! Tables 1 and 2: the nominal model in simulation.
 
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Error, MassSpring, Cart, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Cart, Error, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
 use nalgebra::{SVector, vector};
 
 use crate::lab_tables::{self, fmt_kf, fmt_poles};

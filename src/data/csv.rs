@@ -7,23 +7,24 @@ use super::{Channel, Recording, Schema, check_time};
 use crate::error::Error;
 
 /// The units the CSV reader recognises as a header suffix, with the SI unit
-/// they stand for and the factor to it: `(suffix, SI unit, factor)`. A
-/// header `x1_mm` is channel `x1` in `m`, read values × 0.001; `v1_m_s` is
-/// `v1` in `m/s`. The writer uses the SI suffixes, so every recording whose
-/// units are in this table reads back identical.
+/// they stand for and how many of them make one SI unit:
+/// `(suffix, SI unit, divisor)`. A header `x1_mm` is channel `x1` in `m`,
+/// read values ÷ 1000 (a division, so `0.001` mm is exactly the double
+/// nearest 1e-6 m); `v1_m_s` is `v1` in `m/s`. The writer uses the SI
+/// suffixes.
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::data::KNOWN_UNITS;
-/// assert!(KNOWN_UNITS.contains(&("mm_s", "m/s", 1e-3)));
+/// assert!(KNOWN_UNITS.contains(&("mm_s", "m/s", 1000.0)));
 /// ```
 pub const KNOWN_UNITS: [(&str, &str, f64); 10] = [
-    ("mm_s", "m/s", 1e-3),
+    ("mm_s", "m/s", 1000.0),
     ("m_s", "m/s", 1.0),
     ("rad_s", "rad/s", 1.0),
-    ("mm", "m", 1e-3),
-    ("ms", "s", 1e-3),
+    ("mm", "m", 1000.0),
+    ("ms", "s", 1000.0),
     ("m", "m", 1.0),
     ("s", "s", 1.0),
     ("V", "V", 1.0),
@@ -31,7 +32,7 @@ pub const KNOWN_UNITS: [(&str, &str, f64); 10] = [
     ("rad", "rad", 1.0),
 ];
 
-/// Splits a header into a channel (SI unit) and the factor to SI: the
+/// Splits a header into a channel (SI unit) and the divisor to SI: the
 /// bracket form `name [unit]` / `name (unit)` or a known suffix `name_unit`;
 /// otherwise the whole header is the name, without a unit.
 fn parse_header(header: &str) -> (Channel, f64) {
@@ -43,17 +44,17 @@ fn parse_header(header: &str) -> (Channel, f64) {
         let (name, unit) = (name.trim(), unit.trim());
         let suffix = unit.replace('/', "_");
         return match KNOWN_UNITS.iter().find(|k| k.0 == suffix) {
-            Some(&(_, si, factor)) => (Channel::new(name, si), factor),
+            Some(&(_, si, divisor)) => (Channel::new(name, si), divisor),
             None => (Channel::new(name, unit), 1.0),
         };
     }
-    for &(suffix, si, factor) in &KNOWN_UNITS {
+    for &(suffix, si, divisor) in &KNOWN_UNITS {
         if let Some(name) = header
             .strip_suffix(suffix)
             .and_then(|h| h.strip_suffix('_'))
             .filter(|n| !n.is_empty())
         {
-            return (Channel::new(name, si), factor);
+            return (Channel::new(name, si), divisor);
         }
     }
     (Channel::new(header, ""), 1.0)
@@ -71,6 +72,39 @@ fn header_of(channel: &Channel) -> String {
         format!("{}_{suffix}", channel.name)
     } else {
         format!("{} [{}]", channel.name, channel.unit)
+    }
+}
+
+impl Recording {
+    /// Checks every channel's header reads back as the same channel in the
+    /// same role, so that a written file always reads back identical.
+    fn check_round_trip(&self) -> Result<(), Error> {
+        let inputs = self.schema.inputs().len();
+        for (k, channel) in self.schema.channels().enumerate() {
+            let (parsed, divisor) = parse_header(&header_of(channel));
+            let reason = if matches!(parsed.name.as_str(), "t" | "time") {
+                Some("a channel cannot be named like the time column (t, time)")
+            } else if parsed != *channel || divisor != 1.0 {
+                Some(
+                    "its CSV header would read back as another channel: \
+                     give it an SI unit, or a name that does not end in a unit",
+                )
+            } else if is_input_name(&channel.name) != (k < inputs) {
+                Some(
+                    "in a CSV file, inputs are the channels named u, u1, u2, …: \
+                     rename it so that its role reads back",
+                )
+            } else {
+                None
+            };
+            if let Some(reason) = reason {
+                return Err(Error::Channel {
+                    name: channel.name.clone(),
+                    reason: reason.to_string(),
+                });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -179,32 +213,41 @@ impl Recording {
         }
         let found = || headers.iter().collect::<Vec<_>>().join(",");
 
-        // (column index, factor) of time, and of each channel in order.
+        // (column index, divisor) of time, and of each channel in order.
         let mut time: Option<(usize, f64)> = None;
         let mut inputs: Vec<(Channel, usize, f64)> = Vec::new();
         let mut measurements: Vec<(Channel, usize, f64)> = Vec::new();
         for (i, header) in headers.iter().enumerate() {
-            let (channel, factor) = parse_header(header);
+            let (channel, divisor) = parse_header(header);
             if matches!(channel.name.as_str(), "t" | "time") && channel.unit == "s" {
                 if time.is_some() {
-                    return Err(csv_error(1, format!("two time columns in header `{}`", found())));
+                    return Err(csv_error(
+                        1,
+                        format!("two time columns in header `{}`", found()),
+                    ));
                 }
-                time = Some((i, factor));
+                time = Some((i, divisor));
             } else if matches!(channel.name.as_str(), "t" | "time") {
                 return Err(csv_error(
                     1,
-                    format!("column `{header}` has no time unit: name it t_s or t_ms (header `{}`)", found()),
+                    format!(
+                        "column `{header}` has no time unit: name it t_s or t_ms (header `{}`)",
+                        found()
+                    ),
                 ));
             } else if is_input_name(&channel.name) {
-                inputs.push((channel, i, factor));
+                inputs.push((channel, i, divisor));
             } else {
-                measurements.push((channel, i, factor));
+                measurements.push((channel, i, divisor));
             }
         }
-        let Some((time_index, time_factor)) = time else {
+        let Some((time_index, time_divisor)) = time else {
             return Err(csv_error(
                 1,
-                format!("missing a time column t_s (or t_ms, t [s]); the header is `{}`", found()),
+                format!(
+                    "missing a time column t_s (or t_ms, t [s]); the header is `{}`",
+                    found()
+                ),
             ));
         };
         let schema = Schema::new(
@@ -212,7 +255,7 @@ impl Recording {
             measurements.iter().map(|c| c.0.clone()).collect(),
         )
         .map_err(|e| csv_error(1, format!("{e} (header `{}`)", found())))?;
-        let slots: Vec<(usize, f64, &str)> = std::iter::once((time_index, time_factor, "t"))
+        let slots: Vec<(usize, f64, &str)> = std::iter::once((time_index, time_divisor, "t"))
             .chain(
                 inputs
                     .iter()
@@ -233,12 +276,12 @@ impl Recording {
             }
             let line = record.position().map_or(last_line + 1, |p| p.line());
             last_line = line;
-            for (&(i, factor, name), col) in slots.iter().zip(cols.iter_mut()) {
+            for (&(i, divisor, name), col) in slots.iter().zip(cols.iter_mut()) {
                 let text = record.get(i).unwrap_or("");
                 let value: f64 = text.parse().map_err(|_| {
                     csv_error(line, format!("column {name}: `{text}` is not a number"))
                 })?;
-                let value = value * factor;
+                let value = value / divisor;
                 if !value.is_finite() {
                     return Err(csv_error(
                         line,
@@ -315,7 +358,12 @@ impl Recording {
     /// # Errors
     ///
     /// [`Error::InvalidRecording`] for a non-finite value (the reader would
-    /// refuse it); [`Error::Io`] when the writer fails.
+    /// refuse it); [`Error::Channel`] for a channel whose header would not
+    /// read back as itself (a unit outside [`KNOWN_UNITS`] that is not SI
+    /// such as `mm`, a name ending in a unit, a name `t` or `time`, or an
+    /// input not named `u…` / a measurement named `u…`), so that every
+    /// file written reads back identical; [`Error::Io`] when the writer
+    /// fails.
     ///
     /// # Examples
     ///
@@ -331,6 +379,7 @@ impl Recording {
     /// ```
     pub fn to_writer(&self, writer: impl Write) -> Result<(), Error> {
         self.check_values()?;
+        self.check_round_trip()?;
         let io = |e: csv::Error| match e.into_kind() {
             csv::ErrorKind::Io(e) => Error::io("writing CSV", &e),
             other => Error::io("writing CSV", &std::io::Error::other(format!("{other:?}"))),

@@ -366,7 +366,11 @@ impl Recording {
     /// assert!(Recording::from_columns(Schema::numbered(1, 1), vec![0.0, 0.1], vec![vec![1.0]]).is_err());
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
-    pub fn from_columns(schema: Schema, t: Vec<f64>, columns: Vec<Vec<f64>>) -> Result<Self, Error> {
+    pub fn from_columns(
+        schema: Schema,
+        t: Vec<f64>,
+        columns: Vec<Vec<f64>>,
+    ) -> Result<Self, Error> {
         if columns.len() != schema.len() {
             return Err(Error::LengthMismatch {
                 what: "columns (one per channel)",
@@ -375,7 +379,11 @@ impl Recording {
             });
         }
         if columns.iter().any(|c| c.len() != t.len()) {
-            let found = columns.iter().map(Vec::len).find(|&n| n != t.len()).unwrap_or(0);
+            let found = columns
+                .iter()
+                .map(Vec::len)
+                .find(|&n| n != t.len())
+                .unwrap_or(0);
             return Err(Error::LengthMismatch {
                 what: "a channel column",
                 expected: t.len(),
@@ -387,7 +395,11 @@ impl Recording {
         if let Some(k) = (1..rec.t.len()).find(|&k| rec.t[k] <= rec.t[k - 1]) {
             return Err(Error::InvalidRecording {
                 index: k,
-                reason: format!("time {} s does not increase (previous {} s)", rec.t[k], rec.t[k - 1]),
+                reason: format!(
+                    "time {} s does not increase (previous {} s)",
+                    rec.t[k],
+                    rec.t[k - 1]
+                ),
             });
         }
         Ok(rec)
@@ -526,7 +538,10 @@ impl Recording {
     fn position(&self, name: &str) -> Result<usize, Error> {
         self.schema.position(name).ok_or_else(|| Error::Channel {
             name: name.to_string(),
-            reason: format!("no such channel; the recording has: {}", self.schema.names()),
+            reason: format!(
+                "no such channel; the recording has: {}",
+                self.schema.names()
+            ),
         })
     }
 
@@ -633,8 +648,12 @@ impl Recording {
 
     /// Checks every value is finite (time included).
     fn check_values(&self) -> Result<(), Error> {
-        let named = std::iter::once(("t", &self.t))
-            .chain(self.schema.channels().map(|c| c.name.as_str()).zip(&self.columns));
+        let named = std::iter::once(("t", &self.t)).chain(
+            self.schema
+                .channels()
+                .map(|c| c.name.as_str())
+                .zip(&self.columns),
+        );
         for (name, col) in named {
             if let Some(k) = crate::kernels::reduce::first_non_finite(col) {
                 return Err(Error::InvalidRecording {

@@ -235,7 +235,14 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
         )
     });
     let gain = dare_gain(&a, &b, r, &x)?;
-    finish(gain, x, &(a - b * gain), residual, iterations, Some(sys.dt()))
+    finish(
+        gain,
+        x,
+        &(a - b * gain),
+        residual,
+        iterations,
+        Some(sys.dt()),
+    )
 }
 
 /// The doubling iteration on `(E, G, H)`; returns `H` at convergence.

@@ -54,7 +54,7 @@ pub enum HwErrorKind {
     Permission,
     /// Any other operating-system I/O failure.
     Io,
-    /// A cart left its software travel limits; the rig has been halted.
+    /// A moving part left its software travel limits; the rig has been halted.
     TravelLimit,
     /// A command was out of range or not finite (a NaN voltage, a PWM duty
     /// beyond ±1000, a channel that does not exist).
@@ -69,7 +69,7 @@ pub enum HwErrorKind {
 
 /// Everything that can go wrong in the `hw` module. Each variant carries the
 /// context needed to act on it: which cycle and register, which device,
-/// which cart and limit, which value.
+/// which axis and limit, which value.
 ///
 /// `#[non_exhaustive]`: match with a wildcard arm, or on [`kind`](Self::kind).
 ///
@@ -77,9 +77,9 @@ pub enum HwErrorKind {
 ///
 /// ```
 /// use ctrlab::hw::{HwError, HwErrorKind};
-/// let e = HwError::TravelLimit { cart: 2, position: 0.16, limit: 0.15 };
+/// let e = HwError::TravelLimit { axis: 2, position: 0.16, limit: 0.15 };
 /// assert_eq!(e.kind(), HwErrorKind::TravelLimit);
-/// assert!(e.to_string().contains("cart 2"));
+/// assert!(e.to_string().contains("axis 2"));
 /// ```
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -120,11 +120,12 @@ pub enum HwError {
         #[source]
         source: std::io::Error,
     },
-    /// A cart left its software travel limit; the rig was halted first.
-    #[error("cart {cart} at {position} m is beyond its travel limit ±{limit} m; rig halted")]
+    /// A moving part (an axis: one of the lab's carts) left its software
+    /// travel limit; the rig was halted first.
+    #[error("axis {axis} at {position} m is beyond its travel limit ±{limit} m; rig halted")]
     TravelLimit {
-        /// Which cart, 1 or 2.
-        cart: usize,
+        /// Which axis, counted from 1 (the lab: cart 1 or 2).
+        axis: usize,
         /// Its measured position, m.
         position: f64,
         /// The limit it broke, m (symmetric about zero).

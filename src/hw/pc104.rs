@@ -236,10 +236,11 @@ pub fn duty_from_bytes(low: u8, high: u8) -> i16 {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::hw::{Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
+/// use ctrlab::hw::{Clock, Pc104, VirtualClock};
+/// use ctrlab::lab::SimulatedRig;
 ///
 /// let clock = VirtualClock::new();
-/// let card = SimulatedCard::virtual_time(SimulatedCardConfig::default(), &clock)?;
+/// let card = SimulatedRig::default().card(&Clock::Virtual(clock.clone()))?;
 /// let mut pc104 = Pc104::new(card);
 /// pc104.probe_id(ctrlab::hw::SIMULATED_CARD_ID)?;
 /// pc104.set_pwm(0, 500)?; // +50 %: 12 V
@@ -361,8 +362,8 @@ impl<P: EppPort> Pc104<P> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{Pc104, SimulatedCard, SIMULATED_CARD_ID};
-    /// let mut pc104 = Pc104::new(SimulatedCard::default());
+    /// use ctrlab::hw::{Clock, Pc104, SIMULATED_CARD_ID};
+    /// let mut pc104 = Pc104::new(ctrlab::lab::SimulatedRig::default().card(&Clock::RealTime)?);
     /// assert_eq!(pc104.read_id()?, SIMULATED_CARD_ID);
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```

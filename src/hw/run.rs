@@ -388,7 +388,11 @@ fn check_config(config: &LoopConfig, period: f64) -> Result<usize, HwError> {
         max_consecutive_overruns,
     } = *config;
     if !(period.is_finite() && period >= 1e-6) {
-        return Err(invalid("period", period, "the rig's period must be finite and >= 1 µs"));
+        return Err(invalid(
+            "period",
+            period,
+            "the rig's period must be finite and >= 1 µs",
+        ));
     }
     if !(duration.is_finite() && duration >= period) {
         return Err(invalid(

@@ -317,8 +317,12 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
             return;
         }
         let span = target - self.t_nanos;
-        let max_step = ((self.config.max_substep * 1e9) as u64).max(1);
-        let steps = span.div_ceil(max_step);
+        // Equal steps no longer than `max_substep`, counted as the
+        // sampled-data simulator counts them (the tolerance keeps T / (T / 8)
+        // at 8 steps despite rounding), so both integrate alike.
+        let steps = ((span as f64 * 1e-9 / self.config.max_substep) * (1.0 - 1e-12))
+            .ceil()
+            .max(1.0) as u64;
         let h = span as f64 * 1e-9 / steps as f64;
         let u = vector![self.voltage()];
         let t0 = self.t_nanos as f64 * 1e-9;

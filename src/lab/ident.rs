@@ -17,10 +17,10 @@
 //! that scaling does not change the estimate. The standard errors of stage
 //! 2 treat `k2` as exact.
 
+use super::{Cart, MassSpring};
 use crate::data::Recording;
 use crate::error::Error;
 use crate::ident::{DEFAULT_MAX_CONDITION, LeastSquaresFit, solve_augmented};
-use super::{Cart, MassSpring};
 use crate::model::{Continuous, StateSpace};
 
 /// How derivatives and the input are taken from the samples.
@@ -289,6 +289,18 @@ fn prepare<'a>(rec: &'a Recording, m1: f64, m2: f64) -> Result<Prepared<'a>, Err
         }
     }
     let (u, x1, x2) = (rec.channel("u")?, rec.channel("x1")?, rec.channel("x2")?);
+    // A unitless position column (millimetres, say) must not pass as metres.
+    for channel in rec.schema().channels() {
+        if matches!(channel.name.as_str(), "x1" | "x2") && channel.unit != "m" {
+            return Err(Error::Channel {
+                name: channel.name.clone(),
+                reason: format!(
+                    "positions must be in m (a CSV header x1_m or x1_mm), found unit `{}`",
+                    channel.unit
+                ),
+            });
+        }
+    }
     if rec.len() < MIN_SAMPLES {
         return Err(Error::TooFewSamples {
             what: "mass-spring identification",
@@ -427,6 +439,8 @@ fn estimates<const P: usize>(fit: &LeastSquaresFit) -> [Estimate; P] {
 /// # Errors
 ///
 /// - [`Error::InvalidParameter`] for a mass that is not finite and > 0;
+/// - [`Error::Channel`] for a recording without a channel `u`, `x1` or
+///   `x2` (the message lists those it has), or positions not in m;
 /// - [`Error::TooFewSamples`] for fewer than [`MIN_SAMPLES`]
 ///   samples;
 /// - [`Error::InvalidRecording`] for mismatched columns, non-finite values

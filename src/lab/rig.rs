@@ -297,7 +297,7 @@ impl<P: EppPort> MassSpringRig<P> {
                 // too, the caller's own halt or the card's watchdog follows.
                 self.halt_motor().ok();
                 return Err(HwError::TravelLimit {
-                    cart: cart + 1,
+                    axis: cart + 1,
                     position,
                     limit,
                 });

@@ -2,8 +2,8 @@
 
 use nalgebra::SVector;
 
-use crate::sim::Sensor;
 use crate::signal::Rng;
+use crate::sim::Sensor;
 
 /// The rig's measurement of the state `[x1, v1, x2, v2]`, as
 /// [`MassSpringRig`](super::MassSpringRig) makes it: each position counted
@@ -59,7 +59,11 @@ impl EncoderSensor {
         Self {
             metres_per_count,
             period,
-            noise: if noise.is_finite() && noise > 0.0 { noise } else { 0.0 },
+            noise: if noise.is_finite() && noise > 0.0 {
+                noise
+            } else {
+                0.0
+            },
             rng: Rng::new(seed),
             seed,
             previous: None,

@@ -9,8 +9,8 @@ use crate::hw::{
     Clock, ENCODER_CHANNELS, HwError, MAX_DUTY, Pc104, RegisterMap, SIMULATED_CARD_ID,
     SimulatedCard, SimulatedCardConfig,
 };
-use crate::sim::SampledConfig;
 use crate::model::Dynamics;
+use crate::sim::SampledConfig;
 
 /// The two-cart plant with stick–slip Coulomb friction on each cart, input
 /// in volts (through `truth.gain`): a nonlinear [`Dynamics`] for the
@@ -155,7 +155,13 @@ impl Dynamics<4, 1> for FrictionPlant {
 /// use ctrlab::lab::{MassSpring, SimulatedRig};
 ///
 /// let clock = VirtualClock::new();
-/// let sim = SimulatedRig { truth: MassSpring::nominal(), encoder_noise: 0.5, seed: 7, ..Default::default() };
+/// let sim = SimulatedRig {
+///     truth: MassSpring::nominal(),
+///     encoder_noise: 0.5,
+///     seed: 7,
+///     watchdog_timeout: None, // nobody kicks it in this example
+///     ..Default::default()
+/// };
 /// let mut rig = sim.rig(&Clock::Virtual(clock.clone()))?;
 /// rig.apply_voltage(10.0)?;
 /// clock.advance(5.0)?;
@@ -376,7 +382,11 @@ impl SimulatedRig {
         &self,
         clock: &Clock,
     ) -> Result<MassSpringRig<SimulatedCard<FrictionPlant, 4>>, HwError> {
-        MassSpringRig::new(Pc104::new(self.card(clock)?), self.calibration(), self.period)
+        MassSpringRig::new(
+            Pc104::new(self.card(clock)?),
+            self.calibration(),
+            self.period,
+        )
     }
 
     /// What the rig measures, for the sampled-data simulator: the card's

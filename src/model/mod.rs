@@ -10,5 +10,5 @@ mod dynamics;
 mod state_space;
 
 pub use dynamics::Dynamics;
-pub use state_space::{Continuous, Discrete, Domain, StateSpace};
 pub(crate) use state_space::period_of;
+pub use state_space::{Continuous, Discrete, Domain, StateSpace};

@@ -168,24 +168,47 @@ impl<const M: usize, const P: usize> SampledConfig<M, P> {
         }
         let samples = (self.duration / self.period).round();
         if !(self.duration.is_finite() && samples >= 1.0) {
-            return Err(bad("duration", self.duration, "must be finite and at least one period, s"));
+            return Err(bad(
+                "duration",
+                self.duration,
+                "must be finite and at least one period, s",
+            ));
         }
         if samples > MAX_SAMPLES as f64 {
-            return Err(bad("duration", self.duration, "more samples than sim::MAX_SAMPLES"));
+            return Err(bad(
+                "duration",
+                self.duration,
+                "more samples than sim::MAX_SAMPLES",
+            ));
         }
         if !(self.max_substep.is_finite() && self.max_substep > 0.0) {
-            return Err(bad("max_substep", self.max_substep, "must be finite and > 0 s"));
+            return Err(bad(
+                "max_substep",
+                self.max_substep,
+                "must be finite and > 0 s",
+            ));
         }
         // A sub-step a million times shorter than the period is a unit slip,
         // and unbounded work besides.
         if self.period / self.max_substep > 1e6 {
-            return Err(bad("max_substep", self.max_substep, "more than 10^6 sub-steps per period"));
+            return Err(bad(
+                "max_substep",
+                self.max_substep,
+                "more than 10^6 sub-steps per period",
+            ));
         }
-        if !(self.input_delay.is_finite() && self.input_delay >= 0.0 && self.input_delay < self.period) {
-            return Err(bad("input_delay", self.input_delay, "must be finite, >= 0 and < period, s"));
+        if !(self.input_delay.is_finite()
+            && self.input_delay >= 0.0
+            && self.input_delay < self.period)
+        {
+            return Err(bad(
+                "input_delay",
+                self.input_delay,
+                "must be finite, >= 0 and < period, s",
+            ));
         }
         for &s in &self.saturation {
-            if !(s > 0.0) {
+            if s.is_nan() || s <= 0.0 {
                 return Err(bad("saturation", s, "must be > 0 (infinity for none)"));
             }
         }
@@ -280,7 +303,11 @@ where
     let samples = config.validate()?;
     crate::error::check_finite("x0", &x0).map_err(|_| Error::InvalidParameter {
         name: "x0",
-        value: x0.iter().copied().find(|v| !v.is_finite()).unwrap_or(f64::NAN),
+        value: x0
+            .iter()
+            .copied()
+            .find(|v| !v.is_finite())
+            .unwrap_or(f64::NAN),
         reason: "initial state must be finite",
     })?;
     let period = config.period;
@@ -346,7 +373,14 @@ where
         let delay = config.input_delay;
         integrate(&mut plant, &mut x, t, delay, &held, config.max_substep);
         held = u;
-        integrate(&mut plant, &mut x, t + delay, period - delay, &held, config.max_substep);
+        integrate(
+            &mut plant,
+            &mut x,
+            t + delay,
+            period - delay,
+            &held,
+            config.max_substep,
+        );
         if x.iter().any(|v| !v.is_finite()) {
             return Err(Error::Overflow {
                 operation: "sampled-data simulation (the plant's state diverged)",
