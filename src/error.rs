@@ -190,6 +190,15 @@ pub enum Error {
         /// What is wrong; for a missing channel, the channels there are.
         reason: String,
     },
+    /// A TOML file (a simulated rig's truth, a register map) does not parse
+    /// or holds an unknown field or a value of the wrong type.
+    #[error("TOML{}: {message}", line.map(|l| format!(" line {l}")).unwrap_or_default())]
+    Toml {
+        /// One-based line of the fault, when the parser knows it.
+        line: Option<usize>,
+        /// The parser's message, naming the field.
+        message: String,
+    },
     /// Reading or writing a file failed. Holds the error kind and message
     /// rather than `std::io::Error` so that `Error` stays `Clone + PartialEq`.
     #[error("{context}: {message}")]

@@ -9,16 +9,20 @@
 //! - Tables 5 and 6 run on the rig with the lab's gains;
 //! - the answers the lab report asks for, stated from the numbers.
 //!
-//! Writes `report.md` and one SVG per table into `--out DIR` (default
-//! `target/lab5`).
+//! Writes `report.md`, one SVG per table and every run's recording as CSV
+//! (`runs/`) into `--out DIR` (default `target/lab5`). Ctrl-C halts the rig,
+//! keeps the run's recording and the report so far.
 //!
 //! ```text
 //! cargo run --release --example lab5
 //! cargo run --release --example lab5 -- --out my_report      # elsewhere
-//! cargo run --release --example lab5 -- --real-time          # wall-clock loop (about a minute)
+//! cargo run --release --example lab5 -- --truth truth.toml   # another simulated rig
+//! cargo run --release --example lab5 -- --real-time          # wall-clock loop (about two minutes)
+//! cargo run --release --example lab5 -- --real-time --rt-priority 80   # with SCHED_FIFO
 //! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0   # the real card
 //! ```
 
+mod figures;
 #[path = "../common/lab_tables.rs"]
 mod lab_tables;
 mod report;
@@ -29,25 +33,33 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
+use ctrlab::hw::{RealTime, StopSignal};
+use ctrlab::lab::SimulatedRig;
 use report::Report;
-use rig::{Backend, RigResult, RigRow, RigTable, pct};
+use rig::{Backend, BackendKind, RigResult, RigRow, RigTable, pct};
 
-const USAGE: &str = "usage: lab5 [--out DIR] [--real-time] [--port /dev/parportN]
+const USAGE: &str = "usage: lab5 [--out DIR] [--truth FILE] [--real-time] [--rt-priority N] [--port /dev/parportN]
 
-  --out DIR      where report.md and the SVGs go (default target/lab5)
-  --real-time    run the rig sections on the wall clock instead of virtual time
-  --port PATH    run the rig sections on the real PC104 card (feature `ppdev`)";
+  --out DIR         where report.md, the SVGs and runs/*.csv go (default target/lab5)
+  --truth FILE      the simulated rig from a TOML file (see ctrlab::lab::SimulatedRig)
+  --real-time       run the rig sections on the wall clock instead of virtual time
+  --rt-priority N   run the loop with SCHED_FIFO priority N (1-99), memory locked (Linux)
+  --port PATH       run the rig sections on the real PC104 card (feature `ppdev`)";
 
 struct Args {
     out: PathBuf,
+    truth: Option<PathBuf>,
     real_time: bool,
+    rt_priority: Option<i32>,
     port: Option<PathBuf>,
 }
 
 fn parse_args() -> Result<Option<Args>, String> {
     let mut args = Args {
         out: PathBuf::from("target/lab5"),
+        truth: None,
         real_time: false,
+        rt_priority: None,
         port: None,
     };
     let mut it = std::env::args().skip(1);
@@ -55,6 +67,14 @@ fn parse_args() -> Result<Option<Args>, String> {
         match arg.as_str() {
             "--out" => args.out = it.next().ok_or("--out needs a directory")?.into(),
             "--real-time" => args.real_time = true,
+            "--truth" => args.truth = Some(it.next().ok_or("--truth needs a TOML file")?.into()),
+            "--rt-priority" => {
+                let n = it.next().ok_or("--rt-priority needs a priority 1-99")?;
+                args.rt_priority = Some(
+                    n.parse()
+                        .map_err(|_| format!("--rt-priority: `{n}` is not a number"))?,
+                );
+            }
             "--port" => args.port = Some(it.next().ok_or("--port needs a device path")?.into()),
             "-h" | "--help" => return Ok(None),
             other => return Err(format!("unknown argument `{other}`")),
@@ -63,23 +83,48 @@ fn parse_args() -> Result<Option<Args>, String> {
     Ok(Some(args))
 }
 
-fn backend(args: &Args) -> Result<Backend, String> {
+fn backend(args: &Args) -> Result<Backend, Box<dyn std::error::Error>> {
+    let realtime = args.rt_priority.map(|priority| RealTime {
+        priority,
+        ..RealTime::default()
+    });
+    // Ctrl-C halts the rig and ends the run with its recording, instead of
+    // killing the process with the motor at its last duty.
+    let stop = StopSignal::on_interrupt()?;
+    let kind = backend_kind(args)?;
+    Ok(Backend {
+        kind,
+        realtime,
+        stop,
+        out: args.out.clone(),
+    })
+}
+
+fn backend_kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
     match &args.port {
-        None => Ok(Backend::Simulated {
-            real_time: args.real_time,
-        }),
+        None => {
+            let sim = match &args.truth {
+                Some(path) => SimulatedRig::read_toml(path)?,
+                None => SimulatedRig::default(),
+            };
+            sim.validate()?;
+            Ok(BackendKind::Simulated {
+                sim,
+                real_time: args.real_time,
+            })
+        }
         #[cfg(all(feature = "ppdev", target_os = "linux"))]
         Some(path) => {
             println!(
                 "About to run the rig sections on the REAL card at {}:\n\
-                 - 5 open-loop runs of 5 s with a ±2 V square wave on PWM channel 0;\n\
+                 - 5 open-loop runs of 5 s with a ±8 V square wave on PWM channel 0;\n\
                  - 24 closed-loop runs of 3 s (Tables 5 and 6), saturated at ±24 V,\n\
-                   halting at ±150 mm of travel; 3 s pauses between runs.\n\
+                   halting at ±50 mm of travel; 3 s pauses between runs.\n\
                  Keep a hand on the emergency stop. Starting in 10 s (Ctrl-C to abort).",
                 path.display()
             );
             std::thread::sleep(std::time::Duration::from_secs(10));
-            Ok(Backend::Card(path.clone()))
+            Ok(BackendKind::Card(path.clone()))
         }
         #[cfg(not(all(feature = "ppdev", target_os = "linux")))]
         Some(_) => Err("--port needs the `ppdev` feature on Linux: \
@@ -117,41 +162,44 @@ fn lab(args: &Args) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let backend = backend(args)?;
     std::fs::create_dir_all(&args.out)?;
     let mut report = Report::new(&args.out);
+    let result = sections(&backend, &mut report);
+    if let Err(e) = &result {
+        // Keep what was measured: the report so far, with the reason.
+        report.add(&format!("\n**The lab stopped early:** {e}\n"));
+    }
+    report.add(&format!(
+        "\n_Run time: {:.2} s._\n",
+        started.elapsed().as_secs_f64()
+    ));
+    let path = report.write()?;
+    result.map(|()| path)
+}
+
+fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::error::Error>> {
     report.heading(1, "Lab 5: state feedback control of the two-cart rig");
     report.add(&format!(
         "Generated by `ctrlab` {} (`cargo run --release --example lab5`). Units: mm, s, N, V; poles in 1/s.\n",
         env!("CARGO_PKG_VERSION")
     ));
 
-    simulation::table1(&mut report)?;
-    let table2 = simulation::table2(&mut report)?;
-    let ident = rig::identification(&backend, &mut report)?;
+    simulation::table1(report)?;
+    let table2 = simulation::table2(report)?;
+    let ident = rig::identification(backend, report)?;
     let tables = rig::rig_tables();
     let mut rig_results = Vec::new();
     for table in &tables {
-        rig_results.push(rig::rig_table(&backend, &ident.model, table, &mut report)?);
+        rig_results.push(rig::rig_table(backend, &ident.model, table, report)?);
     }
-    answers(
-        &mut report,
-        &backend,
-        &ident,
-        &table2,
-        &tables,
-        &rig_results,
-    );
-    report.add(&format!(
-        "\n_Run time: {:.2} s._\n",
-        started.elapsed().as_secs_f64()
-    ));
-    Ok(report.write()?)
+    answers(report, backend, &ident, &table2, &tables, &rig_results);
+    Ok(())
 }
 
 /// The values of one figure along a row group, `-` where a row failed.
 fn series(rows: &[(&[f64; 4], &RigResult)], figure: fn(&ctrlab::StepInfo) -> f64) -> String {
     rows.iter()
         .map(|(_, r)| match &r.row {
-            RigRow::Measured(info) => format!("{:.2}", figure(info)),
-            RigRow::Failed(_) => "–".into(),
+            RigRow::Settled(info) => format!("{:.2}", figure(info)),
+            _ => "–".into(),
         })
         .collect::<Vec<_>>()
         .join(", ")
@@ -167,14 +215,14 @@ fn effect(name: &str, context: &str, k: usize, rows: &[(&[f64; 4], &RigResult)])
         .join(", ");
     let failed: Vec<String> = rows
         .iter()
-        .filter(|(_, r)| matches!(r.row, RigRow::Failed(_)))
+        .filter(|(_, r)| !r.row.is_settled())
         .map(|(kf, _)| format!("{}", kf[k]))
         .collect();
     let measured: Vec<&ctrlab::StepInfo> = rows
         .iter()
         .filter_map(|(_, r)| match &r.row {
-            RigRow::Measured(info) => Some(info),
-            RigRow::Failed(_) => None,
+            RigRow::Settled(info) => Some(info),
+            _ => None,
         })
         .collect();
     let mut s = format!(
@@ -206,7 +254,7 @@ fn effect(name: &str, context: &str, k: usize, rows: &[(&[f64; 4], &RigResult)])
         }
     }
     if !failed.is_empty() {
-        s += &format!(" Unstable or halted at {name} = {}.", failed.join(", "));
+        s += &format!(" Not settled at {name} = {} (see the outcome column).", failed.join(", "));
     }
     s
 }
@@ -222,16 +270,26 @@ fn answers(
     report.heading(2, "Answers to the report's questions");
     report.heading(3, "1. The state equations with the identified parameters");
     let m = &ident.model;
+    let [f1, f2] = &ident.coulomb;
     let mut s = format!(
-        "With m1 = {} kg and m2 = {} kg known: k1 = {:.1} N/m, k2 = {:.1} N/m, b1 = {:.3} N·s/m, b2 = {:.3} N·s/m, K = {:.4} N/V (averages of five runs); the matrices are in the section above.",
-        m.m1, m.m2, m.k1, m.k2, m.b1, m.b2, m.gain
+        "With m1 = {} kg and m2 = {} kg known: k1 = {:.1} N/m, k2 = {:.1} N/m, b1 = {:.3} N·s/m, b2 = {:.3} N·s/m, K = {:.4} N/V, and Coulomb friction {:.2} N on cart 1 and {:.2} N on cart 2 (averages of five runs); the matrices are in the section above.",
+        m.m1, m.m2, m.k1, m.k2, m.b1, m.b2, m.gain, f1.mean, f2.mean
     );
+    if let Some(sim) = backend.sim() {
+        s += &format!(
+            " The card's Coulomb friction is {} N and {} N: identified {} and {}.",
+            sim.coulomb_friction[0],
+            sim.coulomb_friction[1],
+            pct(f1.mean, sim.coulomb_friction[0]),
+            pct(f2.mean, sim.coulomb_friction[1]),
+        );
+    }
     if let Some(t) = backend.truth() {
         let avg = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
         let lab_k = avg(ident.lab.iter().map(|e| e.gain.value).collect());
         let cen_k = avg(ident.central.iter().map(|e| e.gain.value).collect());
         s += &format!(
-            " Against the simulated card's truth: k1 {}, k2 {}, b1 {}, b2 {}, K {}. The card's springs differ (k1 = {:.0}, k2 = {:.0} N/m), so the lab's single-spring model is wrong for it whatever the differences: its K is off by {} (Lab) and {} (Central), while identifying k1 and k2 separately recovers K within {}.",
+            " Against the simulated card's truth: k1 {}, k2 {}, b1 {}, b2 {}, K {}. The card's springs differ (k1 = {:.0}, k2 = {:.0} N/m) and its carts have Coulomb friction, so the lab's model is wrong for it whatever the differences: its K is off by {} (Lab) and {} (Central), while identifying k1, k2 and the friction separately recovers K within {}.",
             pct(m.k1, t.k1),
             pct(m.k2, t.k2),
             pct(m.b1, t.b1),
@@ -310,7 +368,7 @@ fn answers(
     let all: Vec<&RigResult> = results.iter().flatten().collect();
     let agree = all
         .iter()
-        .filter(|r| (r.radius < 1.0) == matches!(r.row, RigRow::Measured(_)))
+        .filter(|r| (r.radius < 1.0) == r.row.is_settled())
         .count();
     lines.push(format!(
         "- The gains are volts per millimetre, so on a rig with K = {:.2} N/V they act {:.1} times harder than on the nominal force-input model of Table 2: they saturate the 24 V drive, and the loop that matters is the sampled one (a velocity gain makes the 2 ms loop unstable once K·Kf4·1000·T/m2 passes about 2). The identified model sampled at 2 ms predicts stable/unstable correctly for {agree} of the {} rig runs (stable ↔ metrics measured).",

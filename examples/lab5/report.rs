@@ -72,6 +72,50 @@ impl Report {
         Ok(())
     }
 
+    /// Writes the rig runs as small multiples (position over the setpoint,
+    /// applied voltage beneath) and links the figure.
+    pub fn runs(
+        &mut self,
+        file: &str,
+        title: &str,
+        setpoint_mm: f64,
+        volts_full_scale: f64,
+        runs: &[crate::figures::RunCurve],
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        #[cfg(feature = "plot")]
+        {
+            crate::figures::runs_svg(&self.out.join(file), title, setpoint_mm, volts_full_scale, runs)?;
+            self.add(&format!("![{title}]({file})\n"));
+        }
+        #[cfg(not(feature = "plot"))]
+        {
+            let (_, _, _) = (setpoint_mm, volts_full_scale, runs);
+            self.add(&format!("(figure `{file}`, {title}, needs the `plot` feature)\n"));
+        }
+        Ok(())
+    }
+
+    /// Writes the per-run estimates with their mean and the truth, and
+    /// links the figure.
+    pub fn estimates(
+        &mut self,
+        file: &str,
+        title: &str,
+        panels: &[crate::figures::ParamPanel],
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        #[cfg(feature = "plot")]
+        {
+            crate::figures::estimates_svg(&self.out.join(file), title, panels)?;
+            self.add(&format!("![{title}]({file})\n"));
+        }
+        #[cfg(not(feature = "plot"))]
+        {
+            let _ = panels;
+            self.add(&format!("(figure `{file}`, {title}, needs the `plot` feature)\n"));
+        }
+        Ok(())
+    }
+
     pub fn write(&self) -> std::io::Result<PathBuf> {
         let path = self.out.join("report.md");
         std::fs::write(&path, &self.text)?;

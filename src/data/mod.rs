@@ -646,6 +646,16 @@ impl Recording {
         self.push(t, u.as_slice(), y.as_slice())
     }
 
+    /// Touches every column's spare capacity so its pages are mapped (and,
+    /// under `mlockall`, locked) before a real-time loop pushes into it.
+    pub(crate) fn prefault(&mut self) {
+        for col in std::iter::once(&mut self.t).chain(self.columns.iter_mut()) {
+            let (len, capacity) = (col.len(), col.capacity());
+            col.resize(capacity, 0.0);
+            col.truncate(len);
+        }
+    }
+
     /// Checks every value is finite (time included).
     fn check_values(&self) -> Result<(), Error> {
         let named = std::iter::once(("t", &self.t)).chain(

@@ -62,9 +62,26 @@ pub enum HwErrorKind {
     /// A configuration value (register map, calibration, simulated card) is
     /// invalid.
     InvalidConfig,
-    /// The control loop missed its deadlines too many times in a row; the
-    /// rig has been halted.
-    Overrun,
+    /// The control loop lost its timing: too many overruns or skipped
+    /// deadlines in a window, or a gap between samples long enough for the
+    /// card's watchdog to trip; the rig has been halted.
+    Timing,
+    /// The controller or the reference function panicked; the rig has been
+    /// halted.
+    Panic,
+    /// The run was interrupted (Ctrl-C, SIGTERM, or a stop request); the rig
+    /// has been halted.
+    Interrupted,
+    /// A measurement is physically impossible (an encoder count jumped
+    /// further in one sample than the carts can move): a bus or encoder
+    /// fault; the rig has been halted.
+    BusFault,
+    /// Sustained drive with no encoder motion: the motor, its driver or the
+    /// encoders are not responding; the rig has been halted.
+    NotResponding,
+    /// Real-time scheduling (SCHED_FIFO, memory locking, CPU affinity) was
+    /// asked for but could not be set up.
+    RealTime,
 }
 
 /// Everything that can go wrong in the `hw` module. Each variant carries the
@@ -153,17 +170,92 @@ pub enum HwError {
         /// What the value must satisfy.
         reason: &'static str,
     },
-    /// The control loop overran its period too many times in a row.
+    /// Too many timing faults (overruns and skipped deadlines) within a
+    /// window of time.
     #[error(
-        "control loop overran its {period} s period {consecutive} times in a row (last tick took {last_tick} s); rig halted"
+        "control loop lost its timing: {faults} timing faults (overruns or skipped deadlines) within {window} s at t = {at:.4} s, period {period} s; rig halted"
     )]
-    Overrun {
-        /// Consecutive overruns when the loop gave up.
-        consecutive: usize,
+    TimingFaults {
+        /// Faults counted in the window when the loop gave up.
+        faults: usize,
+        /// The window, s.
+        window: f64,
         /// The loop's period, s.
         period: f64,
-        /// How long the last tick's work took, s.
-        last_tick: f64,
+        /// Time into the run, s.
+        at: f64,
+    },
+    /// Too long without a sample (or a controller that took too long): the
+    /// card's watchdog may trip and, kicked again, re-energise the motor
+    /// with a stale command.
+    #[error(
+        "{what} took {gap:.4} s at t = {at:.4} s, longer than the {limit:.4} s allowed (half the watchdog timeout); rig halted"
+    )]
+    Gap {
+        /// What took too long (`"the interval between two samples"`,
+        /// `"the controller"`).
+        what: &'static str,
+        /// How long it took, s.
+        gap: f64,
+        /// The limit, s.
+        limit: f64,
+        /// Time into the run, s.
+        at: f64,
+    },
+    /// The controller or reference function panicked.
+    #[error("the {what} panicked at t = {at:.4} s: {message}; rig halted")]
+    Panicked {
+        /// `"controller"` or `"reference"`.
+        what: &'static str,
+        /// The panic's message.
+        message: String,
+        /// Time into the run, s.
+        at: f64,
+    },
+    /// The run was stopped by a signal or a stop request.
+    #[error("interrupted at t = {at:.4} s (Ctrl-C, SIGTERM or a stop request); rig halted")]
+    Interrupted {
+        /// Time into the run, s.
+        at: f64,
+    },
+    /// An encoder moved further in one sample than the rig can physically
+    /// move: a bus or counter fault (a flipped bit), not a measurement.
+    #[error(
+        "bus fault: encoder {channel} implies {speed:.3} m/s (limit {limit} m/s): {counts} counts in {interval:.4} s; rig halted"
+    )]
+    BusFault {
+        /// The encoder channel.
+        channel: usize,
+        /// The count change in the sample.
+        counts: i64,
+        /// Over this interval, s.
+        interval: f64,
+        /// The speed it implies, m/s.
+        speed: f64,
+        /// The largest plausible speed, m/s.
+        limit: f64,
+    },
+    /// Sustained drive, no motion.
+    #[error(
+        "motor or encoder not responding: {volts:.2} V applied for {seconds:.3} s and no encoder moved more than {counts} counts; rig halted"
+    )]
+    NotResponding {
+        /// The drive applied, V (its smallest magnitude over the episode).
+        volts: f64,
+        /// How long, s.
+        seconds: f64,
+        /// The motion threshold, counts.
+        counts: i64,
+    },
+    /// Real-time scheduling could not be set up.
+    #[error("cannot {what}: {reason}. {hint}")]
+    RealTime {
+        /// What was asked (`"set SCHED_FIFO priority 80"`, `"lock memory"`, …).
+        what: String,
+        /// The operating system's answer.
+        reason: String,
+        /// How to grant it.
+        hint: &'static str,
     },
 }
 
@@ -194,7 +286,22 @@ impl HwError {
             HwError::TravelLimit { .. } => HwErrorKind::TravelLimit,
             HwError::InvalidCommand { .. } => HwErrorKind::InvalidCommand,
             HwError::InvalidConfig { .. } => HwErrorKind::InvalidConfig,
-            HwError::Overrun { .. } => HwErrorKind::Overrun,
+            HwError::TimingFaults { .. } | HwError::Gap { .. } => HwErrorKind::Timing,
+            HwError::Panicked { .. } => HwErrorKind::Panic,
+            HwError::Interrupted { .. } => HwErrorKind::Interrupted,
+            HwError::BusFault { .. } => HwErrorKind::BusFault,
+            HwError::NotResponding { .. } => HwErrorKind::NotResponding,
+            HwError::RealTime { .. } => HwErrorKind::RealTime,
+        }
+    }
+
+    /// An [`InvalidConfig`](HwError::InvalidConfig) error (crate helper for
+    /// the validators).
+    pub(crate) fn invalid_config(name: &'static str, value: f64, reason: &'static str) -> Self {
+        HwError::InvalidConfig {
+            name,
+            value,
+            reason,
         }
     }
 

@@ -32,7 +32,7 @@
 //! use ctrlab::lab::{MassSpring, SimulatedRig};
 //!
 //! let clock = VirtualClock::new();
-//! let mut rig = SimulatedRig { truth: MassSpring::nominal(), ..Default::default() }
+//! let mut rig = SimulatedRig::ideal(MassSpring::nominal())
 //!     .rig(&Clock::Virtual(clock.clone()))?;
 //! let mut x = rig.read_state()?;
 //! for _ in 0..5000 {
@@ -49,6 +49,7 @@ mod clock;
 mod epp;
 mod error;
 mod pc104;
+mod realtime;
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 mod ppdev;
@@ -56,6 +57,7 @@ mod rig;
 mod run;
 mod sim_card;
 mod sim_config;
+mod stop;
 pub mod testing;
 
 pub use clock::{Clock, VirtualClock};
@@ -69,6 +71,8 @@ pub use pc104::{
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 pub use ppdev::{Ppdev, ioctl};
 pub use rig::Rig;
+pub use realtime::RealTime;
 pub use run::{LoopConfig, LoopStats, RunError, RunOutcome, run};
 pub use sim_card::SimulatedCard;
 pub use sim_config::{SIMULATED_CARD_ID, SimulatedCardConfig};
+pub use stop::StopSignal;

@@ -80,7 +80,8 @@ pub const PWM_DIRECTION_BIT: u8 = 0x80;
 /// let other = RegisterMap { encoder: [0x40, 0x44, 0x48, 0x4c], ..map };
 /// assert!(other.validate().is_ok());
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RegisterMap {
     /// Address of the read-only card ID register.
     pub id: u8,

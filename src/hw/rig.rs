@@ -93,8 +93,7 @@ pub trait Rig<const M: usize, const P: usize> {
     /// Forgets the previous sample, so the next [`read`](Self::read) starts
     /// any differenced estimate (a speed from counts) afresh instead of
     /// differencing against a sample from long ago. The control loop calls
-    /// it at the start of every run and after skipped deadlines. The default
-    /// does nothing.
+    /// it at the start of every run. The default does nothing.
     ///
     /// # Examples
     ///
@@ -113,6 +112,22 @@ pub trait Rig<const M: usize, const P: usize> {
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
     fn restart(&mut self) {}
+
+    /// The rig's watchdog timeout, s, if it has a watchdog: the loop halts
+    /// before half of it passes without a sample. The default is `None`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Clock, Rig};
+    /// use ctrlab::lab::SimulatedRig;
+    /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
+    /// assert_eq!(rig.watchdog_timeout(), Some(0.1));
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    fn watchdog_timeout(&self) -> Option<f64> {
+        None
+    }
 
     /// Tells the rig's watchdog the controller is alive. The default does
     /// nothing (for rigs without a watchdog, or whose
@@ -145,6 +160,9 @@ impl<R: Rig<M, P> + ?Sized, const M: usize, const P: usize> Rig<M, P> for &mut R
     }
     fn schema(&self) -> Schema {
         (**self).schema()
+    }
+    fn watchdog_timeout(&self) -> Option<f64> {
+        (**self).watchdog_timeout()
     }
     #[inline]
     fn restart(&mut self) {

@@ -1,21 +1,38 @@
 //! The fixed-period control loop: drives any [`Controller`] against any
 //! [`Rig`] at the rig's period `T` on absolute deadlines, records every
-//! sample, and stops safely.
+//! sample with its actual time, and fails safe.
 //!
 //! Deadlines are `t0 + k T`, never "now + T", so timing errors do not
-//! accumulate (no drift). A tick whose work ends after the next deadline is an
-//! *overrun*; `max_consecutive_overruns` of them in a row halt the rig and end
-//! the run with [`HwError::Overrun`]. On any error the rig is halted
-//! (PWM to zero) and the error comes back together with everything recorded
-//! so far: nothing measured is lost.
+//! accumulate (no drift). The loop stops, halts the rig (PWM to zero) and
+//! returns the error with everything recorded so far on any of:
+//!
+//! - a rig error (port fault, travel limit, bus fault, a motor that does
+//!   not respond, a non-finite command);
+//! - a panic in the controller or the reference function
+//!   ([`HwError::Panicked`]);
+//! - too many timing faults — overruns (a tick whose work ends after the
+//!   next deadline) and skipped deadlines (the loop fell a period or more
+//!   behind) — within a window ([`HwError::TimingFaults`]);
+//! - a gap: two samples, or a controller update, further apart than
+//!   `max_gap` (by default half the rig's watchdog timeout), after which the
+//!   card's watchdog would cut the motor and the next kick would silently
+//!   re-energise it with a stale command ([`HwError::Gap`]);
+//! - a stop request, e.g. Ctrl-C through [`StopSignal::on_interrupt`]
+//!   ([`HwError::Interrupted`]).
+//!
+//! The recording's time stamps are the actual sampling (latch) instants on
+//! the monotonic clock, so a missed tick shows as a gap, never papered over;
+//! its inputs are those the rig reports as applied.
 
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::{Duration, Instant};
 
 use nalgebra::SVector;
 
+use super::realtime::{self, RealTime};
 use crate::data::Recording;
 use crate::design::Controller;
-use crate::hw::{Clock, HwError, Rig};
+use crate::hw::{Clock, HwError, Rig, StopSignal};
 
 /// Settings of a [`run`].
 ///
@@ -24,28 +41,47 @@ use crate::hw::{Clock, HwError, Rig};
 /// ```
 /// use ctrlab::hw::LoopConfig;
 /// let config = LoopConfig { duration: 3.0, ..LoopConfig::default() };
-/// assert_eq!(config.max_consecutive_overruns, 5);
+/// assert_eq!((config.max_timing_faults, config.timing_window), (25, 0.5));
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoopConfig {
     /// Length of the experiment, s; the loop runs `round(duration / T)`
     /// ticks at the rig's period `T` ([`Rig::period`]).
     pub duration: f64,
-    /// Consecutive overruns that stop the run (default 5).
-    pub max_consecutive_overruns: usize,
+    /// Timing faults (overruns and skipped deadlines) within
+    /// [`timing_window`](Self::timing_window) that stop the run (default
+    /// 25: a tenth of the ticks of 0.5 s at 2 ms).
+    pub max_timing_faults: usize,
+    /// The window timing faults are counted over, s (default 0.5).
+    pub timing_window: f64,
+    /// Longest allowed time between two samples, or for one controller
+    /// update, s. `None` (the default) means half the rig's
+    /// [`watchdog_timeout`](Rig::watchdog_timeout), or no limit for a rig
+    /// without a watchdog. Must be at least the period.
+    pub max_gap: Option<f64>,
+    /// Real-time scheduling for the loop's thread (Linux; opt in).
+    pub realtime: Option<RealTime>,
+    /// A stop request checked every tick (e.g. Ctrl-C:
+    /// [`StopSignal::on_interrupt`]).
+    pub stop: Option<StopSignal>,
 }
 
 impl Default for LoopConfig {
     fn default() -> Self {
         Self {
             duration: 5.0,
-            max_consecutive_overruns: 5,
+            max_timing_faults: 25,
+            timing_window: 0.5,
+            max_gap: None,
+            realtime: None,
+            stop: None,
         }
     }
 }
 
-/// Timing statistics of a run. Lateness is how long after its deadline a tick
-/// started, s (always 0 on the virtual clock).
+/// Timing statistics of a run, in the spirit of cyclictest. Lateness is how
+/// long after its deadline a tick's sample was taken, s (always 0 on the
+/// virtual clock).
 ///
 /// # Examples
 ///
@@ -56,21 +92,52 @@ impl Default for LoopConfig {
 /// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LoopStats {
-    /// Ticks executed.
+    /// Ticks executed (samples recorded).
     pub ticks: usize,
     /// Ticks whose work ended after the next deadline.
     pub overruns: usize,
     /// Deadlines skipped because the loop fell a whole period or more
-    /// behind (real-time clock only); nothing is recorded for them.
+    /// behind (real-time clock only); they show as gaps in the recording.
     pub skipped: usize,
     /// Longest run of consecutive overruns.
     pub max_consecutive_overruns: usize,
+    /// Longest interval between two recorded samples, s.
+    pub max_interval: f64,
     /// Median lateness, s.
     pub lateness_p50: f64,
     /// 99th-percentile lateness, s.
     pub lateness_p99: f64,
+    /// 99.9th-percentile lateness, s.
+    pub lateness_p999: f64,
     /// Largest lateness, s.
     pub lateness_max: f64,
+}
+
+impl std::fmt::Display for LoopStats {
+    /// A cyclictest-like summary line, in µs.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::LoopStats;
+    /// let s = LoopStats { ticks: 5000, lateness_p50: 2e-6, ..Default::default() };
+    /// assert!(s.to_string().starts_with("ticks 5000, p50 2.0 µs"));
+    /// ```
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "ticks {}, p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs, overruns {} (longest run {}), skipped {}, longest interval {:.3} ms",
+            self.ticks,
+            self.lateness_p50 * 1e6,
+            self.lateness_p99 * 1e6,
+            self.lateness_p999 * 1e6,
+            self.lateness_max * 1e6,
+            self.overruns,
+            self.max_consecutive_overruns,
+            self.skipped,
+            self.max_interval * 1e3
+        )
+    }
 }
 
 /// A run that ended in an error: the error, with what was recorded before it.
@@ -84,7 +151,7 @@ pub struct LoopStats {
 ///
 /// let clock = VirtualClock::new();
 /// let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
-/// // Full drive on the default truth (8.5 N/V) runs cart 2 into its travel limit.
+/// // Full drive (26.7 N at 24 V on the default truth) runs cart 2 past its ±50 mm limit.
 /// let err = run(rig, OpenLoop, |_| vector![24.0], &Clock::Virtual(clock), &LoopConfig::default()).unwrap_err();
 /// assert_eq!(err.error.kind(), HwErrorKind::TravelLimit);
 /// assert!(!err.recording.is_empty()); // everything before the breach
@@ -148,25 +215,28 @@ pub struct RunOutcome {
     pub stats: LoopStats,
 }
 
-/// How far the real-time clock sleeps before spinning to a deadline.
+/// How far the loop sleeps before spinning to a deadline without
+/// real-time scheduling.
 const SPIN: Duration = Duration::from_micros(200);
 
 /// Runs `controller` against `rig` for `config.duration` seconds at the
 /// rig's period `T`, with reference `reference(t)` (SI, `t` in s from the
 /// start), timed by `clock`.
 ///
-/// Each tick `k`, at the absolute deadline `k T`: read the measurements (on
-/// [`MassSpringRig`](crate::lab::MassSpringRig) this latches the counters
-/// and kicks the card's watchdog), evaluate the reference, update the
-/// controller, apply its input, tell the controller what was applied
-/// ([`Controller::applied`]), and record `(t, applied input,
-/// measurements)`. At the end the rig is halted. The loop does not call
+/// Each tick `k`, at the absolute deadline `k T`: check the stop request,
+/// read the measurements (on [`MassSpringRig`](crate::lab::MassSpringRig)
+/// this latches the counters and kicks the card's watchdog), evaluate the
+/// reference at the sampling instant, update the controller, apply its
+/// input, tell the controller what was applied ([`Controller::applied`]),
+/// and record `(t, applied input, measurements)` with `t` the actual
+/// sampling instant. At the end the rig is halted. The loop does not call
 /// [`Rig::kick_watchdog`] on its own: a rig with a watchdog kicks it in
 /// `read`, as `MassSpringRig` does (one control write latches and kicks).
 ///
 /// The same controller object runs unchanged in the sampled-data simulator
 /// [`sim::run_sampled`](crate::sim::run_sampled), which follows the same
-/// order.
+/// order. Panics in the controller and the reference are caught (unless
+/// the binary is built with `panic = "abort"`).
 ///
 /// # Errors
 ///
@@ -174,13 +244,12 @@ const SPIN: Duration = Duration::from_micros(200);
 /// error, every sample recorded before it, the measurements read in the
 /// failing tick if there were any, and the statistics. The rig has been
 /// halted (best effort: a dead port cannot be told, but then the card's
-/// watchdog stops the motor). Causes: any rig error (port fault, travel
-/// limit, non-finite command), [`HwError::Overrun`] after
-/// `max_consecutive_overruns` overruns in a row, and
+/// watchdog stops the motor). Causes: see the [module docs](self); and
 /// [`HwError::InvalidConfig`] for a bad `config`, a rig whose period is
 /// not finite and > 0, a controller designed for another period, or a rig
-/// whose schema does not have `M` inputs and `P` measurements (nothing is
-/// run then).
+/// whose schema does not have `M` inputs and `P` measurements, and
+/// [`HwError::RealTime`] when real-time scheduling was asked for and not
+/// granted (nothing is run then).
 ///
 /// # Examples
 ///
@@ -194,7 +263,7 @@ const SPIN: Duration = Duration::from_micros(200);
 /// use nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
-/// let mut rig = SimulatedRig { truth: MassSpring::nominal(), ..Default::default() }
+/// let mut rig = SimulatedRig::ideal(MassSpring::nominal())
 ///     .rig(&Clock::Virtual(clock.clone()))?;
 /// let controller = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
 /// let loop_config = LoopConfig { duration: 1.0, ..LoopConfig::default() };
@@ -239,8 +308,27 @@ where
         }
         Ok(ticks)
     });
-    let ticks = match checked {
-        Ok(ticks) => ticks,
+    let max_gap = config
+        .max_gap
+        .or_else(|| rig.watchdog_timeout().map(|w| 0.5 * w))
+        .unwrap_or(f64::INFINITY);
+    let checked = checked.and_then(|ticks| {
+        if max_gap < period {
+            return Err(HwError::InvalidConfig {
+                name: "max_gap",
+                value: max_gap,
+                reason: "must be at least the rig's period (half the watchdog timeout by default)",
+            });
+        }
+        Ok(ticks)
+    });
+    let realtime = match (checked, &config.realtime) {
+        (Ok(ticks), Some(rt)) => realtime::enter(rt).map(|guard| (ticks, Some(guard))),
+        (Ok(ticks), None) => Ok((ticks, None)),
+        (Err(e), _) => Err(e),
+    };
+    let (ticks, _realtime_guard) = match realtime {
+        Ok(ok) => ok,
         Err(error) => {
             return Err(Box::new(RunError {
                 error,
@@ -250,8 +338,16 @@ where
             }));
         }
     };
+    let spin = config.realtime.map_or(SPIN, |rt| rt.spin);
     let mut recording = Recording::with_capacity(schema, ticks);
     let mut lateness = Vec::with_capacity(ticks);
+    if config.realtime.is_some() {
+        // Fault the pages in now (they stay, locked), not in the first ticks.
+        recording.prefault();
+        lateness.resize(ticks, 0.0);
+        lateness.clear();
+    }
+    let mut faults = FaultWindow::new(config.max_timing_faults, config.timing_window, ticks);
     let mut stats = LoopStats::default();
     let mut consecutive = 0usize;
     controller.reset();
@@ -264,13 +360,24 @@ where
         Clock::RealTime => 0,
     };
     let period_ns = (period * 1e9).round() as u64;
+    let mut previous_sample: Option<f64> = None;
+
+    macro_rules! fail {
+        ($error:expr, $last:expr) => {
+            return Err(stop(rig, $error, recording, $last, stats, lateness))
+        };
+    }
 
     let mut k = 0usize;
     while k < ticks {
-        // Wait for the absolute deadline k·T. On the virtual clock time is
-        // kept in whole nanoseconds, and so is the recorded time.
+        let deadline = k as f64 * period;
+        if config.stop.as_ref().is_some_and(StopSignal::is_requested) {
+            fail!(HwError::Interrupted { at: deadline }, None);
+        }
+        // Wait for the absolute deadline k·T; `t` is the sampling instant.
         let (t, late) = match clock {
             Clock::Virtual(c) => {
+                // Time is kept in whole nanoseconds, and so is the record.
                 let offset = (k as u64).saturating_mul(period_ns);
                 let target = virtual_start.saturating_add(offset);
                 c.advance_nanos(target.saturating_sub(c.now_nanos()));
@@ -281,36 +388,73 @@ where
                 if elapsed > (k + 1) as f64 * period {
                     // A whole period or more behind (the OS took the CPU):
                     // skip the missed deadlines rather than run them back
-                    // to back on stale time, and restart differenced
-                    // estimates, which would otherwise span the gap.
+                    // to back on stale time. Each is a timing fault, and
+                    // the recording shows the gap.
                     let behind = ((elapsed / period) as usize).min(ticks);
-                    stats.skipped += behind - k;
+                    let missed = behind - k;
+                    stats.skipped += missed;
                     k = behind;
-                    rig.restart();
+                    if faults.add(elapsed, missed) {
+                        fail!(timing_faults(&faults, period, elapsed), None);
+                    }
                     if k >= ticks {
                         break;
                     }
                 }
-                let t = k as f64 * period;
-                let deadline = wall_start + Duration::from_secs_f64(t);
-                sleep_until(deadline);
-                (t, (Instant::now() - deadline).as_secs_f64())
+                let target = wall_start + Duration::from_secs_f64(k as f64 * period);
+                realtime::sleep_until(target, spin);
+                let now = Instant::now();
+                (
+                    (now - wall_start).as_secs_f64(),
+                    (now - target).as_secs_f64(),
+                )
             }
         };
         lateness.push(late);
+        if let Some(previous) = previous_sample {
+            let interval = t - previous;
+            stats.max_interval = stats.max_interval.max(interval);
+            if interval > max_gap {
+                let error = HwError::Gap {
+                    what: "the interval between two samples",
+                    gap: interval,
+                    limit: max_gap,
+                    at: t,
+                };
+                fail!(error, None);
+            }
+        }
 
-        let tick = Instant::now();
         let y = match rig.read() {
             Ok(y) => y,
-            Err(error) => return Err(stop(rig, error, recording, None, stats, lateness)),
+            Err(error) => fail!(error, None),
         };
-        let u = controller.update(&y, &reference(t));
+        previous_sample = Some(t);
+        let r = match catch_unwind(AssertUnwindSafe(|| reference(t))) {
+            Ok(r) => r,
+            Err(payload) => fail!(panicked("reference", &payload, t), Some(y.as_slice().to_vec())),
+        };
+        let u = match catch_unwind(AssertUnwindSafe(|| controller.update(&y, &r))) {
+            Ok(u) => u,
+            Err(payload) => fail!(panicked("controller", &payload, t), Some(y.as_slice().to_vec())),
+        };
+        if let Clock::RealTime = clock {
+            // The watchdog counts from the kick in `read`: a controller that
+            // took too long must not have its stale command applied.
+            let took = wall_start.elapsed().as_secs_f64() - t;
+            if took > max_gap {
+                let error = HwError::Gap {
+                    what: "the controller",
+                    gap: took,
+                    limit: max_gap,
+                    at: t,
+                };
+                fail!(error, Some(y.as_slice().to_vec()));
+            }
+        }
         let applied = match rig.apply(&u) {
             Ok(v) => v,
-            Err(error) => {
-                let last = Some(y.as_slice().to_vec());
-                return Err(stop(rig, error, recording, last, stats, lateness));
-            }
+            Err(error) => fail!(error, Some(y.as_slice().to_vec())),
         };
         controller.applied(&applied);
         // Cannot fail: the schema's sizes were checked above.
@@ -319,18 +463,13 @@ where
 
         // An overrun: this tick's work ended after the next deadline.
         if let Clock::RealTime = clock {
-            let end = (Instant::now() - wall_start).as_secs_f64();
-            if end > t + period {
+            let end = wall_start.elapsed().as_secs_f64();
+            if end > deadline + period {
                 stats.overruns += 1;
                 consecutive += 1;
                 stats.max_consecutive_overruns = stats.max_consecutive_overruns.max(consecutive);
-                if consecutive >= config.max_consecutive_overruns {
-                    let error = HwError::Overrun {
-                        consecutive,
-                        period,
-                        last_tick: tick.elapsed().as_secs_f64(),
-                    };
-                    return Err(stop(rig, error, recording, None, stats, lateness));
+                if faults.add(end, 1) {
+                    fail!(timing_faults(&faults, period, end), None);
                 }
             } else {
                 consecutive = 0;
@@ -339,10 +478,69 @@ where
         k += 1;
     }
     if let Err(error) = rig.halt() {
-        return Err(stop(rig, error, recording, None, stats, lateness));
+        fail!(error, None);
     }
     finish_stats(&mut stats, &mut lateness);
     Ok(RunOutcome { recording, stats })
+}
+
+/// The last `limit` timing faults' times, to count them in a window.
+/// Allocated once, before the loop; a limit beyond the run's ticks can
+/// never be reached, so it stores nothing.
+struct FaultWindow {
+    times: Vec<f64>,
+    next: usize,
+    count: usize,
+    window: f64,
+    limit: usize,
+}
+
+impl FaultWindow {
+    fn new(limit: usize, window: f64, ticks: usize) -> Self {
+        let capacity = if limit > ticks { 0 } else { limit.max(1) };
+        Self {
+            times: vec![f64::NEG_INFINITY; capacity],
+            next: 0,
+            count: 0,
+            window,
+            limit,
+        }
+    }
+
+    /// Records `n` faults at time `t`; true when the window now holds
+    /// `limit` faults.
+    fn add(&mut self, t: f64, n: usize) -> bool {
+        let capacity = self.times.len();
+        if capacity == 0 {
+            return false;
+        }
+        for _ in 0..n.min(capacity) {
+            self.times[self.next] = t;
+            self.next = (self.next + 1) % capacity;
+        }
+        self.count = self.count.saturating_add(n);
+        // The oldest of the last `capacity` faults is at `next`.
+        n >= capacity || (self.count >= capacity && t - self.times[self.next] <= self.window)
+    }
+}
+
+fn timing_faults(faults: &FaultWindow, period: f64, at: f64) -> HwError {
+    HwError::TimingFaults {
+        faults: faults.limit,
+        window: faults.window,
+        period,
+        at,
+    }
+}
+
+/// The message of a caught panic.
+fn panicked(what: &'static str, payload: &Box<dyn std::any::Any + Send>, at: f64) -> HwError {
+    let message = payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "(a panic without a message)".to_owned());
+    HwError::Panicked { what, message, at }
 }
 
 /// Halts the rig after `error` and packs up what was recorded.
@@ -374,6 +572,7 @@ fn finish_stats(stats: &mut LoopStats, lateness: &mut [f64]) {
     let at = |q: f64| lateness[((lateness.len() - 1) as f64 * q).round() as usize];
     stats.lateness_p50 = at(0.5);
     stats.lateness_p99 = at(0.99);
+    stats.lateness_p999 = at(0.999);
     stats.lateness_max = at(1.0);
 }
 
@@ -383,10 +582,6 @@ fn check_config(config: &LoopConfig, period: f64) -> Result<usize, HwError> {
         value,
         reason,
     };
-    let LoopConfig {
-        duration,
-        max_consecutive_overruns,
-    } = *config;
     if !(period.is_finite() && period >= 1e-6) {
         return Err(invalid(
             "period",
@@ -394,6 +589,7 @@ fn check_config(config: &LoopConfig, period: f64) -> Result<usize, HwError> {
             "the rig's period must be finite and >= 1 µs",
         ));
     }
+    let duration = config.duration;
     if !(duration.is_finite() && duration >= period) {
         return Err(invalid(
             "duration",
@@ -409,23 +605,20 @@ fn check_config(config: &LoopConfig, period: f64) -> Result<usize, HwError> {
             "more ticks than sim::MAX_SAMPLES",
         ));
     }
-    if max_consecutive_overruns == 0 {
+    if config.max_timing_faults == 0 {
+        return Err(invalid("max_timing_faults", 0.0, "must be at least 1"));
+    }
+    if !(config.timing_window.is_finite() && config.timing_window > 0.0) {
         return Err(invalid(
-            "max_consecutive_overruns",
-            0.0,
-            "must be at least 1",
+            "timing_window",
+            config.timing_window,
+            "must be finite and > 0 s",
         ));
     }
+    if let Some(gap) = config.max_gap
+        && gap.is_nan()
+    {
+        return Err(invalid("max_gap", gap, "must be a number of seconds"));
+    }
     Ok(ticks as usize)
-}
-
-/// Sleeps until `deadline`, spinning the last [`SPIN`] for precision.
-fn sleep_until(deadline: Instant) {
-    let now = Instant::now();
-    if deadline > now + SPIN {
-        std::thread::sleep(deadline - now - SPIN);
-    }
-    while Instant::now() < deadline {
-        std::hint::spin_loop();
-    }
 }

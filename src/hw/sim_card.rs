@@ -42,8 +42,8 @@ enum Time {
 ///   steps. A latch at time t therefore captures the encoder counts of the
 ///   plant state at time t: `round(x / units_per_count + noise)`, relative
 ///   to the last clear, for each connected encoder.
-/// - PWM duties take effect when the high byte is written; magnitudes above
-///   1000 saturate.
+/// - PWM duties take effect `pwm_delay` after the high byte is written
+///   (immediately by default); magnitudes above 1000 saturate.
 /// - The watchdog: with no kick for `watchdog_timeout`, every PWM output is
 ///   zeroed at exactly that instant of card time, and PWM writes are zeroed
 ///   until the next kick.
@@ -87,6 +87,8 @@ pub struct SimulatedCard<D, const N: usize> {
     address: u8,
     pwm_low: [u8; PWM_CHANNELS],
     duty: [i16; PWM_CHANNELS],
+    /// A written duty not applied yet, and the instant (ns) it takes effect.
+    pending: [Option<(i16, u64)>; PWM_CHANNELS],
     latched: [u32; ENCODER_CHANNELS],
     offset: [i64; ENCODER_CHANNELS],
     last_kick_nanos: u64,
@@ -145,6 +147,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
             address: 0,
             pwm_low: [0; PWM_CHANNELS],
             duty: [0; PWM_CHANNELS],
+            pending: [None; PWM_CHANNELS],
             latched: [0; ENCODER_CHANNELS],
             offset: [0; ENCODER_CHANNELS],
             last_kick_nanos: t_nanos,
@@ -249,7 +252,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// ```
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// use nalgebra::vector;
-    /// let rig = SimulatedRig { initial_state: vector![0.01, 0.0, 0.02, 0.0], ..Default::default() };
+    /// let rig = SimulatedRig { initial_state: [0.01, 0.0, 0.02, 0.0], ..Default::default() };
     /// assert_eq!(rig.card(&Clock::RealTime)?.true_state()[2], 0.02);
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
@@ -300,14 +303,38 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// Integrates the plant from the card's time to `target` (ns), holding
     /// the voltage, tripping the watchdog at its deadline on the way.
     fn advance_to(&mut self, target: u64) {
-        if let Some(deadline) = self.watchdog_deadline()
-            && deadline <= target
-            && self.duty.iter().any(|&d| d != 0)
-        {
-            if deadline > self.t_nanos {
-                self.integrate_to(deadline);
+        // At most one watchdog trip and one pending write per channel lie
+        // ahead, so this loop ends after PWM_CHANNELS + 2 rounds.
+        for _ in 0..PWM_CHANNELS + 2 {
+            let watchdog = self
+                .watchdog_deadline()
+                .filter(|_| {
+                    self.duty.iter().any(|&d| d != 0)
+                        || self.pending.iter().any(|p| p.is_some_and(|(d, _)| d != 0))
+                })
+                .filter(|&deadline| deadline <= target);
+            let write = (0..PWM_CHANNELS)
+                .filter_map(|n| self.pending[n].map(|(_, at)| (at, n)))
+                .filter(|&(at, _)| at <= target)
+                .min();
+            match (watchdog, write) {
+                (Some(deadline), w) if w.is_none_or(|(at, _)| deadline <= at) => {
+                    self.integrate_to(deadline);
+                    // Every output goes to zero, and so would any write
+                    // still in flight.
+                    self.duty = [0; PWM_CHANNELS];
+                    self.pending = [None; PWM_CHANNELS];
+                }
+                (_, Some((at, n))) => {
+                    self.integrate_to(at);
+                    let expired = self
+                        .watchdog_deadline()
+                        .is_some_and(|deadline| deadline <= at);
+                    let duty = self.pending[n].take().map_or(0, |(d, _)| d);
+                    self.duty[n] = if expired { 0 } else { duty };
+                }
+                _ => break,
             }
-            self.duty = [0; PWM_CHANNELS];
         }
         self.integrate_to(target);
     }
@@ -397,14 +424,18 @@ impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
             }
             Reg::PwmLow(n) => self.pwm_low[n] = value,
             Reg::PwmHigh(n) => {
-                let expired = self
-                    .watchdog_deadline()
-                    .is_some_and(|deadline| deadline <= self.t_nanos);
-                self.duty[n] = if expired {
-                    0
+                let duty = duty_from_bytes(self.pwm_low[n], value);
+                let delay = (self.config.pwm_delay * 1e9).round() as u64;
+                if delay == 0 {
+                    let expired = self
+                        .watchdog_deadline()
+                        .is_some_and(|deadline| deadline <= self.t_nanos);
+                    self.duty[n] = if expired { 0 } else { duty };
                 } else {
-                    duty_from_bytes(self.pwm_low[n], value)
-                };
+                    // The drive takes the new duty `pwm_delay` later; a
+                    // newer write replaces one still pending.
+                    self.pending[n] = Some((duty, self.t_nanos.saturating_add(delay)));
+                }
             }
             Reg::Open | Reg::Id | Reg::Encoder(..) => {}
         }

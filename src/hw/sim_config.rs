@@ -72,6 +72,9 @@ pub struct SimulatedCardConfig<const N: usize> {
     pub watchdog_timeout: Option<f64>,
     /// Largest RK4 sub-step, s (> 0).
     pub max_substep: f64,
+    /// Delay from writing a PWM duty to the drive applying it, s (≥ 0,
+    /// below 1 s): the card's latch-to-PWM and the driver's own delay.
+    pub pwm_delay: f64,
     /// Plant state when the card is created.
     pub initial_state: SVector<f64, N>,
 }
@@ -90,6 +93,7 @@ impl<const N: usize> Default for SimulatedCardConfig<N> {
             seed: 0x5eed,
             watchdog_timeout: Some(0.100),
             max_substep: 0.25e-3,
+            pwm_delay: 0.0,
             initial_state: SVector::zeros(),
         }
     }
@@ -132,21 +136,28 @@ impl<const N: usize> SimulatedCardConfig<N> {
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(invalid(name, value, "must be finite and > 0"));
+                return Err(HwError::invalid_config(name, value, "must be finite and > 0"));
             }
         }
         if self.max_substep < 1e-9 {
-            return Err(invalid("max_substep", self.max_substep, "must be ≥ 1 ns"));
+            return Err(HwError::invalid_config("max_substep", self.max_substep, "must be ≥ 1 ns"));
+        }
+        if !(self.pwm_delay.is_finite() && (0.0..1.0).contains(&self.pwm_delay)) {
+            return Err(HwError::invalid_config(
+                "pwm_delay",
+                self.pwm_delay,
+                "must be finite, ≥ 0 and below 1 s",
+            ));
         }
         if !(self.encoder_noise.is_finite() && self.encoder_noise >= 0.0) {
-            return Err(invalid(
+            return Err(HwError::invalid_config(
                 "encoder_noise",
                 self.encoder_noise,
                 "must be finite and ≥ 0",
             ));
         }
         if self.pwm_channel >= PWM_CHANNELS {
-            return Err(invalid(
+            return Err(HwError::invalid_config(
                 "pwm_channel",
                 self.pwm_channel as f64,
                 "must be 0–3",
@@ -155,14 +166,14 @@ impl<const N: usize> SimulatedCardConfig<N> {
         for (i, state) in self.encoders.iter().enumerate() {
             let Some(state) = *state else { continue };
             if state >= N {
-                return Err(invalid(
+                return Err(HwError::invalid_config(
                     "encoders",
                     state as f64,
                     "names a state beyond the plant's",
                 ));
             }
             if self.encoders[..i].contains(&Some(state)) {
-                return Err(invalid(
+                return Err(HwError::invalid_config(
                     "encoders",
                     state as f64,
                     "two encoder channels count the same state",
@@ -170,16 +181,8 @@ impl<const N: usize> SimulatedCardConfig<N> {
             }
         }
         if let Some(value) = self.initial_state.iter().find(|v| !v.is_finite()) {
-            return Err(invalid("initial_state", *value, "must be finite"));
+            return Err(HwError::invalid_config("initial_state", *value, "must be finite"));
         }
         Ok(())
-    }
-}
-
-fn invalid(name: &'static str, value: f64, reason: &'static str) -> HwError {
-    HwError::InvalidConfig {
-        name,
-        value,
-        reason,
     }
 }

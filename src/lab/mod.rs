@@ -26,7 +26,7 @@
 //! use ctrlab::{StateFeedback, sim::run_sampled};
 //! use nalgebra::vector;
 //!
-//! let sim = SimulatedRig { truth: MassSpring::nominal(), ..Default::default() };
+//! let sim = SimulatedRig::ideal(MassSpring::nominal());
 //! let law = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
 //! let simulated = run_sampled(sim.plant(), sim.sensor(), law, |_| vector![0.030],
 //!                             vector![0.0, 0.0, 0.0, 0.0], &sim.sampled_config(1.0))?;
@@ -41,6 +41,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod calibration;
 mod gains;
 pub mod ident;
 mod plant;
@@ -49,7 +50,8 @@ mod sensor;
 mod simulated;
 
 pub use plant::{Cart, MassSpring};
-pub use rig::{Calibration, MassSpringRig};
+pub use calibration::Calibration;
+pub use rig::MassSpringRig;
 pub use sensor::EncoderSensor;
 pub use simulated::{FrictionPlant, SimulatedRig};
 

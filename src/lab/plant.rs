@@ -88,7 +88,8 @@ impl Cart {
 /// assert!((x1 - 0.010).abs() < 1e-15 && (x2 - 0.020).abs() < 1e-15);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct MassSpring {
     /// Mass of cart 1, kg (> 0).
     pub m1: f64,

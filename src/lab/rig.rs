@@ -1,134 +1,37 @@
-//! The lab's two-cart rig on the PC104 card, [`MassSpringRig`], and its
-//! [`Calibration`].
+//! The lab's two-cart rig on the PC104 card, [`MassSpringRig`].
+
+use std::time::Instant;
 
 use nalgebra::{SVector, vector};
 
+use super::Calibration;
 use crate::data::Schema;
-use crate::hw::{ENCODER_CHANNELS, EppPort, HwError, MAX_DUTY, PWM_CHANNELS, Pc104, Rig};
-
-/// How the rig's counts and volts map to SI, and which channels are wired
-/// where.
-///
-/// The default is the lab's rig as [`SimulatedRig`](super::SimulatedRig)
-/// models it: 80 mm per 8192 counts (9.765625 µm per count), both encoders
-/// counting up when the carts move away from the wall, 24 V full scale, the
-/// motor on PWM channel 0, cart 1 on encoder 0, cart 2 on encoder 1, travel
-/// limits ±0.15 m on both carts.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::Calibration;
-/// let cal = Calibration::default();
-/// assert_eq!(cal.metres_per_count * 8192.0, 0.080);
-/// let flipped = Calibration { sign: [1.0, -1.0], ..cal };
-/// assert!(flipped.validate().is_ok());
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Calibration {
-    /// Cart travel per encoder count, m (> 0).
-    pub metres_per_count: f64,
-    /// Sign of each encoder (cart 1, cart 2): +1 when counting up means the
-    /// cart moves away from the wall, −1 otherwise.
-    pub sign: [f64; 2],
-    /// Motor voltage at 100 % duty, V (> 0); commands saturate at ±this.
-    pub volts_full_scale: f64,
-    /// The PWM channel driving the motor (0–3).
-    pub pwm_channel: usize,
-    /// The encoder channels of cart 1 and cart 2 (0–3, distinct).
-    pub encoder_channels: [usize; 2],
-    /// Software travel limits of cart 1 and cart 2, m (> 0, symmetric about
-    /// the position where the counters were cleared).
-    pub travel_limits: [f64; 2],
-}
-
-impl Default for Calibration {
-    fn default() -> Self {
-        Self {
-            metres_per_count: 0.080 / 8192.0,
-            sign: [1.0, 1.0],
-            volts_full_scale: 24.0,
-            pwm_channel: 0,
-            encoder_channels: [0, 1],
-            travel_limits: [0.15, 0.15],
-        }
-    }
-}
-
-impl Calibration {
-    /// Checks every field.
-    ///
-    /// # Errors
-    ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{hw::HwError, lab::Calibration};
-    /// let bad = Calibration { sign: [1.0, 0.5], ..Calibration::default() };
-    /// assert!(matches!(bad.validate(), Err(HwError::InvalidConfig { name: "sign", .. })));
-    /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        let positive = [
-            ("metres_per_count", self.metres_per_count),
-            ("volts_full_scale", self.volts_full_scale),
-            ("travel_limits", self.travel_limits[0]),
-            ("travel_limits", self.travel_limits[1]),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(invalid(name, value, "must be finite and > 0"));
-            }
-        }
-        for s in self.sign {
-            if s != 1.0 && s != -1.0 {
-                return Err(invalid("sign", s, "must be +1 or -1"));
-            }
-        }
-        if self.pwm_channel >= PWM_CHANNELS {
-            return Err(invalid(
-                "pwm_channel",
-                self.pwm_channel as f64,
-                "must be 0–3",
-            ));
-        }
-        let [e1, e2] = self.encoder_channels;
-        if e1 >= ENCODER_CHANNELS || e2 >= ENCODER_CHANNELS || e1 == e2 {
-            return Err(invalid(
-                "encoder_channels",
-                e2 as f64,
-                "must be two distinct channels 0–3",
-            ));
-        }
-        Ok(())
-    }
-}
-
-fn invalid(name: &'static str, value: f64, reason: &'static str) -> HwError {
-    HwError::InvalidConfig {
-        name,
-        value,
-        reason,
-    }
-}
+use crate::hw::{Clock, EppPort, HwError, MAX_DUTY, Pc104, Rig};
 
 /// The lab's two-cart rig on a [`Pc104`] card: counts to metres, volts to
 /// PWM duty, with the safety the rig needs. A [`Rig`] with one input (the
 /// motor, V) and four measurements `[x1, v1, x2, v2]` (m, m/s), named by
 /// [`schema`](super::schema).
 ///
+/// - Building it probes the card's ID ([`Calibration::card_id`]): an open
+///   bus (`0x00` or `0xff`) or another card is refused before anything is
+///   written.
 /// - [`read_state`](Self::read_state) latches both counters **and kicks the
 ///   watchdog** in one control write, reads cart 1's and cart 2's counters,
-///   and returns `[x1, v1, x2, v2]`; speeds are backward differences of
-///   the counts over `period` (as the lab: "speeds come from counting pulses
-///   over the sampling period"), so read exactly once per period; the first
-///   read reports zero speeds. A cart beyond its travel limit halts the rig
-///   and returns [`HwError::TravelLimit`].
+///   and returns `[x1, v1, x2, v2]`; each speed is the count change over
+///   the actual interval since the previous read, timed on the rig's
+///   [`Clock`] (the first read reports zero speeds).
+/// - Every read checks the measurement is physical, halting the rig
+///   otherwise: a cart beyond its travel limit ([`HwError::TravelLimit`]),
+///   a count change faster than [`Calibration::max_speed`]
+///   ([`HwError::BusFault`]: a flipped bit, a glitch on the bus), or
+///   sustained drive with no encoder motion ([`HwError::NotResponding`]).
 /// - [`apply_voltage`](Self::apply_voltage) saturates to
 ///   ±`volts_full_scale` and quantises to the card's 0.1 % duty steps; a
 ///   non-finite command halts the rig and returns
-///   [`HwError::InvalidCommand`].
+///   [`HwError::InvalidCommand`]. A command more than the watchdog timeout
+///   after the last read would re-energise a motor the card has cut: it is
+///   refused ([`HwError::Gap`]) and the rig halted.
 /// - Dropping the rig sets the PWM to zero (errors ignored: there is no one
 ///   left to tell).
 ///
@@ -147,7 +50,7 @@ fn invalid(name: &'static str, value: f64, reason: &'static str) -> HwError {
 /// assert_eq!(rig.card().port().pwm_duty(0), 1000);
 /// clock.advance(0.02)?;
 /// let x = rig.read_state()?;
-/// assert!(x[2] > 0.0 && x[2] < 0.15);
+/// assert!(x[2] > 0.0 && x[2] < 0.05);
 /// assert!(rig.apply_voltage(f64::NAN).is_err());
 /// assert_eq!(rig.card().port().pwm_duty(0), 0); // halted
 /// # Ok::<(), ctrlab::hw::HwError>(())
@@ -157,39 +60,98 @@ pub struct MassSpringRig<P: EppPort> {
     card: Pc104<P>,
     calibration: Calibration,
     period: f64,
-    previous: Option<[i64; 2]>,
+    clock: Clock,
+    start: Instant,
+    /// Counts and time (s on `clock`) of the previous read.
+    previous: Option<([i64; 2], f64)>,
+    /// Time of the last watchdog kick (s on `clock`).
+    last_kick: Option<f64>,
+    /// The voltage last applied, V.
+    volts: f64,
+    /// A stretch of drive ≥ `stall_volts`: when it began, the counts then,
+    /// and the smallest drive seen; `None` once an encoder moved.
+    stall: Option<(f64, [i64; 2], f64)>,
+    /// The current stretch of drive has moved an encoder.
+    moved: bool,
 }
 
 impl<P: EppPort> MassSpringRig<P> {
-    /// The rig on `card` with `calibration`, read every `period` seconds.
-    /// Talks to the card only when used.
+    /// The rig on `card` with `calibration`, read every `period` seconds,
+    /// timed on the wall clock. Reads the card's ID register once.
     ///
     /// # Errors
     ///
     /// [`HwError::InvalidConfig`] for an invalid calibration or a period
-    /// that is not finite and > 0.
+    /// that is not finite and > 0; [`HwError::NotPresent`] when the ID
+    /// register reads an open bus or another ID; port errors.
     ///
     /// # Examples
     ///
     /// ```
     /// use ctrlab::hw::{HwErrorKind, Pc104, testing::RegisterFile};
     /// use ctrlab::lab::{Calibration, MassSpringRig};
-    /// let rig = MassSpringRig::new(Pc104::new(RegisterFile::new()), Calibration::default(), 0.002)?;
+    ///
+    /// let mut regs = RegisterFile::new();
+    /// regs.set(0x00, 0xa5); // the ID register
+    /// let rig = MassSpringRig::new(Pc104::new(regs.clone()), Calibration::default(), 0.002)?;
     /// assert_eq!(rig.period(), 0.002);
-    /// let bad = MassSpringRig::new(Pc104::new(RegisterFile::new()), Calibration::default(), 0.0);
+    /// let bad = MassSpringRig::new(Pc104::new(regs), Calibration::default(), 0.0);
     /// assert_eq!(bad.unwrap_err().kind(), HwErrorKind::InvalidConfig);
+    /// // No card: the bus reads 0xff.
+    /// let mut open = RegisterFile::new();
+    /// open.set(0x00, 0xff);
+    /// let err = MassSpringRig::new(Pc104::new(open), Calibration::default(), 0.002).unwrap_err();
+    /// assert_eq!(err.kind(), HwErrorKind::NotPresent);
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
     pub fn new(card: Pc104<P>, calibration: Calibration, period: f64) -> Result<Self, HwError> {
+        Self::with_clock(card, calibration, period, Clock::RealTime)
+    }
+
+    /// [`new`](Self::new) with the speeds and watchdog timed on `clock` (a
+    /// simulated card's virtual clock).
+    ///
+    /// # Errors
+    ///
+    /// As [`new`](Self::new).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Clock, Pc104, VirtualClock};
+    /// use ctrlab::lab::{MassSpringRig, SimulatedRig};
+    /// let sim = SimulatedRig::default();
+    /// let clock = Clock::Virtual(VirtualClock::new());
+    /// let rig = MassSpringRig::with_clock(Pc104::new(sim.card(&clock)?), sim.calibration(), 0.002, clock)?;
+    /// assert_eq!(rig.calibration().card_id, 0xa5);
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    pub fn with_clock(
+        mut card: Pc104<P>,
+        calibration: Calibration,
+        period: f64,
+        clock: Clock,
+    ) -> Result<Self, HwError> {
         calibration.validate()?;
         if !(period.is_finite() && period > 0.0) {
-            return Err(invalid("period", period, "must be finite and > 0 s"));
+            return Err(HwError::InvalidConfig {
+                name: "period",
+                value: period,
+                reason: "must be finite and > 0 s",
+            });
         }
+        card.probe_id(calibration.card_id)?;
         Ok(Self {
             card,
             calibration,
             period,
+            clock,
+            start: Instant::now(),
             previous: None,
+            last_kick: None,
+            volts: 0.0,
+            stall: None,
+            moved: false,
         })
     }
 
@@ -235,7 +197,7 @@ impl<P: EppPort> MassSpringRig<P> {
         &self.calibration
     }
 
-    /// The sampling period the speeds are computed over, s.
+    /// The sampling period the loop runs the rig at, s.
     ///
     /// # Examples
     ///
@@ -249,11 +211,26 @@ impl<P: EppPort> MassSpringRig<P> {
         self.period
     }
 
+    /// Now on the rig's clock, s.
+    fn now(&self) -> f64 {
+        match &self.clock {
+            Clock::Virtual(c) => c.now_nanos() as f64 / 1e9,
+            Clock::RealTime => self.start.elapsed().as_secs_f64(),
+        }
+    }
+
     /// The duty for `volts` (finite): saturated, quantised to 0.1 %.
     fn duty(&self, volts: f64) -> i16 {
         let full = self.calibration.volts_full_scale;
         let fraction = volts.clamp(-full, full) / full;
         (fraction * f64::from(MAX_DUTY)).round() as i16
+    }
+
+    /// Halts and returns `error`: the fault is what to report; should the
+    /// halt fail too, the caller's own halt or the card's watchdog follows.
+    fn fault<T>(&mut self, error: HwError) -> Result<T, HwError> {
+        self.halt_motor().ok();
+        Err(error)
     }
 
     /// Samples the state `[x1, v1, x2, v2]` (m, m/s): latches the counters
@@ -262,15 +239,17 @@ impl<P: EppPort> MassSpringRig<P> {
     ///
     /// # Errors
     ///
-    /// Port errors; [`HwError::TravelLimit`] (after halting) when a cart is
-    /// beyond its limit.
+    /// Port errors; after halting: [`HwError::TravelLimit`] when a cart is
+    /// beyond its limit, [`HwError::BusFault`] for a count change faster
+    /// than the carts can move, [`HwError::NotResponding`] for sustained
+    /// drive with no motion.
     ///
     /// # Examples
     ///
     /// ```
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// use nalgebra::vector;
-    /// let mut rig = SimulatedRig { initial_state: vector![0.001, 0.0, 0.002, 0.0], ..Default::default() }
+    /// let mut rig = SimulatedRig { initial_state: [0.001, 0.0, 0.002, 0.0], ..Default::default() }
     ///     .rig(&Clock::RealTime)?;
     /// let x = rig.read_state()?; // the counters count from where they were cleared: 0
     /// assert_eq!(x[3], 0.0);
@@ -279,31 +258,80 @@ impl<P: EppPort> MassSpringRig<P> {
     pub fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError> {
         let cal = self.calibration;
         self.card.latch_and_kick()?;
+        let now = self.now();
+        self.last_kick = Some(now);
         let counts = [
             self.card.read_counter(cal.encoder_channels[0])?,
             self.card.read_counter(cal.encoder_channels[1])?,
         ];
-        let previous = self.previous.replace(counts).unwrap_or(counts);
+        let (previous, interval) = match self.previous.replace((counts, now)) {
+            Some((c, t)) if now > t => (c, now - t),
+            _ => (counts, 0.0),
+        };
         let mut x = SVector::<f64, 4>::zeros();
         for cart in 0..2 {
             let scale = cal.sign[cart] * cal.metres_per_count;
+            let moved = counts[cart].saturating_sub(previous[cart]);
             x[2 * cart] = counts[cart] as f64 * scale;
-            x[2 * cart + 1] = (counts[cart] - previous[cart]) as f64 * scale / self.period;
+            if interval > 0.0 {
+                let speed = moved as f64 * scale / interval;
+                if speed.abs() > cal.max_speed {
+                    // The sample is not a measurement: forget it.
+                    self.previous = None;
+                    return self.fault(HwError::BusFault {
+                        channel: cal.encoder_channels[cart],
+                        counts: moved,
+                        interval,
+                        speed,
+                        limit: cal.max_speed,
+                    });
+                }
+                x[2 * cart + 1] = speed;
+            }
         }
         for cart in 0..2 {
             let (position, limit) = (x[2 * cart], cal.travel_limits[cart]);
             if position.abs() > limit {
-                // The breach is the error to report; should the halt fail
-                // too, the caller's own halt or the card's watchdog follows.
-                self.halt_motor().ok();
-                return Err(HwError::TravelLimit {
+                return self.fault(HwError::TravelLimit {
                     axis: cart + 1,
                     position,
                     limit,
                 });
             }
         }
+        self.check_response(counts, now)?;
         Ok(x)
+    }
+
+    /// Sustained drive must move an encoder (see [`Calibration::stall_volts`]).
+    fn check_response(&mut self, counts: [i64; 2], now: f64) -> Result<(), HwError> {
+        let cal = self.calibration;
+        if self.volts.abs() < cal.stall_volts {
+            self.stall = None;
+            self.moved = false;
+            return Ok(());
+        }
+        if self.moved {
+            return Ok(());
+        }
+        let (since, start, weakest) = *self.stall.get_or_insert((now, counts, self.volts.abs()));
+        let weakest = weakest.min(self.volts.abs());
+        self.stall = Some((since, start, weakest));
+        let motion = (0..2)
+            .map(|i| counts[i].saturating_sub(start[i]).saturating_abs())
+            .max()
+            .unwrap_or(0);
+        if motion >= cal.stall_counts {
+            self.moved = true;
+            self.stall = None;
+        } else if now - since >= cal.stall_time {
+            return self.fault(HwError::NotResponding {
+                volts: weakest,
+                seconds: now - since,
+                counts: cal.stall_counts,
+            });
+        }
+        Ok(())
     }
 
     /// Applies `volts` to the motor, saturated to ±`volts_full_scale` and
@@ -312,8 +340,10 @@ impl<P: EppPort> MassSpringRig<P> {
     ///
     /// # Errors
     ///
-    /// Port errors; [`HwError::InvalidCommand`] (after halting) for a
-    /// non-finite voltage.
+    /// Port errors; after halting: [`HwError::InvalidCommand`] for a
+    /// non-finite voltage, [`HwError::Gap`] when the watchdog timeout has
+    /// passed since the last read (the card has cut the motor; applying now
+    /// would re-energise it with a stale command).
     ///
     /// # Examples
     ///
@@ -325,21 +355,34 @@ impl<P: EppPort> MassSpringRig<P> {
     /// ```
     pub fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError> {
         if !volts.is_finite() {
-            // As for a travel-limit breach: report the cause.
-            self.halt_motor().ok();
-            return Err(HwError::InvalidCommand {
+            let error = HwError::InvalidCommand {
                 what: "voltage",
                 channel: Some(self.calibration.pwm_channel),
                 value: volts,
                 limit: self.calibration.volts_full_scale,
-            });
+            };
+            return self.fault(error);
+        }
+        if let (Some(timeout), Some(kick)) = (self.calibration.watchdog_timeout, self.last_kick) {
+            let now = self.now();
+            if now - kick >= timeout && volts != 0.0 {
+                let error = HwError::Gap {
+                    what: "the time since the last watchdog kick",
+                    gap: now - kick,
+                    limit: timeout,
+                    at: now,
+                };
+                return self.fault(error);
+            }
         }
         let duty = self.duty(volts);
         self.card.set_pwm(self.calibration.pwm_channel, duty)?;
-        Ok(f64::from(duty) / f64::from(MAX_DUTY) * self.calibration.volts_full_scale)
+        self.volts = f64::from(duty) / f64::from(MAX_DUTY) * self.calibration.volts_full_scale;
+        Ok(self.volts)
     }
 
     fn halt_motor(&mut self) -> Result<(), HwError> {
+        self.volts = 0.0;
         self.card.set_pwm(self.calibration.pwm_channel, 0)
     }
 }
@@ -367,12 +410,20 @@ impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
         super::schema()
     }
 
+    fn watchdog_timeout(&self) -> Option<f64> {
+        self.calibration.watchdog_timeout
+    }
+
     fn kick_watchdog(&mut self) -> Result<(), HwError> {
-        self.card.kick_watchdog()
+        self.card.kick_watchdog()?;
+        self.last_kick = Some(self.now());
+        Ok(())
     }
 
     fn restart(&mut self) {
         self.previous = None;
+        self.stall = None;
+        self.moved = false;
     }
 }
 

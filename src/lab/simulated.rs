@@ -10,6 +10,7 @@ use crate::hw::{
     SimulatedCard, SimulatedCardConfig,
 };
 use crate::model::Dynamics;
+use crate::error::Error;
 use crate::sim::SampledConfig;
 
 /// The two-cart plant with stick–slip Coulomb friction on each cart, input
@@ -17,8 +18,9 @@ use crate::sim::SampledConfig;
 /// simulated card and the sampled-data simulator.
 ///
 /// A cart at rest stays at rest while the other forces on it are within
-/// ±F; a sliding cart feels −F·sign(v); a cart whose speed reaches zero in a
-/// sub-step sticks if the other forces are within ±F. The stick and slip
+/// ±F_s (its stiction, the breakaway force, at least its Coulomb force
+/// F); a sliding cart feels −F·sign(v); a cart whose speed reaches zero in a
+/// sub-step sticks if the other forces are within ±F_s. The stick and slip
 /// decisions are taken in [`update_mode`](Dynamics::update_mode) between
 /// integration steps, so a stuck cart's speed is exactly zero.
 ///
@@ -42,8 +44,11 @@ use crate::sim::SampledConfig;
 pub struct FrictionPlant {
     /// The linear plant (masses, springs, viscous friction, motor gain).
     pub truth: MassSpring,
-    /// Coulomb friction force on cart 1 and cart 2, N (≥ 0).
+    /// Coulomb (sliding) friction force on cart 1 and cart 2, N (≥ 0).
     pub friction: [f64; 2],
+    /// Breakaway (static) friction force on cart 1 and cart 2, N; taken as
+    /// at least `friction`.
+    pub stiction: [f64; 2],
     /// Each cart's sliding direction (±1) for the current step, or 0 while
     /// it sticks; only used for a cart with friction.
     direction: [f64; 2],
@@ -64,8 +69,30 @@ impl FrictionPlant {
         Self {
             truth,
             friction,
+            stiction: friction,
             direction: [0.0; 2],
         }
+    }
+
+    /// The same plant with breakaway forces `stiction` (N, cart 1 and cart
+    /// 2; each taken as at least the Coulomb force).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// let p = FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]).with_stiction([1.3, 2.5]);
+    /// assert_eq!(p.stiction, [1.3, 2.5]);
+    /// ```
+    #[must_use]
+    pub fn with_stiction(mut self, stiction: [f64; 2]) -> Self {
+        self.stiction = stiction;
+        self
+    }
+
+    /// The force that holds a cart at rest, N.
+    fn breakaway(&self, cart: usize) -> f64 {
+        self.stiction[cart].max(self.friction[cart])
     }
 
     fn mass(&self, cart: usize) -> f64 {
@@ -101,10 +128,10 @@ impl Dynamics<4, 1> for FrictionPlant {
     }
 
     /// First, a sliding cart whose speed reached or crossed zero sticks if
-    /// the other forces are within its friction, otherwise reverses; then a
-    /// sticking cart breaks away when the other forces (under the input
-    /// held next) exceed its friction, and a sliding one slides the way it
-    /// moves.
+    /// the other forces are within its breakaway force, otherwise reverses;
+    /// then a sticking cart breaks away when the other forces (under the
+    /// input held next) exceed its breakaway force, and a sliding one
+    /// slides the way it moves.
     fn update_mode(&mut self, _t: f64, x: &mut SVector<f64, 4>, u: &SVector<f64, 1>) {
         for cart in 0..2 {
             if self.friction[cart] == 0.0 {
@@ -114,7 +141,7 @@ impl Dynamics<4, 1> for FrictionPlant {
             let direction = self.direction[cart];
             if direction != 0.0 && v * direction <= 0.0 {
                 let force = self.other_force(x, u, cart);
-                if force.abs() <= self.friction[cart] {
+                if force.abs() <= self.breakaway(cart) {
                     x[2 * cart + 1] = 0.0;
                     self.direction[cart] = 0.0;
                 } else {
@@ -122,12 +149,13 @@ impl Dynamics<4, 1> for FrictionPlant {
                 }
             }
             let v = x[2 * cart + 1];
-            if self.direction[cart] == 0.0 {
+            if self.direction[cart] == 0.0 && v != 0.0 {
+                // Moving without a mode yet (an initial speed): it slides.
+                self.direction[cart] = v.signum();
+            } else if self.direction[cart] == 0.0 {
                 let force = self.other_force(x, u, cart);
-                if force.abs() > self.friction[cart] {
+                if force.abs() > self.breakaway(cart) {
                     self.direction[cart] = force.signum();
-                } else {
-                    x[2 * cart + 1] = 0.0;
                 }
             } else if v != 0.0 {
                 self.direction[cart] = v.signum();
@@ -140,13 +168,65 @@ impl Dynamics<4, 1> for FrictionPlant {
 /// the register-level [`SimulatedCard`], read through [`Pc104`] by a
 /// [`MassSpringRig`] whose [`Calibration`] matches the card.
 ///
-/// The defaults: the [`default_truth`](Self::default_truth) plant, no
-/// Coulomb friction, the default [`RegisterMap`], 24 V supply, 8192 counts
-/// (2048 pulses × 4) per revolution and 80 mm of travel per revolution (the
-/// lab's figures, so 9.765625 µm per count), the motor on PWM channel 0,
-/// cart 1 on encoder 0 and cart 2 on encoder 1, no noise, a 100 ms
-/// watchdog, RK4 sub-steps of at most 0.25 ms, both carts at rest at 0,
-/// read every 2 ms, travel limits ±0.15 m.
+/// # The default rig, and why
+///
+/// The default is meant to behave like the lab's real rig, not like the
+/// textbook model, so that a student's results on it look like theirs:
+///
+/// - **The plant** ([`default_truth`](Self::default_truth)): the lab's
+///   masses m1 = 1.3 kg and m2 = 0.7 kg, springs k1 = 950 N/m and
+///   k2 = 1020 N/m (real springs never match the nominal 1000 N/m or each
+///   other), b1 = 12 N·s/m of viscous friction on cart 1.
+/// - **The motor.** A 24 V DC motor on a voltage-mode PWM drive pushes with
+///   `F = (kt / r)(V − (kt / r) v) / R`. With a torque constant
+///   kt = 0.05 N·m/A, pinion radius r = 15 mm and armature resistance
+///   R = 3 Ω (8 A at stall), that is a gain K = kt / (r R) = 1.11 N/V
+///   (26.7 N at 24 V) and a back-EMF damping (kt / r)² / R = 3.7 N·s/m on
+///   cart 2, which with 1.8 N·s/m of rail friction makes b2 = 5.5 N·s/m.
+///   (A gain of 8.5 N/V would need R ≤ 0.084 Ω and 285 A at stall.)
+/// - **Coulomb friction and stiction:** 1 N sliding and 1.2 N breakaway on
+///   cart 1, 2 N and 2.4 N on cart 2 (the motor's brushes and gears): small
+///   carts on a rail stop short of where the springs alone would put them.
+/// - **Delay:** 0.15 ms from the PWM write to the drive applying it.
+/// - **Sensing:** encoders of 8192 counts (2048 pulses × 4) per 80 mm,
+///   9.765625 µm per count, with σ = 0.3 count of noise (edge jitter).
+/// - **Safety:** travel limits ±50 mm (full drive, 24 V, would deflect
+///   cart 2 by 54 mm), the card's 100 ms watchdog.
+///
+/// Everything else is the card's default: register map, ID `0xa5`, motor on
+/// PWM channel 0, cart 1 on encoder 0 and cart 2 on encoder 1, RK4
+/// sub-steps of at most 0.25 ms, both carts at rest at 0, read every 2 ms.
+///
+/// # In a file
+///
+/// Every field can be set from a TOML file ([`from_toml`](Self::from_toml),
+/// `lab5 --truth truth.toml`); fields left out keep their default, unknown
+/// fields are an error:
+///
+/// ```
+/// use ctrlab::lab::SimulatedRig;
+///
+/// let rig = SimulatedRig::from_toml(r#"
+///     coulomb_friction = [0.5, 1.5]   # N, cart 1 and cart 2
+///     stiction = [0.6, 1.8]           # N, breakaway
+///     pwm_delay = 0.0002              # s
+///     encoder_noise = 0.5             # counts
+///     seed = 42
+///
+///     [truth]                         # SI: kg, N/m, N·s/m, N/V
+///     m1 = 1.3
+///     m2 = 0.72
+///     k1 = 980.0
+///     k2 = 1010.0
+///     b1 = 11.0
+///     b2 = 6.0
+///     gain = 1.2
+/// "#)?;
+/// assert_eq!((rig.truth.gain, rig.coulomb_friction[1]), (1.2, 1.5));
+/// assert_eq!(rig.travel_limits, [0.05, 0.05]); // a default
+/// assert!(SimulatedRig::from_toml("gian = 1.2").is_err()); // a typo is refused
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 ///
 /// # Examples
 ///
@@ -156,11 +236,8 @@ impl Dynamics<4, 1> for FrictionPlant {
 ///
 /// let clock = VirtualClock::new();
 /// let sim = SimulatedRig {
-///     truth: MassSpring::nominal(),
-///     encoder_noise: 0.5,
-///     seed: 7,
 ///     watchdog_timeout: None, // nobody kicks it in this example
-///     ..Default::default()
+///     ..SimulatedRig::ideal(MassSpring::nominal())
 /// };
 /// let mut rig = sim.rig(&Clock::Virtual(clock.clone()))?;
 /// rig.apply_voltage(10.0)?;
@@ -168,13 +245,19 @@ impl Dynamics<4, 1> for FrictionPlant {
 /// assert!((rig.read_state()?[2] - 0.020).abs() < 1e-4); // 10 N: 20 mm
 /// # Ok::<(), ctrlab::hw::HwError>(())
 /// ```
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct SimulatedRig {
-    /// The plant inside; `truth.gain` is the motor's N per volt.
+    /// The linear plant inside; `truth.gain` is the motor's N per volt.
     pub truth: MassSpring,
-    /// Coulomb friction force on cart 1 and cart 2, N (≥ 0), stick–slip
-    /// (see [`FrictionPlant`]).
+    /// Coulomb (sliding) friction force on cart 1 and cart 2, N (≥ 0), see
+    /// [`FrictionPlant`].
     pub coulomb_friction: [f64; 2],
+    /// Breakaway (static) friction force on cart 1 and cart 2, N (taken as
+    /// at least the Coulomb force).
+    pub stiction: [f64; 2],
+    /// Delay from a PWM write to the drive applying it, s (≥ 0, < 1).
+    pub pwm_delay: f64,
     /// Where the card's registers are.
     pub map: RegisterMap,
     /// What the ID register reads.
@@ -200,8 +283,8 @@ pub struct SimulatedRig {
     /// Largest RK4 sub-step, s (> 0).
     pub max_substep: f64,
     /// Plant state `[x1, v1, x2, v2]` (m, m/s) when the card is created.
-    pub initial_state: SVector<f64, 4>,
-    /// The rig's sampling period, s (its speeds are differenced over it).
+    pub initial_state: [f64; 4],
+    /// The rig's sampling period, s.
     pub period: f64,
     /// Software travel limits of cart 1 and cart 2, m.
     pub travel_limits: [f64; 2],
@@ -212,7 +295,9 @@ impl Default for SimulatedRig {
         let card = SimulatedCardConfig::<4>::default();
         Self {
             truth: Self::default_truth(),
-            coulomb_friction: [0.0; 2],
+            coulomb_friction: [1.0, 2.0],
+            stiction: [1.2, 2.4],
+            pwm_delay: 0.15e-3,
             map: card.map,
             card_id: SIMULATED_CARD_ID,
             supply_voltage: card.supply_voltage,
@@ -220,11 +305,11 @@ impl Default for SimulatedRig {
             travel_per_revolution: card.travel_per_revolution,
             pwm_channel: 0,
             encoder_channels: [0, 1],
-            encoder_noise: 0.0,
+            encoder_noise: 0.3,
             seed: card.seed,
             watchdog_timeout: card.watchdog_timeout,
             max_substep: card.max_substep,
-            initial_state: SVector::zeros(),
+            initial_state: [0.0; 4],
             period: 0.002,
             travel_limits: Calibration::default().travel_limits,
         }
@@ -232,26 +317,19 @@ impl Default for SimulatedRig {
 }
 
 impl SimulatedRig {
-    /// The default plant inside the simulated card: plausible for the lab's
-    /// rig and deliberately **not** [`MassSpring::nominal`], so
-    /// identification has something to find: m1 = 1.3 kg, m2 = 0.7 kg,
-    /// k1 = 950 N/m, k2 = 1020 N/m, b1 = 12.3 N·s/m, b2 = 6.1 N·s/m,
-    /// motor gain 8.5 N/V.
-    ///
-    /// The frictions and gain are those of the project's reference
-    /// identification data set (`tests/data/ident_square_wave.json`, 8.5 N/V:
-    /// about 200 N at the full 24 V); the springs are made unequal because
-    /// real ones never match. At this gain the lab's per-millimetre gains
-    /// act 8.5 times harder than on the force-input model, so several rows
-    /// of Tables 5 and 6 go unstable on this rig; `lab5` reports them as
-    /// such.
+    /// The default plant inside the simulated card (see [the reasoning
+    /// above](Self#the-default-rig-and-why)): m1 = 1.3 kg, m2 = 0.7 kg,
+    /// k1 = 950 N/m, k2 = 1020 N/m, b1 = 12 N·s/m, b2 = 5.5 N·s/m
+    /// (including the motor's back-EMF), motor gain K = 1.11 N/V.
+    /// Deliberately not [`MassSpring::nominal`], so identification has
+    /// something to find.
     ///
     /// # Examples
     ///
     /// ```
     /// use ctrlab::lab::{MassSpring, SimulatedRig};
     /// let truth = SimulatedRig::default_truth();
-    /// assert_eq!((truth.k1, truth.k2, truth.gain), (950.0, 1020.0, 8.5));
+    /// assert_eq!((truth.k1, truth.k2, truth.gain), (950.0, 1020.0, 1.11));
     /// assert_ne!(truth, MassSpring::nominal());
     /// ```
     pub fn default_truth() -> MassSpring {
@@ -260,10 +338,98 @@ impl SimulatedRig {
             m2: 0.7,
             k1: 950.0,
             k2: 1020.0,
-            b1: 12.3,
-            b2: 6.1,
-            gain: 8.5,
+            b1: 12.0,
+            b2: 5.5,
+            gain: 1.11,
         }
+    }
+
+    /// The rig with `truth` inside and nothing a linear model lacks: no
+    /// Coulomb friction or stiction, no PWM delay, no encoder noise (the
+    /// counts' quantisation, the ±24 V drive in 0.1 % steps, the watchdog
+    /// and the travel limits stay). For comparing the rig with linear
+    /// predictions exactly.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{MassSpring, SimulatedRig};
+    /// let rig = SimulatedRig::ideal(MassSpring::nominal());
+    /// assert_eq!((rig.coulomb_friction, rig.pwm_delay, rig.encoder_noise), ([0.0; 2], 0.0, 0.0));
+    /// assert_eq!(rig.travel_limits, SimulatedRig::default().travel_limits);
+    /// ```
+    pub fn ideal(truth: MassSpring) -> Self {
+        Self {
+            truth,
+            coulomb_friction: [0.0; 2],
+            stiction: [0.0; 2],
+            pwm_delay: 0.0,
+            encoder_noise: 0.0,
+            ..Self::default()
+        }
+    }
+
+    /// A simulated rig from TOML text: every field of [`SimulatedRig`],
+    /// each optional (see [In a file](Self#in-a-file)).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Toml`] with the line and the parser's message, which names
+    /// the field (an unknown field, a value of the wrong type). The values
+    /// themselves are checked when the rig is built
+    /// ([`validate`](Self::validate)).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::SimulatedRig;
+    /// assert_eq!(SimulatedRig::from_toml("")?, SimulatedRig::default());
+    /// let err = SimulatedRig::from_toml("seed = \"seven\"").unwrap_err();
+    /// assert!(err.to_string().contains("seed"));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn from_toml(text: &str) -> Result<Self, Error> {
+        toml::from_str(text).map_err(|e| Error::Toml {
+            line: e
+                .span()
+                .map(|span| text[..span.start.min(text.len())].lines().count().max(1)),
+            message: e.message().to_string(),
+        })
+    }
+
+    /// The simulated rig in `path` ([`from_toml`](Self::from_toml)).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Io`] with the path, and the errors of
+    /// [`from_toml`](Self::from_toml).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, lab::SimulatedRig};
+    /// assert!(matches!(SimulatedRig::read_toml("no/such/truth.toml"), Err(Error::Io { .. })));
+    /// ```
+    pub fn read_toml(path: impl AsRef<std::path::Path>) -> Result<Self, Error> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::io(format!("reading {}", path.display()), &e))?;
+        Self::from_toml(&text)
+    }
+
+    /// The rig as TOML text, every field written; reads back equal.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::SimulatedRig;
+    /// let rig = SimulatedRig::default();
+    /// assert_eq!(SimulatedRig::from_toml(&rig.to_toml())?, rig);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn to_toml(&self) -> String {
+        // Plain numbers, arrays and tables: serialisation cannot fail.
+        toml::to_string(self).unwrap_or_default()
     }
 
     /// Cart travel per encoder count, m.
@@ -288,7 +454,7 @@ impl SimulatedRig {
     /// assert_eq!(sim.plant().friction, [1.0, 2.0]);
     /// ```
     pub fn plant(&self) -> FrictionPlant {
-        FrictionPlant::new(self.truth, self.coulomb_friction)
+        FrictionPlant::new(self.truth, self.coulomb_friction).with_stiction(self.stiction)
     }
 
     /// The card's configuration: encoders on the carts' positions.
@@ -319,7 +485,8 @@ impl SimulatedRig {
             seed: self.seed,
             watchdog_timeout: self.watchdog_timeout,
             max_substep: self.max_substep,
-            initial_state: self.initial_state,
+            pwm_delay: self.pwm_delay,
+            initial_state: SVector::from(self.initial_state),
         }
     }
 
@@ -340,6 +507,9 @@ impl SimulatedRig {
             pwm_channel: self.pwm_channel,
             encoder_channels: self.encoder_channels,
             travel_limits: self.travel_limits,
+            card_id: self.card_id,
+            watchdog_timeout: self.watchdog_timeout,
+            ..Calibration::default()
         }
     }
 
@@ -382,10 +552,11 @@ impl SimulatedRig {
         &self,
         clock: &Clock,
     ) -> Result<MassSpringRig<SimulatedCard<FrictionPlant, 4>>, HwError> {
-        MassSpringRig::new(
+        MassSpringRig::with_clock(
             Pc104::new(self.card(clock)?),
             self.calibration(),
             self.period,
+            clock.clone(),
         )
     }
 
@@ -425,6 +596,7 @@ impl SimulatedRig {
     pub fn sampled_config(&self, duration: f64) -> SampledConfig<1, 4> {
         SampledConfig {
             max_substep: self.max_substep,
+            input_delay: self.pwm_delay,
             saturation: [self.supply_voltage],
             input_quantisation: [self.supply_voltage / f64::from(MAX_DUTY)],
             schema: Some(schema()),
@@ -464,13 +636,14 @@ impl SimulatedRig {
                 reason: "invalid plant parameters",
             },
         })?;
-        for f in self.coulomb_friction {
-            if !(f.is_finite() && f >= 0.0) {
-                return Err(HwError::InvalidConfig {
-                    name: "coulomb_friction",
-                    value: f,
-                    reason: "must be finite and ≥ 0",
-                });
+        for (name, forces) in [
+            ("coulomb_friction", self.coulomb_friction),
+            ("stiction", self.stiction),
+        ] {
+            for f in forces {
+                if !(f.is_finite() && f >= 0.0) {
+                    return Err(HwError::invalid_config(name, f, "must be finite and ≥ 0"));
+                }
             }
         }
         let [e1, e2] = self.encoder_channels;

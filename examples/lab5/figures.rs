@@ -1,0 +1,198 @@
+//! lab5's figures (feature `plot`): the rig runs as small multiples, each
+//! run's position over its setpoint with the applied voltage beneath, and
+//! the identification estimates per run against their mean and the truth.
+
+#[cfg(feature = "plot")]
+use plotters::prelude::*;
+
+/// One closed-loop rig run to draw.
+pub struct RunCurve {
+    /// Panel title (the gains, and the outcome).
+    pub title: String,
+    /// Time, s.
+    pub t: Vec<f64>,
+    /// Position, mm.
+    pub x_mm: Vec<f64>,
+    /// Applied voltage, V.
+    pub u: Vec<f64>,
+}
+
+/// One identified parameter: its estimate per run and scheme.
+pub struct ParamPanel {
+    /// Name and unit (`"k1 (N/m)"`).
+    pub name: String,
+    /// (scheme, estimate per run).
+    pub schemes: Vec<(String, Vec<f64>)>,
+    /// The truth (simulated rig only).
+    pub truth: Option<f64>,
+}
+
+const WIDTH: u32 = 1200;
+/// Scheme colours: distinguishable for colour-blind readers (Okabe–Ito).
+#[cfg(feature = "plot")]
+const OKABE_ITO: [RGBColor; 4] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+];
+
+#[cfg(feature = "plot")]
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if !lo.is_finite() {
+        return (-1.0, 1.0);
+    }
+    let pad = if hi > lo { 0.08 * (hi - lo) } else { 0.5 * lo.abs().max(1.0) };
+    (lo - pad, hi + pad)
+}
+
+/// A grid of panels, one per run: position (mm) and the setpoint as a
+/// dashed line on top, the applied voltage (V) beneath. Small multiples
+/// keep 15 runs readable where one chart of 15 curves would not be.
+#[cfg(feature = "plot")]
+pub fn runs_svg(
+    path: &std::path::Path,
+    title: &str,
+    setpoint_mm: f64,
+    volts_full_scale: f64,
+    runs: &[RunCurve],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let cols = 3usize;
+    let rows = runs.len().div_ceil(cols).max(1);
+    let height = 60 + 260 * rows as u32;
+    let root = SVGBackend::new(path, (WIDTH, height)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 24))?;
+    let cells = root.split_evenly((rows, cols));
+    let t_end = runs
+        .iter()
+        .filter_map(|r| r.t.last().copied())
+        .fold(0.0, f64::max)
+        .max(1e-3);
+    for (run, cell) in runs.iter().zip(cells.iter()) {
+        let (top, bottom) = cell.split_vertically(160);
+        let (y0, y1) = range(run.x_mm.iter().copied().chain([0.0, setpoint_mm]));
+        let mut chart = ChartBuilder::on(&top)
+            .caption(&run.title, ("sans-serif", 14))
+            .margin(6)
+            .x_label_area_size(0)
+            .y_label_area_size(48)
+            .build_cartesian_2d(0.0..t_end, y0..y1)?;
+        chart
+            .configure_mesh()
+            .y_desc("mm")
+            .label_style(("sans-serif", 11))
+            .draw()?;
+        chart.draw_series(DashedLineSeries::new(
+            [(0.0, setpoint_mm), (t_end, setpoint_mm)],
+            6,
+            4,
+            BLACK.stroke_width(1),
+        ))?;
+        chart.draw_series(LineSeries::new(
+            run.t.iter().copied().zip(run.x_mm.iter().copied()),
+            OKABE_ITO[0].stroke_width(2),
+        ))?;
+        let v = volts_full_scale * 1.1;
+        let mut volts = ChartBuilder::on(&bottom)
+            .margin(6)
+            .x_label_area_size(28)
+            .y_label_area_size(48)
+            .build_cartesian_2d(0.0..t_end, -v..v)?;
+        volts
+            .configure_mesh()
+            .x_desc("t (s)")
+            .y_desc("V")
+            .label_style(("sans-serif", 11))
+            .draw()?;
+        volts.draw_series(LineSeries::new(
+            run.t.iter().copied().zip(run.u.iter().copied()),
+            OKABE_ITO[1].stroke_width(1),
+        ))?;
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// One panel per parameter: each run's estimate per scheme as points, their
+/// mean as a line in the scheme's colour, the truth as a black dashed line;
+/// the legend sits below the panels, outside the data.
+#[cfg(feature = "plot")]
+pub fn estimates_svg(
+    path: &std::path::Path,
+    title: &str,
+    panels: &[ParamPanel],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let height = 440;
+    let root = SVGBackend::new(path, (WIDTH, height)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 24))?;
+    let (plots, legend) = root.split_vertically(height - 90);
+    let cells = plots.split_evenly((1, panels.len().max(1)));
+    for (panel, cell) in panels.iter().zip(cells.iter()) {
+        let runs = panel.schemes.iter().map(|(_, v)| v.len()).max().unwrap_or(1);
+        let (y0, y1) = range(
+            panel
+                .schemes
+                .iter()
+                .flat_map(|(_, v)| v.iter().copied())
+                .chain(panel.truth),
+        );
+        let mut chart = ChartBuilder::on(cell)
+            .caption(&panel.name, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(30)
+            .y_label_area_size(64)
+            .build_cartesian_2d(0.5..runs as f64 + 0.5, y0..y1)?;
+        chart
+            .configure_mesh()
+            .x_desc("run")
+            .x_labels(runs)
+            .label_style(("sans-serif", 11))
+            .draw()?;
+        for (k, (_, values)) in panel.schemes.iter().enumerate() {
+            let color = OKABE_ITO[k % OKABE_ITO.len()];
+            // Schemes side by side within a run, so points do not hide.
+            let offset = (k as f64 - (panel.schemes.len() as f64 - 1.0) / 2.0) * 0.12;
+            chart.draw_series(values.iter().enumerate().map(|(i, &v)| {
+                Circle::new((i as f64 + 1.0 + offset, v), 4, color.filled())
+            }))?;
+            let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
+            chart.draw_series(LineSeries::new(
+                [(0.5, mean), (runs as f64 + 0.5, mean)],
+                color.stroke_width(1),
+            ))?;
+        }
+        if let Some(truth) = panel.truth {
+            chart.draw_series(DashedLineSeries::new(
+                [(0.5, truth), (runs as f64 + 0.5, truth)],
+                6,
+                4,
+                BLACK.stroke_width(2),
+            ))?;
+        }
+    }
+    // The legend: scheme colours (points and their mean), and the truth.
+    let names: Vec<&str> = panels
+        .first()
+        .map(|p| p.schemes.iter().map(|(n, _)| n.as_str()).collect())
+        .unwrap_or_default();
+    let mut x = 20;
+    for (k, name) in names.iter().enumerate() {
+        let color = OKABE_ITO[k % OKABE_ITO.len()];
+        legend.draw(&Circle::new((x, 30), 5, color.filled()))?;
+        legend.draw(&Text::new(
+            format!("{name} (points: runs, line: mean)"),
+            (x + 12, 22),
+            ("sans-serif", 14),
+        ))?;
+        x += 330;
+    }
+    legend.draw(&PathElement::new([(x, 30), (x + 30, 30)], BLACK.stroke_width(2)))?;
+    legend.draw(&Text::new("truth (dashed)", (x + 36, 22), ("sans-serif", 14)))?;
+    legend.present()?;
+    Ok(())
+}

@@ -1,0 +1,229 @@
+//! Real-time scheduling for the control loop on Linux: SCHED_FIFO, locked
+//! memory, CPU affinity and absolute-deadline sleeps.
+//!
+//! This is the crate's one file of `unsafe` code for the scheduler and
+//! clock system calls (the parallel port has its own, `ppdev.rs`); each
+//! block says why it is sound. On other systems asking for [`RealTime`] is
+//! an error and sleeps fall back to `std::thread::sleep`.
+#![allow(unsafe_code)]
+
+use std::time::{Duration, Instant};
+
+use super::HwError;
+
+/// Opt-in real-time settings for [`run`](super::run)'s thread, as
+/// cyclictest uses them: SCHED_FIFO at `priority`, all memory locked
+/// (`mlockall`), optionally pinned to one CPU. The loop then sleeps to each
+/// absolute deadline with `clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME)`
+/// and spins only the last `spin`. Everything is restored when the run
+/// ends.
+///
+/// Needs the right to do so: an `rtprio` limit (`ulimit -r`, or
+/// `@realtime - rtprio 99` and `memlock unlimited` in
+/// `/etc/security/limits.conf`), `CAP_SYS_NICE` and `CAP_IPC_LOCK`
+/// (`setcap cap_sys_nice,cap_ipc_lock+ep` on the binary), or root. Without
+/// it [`run`](super::run) refuses to start with [`HwError::RealTime`], which
+/// says how to grant it.
+///
+/// A SCHED_FIFO thread that never sleeps starves everything else on its
+/// CPU; the loop sleeps every period, and a stock kernel still throttles
+/// real-time threads to 95 % of each second (`sched_rt_runtime_us`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{LoopConfig, RealTime};
+/// let config = LoopConfig { realtime: Some(RealTime { priority: 80, cpu: Some(1), ..RealTime::default() }), ..LoopConfig::default() };
+/// assert!(config.realtime.unwrap().lock_memory);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RealTime {
+    /// SCHED_FIFO priority, 1–99 (default 80; cyclictest's usual 80–95).
+    pub priority: i32,
+    /// Lock all current and future memory (default true), so no page fault
+    /// stalls a tick.
+    pub lock_memory: bool,
+    /// Pin the loop's thread to this CPU (default none).
+    pub cpu: Option<usize>,
+    /// How long before each deadline to stop sleeping and spin (default
+    /// 20 µs: with SCHED_FIFO the wake-up itself is accurate).
+    pub spin: Duration,
+}
+
+impl Default for RealTime {
+    fn default() -> Self {
+        Self {
+            priority: 80,
+            lock_memory: true,
+            cpu: None,
+            spin: Duration::from_micros(20),
+        }
+    }
+}
+
+const HINT_PRIORITY: &str = "Grant real-time priority: raise the rtprio limit (`ulimit -r 99`, or `@realtime - rtprio 99` in /etc/security/limits.conf and add the user to group realtime), give the binary CAP_SYS_NICE (`sudo setcap cap_sys_nice,cap_ipc_lock+ep <binary>`), or run as root";
+const HINT_MEMORY: &str = "Grant memory locking: raise the memlock limit (`ulimit -l unlimited`, or `@realtime - memlock unlimited` in /etc/security/limits.conf), give the binary CAP_IPC_LOCK, or set `lock_memory: false`";
+const HINT_CPU: &str = "Pick a CPU this process may run on (see `nproc` and `taskset -p $$`)";
+
+/// What [`enter`] changed, restored on drop.
+#[derive(Debug)]
+pub(crate) struct Guard {
+    #[cfg(target_os = "linux")]
+    policy: libc::c_int,
+    #[cfg(target_os = "linux")]
+    param: libc::sched_param,
+    #[cfg(target_os = "linux")]
+    affinity: Option<libc::cpu_set_t>,
+    locked: bool,
+}
+
+fn refused(what: String, hint: &'static str) -> HwError {
+    HwError::RealTime {
+        what,
+        reason: std::io::Error::last_os_error().to_string(),
+        hint,
+    }
+}
+
+/// Applies `rt` to the calling thread; the guard undoes it.
+#[cfg(target_os = "linux")]
+pub(crate) fn enter(rt: &RealTime) -> Result<Guard, HwError> {
+    // SAFETY: sched_getscheduler and sched_getparam only read the calling
+    // thread's (pid 0) attributes into a sched_param we own.
+    let (policy, param) = unsafe {
+        let mut param: libc::sched_param = std::mem::zeroed();
+        (libc::sched_getscheduler(0), {
+            libc::sched_getparam(0, &mut param);
+            param
+        })
+    };
+    let min = unsafe { libc::sched_get_priority_min(libc::SCHED_FIFO) };
+    let max = unsafe { libc::sched_get_priority_max(libc::SCHED_FIFO) };
+    if !(min..=max).contains(&rt.priority) {
+        return Err(HwError::InvalidConfig {
+            name: "priority",
+            value: f64::from(rt.priority),
+            reason: "SCHED_FIFO priority must be within 1–99",
+        });
+    }
+    let mut guard = Guard {
+        policy,
+        param,
+        affinity: None,
+        locked: false,
+    };
+    if let Some(cpu) = rt.cpu {
+        // SAFETY: cpu_set_t is plain data; CPU_ZERO/CPU_SET write within it
+        // (CPU_SET ignores a cpu beyond its bit count); sched_[gs]etaffinity
+        // read and write exactly size_of::<cpu_set_t>() bytes of sets we own.
+        let applied = unsafe {
+            let mut old: libc::cpu_set_t = std::mem::zeroed();
+            let size = std::mem::size_of::<libc::cpu_set_t>();
+            let ok = libc::sched_getaffinity(0, size, &mut old) == 0;
+            let mut set: libc::cpu_set_t = std::mem::zeroed();
+            libc::CPU_ZERO(&mut set);
+            libc::CPU_SET(cpu, &mut set);
+            if ok && cpu < 8 * size && libc::sched_setaffinity(0, size, &set) == 0 {
+                Some(old)
+            } else {
+                None
+            }
+        };
+        match applied {
+            Some(old) => guard.affinity = Some(old),
+            None => return Err(refused(format!("pin the loop to CPU {cpu}"), HINT_CPU)),
+        }
+    }
+    if rt.lock_memory {
+        // SAFETY: mlockall takes flags only.
+        if unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) } != 0 {
+            return Err(refused("lock memory (mlockall)".to_owned(), HINT_MEMORY));
+        }
+        guard.locked = true;
+    }
+    let fifo = libc::sched_param {
+        sched_priority: rt.priority,
+    };
+    // SAFETY: sets the calling thread's policy from a sched_param we own.
+    if unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &fifo) } != 0 {
+        return Err(refused(
+            format!("set SCHED_FIFO priority {}", rt.priority),
+            HINT_PRIORITY,
+        ));
+    }
+    Ok(guard)
+}
+
+#[cfg(not(target_os = "linux"))]
+pub(crate) fn enter(_rt: &RealTime) -> Result<Guard, HwError> {
+    Err(HwError::RealTime {
+        what: "set real-time scheduling".to_owned(),
+        reason: "only implemented on Linux".to_owned(),
+        hint: "Run without `realtime`",
+    })
+}
+
+#[cfg(target_os = "linux")]
+impl Drop for Guard {
+    fn drop(&mut self) {
+        // SAFETY: restores the calling thread's attributes saved in
+        // `enter` from values we own; failures leave the (harmless)
+        // real-time setting in place, and there is no one to tell.
+        unsafe {
+            libc::sched_setscheduler(0, self.policy, &self.param);
+            if let Some(old) = &self.affinity {
+                libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), old);
+            }
+            if self.locked {
+                libc::munlockall();
+            }
+        }
+    }
+}
+
+/// Sleeps until `deadline`, the last `spin` by spinning. On Linux the sleep
+/// is `clock_nanosleep` to the absolute deadline on CLOCK_MONOTONIC (the
+/// clock `Instant` reads), so a late wake-up does not shift later ticks.
+pub(crate) fn sleep_until(deadline: Instant, spin: Duration) {
+    let now = Instant::now();
+    if deadline > now + spin {
+        sleep_absolute(deadline - spin, now);
+    }
+    while Instant::now() < deadline {
+        std::hint::spin_loop();
+    }
+}
+
+#[cfg(target_os = "linux")]
+fn sleep_absolute(wake: Instant, now: Instant) {
+    // SAFETY: clock_gettime writes one timespec we own.
+    let mut ts = unsafe {
+        let mut ts: libc::timespec = std::mem::zeroed();
+        libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts);
+        ts
+    };
+    let ahead = wake.saturating_duration_since(now);
+    let nanos = ts.tv_nsec as u64 + u64::from(ahead.subsec_nanos());
+    ts.tv_sec += ahead.as_secs() as libc::time_t + (nanos / 1_000_000_000) as libc::time_t;
+    ts.tv_nsec = (nanos % 1_000_000_000) as libc::c_long;
+    // SAFETY: reads the timespec we own; a null remainder is allowed with
+    // TIMER_ABSTIME. Retried on EINTR (a signal), bounded by the deadline.
+    for _ in 0..1000 {
+        let rc = unsafe {
+            libc::clock_nanosleep(
+                libc::CLOCK_MONOTONIC,
+                libc::TIMER_ABSTIME,
+                &ts,
+                std::ptr::null_mut(),
+            )
+        };
+        if rc != libc::EINTR {
+            break;
+        }
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn sleep_absolute(wake: Instant, now: Instant) {
+    std::thread::sleep(wake.saturating_duration_since(now));
+}

@@ -1,0 +1,142 @@
+//! [`Calibration`]: how the lab's rig maps counts and volts to SI, and
+//! what it checks.
+
+use crate::hw::{ENCODER_CHANNELS, HwError, PWM_CHANNELS};
+
+/// How the rig's counts and volts map to SI, and which channels are wired
+/// where.
+///
+/// The default is the lab's rig as [`SimulatedRig`](super::SimulatedRig)
+/// models it: 80 mm per 8192 counts (9.765625 µm per count), both encoders
+/// counting up when the carts move away from the wall, 24 V full scale, the
+/// motor on PWM channel 0, cart 1 on encoder 0, cart 2 on encoder 1, travel
+/// limits ±50 mm on both carts, the simulated card's ID `0xa5` and 100 ms
+/// watchdog, and the plausibility checks: no cart faster than 2 m/s (a
+/// faster count change is a bus fault), and at least 6 V held for 0.5 s must
+/// move an encoder by 3 counts (or the motor or encoder is not
+/// responding).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::Calibration;
+/// let cal = Calibration::default();
+/// assert_eq!(cal.metres_per_count * 8192.0, 0.080);
+/// let flipped = Calibration { sign: [1.0, -1.0], ..cal };
+/// assert!(flipped.validate().is_ok());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Calibration {
+    /// Cart travel per encoder count, m (> 0).
+    pub metres_per_count: f64,
+    /// Sign of each encoder (cart 1, cart 2): +1 when counting up means the
+    /// cart moves away from the wall, −1 otherwise.
+    pub sign: [f64; 2],
+    /// Motor voltage at 100 % duty, V (> 0); commands saturate at ±this.
+    pub volts_full_scale: f64,
+    /// The PWM channel driving the motor (0–3).
+    pub pwm_channel: usize,
+    /// The encoder channels of cart 1 and cart 2 (0–3, distinct).
+    pub encoder_channels: [usize; 2],
+    /// Software travel limits of cart 1 and cart 2, m (> 0, symmetric about
+    /// the position where the counters were cleared).
+    pub travel_limits: [f64; 2],
+    /// What the card's ID register must read; the rig checks it when it is
+    /// built (and tells an open bus, `0x00` or `0xff`, from a card).
+    pub card_id: u8,
+    /// The card's watchdog timeout, s, if it has one: the control loop
+    /// halts before half of it passes without a sample.
+    pub watchdog_timeout: Option<f64>,
+    /// The fastest a cart can physically move, m/s (> 0): a count change
+    /// implying more is a bus or counter fault, not a measurement.
+    pub max_speed: f64,
+    /// Drive at or above this magnitude, V (> 0), held for
+    /// [`stall_time`](Self::stall_time) without either encoder moving
+    /// [`stall_counts`](Self::stall_counts) counts means the motor or an
+    /// encoder is not responding.
+    pub stall_volts: f64,
+    /// See [`stall_volts`](Self::stall_volts), s (> 0).
+    pub stall_time: f64,
+    /// See [`stall_volts`](Self::stall_volts), counts (≥ 1).
+    pub stall_counts: i64,
+}
+
+impl Default for Calibration {
+    fn default() -> Self {
+        Self {
+            metres_per_count: 0.080 / 8192.0,
+            sign: [1.0, 1.0],
+            volts_full_scale: 24.0,
+            pwm_channel: 0,
+            encoder_channels: [0, 1],
+            travel_limits: [0.050, 0.050],
+            card_id: crate::hw::SIMULATED_CARD_ID,
+            watchdog_timeout: Some(0.100),
+            max_speed: 2.0,
+            stall_volts: 6.0,
+            stall_time: 0.5,
+            stall_counts: 3,
+        }
+    }
+}
+
+impl Calibration {
+    /// Checks every field.
+    ///
+    /// # Errors
+    ///
+    /// [`HwError::InvalidConfig`] naming the first bad field.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::HwError, lab::Calibration};
+    /// let bad = Calibration { sign: [1.0, 0.5], ..Calibration::default() };
+    /// assert!(matches!(bad.validate(), Err(HwError::InvalidConfig { name: "sign", .. })));
+    /// ```
+    pub fn validate(&self) -> Result<(), HwError> {
+        let positive = [
+            ("metres_per_count", self.metres_per_count),
+            ("volts_full_scale", self.volts_full_scale),
+            ("travel_limits", self.travel_limits[0]),
+            ("travel_limits", self.travel_limits[1]),
+            ("watchdog_timeout", self.watchdog_timeout.unwrap_or(1.0)),
+            ("max_speed", self.max_speed),
+            ("stall_volts", self.stall_volts),
+            ("stall_time", self.stall_time),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(HwError::invalid_config(name, value, "must be finite and > 0"));
+            }
+        }
+        for s in self.sign {
+            if s != 1.0 && s != -1.0 {
+                return Err(HwError::invalid_config("sign", s, "must be +1 or -1"));
+            }
+        }
+        if self.pwm_channel >= PWM_CHANNELS {
+            return Err(HwError::invalid_config(
+                "pwm_channel",
+                self.pwm_channel as f64,
+                "must be 0–3",
+            ));
+        }
+        if self.stall_counts < 1 {
+            return Err(HwError::invalid_config(
+                "stall_counts",
+                self.stall_counts as f64,
+                "must be at least 1",
+            ));
+        }
+        let [e1, e2] = self.encoder_channels;
+        if e1 >= ENCODER_CHANNELS || e2 >= ENCODER_CHANNELS || e1 == e2 {
+            return Err(HwError::invalid_config(
+                "encoder_channels",
+                e2 as f64,
+                "must be two distinct channels 0–3",
+            ));
+        }
+        Ok(())
+    }
+}
