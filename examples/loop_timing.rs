@@ -46,7 +46,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 println!("usage: loop_timing [SECONDS] [--rt-priority N] [--cpu K]");
                 return Ok(());
             }
-            s => seconds = s.parse().map_err(|_| format!("not a duration in s: `{s}`"))?,
+            s => {
+                seconds = s
+                    .parse()
+                    .map_err(|_| format!("not a duration in s: `{s}`"))?
+            }
         }
     }
     let rig = SimulatedRig::default().rig(&Clock::RealTime)?;

@@ -81,8 +81,10 @@ fn golden_counter_read_is_four_addressed_bytes_low_first() {
 
 #[test]
 fn golden_rig_iteration() {
-    // One loop iteration through the rig: latch+kick, cart 1, cart 2, PWM.
+    // Building the rig probes the ID register (read only, nothing
+    // written); then one loop iteration: latch+kick, cart 1, cart 2, PWM.
     let mut port = RecordingPort::default();
+    port.inner_mut().set(0x00, 0xa5); // the card's ID
     port.inner_mut().set_u32_le(0x20, 1024); // cart 1: 10 mm
     port.inner_mut().set_u32_le(0x24, 0xffff_fc00); // cart 2: -1024 counts
     let mut rig = MassSpringRig::new(Pc104::new(&mut port), Calibration::default(), 0.002).unwrap();
@@ -93,6 +95,8 @@ fn golden_rig_iteration() {
     assert_eq!(
         port.log(),
         &[
+            A(0x00),
+            R(0xa5),
             A(0x01),
             W(0x05),
             A(0x20),

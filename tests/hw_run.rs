@@ -1,6 +1,12 @@
 //! The fixed-period loop through the full driver stack
 //! (`MassSpringRig` → `Pc104` → `SimulatedCard`): agreement with the design
 //! module's simulation, and failing safe.
+//!
+//! Checks of the loop's and the driver's exact behaviour run on
+//! [`SimulatedRig::ideal`] (no friction, stiction, PWM delay or noise: the
+//! card's duty is the last one written, and linear references apply); runs
+//! meant to look like the lab's run on the realistic default rig. The
+//! fault-injection tests of issue 9 are in `faults.rs`.
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
@@ -17,6 +23,8 @@ use proptest::prelude::*;
 const PERIOD: f64 = 0.002;
 /// EPP cycles of one tick: latch+kick (2), two 4-byte counters (16), PWM (4).
 const CYCLES_PER_TICK: usize = 22;
+/// EPP cycles of the ID probe when a rig is built (address write, data read).
+const PROBE_CYCLES: usize = 2;
 
 /// The lab's simulated card (the two carts with friction inside).
 type Card = SimulatedCard<FrictionPlant, 4>;
@@ -34,9 +42,16 @@ fn sim_rig(config: SimulatedRig) -> (VirtualClock, MassSpringRig<Card>) {
     (clock, rig)
 }
 
-/// The lab's rig on any port (a card behind a fault-injecting port).
-fn rig<P: EppPort>(port: P) -> MassSpringRig<P> {
-    MassSpringRig::new(Pc104::new(port), Calibration::default(), PERIOD).unwrap()
+/// The lab's rig on any port (a card behind a fault-injecting port), timed
+/// on the card's virtual clock.
+fn rig<P: EppPort>(port: P, clock: &VirtualClock) -> MassSpringRig<P> {
+    let clock = Clock::Virtual(clock.clone());
+    MassSpringRig::with_clock(Pc104::new(port), Calibration::default(), PERIOD, clock).unwrap()
+}
+
+/// The default truth without friction, stiction, PWM delay or noise.
+fn ideal() -> SimulatedRig {
+    SimulatedRig::ideal(SimulatedRig::default_truth())
 }
 
 fn config(duration: f64) -> LoopConfig {
@@ -81,8 +96,8 @@ fn sampled_simulation(
 
 #[test]
 fn table2_row_through_the_full_stack_matches_the_simulation() {
-    // Truth = the nominal model (1 N/V), no noise, no Coulomb friction, the
-    // lab's 30 mm setpoint. At 1 N/V the loop asks for up to 300 V (10 V/mm
+    // Truth = the nominal model (1 N/V), no noise, no friction or stiction,
+    // no PWM delay (the ideal rig), the lab's 30 mm setpoint. At 1 N/V the loop asks for up to 300 V (10 V/mm
     // × 30 mm), which a 24 V drive would clip: saturation is a nonlinearity
     // the linear design model does not have, so this check of the driver
     // stack gives the card a 400 V supply (PWM steps of 0.4 V) to compare
@@ -91,16 +106,25 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
     let supply = 400.0;
     let clock = VirtualClock::new();
     let sim = SimulatedRig {
-        truth,
         supply_voltage: supply,
-        ..Default::default()
+        ..SimulatedRig::ideal(truth)
     };
     let gains = [0.0, 0.0, 10.0, 0.1];
     let ctrl = StateFeedback::from_lab_gains(gains, Cart::Two).unwrap();
     let setpoint = 0.030;
     // The simulated rig's calibration has the card's supply as full scale.
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    assert_eq!(rig.calibration().volts_full_scale, supply);
+    assert_eq!(sim.calibration().volts_full_scale, supply);
+    // 300 N on cart 2 drives it past the 2 m/s that the lab's 24 V motor
+    // can reach (the rig would call that a bus fault): this unphysical drive
+    // needs a looser plausibility limit, well above the run's peak speed
+    // (printed: 2.007 m/s, at the 5th sample).
+    let calibration = Calibration {
+        max_speed: 10.0,
+        ..sim.calibration()
+    };
+    let virtual_clock = Clock::Virtual(clock.clone());
+    let card = Pc104::new(sim.card(&virtual_clock).unwrap());
+    let rig = MassSpringRig::with_clock(card, calibration, PERIOD, virtual_clock).unwrap();
     let out = run(
         rig,
         ctrl,
@@ -114,6 +138,12 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
     let u = rec.channel("u").unwrap();
     assert!(u.iter().all(|u| u.abs() < supply), "no saturation");
     let (t, x2) = (rec.time(), rec.channel("x2").unwrap());
+    let peak = rec
+        .channel("v2")
+        .unwrap()
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    println!("peak speed of cart 2: {peak} m/s");
 
     let sim = sampled_simulation(&truth, ctrl, setpoint, rec.len());
     let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<_>>();
@@ -140,13 +170,17 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
 
 #[test]
 fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
+    // The realistic rig (friction, stiction, PWM delay, noise): all of it
+    // is deterministic for a given seed. ±5 V is 5.55 N on the 1.11 N/V
+    // motor, enough to break cart 2 away (2.4 N), under the 6 V the stall
+    // check watches.
     let make = || {
         let (clock, rig) = sim_rig(SimulatedRig {
             encoder_noise: 0.5,
             seed: 7,
             ..Default::default()
         });
-        let square = SquareWave::new(2.0, 0.2).unwrap();
+        let square = SquareWave::new(5.0, 0.2).unwrap();
         run(
             rig,
             OpenLoop,
@@ -158,15 +192,20 @@ fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
     };
     let (a, b) = (make(), make());
     assert_eq!(a.recording, b.recording);
-    // ±2 V is a whole number of 24 mV duty steps? 2/0.024 = 83.3: the card
-    // applies 83 steps = 1.992 V, and that is what is recorded.
+    // ±5 V is a whole number of 24 mV duty steps? 5/0.024 = 208.3: the card
+    // applies 208 steps = 4.992 V, and that is what is recorded.
     assert!(
         a.recording
             .channel("u")
             .unwrap()
             .iter()
-            .all(|u| (u.abs() - 1.992).abs() < 1e-12)
+            .all(|u| (u.abs() - 4.992).abs() < 1e-12)
     );
+    // And the carts moved (by far more than the noise): x2 swings by
+    // millimetres (11 mm of static deflection each way without friction).
+    let x2 = a.recording.channel("x2").unwrap();
+    let swing = x2.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(swing > 0.005, "{swing}");
     let t = a.recording.time();
     assert!(t.windows(2).all(|w| ((w[1] - w[0]) - PERIOD).abs() < 1e-12));
     assert_eq!(a.stats.ticks, 500);
@@ -175,13 +214,14 @@ fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
 
 #[test]
 fn a_travel_limit_breach_halts_and_keeps_the_recording() {
-    // +24 V on the default truth (8.5 N/V) would push cart 2 to ~0.4 m.
+    // The realistic rig: +24 V (26.6 N on the 1.11 N/V motor) would deflect
+    // cart 2 by 54 mm at rest, and the step overshoots: past ±50 mm.
     let (clock, mut rig) = sim_rig(SimulatedRig::default());
     let err = run(
         &mut rig,
         OpenLoop,
         |_| vector![24.0],
-        &Clock::Virtual(clock),
+        &Clock::Virtual(clock.clone()),
         &config(5.0),
     )
     .unwrap_err();
@@ -197,8 +237,11 @@ fn a_travel_limit_breach_halts_and_keeps_the_recording() {
             .channel("x2")
             .unwrap()
             .iter()
-            .all(|x| x.abs() <= 0.15)
+            .all(|x| x.abs() <= 0.05)
     );
+    // The halt was written; the drive takes it the PWM delay later.
+    clock.advance(SimulatedRig::default().pwm_delay).unwrap();
+    rig.card_mut().port_mut().sync();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
 
@@ -211,7 +254,8 @@ fn a_non_finite_command_halts_the_same_way() {
             vector![if self.0 == 0 { f64::NAN } else { 3.0 }]
         }
     }
-    let (clock, mut rig) = sim_rig(SimulatedRig::default());
+    // No PWM delay: the card's duty is the halt as soon as it is written.
+    let (clock, mut rig) = sim_rig(ideal());
     let err = run(
         &mut rig,
         NanAfter(11),
@@ -234,9 +278,10 @@ fn a_non_finite_command_halts_the_same_way() {
 fn a_dead_port_leaves_the_motor_to_the_watchdog() {
     // Every cycle fails from tick 50 on, so even the halt cannot reach the
     // card: the last duty stays until the card's watchdog (100 ms) trips.
-    let (clock, card) = card(SimulatedRig::default());
-    let port = RecordingPort::new(card).fail_from(50 * CYCLES_PER_TICK);
-    let mut rig = rig(port);
+    // No PWM delay, so the watchdog's trip is the only change of duty.
+    let (clock, card) = card(ideal());
+    let port = RecordingPort::new(card).fail_from(PROBE_CYCLES + 50 * CYCLES_PER_TICK);
+    let mut rig = rig(port, &clock);
     let err = run(
         &mut rig,
         OpenLoop,
@@ -273,20 +318,32 @@ fn overruns_stop_the_loop_safely() {
             vector![1.0]
         }
     }
-    let mut rig = SimulatedRig::default().rig(&Clock::RealTime).unwrap();
+    // No PWM delay: the card's duty is the halt as soon as it is written.
+    let mut rig = ideal().rig(&Clock::RealTime).unwrap();
     let cfg = LoopConfig {
         duration: 1.0,
-        max_consecutive_overruns: 3,
+        max_timing_faults: 3,
+        ..LoopConfig::default()
     };
     let err = run(&mut rig, Slow, |_| vector![0.0], &Clock::RealTime, &cfg).unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Overrun);
-    assert_eq!(err.recording.len(), 3);
-    assert_eq!(err.stats.overruns, 3);
+    assert_eq!(err.error.kind(), HwErrorKind::Timing);
+    // Each 3 ms tick overruns and makes the loop skip the deadline it
+    // overran: two faults a tick, so three faults end it in the second.
+    assert!(
+        matches!(
+            err.error,
+            ctrlab::hw::HwError::TimingFaults { faults: 3, .. }
+        ),
+        "{}",
+        err.error
+    );
+    assert!(err.recording.len() <= 2, "{}", err.recording.len());
+    assert!(err.stats.overruns + err.stats.skipped >= 3);
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
 
 #[test]
-fn a_stall_is_skipped_not_caught_up() {
+fn a_short_stall_is_skipped_not_caught_up() {
     /// Stalls 7 ms (3.5 periods) once, at tick 5.
     struct Stall(usize);
     impl Controller<4, 1, 1> for Stall {
@@ -298,15 +355,38 @@ fn a_stall_is_skipped_not_caught_up() {
             vector![1.0]
         }
     }
-    let rig = SimulatedRig::default().rig(&Clock::RealTime).unwrap();
-    let out = run(
-        rig,
-        Stall(0),
-        |_| vector![0.0],
-        &Clock::RealTime,
-        &config(0.05),
-    )
-    .unwrap();
+    // No limit on timing faults within reach: a busy machine's own skipped
+    // deadlines must not end this run; the limit is tested above.
+    let cfg = LoopConfig {
+        max_timing_faults: 10_000,
+        ..config(0.05)
+    };
+    // Up to 5 attempts: a busy machine (a parallel build on two CPUs) can
+    // take the CPU from the loop for more than 50 ms (an error), or between
+    // the loop's time stamp and the rig's latch after the stall, which shows
+    // as a speed that does not match the recorded interval. Neither is what
+    // this test checks; a fault of the library shows in every attempt.
+    // (Shorter hiccups only add gaps and skipped deadlines of their own,
+    // which the checks below allow for.)
+    let mut why = String::new();
+    let out = (0..5)
+        .find_map(|_| {
+            // Without stiction, 1 V moves the carts (on the realistic rig
+            // 1.1 N would not break cart 2 away), so the speed over the gap
+            // is measurable.
+            let rig = ideal().rig(&Clock::RealTime).unwrap();
+            let attempt = run(rig, Stall(0), |_| vector![0.0], &Clock::RealTime, &cfg);
+            why = match &attempt {
+                Err(e) => e.to_string(),
+                Ok(out) => match disturbance(out) {
+                    None => return attempt.ok(),
+                    Some(why) => why,
+                },
+            };
+            println!("disturbed, trying again: {why}");
+            None
+        })
+        .unwrap_or_else(|| panic!("every attempt was disturbed; the last: {why}"));
     let s = &out.stats;
     // Tick 5's work ends at least 7 ms after its deadline (10 ms), past
     // deadlines 12 and 14 ms at least: two or more are skipped, not run late.
@@ -321,15 +401,40 @@ fn a_stall_is_skipped_not_caught_up() {
         gap >= 3.0 * PERIOD - 1e-12,
         "the recording shows the gap: {gap}"
     );
-    // The first sample after the gap has its speed estimate restarted.
-    let after = t
-        .windows(2)
-        .position(|w| w[1] - w[0] > 1.5 * PERIOD)
-        .unwrap()
-        + 1;
-    let v2 = rec.channel("v2").unwrap();
-    assert_eq!(v2[after], 0.0);
+    // The first sample after the stall (the 6th update, sample 5) has its
+    // speed over the actual interval (the rig times its latches itself,
+    // within microseconds of the loop).
+    let after = 6;
+    assert!(t[after] - t[after - 1] > 0.007, "{t:?}");
+    let (x2, v2) = (rec.channel("x2").unwrap(), rec.channel("v2").unwrap());
+    let over_gap = (x2[after] - x2[after - 1]) / (t[after] - t[after - 1]);
+    assert!(over_gap != 0.0, "the cart moved during the gap");
+    assert!(
+        (v2[after] / over_gap - 1.0).abs() < 0.05,
+        "speed {} vs {over_gap} over the gap",
+        v2[after]
+    );
     assert!(s.lateness_p50 <= s.lateness_p99 && s.lateness_p99 <= s.lateness_max);
+}
+
+/// What disturbed a run of `a_short_stall_is_skipped_not_caught_up`, if
+/// anything did: so little of the CPU that it ran fewer than 7 of its 25
+/// deadlines, or a speed after the stall (sample 6) more than 5 % from the
+/// count change over the recorded interval.
+fn disturbance(out: &ctrlab::hw::RunOutcome) -> Option<String> {
+    let t = out.recording.time();
+    if t.len() < 7 {
+        return Some(format!("only {} samples: {}", t.len(), out.stats));
+    }
+    let (x2, v2) = (
+        out.recording.channel("x2").ok()?,
+        out.recording.channel("v2").ok()?,
+    );
+    let over_gap = (x2[6] - x2[5]) / (t[6] - t[5]);
+    if (v2[6] / over_gap - 1.0).abs() >= 0.05 {
+        return Some(format!("speed {} vs {over_gap} over the gap", v2[6]));
+    }
+    None
 }
 
 #[test]
@@ -448,11 +553,27 @@ fn bad_loop_settings_are_refused_before_anything_runs() {
         ),
         (
             LoopConfig {
-                max_consecutive_overruns: 0,
+                max_timing_faults: 0,
                 ..LoopConfig::default()
             },
             PERIOD,
-            "max_consecutive_overruns",
+            "max_timing_faults",
+        ),
+        (
+            LoopConfig {
+                timing_window: 0.0,
+                ..LoopConfig::default()
+            },
+            PERIOD,
+            "timing_window",
+        ),
+        (
+            LoopConfig {
+                max_gap: Some(0.001),
+                ..LoopConfig::default()
+            },
+            PERIOD,
+            "max_gap",
         ),
     ] {
         let (clock, mut rig) = sim_rig(SimulatedRig::default());
@@ -489,9 +610,10 @@ proptest! {
 
     #[test]
     fn a_fault_at_any_cycle_ends_the_run_with_everything_before_it(k in 0usize..(40 * CYCLES_PER_TICK)) {
-        let (clock, card) = card(SimulatedRig::default());
-        let port = RecordingPort::new(card).fail_at(k);
-        let mut rig = rig(port);
+        // No PWM delay: the card's duty is the halt as soon as it is written.
+        let (clock, card) = card(ideal());
+        let port = RecordingPort::new(card).fail_at(PROBE_CYCLES + k);
+        let mut rig = rig(port, &clock);
         let result = run(&mut rig, OpenLoop, |_| vector![3.0], &Clock::Virtual(clock), &config(0.1));
         let err = result.expect_err("cycle k is inside the 50-tick run");
         prop_assert_eq!(err.error.kind(), HwErrorKind::Timeout);

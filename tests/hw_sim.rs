@@ -1,6 +1,13 @@
 //! The simulated card against independent references (the exact ZOH model,
-//! static deflections, a hand-switched watchdog reference), and the rig's
-//! safety: saturation, travel limits, non-finite commands, drop.
+//! static deflections, a hand-switched watchdog reference, a hand-delayed
+//! PWM write), and the rig's safety: saturation, travel limits, non-finite
+//! commands, drop.
+//!
+//! Tests of the card's and the driver's exact behaviour run on
+//! [`SimulatedRig::ideal`] (no Coulomb friction, stiction, PWM delay or
+//! encoder noise), so a linear reference applies to the count; tests of the
+//! lab's rig as it behaves (friction dead band, travel limits under full
+//! drive, the PWM delay) run on the realistic [`SimulatedRig::default`].
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
@@ -14,6 +21,8 @@ use nalgebra::{SVector, vector};
 /// 80 mm per 8192 counts.
 const MPC: f64 = 0.080 / 8192.0;
 const PERIOD_NS: u64 = 2_000_000;
+/// EPP cycles of the ID probe when a rig is built: address write, data read.
+const PROBE_CYCLES: usize = 2;
 
 /// The lab's simulated card (two carts, friction model inside).
 type Card = SimulatedCard<FrictionPlant, 4>;
@@ -24,11 +33,14 @@ fn sim(config: SimulatedRig) -> (VirtualClock, Card) {
     (clock, card)
 }
 
+/// The default truth without friction, stiction, PWM delay or noise.
+fn ideal() -> SimulatedRig {
+    SimulatedRig::ideal(SimulatedRig::default_truth())
+}
+
+/// The nominal plant (1 N/V) without friction, stiction, PWM delay or noise.
 fn nominal_config() -> SimulatedRig {
-    SimulatedRig {
-        truth: MassSpring::nominal(),
-        ..Default::default()
-    }
+    SimulatedRig::ideal(MassSpring::nominal())
 }
 
 // ---- the simulated card ----------------------------------------------------
@@ -52,10 +64,11 @@ fn card_id_and_probe() {
 fn plant_matches_the_exact_zoh_discretisation() {
     // The card's RK4 sub-steps against the crate's exact ZOH model: the
     // voltage is held between accesses, so the two agree to RK4's error.
+    // The ideal rig: friction and the PWM delay are not in the linear model.
     let truth = SimulatedRig::default_truth();
     let (clock, card) = sim(SimulatedRig {
         watchdog_timeout: None,
-        ..Default::default()
+        ..ideal()
     });
     let mut pc104 = Pc104::new(card);
     let d = truth
@@ -76,9 +89,9 @@ fn plant_matches_the_exact_zoh_discretisation() {
         let got = pc104.port().true_state();
         scale = scale.max(x.norm());
         // RK4's local error is about (hω)⁵/120 of the state, with the
-        // fastest mode ω ≈ 62 rad/s and h = 0.25 ms: 7e-12 per sub-step,
-        // 5.6e-8 after the 8000 sub-steps of this run. Observed: 1e-8 at
-        // step 80, growing linearly.
+        // fastest mode |s| = 50.6 rad/s of the default truth and
+        // h = 0.25 ms: 2.7e-12 per sub-step, 2.1e-8 after the 8000 sub-steps
+        // of this run, inside the 1e-7 bound.
         assert!((got - x).norm() <= 1e-7 * scale, "step {k}: {got} vs {x}");
     }
 }
@@ -86,9 +99,10 @@ fn plant_matches_the_exact_zoh_discretisation() {
 #[test]
 fn a_latch_captures_the_counts_of_the_state_at_that_instant() {
     let (clock, card) = sim(SimulatedRig {
-        initial_state: vector![0.004, 0.0, -0.013, 0.0],
+        initial_state: [0.004, 0.0, -0.013, 0.0],
         watchdog_timeout: None,
-        ..Default::default()
+        // Noiseless: the count is exactly the rounded state.
+        ..ideal()
     });
     let mut pc104 = Pc104::new(card);
     for _ in 0..200 {
@@ -108,8 +122,9 @@ fn a_latch_captures_the_counts_of_the_state_at_that_instant() {
 #[test]
 fn clearing_zeroes_the_counters_where_the_carts_are() {
     let (clock, card) = sim(SimulatedRig {
-        initial_state: vector![0.004, 0.0, 0.013, 0.0],
-        ..Default::default()
+        initial_state: [0.004, 0.0, 0.013, 0.0],
+        // Noiseless: the counts are exactly the rounded state.
+        ..ideal()
     });
     let mut pc104 = Pc104::new(card);
     pc104.latch().unwrap();
@@ -129,9 +144,11 @@ fn clearing_zeroes_the_counters_where_the_carts_are() {
 
 #[test]
 fn watchdog_zeroes_the_pwm_when_not_kicked() {
+    // No PWM delay: a duty applies when written, so the hand-switched
+    // reference below is exact (the delay's own test is further down).
     let config = SimulatedRig {
-        initial_state: vector![0.0, 0.0, 0.0, 0.0],
-        ..Default::default()
+        initial_state: [0.0, 0.0, 0.0, 0.0],
+        ..ideal()
     };
     let (clock, card) = sim(config.clone());
     let mut pc104 = Pc104::new(card);
@@ -174,6 +191,80 @@ fn watchdog_zeroes_the_pwm_when_not_kicked() {
 }
 
 #[test]
+fn the_pwm_delay_applies_a_duty_exactly_that_long_after_its_write() {
+    // The realistic rig (friction, stiction, 0.15 ms delay) against the same
+    // rig without the delay, whose write is made 0.15 ms later by hand. Both
+    // cards are accessed at the same instants, so they integrate the same
+    // sub-steps and end in the same state.
+    let delayed = SimulatedRig {
+        watchdog_timeout: None,
+        ..Default::default()
+    };
+    let delay = delayed.pwm_delay;
+    assert_eq!(delay, 0.15e-3);
+    let (clock, card) = sim(delayed.clone());
+    let (clock2, card2) = sim(SimulatedRig {
+        pwm_delay: 0.0,
+        ..delayed
+    });
+    let (mut a, mut b) = (Pc104::new(card), Pc104::new(card2));
+    clock.advance(0.001).unwrap();
+    clock2.advance(0.001).unwrap();
+    a.set_pwm(0, 500).unwrap(); // 12 V, 13.3 N: breaks away
+    b.latch().unwrap(); // the same access instant, no write
+    assert_eq!(a.port().pwm_duty(0), 0, "not applied when written");
+    clock.advance(0.1e-3).unwrap();
+    clock2.advance(0.1e-3).unwrap();
+    a.latch().unwrap();
+    b.latch().unwrap();
+    assert_eq!(a.port().pwm_duty(0), 0, "nor 0.1 ms later");
+    clock.advance(delay - 0.1e-3).unwrap();
+    clock2.advance(delay - 0.1e-3).unwrap();
+    a.latch().unwrap();
+    b.set_pwm(0, 500).unwrap();
+    assert_eq!(a.port().pwm_duty(0), 500, "applied at the delay");
+    clock.advance(0.05).unwrap();
+    clock2.advance(0.05).unwrap();
+    a.latch().unwrap();
+    b.latch().unwrap();
+    let (x, y) = (a.port().true_state(), b.port().true_state());
+    assert!(y[2] > 0.0, "cart 2 moved: {y}");
+    assert!((x - y).norm() <= 1e-12 * y.norm(), "{x} vs {y}");
+}
+
+#[test]
+fn the_watchdog_also_cancels_a_pwm_write_in_flight() {
+    // On the realistic rig a write takes 0.15 ms to apply: one made just
+    // before the watchdog trips never applies, and the trip is at exactly
+    // the timeout (100 ms after the card was created, its last kick).
+    let (clock, card) = sim(SimulatedRig::default());
+    let mut pc104 = Pc104::new(card);
+    pc104.set_pwm(0, 500).unwrap();
+    clock.advance(0.0999).unwrap();
+    pc104.set_pwm(0, 300).unwrap(); // would apply at 100.05 ms
+    clock.advance(0.00009).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(pc104.port().pwm_duty(0), 500, "99.99 ms: not yet");
+    clock.advance(0.0001).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(
+        pc104.port().pwm_duty(0),
+        0,
+        "100.09 ms: tripped, write lost"
+    );
+    // Until a kick, delayed writes are zeroed too.
+    pc104.set_pwm(0, 300).unwrap();
+    clock.advance(0.001).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(pc104.port().pwm_duty(0), 0);
+    pc104.kick_watchdog().unwrap();
+    pc104.set_pwm(0, 300).unwrap();
+    clock.advance(0.001).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(pc104.port().pwm_duty(0), 300);
+}
+
+#[test]
 fn noise_is_seeded_and_of_the_configured_size() {
     let run = |seed: u64| {
         let (_clock, card) = sim(SimulatedRig {
@@ -208,12 +299,13 @@ fn noise_is_seeded_and_of_the_configured_size() {
 
 #[test]
 fn coulomb_friction_sticks_below_breakaway_and_stops_in_the_dead_band() {
+    // Coulomb friction alone (the ideal rig's stiction is 0, taken as the
+    // Coulomb force): the breakaway force is 2 N.
     let truth = MassSpring::nominal();
     let (clock, card) = sim(SimulatedRig {
-        truth,
         coulomb_friction: [0.0, 2.0],
         watchdog_timeout: None,
-        ..Default::default()
+        ..SimulatedRig::ideal(truth)
     });
     let mut pc104 = Pc104::new(card);
     // 1.008 N (42 ‰ of 24 V with the nominal 1 N/V) against 2 N: no motion.
@@ -236,6 +328,28 @@ fn coulomb_friction_sticks_below_breakaway_and_stops_in_the_dead_band() {
     assert!((x[0] - x1_rest).abs() < 1e-9, "{x}");
     // And the dead band is a real band: frictionless, x2 would be 24 mm.
     assert!(x[2] > 0.020 && x[2] < 0.028, "{x}");
+}
+
+#[test]
+fn stiction_holds_a_cart_that_coulomb_friction_alone_would_let_slide() {
+    // 2.208 N (92 ‰ of 24 V at 1 N/V) on cart 2: more than its 2 N of
+    // sliding friction, less than the 2.4 N breakaway of the default rig.
+    let run = |stiction: [f64; 2]| {
+        let (clock, card) = sim(SimulatedRig {
+            coulomb_friction: [0.0, 2.0],
+            stiction,
+            watchdog_timeout: None,
+            ..SimulatedRig::ideal(MassSpring::nominal())
+        });
+        let mut pc104 = Pc104::new(card);
+        pc104.set_pwm(0, 92).unwrap();
+        clock.advance(1.0).unwrap();
+        pc104.latch().unwrap();
+        pc104.port().true_state()
+    };
+    assert_eq!(run([0.0, 2.4]), SVector::<f64, 4>::zeros());
+    assert!(run([0.0, 0.0])[2] > 0.0);
+    assert_eq!(SimulatedRig::default().stiction, [1.2, 2.4]);
 }
 
 #[test]
@@ -314,18 +428,19 @@ fn hold<P: EppPort>(
 
 #[test]
 fn open_loop_reaches_the_static_deflection_of_the_truth() {
-    for (config, volts) in [
-        (nominal_config(), 12.0),
-        (SimulatedRig::default(), 3.0),
-        (SimulatedRig::default(), -4.8),
-    ] {
+    // Without friction (ideal rigs) the carts settle exactly where the
+    // truth's springs put them; the realistic rig's dead band is the next
+    // test.
+    for (config, volts) in [(nominal_config(), 12.0), (ideal(), 3.0), (ideal(), -4.8)] {
         let truth = config.truth;
         let (clock, mut rig) = rig_on(config);
         let x = hold(&clock, &mut rig, volts, 10.0);
         // 12 V, 3 V and -4.8 V are exact multiples of the 24 mV duty step.
         let (x1, x2) = truth.static_deflection(truth.gain * volts).unwrap();
         // Encoder quantisation: half a count (plus the residual transient,
-        // e^(-35) of the initial deflection after 10 s: nothing).
+        // at most e^(-37) of the initial deflection after 10 s, the slowest
+        // decay rate being 3.7 /s on the nominal plant, 4.26 /s on the
+        // default truth: nothing).
         assert!(
             (x[0] - x1).abs() <= MPC / 2.0 + 1e-9,
             "{truth:?}: x1 {} vs {x1}",
@@ -341,16 +456,55 @@ fn open_loop_reaches_the_static_deflection_of_the_truth() {
 }
 
 #[test]
-fn speeds_are_count_differences_over_the_period() {
+fn the_realistic_rig_stops_within_its_friction_dead_band() {
+    // The default rig: 3 V (3.33 N on the 1.11 N/V motor) breaks cart 2
+    // away (2.4 N of stiction), and the carts stop where the other forces
+    // on each are within its breakaway force, not at the frictionless
+    // static deflection.
+    let sim = SimulatedRig::default();
+    let (truth, stiction) = (sim.truth, sim.stiction);
+    let volts = 3.0; // 125 duty steps exactly
+    let (clock, mut rig) = rig_on(sim.clone());
+    let measured = hold(&clock, &mut rig, volts, 10.0);
+    let x = rig.card().port().true_state();
+    assert_eq!((x[1], x[3]), (0.0, 0.0), "both carts stuck: {x}");
+    let on_cart1 = -(truth.k1 + truth.k2) * x[0] + truth.k2 * x[2];
+    let on_cart2 = truth.k2 * (x[0] - x[2]) + truth.gain * volts;
+    assert!(on_cart1.abs() <= stiction[0], "{on_cart1} N on cart 1");
+    assert!(on_cart2.abs() <= stiction[1], "{on_cart2} N on cart 2");
+    // The band is wide: 2.4 N on cart 2 is ±4.9 mm of x2 about the 6.8 mm
+    // frictionless deflection.
+    let (_, x2_static) = truth.static_deflection(truth.gain * volts).unwrap();
+    println!("x2 {} mm, frictionless {} mm", x[2] * 1e3, x2_static * 1e3);
+    assert!(x[2] > 0.0 && x[2] < 2.0 * x2_static, "{x}");
+    assert!(
+        (x[2] - x2_static).abs() > 10.0 * MPC,
+        "friction made no difference: {x}"
+    );
+    // What the rig reads is that state, give or take the encoder noise:
+    // σ = 0.3 count plus half a count of rounding; 3 counts is 8σ.
+    for i in [0, 2] {
+        assert!(
+            (measured[i] - x[i]).abs() <= 3.0 * MPC,
+            "{i}: {measured} vs {x}"
+        );
+    }
+}
+
+#[test]
+fn speeds_are_count_differences_over_the_actual_interval() {
+    // Speeds are differenced over the time between two reads on the rig's
+    // clock, whatever the interval: here alternately 2 ms and 3.1 ms.
     let (clock, mut rig) = rig_on(nominal_config());
     let mut previous = rig.read_state().unwrap();
     let mut moved = false;
-    for _ in 0..200 {
+    for k in 0..200 {
         rig.apply_voltage(10.0).unwrap();
-        clock.advance_nanos(PERIOD_NS);
+        let interval = if k % 2 == 0 { 0.002 } else { 0.0031 };
+        clock.advance(interval).unwrap();
         let x = rig.read_state().unwrap();
         for i in [0, 2] {
-            let expected = (x[i] - previous[i]) / 0.002;
+            let expected = (x[i] - previous[i]) / interval;
             assert!((x[i + 1] - expected).abs() <= 1e-9 * expected.abs().max(1.0));
         }
         moved |= x[3] > 0.01;
@@ -361,7 +515,8 @@ fn speeds_are_count_differences_over_the_period() {
 
 #[test]
 fn voltages_saturate_and_quantise() {
-    let (_clock, mut rig) = rig_on(SimulatedRig::default());
+    // No PWM delay, so the card shows each duty as it is written.
+    let (_clock, mut rig) = rig_on(ideal());
     for (volts, duty) in [
         (100.0, 1000),
         (-1e9, -1000),
@@ -380,8 +535,10 @@ fn voltages_saturate_and_quantise() {
 #[test]
 fn non_finite_voltage_halts_the_rig() {
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        let (_clock, mut rig) = rig_on(SimulatedRig::default());
+        // No PWM delay, so the card shows the 10 V and then the halt at once.
+        let (_clock, mut rig) = rig_on(ideal());
         rig.apply_voltage(10.0).unwrap();
+        assert_eq!(rig.card().port().pwm_duty(0), 417); // 10 V / 24 mV
         let err = rig.apply_voltage(bad).unwrap_err();
         assert_eq!(err.kind(), HwErrorKind::InvalidCommand, "{bad}");
         assert_eq!(rig.card().port().pwm_duty(0), 0, "{bad}");
@@ -390,9 +547,14 @@ fn non_finite_voltage_halts_the_rig() {
 
 #[test]
 fn travel_limit_breach_halts_the_rig() {
-    let (clock, mut rig) = rig_on(SimulatedRig::default());
+    // The realistic rig: 24 V (26.6 N on the 1.11 N/V motor) would deflect
+    // cart 2 by 54 mm at rest, less 4 mm for its 2 N of friction, and the
+    // step overshoots: past the ±50 mm limit.
+    let sim = SimulatedRig::default();
+    let (_, x2_static) = sim.truth.static_deflection(sim.truth.gain * 24.0).unwrap();
+    assert!(x2_static > 0.054 && sim.travel_limits == [0.05, 0.05]);
+    let (clock, mut rig) = rig_on(sim);
     let mut err = None;
-    // 24 V on the default truth would deflect cart 2 by 0.41 m.
     for _ in 0..5000 {
         rig.apply_voltage(24.0).unwrap();
         clock.advance_nanos(PERIOD_NS);
@@ -408,17 +570,25 @@ fn travel_limit_breach_halts_the_rig() {
             position,
             limit,
         }) => {
-            assert_eq!(limit, 0.15);
-            assert!(position > 0.15 && position < 0.16, "{position}");
+            assert_eq!(limit, 0.05);
+            // Found at the first sample past it: within one period at the
+            // largest speed the rig accepts (any faster is a bus fault).
+            let step = Calibration::default().max_speed * 0.002;
+            assert!(position > 0.05 && position < 0.05 + step, "{position}");
         }
         other => panic!("expected a travel-limit breach of cart 2, got {other:?}"),
     }
+    // The halt was written; the drive takes it the PWM delay later.
+    assert_eq!(rig.card().port().pwm_duty(0), 1000, "24 V until then");
+    clock.advance(SimulatedRig::default().pwm_delay).unwrap();
+    rig.card_mut().port_mut().sync();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
 
 #[test]
 fn dropping_the_rig_zeroes_the_pwm() {
-    let (_clock, mut card) = sim(SimulatedRig::default());
+    // No PWM delay, so the card shows each duty as it is written.
+    let (_clock, mut card) = sim(ideal());
     {
         let mut rig =
             MassSpringRig::new(Pc104::new(&mut card), Calibration::default(), 0.002).unwrap();
@@ -430,7 +600,9 @@ fn dropping_the_rig_zeroes_the_pwm() {
 
 #[test]
 fn read_state_kicks_the_watchdog_and_stopping_trips_it() {
-    let (clock, mut rig) = rig_on(SimulatedRig::default());
+    // Without stiction (1.2 V, 1.3 N would not move the realistic rig's
+    // cart 2) and without the PWM delay.
+    let (clock, mut rig) = rig_on(ideal());
     // A 1 s run of a loop that reads and writes every period: never trips.
     let x = hold(&clock, &mut rig, 1.2, 1.0);
     assert!(x[2] > 0.0);
@@ -444,16 +616,19 @@ fn read_state_kicks_the_watchdog_and_stopping_trips_it() {
 #[test]
 fn encoder_signs_and_channels_follow_the_calibration() {
     let (clock, card) = sim(SimulatedRig {
-        initial_state: vector![0.002, 0.0, 0.005, 0.0],
+        initial_state: [0.002, 0.0, 0.005, 0.0],
         encoder_channels: [3, 2],
-        ..Default::default()
+        // Noiseless: the counts are exactly the rounded state.
+        ..ideal()
     });
     let cal = Calibration {
         sign: [-1.0, 1.0],
         encoder_channels: [3, 2],
         ..Calibration::default()
     };
-    let mut rig = MassSpringRig::new(Pc104::new(card), cal, 0.002).unwrap();
+    let mut rig =
+        MassSpringRig::with_clock(Pc104::new(card), cal, 0.002, Clock::Virtual(clock.clone()))
+            .unwrap();
     clock.advance(0.0).unwrap();
     let x = rig.read_state().unwrap();
     assert_eq!(x[0], -(0.002 / MPC).round() * MPC);
@@ -462,9 +637,21 @@ fn encoder_signs_and_channels_follow_the_calibration() {
 
 #[test]
 fn a_dead_port_surfaces_as_an_error_from_the_rig() {
-    // Cycle 0 is the latch's address write.
+    // Dead from the start: building the rig fails at the ID probe (cycle 0,
+    // its address write).
     let (_clock, card) = sim(SimulatedRig::default());
     let port = RecordingPort::new(card).fail_from(0);
+    let err = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap_err();
+    assert!(matches!(
+        err,
+        HwError::Timeout {
+            cycle: CycleKind::AddressWrite,
+            register: Some(0x00)
+        }
+    ));
+    // Dead after the probe (cycles 0–1): cycle 2 is the latch's address write.
+    let (_clock, card) = sim(SimulatedRig::default());
+    let port = RecordingPort::new(card).fail_from(PROBE_CYCLES);
     let mut rig = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap();
     let err = rig.read_state().unwrap_err();
     assert!(matches!(
@@ -478,15 +665,24 @@ fn a_dead_port_surfaces_as_an_error_from_the_rig() {
 
 #[test]
 fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
-    // An iteration is 22 cycles: latch+kick (2), two counters (2 × 8), PWM (4).
+    // An iteration is 22 cycles: latch+kick (2), two counters (2 × 8), PWM
+    // (4); before them, building the rig probes the ID (2). No PWM delay, so
+    // the card's duty is the last one written whole.
     const CYCLES: usize = 22;
     for k in 0..CYCLES {
-        let (clock, card) = sim(SimulatedRig::default());
-        let port = RecordingPort::new(card).fail_at(CYCLES + k);
-        let mut rig = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap();
+        let (clock, card) = sim(ideal());
+        let port = RecordingPort::new(card).fail_at(PROBE_CYCLES + CYCLES + k);
+        let virtual_clock = Clock::Virtual(clock.clone());
+        let mut rig = MassSpringRig::with_clock(
+            Pc104::new(port),
+            Calibration::default(),
+            0.002,
+            virtual_clock,
+        )
+        .unwrap();
         rig.read_state().unwrap();
         rig.apply_voltage(6.0).unwrap();
-        assert_eq!(rig.card().port().attempts(), CYCLES);
+        assert_eq!(rig.card().port().attempts(), PROBE_CYCLES + CYCLES);
         clock.advance_nanos(PERIOD_NS);
         let result = rig
             .read_state()

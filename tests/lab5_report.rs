@@ -80,13 +80,21 @@ fn the_lab5_report_has_every_table_with_numbers() {
             if let Some(o) = outcome
                 && row[o] != "settled"
             {
-                let known = ["too slow", "bounded oscillation", "sustained oscillation", "diverged"];
+                let known = [
+                    "too slow",
+                    "bounded oscillation",
+                    "sustained oscillation",
+                    "diverged",
+                ];
                 assert!(
                     known.iter().any(|k| row[o].starts_with(k)),
                     "Table {n}: unexplained outcome `{}` in {row:?}",
                     row[o]
                 );
-                assert!(!row[o].contains("{ ") && !row[o].contains("Some("), "Debug text in {row:?}");
+                assert!(
+                    !row[o].contains("{ ") && !row[o].contains("Some("),
+                    "Debug text in {row:?}"
+                );
                 continue;
             }
             for cell in &row[pot..pot + 3] {

@@ -41,11 +41,17 @@ const OKABE_ITO: [RGBColor; 4] = [
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
     if !lo.is_finite() {
         return (-1.0, 1.0);
     }
-    let pad = if hi > lo { 0.08 * (hi - lo) } else { 0.5 * lo.abs().max(1.0) };
+    let pad = if hi > lo {
+        0.08 * (hi - lo)
+    } else {
+        0.5 * lo.abs().max(1.0)
+    };
     (lo - pad, hi + pad)
 }
 
@@ -133,7 +139,12 @@ pub fn estimates_svg(
     let (plots, legend) = root.split_vertically(height - 90);
     let cells = plots.split_evenly((1, panels.len().max(1)));
     for (panel, cell) in panels.iter().zip(cells.iter()) {
-        let runs = panel.schemes.iter().map(|(_, v)| v.len()).max().unwrap_or(1);
+        let runs = panel
+            .schemes
+            .iter()
+            .map(|(_, v)| v.len())
+            .max()
+            .unwrap_or(1);
         let (y0, y1) = range(
             panel
                 .schemes
@@ -157,9 +168,12 @@ pub fn estimates_svg(
             let color = OKABE_ITO[k % OKABE_ITO.len()];
             // Schemes side by side within a run, so points do not hide.
             let offset = (k as f64 - (panel.schemes.len() as f64 - 1.0) / 2.0) * 0.12;
-            chart.draw_series(values.iter().enumerate().map(|(i, &v)| {
-                Circle::new((i as f64 + 1.0 + offset, v), 4, color.filled())
-            }))?;
+            chart.draw_series(
+                values
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &v)| Circle::new((i as f64 + 1.0 + offset, v), 4, color.filled())),
+            )?;
             let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
             chart.draw_series(LineSeries::new(
                 [(0.5, mean), (runs as f64 + 0.5, mean)],
@@ -191,8 +205,15 @@ pub fn estimates_svg(
         ))?;
         x += 330;
     }
-    legend.draw(&PathElement::new([(x, 30), (x + 30, 30)], BLACK.stroke_width(2)))?;
-    legend.draw(&Text::new("truth (dashed)", (x + 36, 22), ("sans-serif", 14)))?;
+    legend.draw(&PathElement::new(
+        [(x, 30), (x + 30, 30)],
+        BLACK.stroke_width(2),
+    ))?;
+    legend.draw(&Text::new(
+        "truth (dashed)",
+        (x + 36, 22),
+        ("sans-serif", 14),
+    ))?;
     legend.present()?;
     Ok(())
 }

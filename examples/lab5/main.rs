@@ -38,7 +38,8 @@ use ctrlab::lab::SimulatedRig;
 use report::Report;
 use rig::{Backend, BackendKind, RigResult, RigRow, RigTable, pct};
 
-const USAGE: &str = "usage: lab5 [--out DIR] [--truth FILE] [--real-time] [--rt-priority N] [--port /dev/parportN]
+const USAGE: &str =
+    "usage: lab5 [--out DIR] [--truth FILE] [--real-time] [--rt-priority N] [--port /dev/parportN]
 
   --out DIR         where report.md, the SVGs and runs/*.csv go (default target/lab5)
   --truth FILE      the simulated rig from a TOML file (see ctrlab::lab::SimulatedRig)
@@ -254,7 +255,10 @@ fn effect(name: &str, context: &str, k: usize, rows: &[(&[f64; 4], &RigResult)])
         }
     }
     if !failed.is_empty() {
-        s += &format!(" Not settled at {name} = {} (see the outcome column).", failed.join(", "));
+        s += &format!(
+            " Not settled at {name} = {} (see the outcome column).",
+            failed.join(", ")
+        );
     }
     s
 }

@@ -84,13 +84,21 @@ impl Report {
     ) -> Result<(), Box<dyn std::error::Error>> {
         #[cfg(feature = "plot")]
         {
-            crate::figures::runs_svg(&self.out.join(file), title, setpoint_mm, volts_full_scale, runs)?;
+            crate::figures::runs_svg(
+                &self.out.join(file),
+                title,
+                setpoint_mm,
+                volts_full_scale,
+                runs,
+            )?;
             self.add(&format!("![{title}]({file})\n"));
         }
         #[cfg(not(feature = "plot"))]
         {
             let (_, _, _) = (setpoint_mm, volts_full_scale, runs);
-            self.add(&format!("(figure `{file}`, {title}, needs the `plot` feature)\n"));
+            self.add(&format!(
+                "(figure `{file}`, {title}, needs the `plot` feature)\n"
+            ));
         }
         Ok(())
     }
@@ -111,7 +119,9 @@ impl Report {
         #[cfg(not(feature = "plot"))]
         {
             let _ = panels;
-            self.add(&format!("(figure `{file}`, {title}, needs the `plot` feature)\n"));
+            self.add(&format!(
+                "(figure `{file}`, {title}, needs the `plot` feature)\n"
+            ));
         }
         Ok(())
     }

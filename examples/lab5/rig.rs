@@ -275,9 +275,8 @@ pub fn identification(
     }
 
     let truth = backend.truth();
-    let coulomb = |e: &SeparateSpringsEstimate, cart: usize| {
-        e.coulomb.map_or(f64::NAN, |c| c[cart].value)
-    };
+    let coulomb =
+        |e: &SeparateSpringsEstimate, cart: usize| e.coulomb.map_or(f64::NAN, |c| c[cart].value);
     let mut rows3 = Vec::new();
     let mut rows4 = Vec::new();
     for i in 0..lab.len() {
@@ -680,11 +679,7 @@ pub fn rig_table(
             "{} (ρ = {radius:.3})",
             if radius < 1.0 { "stable" } else { "unstable" }
         );
-        let name = format!(
-            "{}_row{}",
-            table.file.trim_end_matches(".svg"),
-            i + 1
-        );
+        let name = format!("{}_row{}", table.file.trim_end_matches(".svg"), i + 1);
         let outcome = backend.experiment(
             &name,
             100 + i as u64,
@@ -793,7 +788,10 @@ pub fn rig_table(
     }
     report.runs(
         table.file,
-        &format!("{}: position (setpoint dashed) and applied voltage", table.name),
+        &format!(
+            "{}: position (setpoint dashed) and applied voltage",
+            table.name
+        ),
         table.setpoint_mm,
         full_scale,
         &curves,

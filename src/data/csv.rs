@@ -3,7 +3,7 @@
 use std::io::{Read, Write};
 use std::path::Path;
 
-use super::{Channel, Recording, Schema, check_time};
+use super::{Channel, Recording, Schema};
 use crate::error::Error;
 
 /// The units the CSV reader recognises as a header suffix, with the SI unit
@@ -170,11 +170,13 @@ impl Recording {
     ///
     /// Channels named `u` or `u1`, `u2`, … are the inputs, the others the
     /// measurements, in file order. Surrounding whitespace is trimmed. The
-    /// time column must increase strictly and be uniformly sampled (each
-    /// interval within [`MAX_JITTER`](super::MAX_JITTER) of the mean), with
-    /// at least two rows; what a file must hold beyond that is for its user
-    /// to check (the lab's identification asks for its own channels and
-    /// rows).
+    /// time column must increase strictly, with at least two rows; it need
+    /// not be uniform (a rig's recording holds its actual sampling instants,
+    /// jitter and gaps included): [`sample_period`](Recording::sample_period)
+    /// checks uniformity for those who need it, and the lab's
+    /// identification splits at gaps. What a file must hold beyond that is
+    /// for its user to check (the lab's identification asks for its own
+    /// channels and rows).
     ///
     /// # Errors
     ///
@@ -182,8 +184,8 @@ impl Recording {
     /// input, a missing or duplicated time column (the message shows the
     /// header found), two columns for one channel, a row with the wrong
     /// number of fields, a value that is not a finite number, a time that
-    /// does not increase, irregular sampling (the jitter is in the message),
-    /// fewer than two rows, or bytes the CSV parser rejects (invalid
+    /// does not increase (or an interval that overflows), fewer than two
+    /// rows, or bytes the CSV parser rejects (invalid
     /// UTF-8). [`Error::Io`] for a failing reader.
     ///
     /// # Examples
@@ -301,7 +303,25 @@ impl Recording {
         }
         let mut cols = cols.into_iter();
         let t = cols.next().unwrap_or_default();
-        check_time(&t).map_err(|(k, reason)| csv_error(lines[k], reason))?;
+        // Increasing, but not necessarily uniform: a rig's recording has its
+        // actual sampling instants, jitter and gaps included, and must read
+        // back; `sample_period` and identification judge the timing.
+        if let Some(k) = (1..t.len()).find(|&k| t[k] <= t[k - 1]) {
+            return Err(csv_error(
+                lines[k],
+                format!(
+                    "time {} s does not increase (previous {} s)",
+                    t[k],
+                    t[k - 1]
+                ),
+            ));
+        }
+        if let Some(k) = (1..t.len()).find(|&k| !(t[k] - t[k - 1]).is_finite()) {
+            return Err(csv_error(
+                lines[k],
+                format!("the interval from {} s to {} s overflows", t[k - 1], t[k]),
+            ));
+        }
         Ok(Recording {
             schema,
             t,

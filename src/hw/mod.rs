@@ -49,10 +49,10 @@ mod clock;
 mod epp;
 mod error;
 mod pc104;
-mod realtime;
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 mod ppdev;
+mod realtime;
 mod rig;
 mod run;
 mod sim_card;
@@ -70,8 +70,8 @@ pub use pc104::{
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 pub use ppdev::{Ppdev, ioctl};
-pub use rig::Rig;
 pub use realtime::RealTime;
+pub use rig::Rig;
 pub use run::{LoopConfig, LoopStats, RunError, RunOutcome, run};
 pub use sim_card::SimulatedCard;
 pub use sim_config::{SIMULATED_CARD_ID, SimulatedCardConfig};

@@ -377,8 +377,9 @@ impl<P: EppPort> Pc104<P> {
     ///
     /// # Errors
     ///
-    /// [`HwError::NotPresent`] when the ID differs (an empty port typically
-    /// reads `0xff` or `0x00`), port errors otherwise.
+    /// [`HwError::NotPresent`] when the ID differs, saying whether the bus
+    /// is open (`0x00` or `0xff`: no card answers) or another card answers;
+    /// port errors otherwise.
     ///
     /// # Examples
     ///
@@ -390,16 +391,24 @@ impl<P: EppPort> Pc104<P> {
     pub fn probe_id(&mut self, expected: u8) -> Result<u8, HwError> {
         let found = self.read_id()?;
         if found == expected {
-            Ok(found)
-        } else {
-            Err(HwError::NotPresent {
-                device: "PC104 card".to_owned(),
-                reason: format!(
-                    "ID register {:#04x} read {found:#04x}, expected {expected:#04x}",
-                    self.map.id
-                ),
-            })
+            return Ok(found);
         }
+        let reason = if found == 0x00 || found == 0xff {
+            format!(
+                "no card answers: the ID register {:#04x} reads {found:#04x}, an open bus \
+                 (no card, card unpowered, or the port not in EPP mode); expected {expected:#04x}",
+                self.map.id
+            )
+        } else {
+            format!(
+                "another card answers: the ID register {:#04x} reads {found:#04x}, expected {expected:#04x}",
+                self.map.id
+            )
+        };
+        Err(HwError::NotPresent {
+            device: "PC104 card".to_owned(),
+            reason,
+        })
     }
 
     /// Sets PWM `channel` (0–3) to `duty` in −1000…1000 (0.1 % steps; the

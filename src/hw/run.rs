@@ -244,7 +244,13 @@ const SPIN: Duration = Duration::from_micros(200);
 /// error, every sample recorded before it, the measurements read in the
 /// failing tick if there were any, and the statistics. The rig has been
 /// halted (best effort: a dead port cannot be told, but then the card's
-/// watchdog stops the motor). Causes: see the [module docs](self); and
+/// watchdog stops the motor). Causes: a rig error (port fault, travel
+/// limit, [`HwError::BusFault`], [`HwError::NotResponding`], a non-finite
+/// command); a panic in the controller or the reference
+/// ([`HwError::Panicked`]); `max_timing_faults` overruns and skipped
+/// deadlines within `timing_window` ([`HwError::TimingFaults`]); two
+/// samples, or one controller update, further apart than `max_gap`
+/// ([`HwError::Gap`]); a stop request ([`HwError::Interrupted`]); and
 /// [`HwError::InvalidConfig`] for a bad `config`, a rig whose period is
 /// not finite and > 0, a controller designed for another period, or a rig
 /// whose schema does not have `M` inputs and `P` measurements, and
@@ -432,11 +438,17 @@ where
         previous_sample = Some(t);
         let r = match catch_unwind(AssertUnwindSafe(|| reference(t))) {
             Ok(r) => r,
-            Err(payload) => fail!(panicked("reference", &payload, t), Some(y.as_slice().to_vec())),
+            Err(payload) => fail!(
+                panicked("reference", &payload, t),
+                Some(y.as_slice().to_vec())
+            ),
         };
         let u = match catch_unwind(AssertUnwindSafe(|| controller.update(&y, &r))) {
             Ok(u) => u,
-            Err(payload) => fail!(panicked("controller", &payload, t), Some(y.as_slice().to_vec())),
+            Err(payload) => fail!(
+                panicked("controller", &payload, t),
+                Some(y.as_slice().to_vec())
+            ),
         };
         if let Clock::RealTime = clock {
             // The watchdog counts from the kick in `read`: a controller that

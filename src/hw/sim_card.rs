@@ -266,8 +266,10 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::{Clock, Pc104}, lab::SimulatedRig};
-    /// let mut pc104 = Pc104::new(SimulatedRig::default().card(&Clock::RealTime)?);
+    /// use ctrlab::{hw::{Clock, Pc104}, lab::{MassSpring, SimulatedRig}};
+    /// // The ideal rig's drive has no delay: the duty applies at once.
+    /// let card = SimulatedRig::ideal(MassSpring::nominal()).card(&Clock::RealTime)?;
+    /// let mut pc104 = Pc104::new(card);
     /// pc104.set_pwm(2, -125)?;
     /// assert_eq!(pc104.port().pwm_duty(2), -125);
     /// # Ok::<(), ctrlab::hw::HwError>(())
@@ -282,8 +284,9 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::{Clock, Pc104}, lab::SimulatedRig};
-    /// let mut pc104 = Pc104::new(SimulatedRig::default().card(&Clock::RealTime)?);
+    /// use ctrlab::{hw::{Clock, Pc104}, lab::{MassSpring, SimulatedRig}};
+    /// let card = SimulatedRig::ideal(MassSpring::nominal()).card(&Clock::RealTime)?;
+    /// let mut pc104 = Pc104::new(card);
     /// pc104.set_pwm(0, -1000)?;
     /// assert_eq!(pc104.port().voltage(), -24.0);
     /// # Ok::<(), ctrlab::hw::HwError>(())

@@ -136,11 +136,19 @@ impl<const N: usize> SimulatedCardConfig<N> {
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(HwError::invalid_config(name, value, "must be finite and > 0"));
+                return Err(HwError::invalid_config(
+                    name,
+                    value,
+                    "must be finite and > 0",
+                ));
             }
         }
         if self.max_substep < 1e-9 {
-            return Err(HwError::invalid_config("max_substep", self.max_substep, "must be ≥ 1 ns"));
+            return Err(HwError::invalid_config(
+                "max_substep",
+                self.max_substep,
+                "must be ≥ 1 ns",
+            ));
         }
         if !(self.pwm_delay.is_finite() && (0.0..1.0).contains(&self.pwm_delay)) {
             return Err(HwError::invalid_config(
@@ -181,7 +189,11 @@ impl<const N: usize> SimulatedCardConfig<N> {
             }
         }
         if let Some(value) = self.initial_state.iter().find(|v| !v.is_finite()) {
-            return Err(HwError::invalid_config("initial_state", *value, "must be finite"));
+            return Err(HwError::invalid_config(
+                "initial_state",
+                *value,
+                "must be finite",
+            ));
         }
         Ok(())
     }

@@ -12,9 +12,9 @@ use crate::hw::{ENCODER_CHANNELS, HwError, PWM_CHANNELS};
 /// motor on PWM channel 0, cart 1 on encoder 0, cart 2 on encoder 1, travel
 /// limits ±50 mm on both carts, the simulated card's ID `0xa5` and 100 ms
 /// watchdog, and the plausibility checks: no cart faster than 2 m/s (a
-/// faster count change is a bus fault), and at least 6 V held for 0.5 s must
-/// move an encoder by 3 counts (or the motor or encoder is not
-/// responding).
+/// faster count change is a bus fault), and a change of drive of 6 V held
+/// for 0.5 s must move an encoder by 3 counts (or the motor or encoder is
+/// not responding).
 ///
 /// # Examples
 ///
@@ -50,10 +50,13 @@ pub struct Calibration {
     /// The fastest a cart can physically move, m/s (> 0): a count change
     /// implying more is a bus or counter fault, not a measurement.
     pub max_speed: f64,
-    /// Drive at or above this magnitude, V (> 0), held for
-    /// [`stall_time`](Self::stall_time) without either encoder moving
-    /// [`stall_counts`](Self::stall_counts) counts means the motor or an
-    /// encoder is not responding.
+    /// A drive that has changed by this much, V (> 0), since an encoder
+    /// last moved [`stall_counts`](Self::stall_counts) counts, held for
+    /// [`stall_time`](Self::stall_time) without either encoder moving,
+    /// means the motor or an encoder is not responding. (A steady drive
+    /// holding the carts against the springs or their friction is not a
+    /// fault; a new command the carts do not follow is: 6 V is 6.7 N on the
+    /// lab's motor, millimetres on its springs.)
     pub stall_volts: f64,
     /// See [`stall_volts`](Self::stall_volts), s (> 0).
     pub stall_time: f64,
@@ -107,7 +110,11 @@ impl Calibration {
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(HwError::invalid_config(name, value, "must be finite and > 0"));
+                return Err(HwError::invalid_config(
+                    name,
+                    value,
+                    "must be finite and > 0",
+                ));
             }
         }
         for s in self.sign {

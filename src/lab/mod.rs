@@ -49,8 +49,8 @@ mod rig;
 mod sensor;
 mod simulated;
 
-pub use plant::{Cart, MassSpring};
 pub use calibration::Calibration;
+pub use plant::{Cart, MassSpring};
 pub use rig::MassSpringRig;
 pub use sensor::EncoderSensor;
 pub use simulated::{FrictionPlant, SimulatedRig};

@@ -24,8 +24,8 @@ use crate::hw::{Clock, EppPort, HwError, MAX_DUTY, Pc104, Rig};
 /// - Every read checks the measurement is physical, halting the rig
 ///   otherwise: a cart beyond its travel limit ([`HwError::TravelLimit`]),
 ///   a count change faster than [`Calibration::max_speed`]
-///   ([`HwError::BusFault`]: a flipped bit, a glitch on the bus), or
-///   sustained drive with no encoder motion ([`HwError::NotResponding`]).
+///   ([`HwError::BusFault`]: a flipped bit, a glitch on the bus), or a
+///   change of drive that moves no encoder ([`HwError::NotResponding`]).
 /// - [`apply_voltage`](Self::apply_voltage) saturates to
 ///   ±`volts_full_scale` and quantises to the card's 0.1 % duty steps; a
 ///   non-finite command halts the rig and returns
@@ -47,11 +47,13 @@ use crate::hw::{Clock, EppPort, HwError, MAX_DUTY, Pc104, Rig};
 /// let clock = VirtualClock::new();
 /// let mut rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
 /// assert_eq!(rig.apply_voltage(100.0)?, 24.0); // saturates at 24 V
-/// assert_eq!(rig.card().port().pwm_duty(0), 1000);
 /// clock.advance(0.02)?;
-/// let x = rig.read_state()?;
+/// let x = rig.read_state()?; // the drive took the duty 0.15 ms after the write
+/// assert_eq!(rig.card().port().pwm_duty(0), 1000);
 /// assert!(x[2] > 0.0 && x[2] < 0.05);
 /// assert!(rig.apply_voltage(f64::NAN).is_err());
+/// clock.advance(0.001)?; // past the PWM delay
+/// rig.card_mut().port_mut().sync();
 /// assert_eq!(rig.card().port().pwm_duty(0), 0); // halted
 /// # Ok::<(), ctrlab::hw::HwError>(())
 /// ```
@@ -62,17 +64,20 @@ pub struct MassSpringRig<P: EppPort> {
     period: f64,
     clock: Clock,
     start: Instant,
-    /// Counts and time (s on `clock`) of the previous read.
-    previous: Option<([i64; 2], f64)>,
+    /// Counts of the previous read, its time stamp (s on `clock`, the
+    /// middle of the instants bracketing the latch) and the earliest the
+    /// latch can have been.
+    previous: Option<([i64; 2], f64, f64)>,
     /// Time of the last watchdog kick (s on `clock`).
     last_kick: Option<f64>,
     /// The voltage last applied, V.
     volts: f64,
-    /// A stretch of drive ≥ `stall_volts`: when it began, the counts then,
-    /// and the smallest drive seen; `None` once an encoder moved.
-    stall: Option<(f64, [i64; 2], f64)>,
-    /// The current stretch of drive has moved an encoder.
-    moved: bool,
+    /// The counts when an encoder last moved `stall_counts`, and the drive
+    /// then, V.
+    motion: Option<([i64; 2], f64)>,
+    /// Since when the drive has differed from that by `stall_volts` or more
+    /// with no motion, and the smallest such difference, V.
+    stall: Option<(f64, f64)>,
 }
 
 impl<P: EppPort> MassSpringRig<P> {
@@ -150,8 +155,8 @@ impl<P: EppPort> MassSpringRig<P> {
             previous: None,
             last_kick: None,
             volts: 0.0,
+            motion: None,
             stall: None,
-            moved: false,
         })
     }
 
@@ -257,16 +262,22 @@ impl<P: EppPort> MassSpringRig<P> {
     /// ```
     pub fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError> {
         let cal = self.calibration;
+        // The latch happens between these two instants: a preemption in
+        // between widens the bracket, never shortens an interval.
+        let before = self.now();
         self.card.latch_and_kick()?;
-        let now = self.now();
-        self.last_kick = Some(now);
+        let after = self.now();
+        self.last_kick = Some(after);
         let counts = [
             self.card.read_counter(cal.encoder_channels[0])?,
             self.card.read_counter(cal.encoder_channels[1])?,
         ];
-        let (previous, interval) = match self.previous.replace((counts, now)) {
-            Some((c, t)) if now > t => (c, now - t),
-            _ => (counts, 0.0),
+        let stamp = 0.5 * (before + after);
+        let (previous, interval, longest) = match self.previous.replace((counts, stamp, before)) {
+            // Speeds over the best estimate of the interval; the bus-fault
+            // check over the longest it can have been.
+            Some((c, t, earliest)) if stamp > t => (c, stamp - t, after - earliest),
+            _ => (counts, 0.0, 0.0),
         };
         let mut x = SVector::<f64, 4>::zeros();
         for cart in 0..2 {
@@ -274,19 +285,19 @@ impl<P: EppPort> MassSpringRig<P> {
             let moved = counts[cart].saturating_sub(previous[cart]);
             x[2 * cart] = counts[cart] as f64 * scale;
             if interval > 0.0 {
-                let speed = moved as f64 * scale / interval;
-                if speed.abs() > cal.max_speed {
+                let fastest = moved as f64 * scale / longest;
+                if fastest.abs() > cal.max_speed {
                     // The sample is not a measurement: forget it.
                     self.previous = None;
                     return self.fault(HwError::BusFault {
                         channel: cal.encoder_channels[cart],
                         counts: moved,
-                        interval,
-                        speed,
+                        interval: longest,
+                        speed: fastest,
                         limit: cal.max_speed,
                     });
                 }
-                x[2 * cart + 1] = speed;
+                x[2 * cart + 1] = moved as f64 * scale / interval;
             }
         }
         for cart in 0..2 {
@@ -299,32 +310,36 @@ impl<P: EppPort> MassSpringRig<P> {
                 });
             }
         }
-        self.check_response(counts, now)?;
+        self.check_response(counts, after)?;
         Ok(x)
     }
 
-    /// Sustained drive must move an encoder (see [`Calibration::stall_volts`]).
+    /// A change of drive must move an encoder (see
+    /// [`Calibration::stall_volts`]): the drive is compared with what it
+    /// was when an encoder last moved, so a deflection held against the
+    /// springs, or carts stuck in their friction under a steady drive, is
+    /// not a fault, while a motor that does not answer a new command is.
     fn check_response(&mut self, counts: [i64; 2], now: f64) -> Result<(), HwError> {
         let cal = self.calibration;
-        if self.volts.abs() < cal.stall_volts {
-            self.stall = None;
-            self.moved = false;
-            return Ok(());
-        }
-        if self.moved {
-            return Ok(());
-        }
-        let (since, start, weakest) = *self.stall.get_or_insert((now, counts, self.volts.abs()));
-        let weakest = weakest.min(self.volts.abs());
-        self.stall = Some((since, start, weakest));
+        let (reference, drive) = *self.motion.get_or_insert((counts, 0.0));
         let motion = (0..2)
-            .map(|i| counts[i].saturating_sub(start[i]).saturating_abs())
+            .map(|i| counts[i].saturating_sub(reference[i]).saturating_abs())
             .max()
             .unwrap_or(0);
         if motion >= cal.stall_counts {
-            self.moved = true;
+            self.motion = Some((counts, self.volts));
             self.stall = None;
-        } else if now - since >= cal.stall_time {
+            return Ok(());
+        }
+        let change = (self.volts - drive).abs();
+        if change < cal.stall_volts {
+            self.stall = None;
+            return Ok(());
+        }
+        let (since, weakest) = self.stall.get_or_insert((now, change));
+        *weakest = weakest.min(change);
+        let (since, weakest) = (*since, *weakest);
+        if now - since >= cal.stall_time {
             return self.fault(HwError::NotResponding {
                 volts: weakest,
                 seconds: now - since,
@@ -422,8 +437,8 @@ impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
 
     fn restart(&mut self) {
         self.previous = None;
+        self.motion = None;
         self.stall = None;
-        self.moved = false;
     }
 }
 

@@ -5,12 +5,12 @@
 use nalgebra::SVector;
 
 use super::{Calibration, EncoderSensor, MassSpring, MassSpringRig, schema};
+use crate::error::Error;
 use crate::hw::{
     Clock, ENCODER_CHANNELS, HwError, MAX_DUTY, Pc104, RegisterMap, SIMULATED_CARD_ID,
     SimulatedCard, SimulatedCardConfig,
 };
 use crate::model::Dynamics;
-use crate::error::Error;
 use crate::sim::SampledConfig;
 
 /// The two-cart plant with stick–slip Coulomb friction on each cart, input
@@ -393,7 +393,9 @@ impl SimulatedRig {
             line: e
                 .span()
                 .map(|span| text[..span.start.min(text.len())].lines().count().max(1)),
-            message: e.message().to_string(),
+            // The full message quotes the offending line, so it names the
+            // field even where the parser's own message does not.
+            message: e.to_string().trim_end().to_string(),
         })
     }
 

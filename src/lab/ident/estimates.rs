@@ -1,0 +1,220 @@
+//! The identified parameters: [`Estimate`], [`MassSpringEstimate`],
+//! [`SeparateSpringsEstimate`].
+
+use super::{Scheme, Timing};
+use crate::error::Error;
+use crate::ident::LeastSquaresFit;
+use crate::lab::{Cart, MassSpring};
+use crate::model::{Continuous, StateSpace};
+
+/// One identified parameter and its standard error (same unit).
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::lab::ident::Estimate;
+/// let k = Estimate { value: 950.0, std_error: 1.9 };
+/// assert!((k.relative_error() - 0.002).abs() < 1e-15);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// The estimate.
+    pub value: f64,
+    /// Its standard error from the least-squares covariance.
+    pub std_error: f64,
+}
+
+impl Estimate {
+    /// `std_error / |value|`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::ident::Estimate;
+    /// assert_eq!(Estimate { value: -2.0, std_error: 0.5 }.relative_error(), 0.25);
+    /// ```
+    pub fn relative_error(&self) -> f64 {
+        self.std_error / self.value.abs()
+    }
+}
+
+/// The parameters identified by [`identify`](super::identify) (equal springs `k1 = k2 = k12`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, lab::ident::{identify, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+/// assert!((est.k12.value - 950.0).abs() < 0.003 * 950.0);
+/// let sys = est.state_space()?; // the identified model, output cart 2
+/// assert!((sys.b()[(3, 0)] - est.gain.value / 0.7).abs() < 1e-12);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct MassSpringEstimate {
+    /// Spring constant `k1 = k2`, N/m.
+    pub k12: Estimate,
+    /// Viscous friction of cart 1, N·s/m.
+    pub b1: Estimate,
+    /// Motor gain `K`, N per input unit (N/V on the rig).
+    pub gain: Estimate,
+    /// Viscous friction of cart 2, N·s/m.
+    pub b2: Estimate,
+    /// Coulomb friction force of cart 1 and cart 2, N, when identified
+    /// ([`Options::coulomb`](super::Options::coulomb)); `None` otherwise.
+    pub coulomb: Option<[Estimate; 2]>,
+    /// Mass of cart 1 used, kg.
+    pub m1: f64,
+    /// Mass of cart 2 used, kg.
+    pub m2: f64,
+    /// Mean sampling period over the segments used, s: the recording's
+    /// period when it has no gap.
+    pub dt: f64,
+    /// The scheme used.
+    pub scheme: Scheme,
+    /// The recording's segments, gaps and jitter.
+    pub timing: Timing,
+    /// Stage 1 fit (`θ = [k12, b1]`, then `F1` with Coulomb friction): fit
+    /// %, R², condition number, rows, ….
+    pub first: LeastSquaresFit,
+    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction).
+    pub second: LeastSquaresFit,
+}
+
+impl MassSpringEstimate {
+    /// The identified plant as [`MassSpring`] parameters.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let p = identify(&rec, 1.3, 0.7, Scheme::Lab)?.plant();
+    /// assert_eq!(p.k1, p.k2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn plant(&self) -> MassSpring {
+        MassSpring {
+            m1: self.m1,
+            m2: self.m2,
+            k1: self.k12.value,
+            k2: self.k12.value,
+            b1: self.b1.value,
+            b2: self.b2.value,
+            gain: self.gain.value,
+        }
+    }
+
+    /// The identified continuous model (equation (3)), output the position
+    /// of cart 2, input in the recording's input unit.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] when an estimate is negative (e.g. a
+    /// friction estimate from a run with too little motion).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+    /// let a = *est.state_space()?.a();
+    /// assert_eq!(a[(1, 0)], -2.0 * est.k12.value / 1.3);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
+        self.plant().state_space(Cart::Two)
+    }
+}
+
+/// The parameters identified by [`identify_separate_springs`](super::identify_separate_springs) (`k1 ≠ k2`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+/// // The fixture's springs are equal: both estimates find 950 N/m.
+/// assert!((est.k1.value / est.k2.value - 1.0).abs() < 0.01);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeparateSpringsEstimate {
+    /// Spring between the wall and cart 1, N/m.
+    pub k1: Estimate,
+    /// Spring between the carts, N/m.
+    pub k2: Estimate,
+    /// Viscous friction of cart 1, N·s/m.
+    pub b1: Estimate,
+    /// Motor gain `K`, N per input unit.
+    pub gain: Estimate,
+    /// Viscous friction of cart 2, N·s/m.
+    pub b2: Estimate,
+    /// Coulomb friction force of cart 1 and cart 2, N, when identified
+    /// ([`Options::coulomb`](super::Options::coulomb)); `None` otherwise.
+    pub coulomb: Option<[Estimate; 2]>,
+    /// Mass of cart 1 used, kg.
+    pub m1: f64,
+    /// Mass of cart 2 used, kg.
+    pub m2: f64,
+    /// Mean sampling period over the segments used, s: the recording's
+    /// period when it has no gap.
+    pub dt: f64,
+    /// The scheme used.
+    pub scheme: Scheme,
+    /// The recording's segments, gaps and jitter.
+    pub timing: Timing,
+    /// Stage 1 fit (`θ = [k1, k2, b1]`, then `F1` with Coulomb friction).
+    pub first: LeastSquaresFit,
+    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction).
+    pub second: LeastSquaresFit,
+}
+
+impl SeparateSpringsEstimate {
+    /// The identified plant as [`MassSpring`] parameters.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+    /// assert_eq!(est.plant().k2, est.k2.value);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn plant(&self) -> MassSpring {
+        MassSpring {
+            m1: self.m1,
+            m2: self.m2,
+            k1: self.k1.value,
+            k2: self.k2.value,
+            b1: self.b1.value,
+            b2: self.b2.value,
+            gain: self.gain.value,
+        }
+    }
+
+    /// The identified continuous model, output the position of cart 2.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] when an estimate is negative.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+    /// assert_eq!(est.state_space()?.a()[(3, 0)], est.k2.value / 0.7);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
+        self.plant().state_space(Cart::Two)
+    }
+}

@@ -1,0 +1,128 @@
+//! [`Options`] of the identification.
+
+use super::{DEFAULT_MAX_JITTER, GAP_RATIO, Scheme};
+use crate::error::Error;
+
+/// Default speed above which a cart counts as moving for the Coulomb
+/// column, m/s ([`Options::min_speed`]): 5 mm/s, just above one encoder
+/// count (9.8 µm) per 2 ms sample.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{DEFAULT_MIN_SPEED, Options};
+/// assert_eq!(Options::default().min_speed, DEFAULT_MIN_SPEED);
+/// ```
+pub const DEFAULT_MIN_SPEED: f64 = 0.005;
+
+/// How [`identify_with`](super::identify_with) and
+/// [`identify_separate_springs_with`](super::identify_separate_springs_with)
+/// fit.
+///
+/// The default is [`Scheme::Central`] without Coulomb friction, the
+/// [`DEFAULT_MIN_SPEED`] and [`DEFAULT_MAX_JITTER`]: exactly
+/// `identify(rec, m1, m2, Scheme::Central)`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{Options, Scheme};
+///
+/// // The rig's carts have dry friction: fit it too.
+/// let options = Options { coulomb: true, ..Options::default() };
+/// assert_eq!(options.scheme, Scheme::Central);
+/// assert_eq!((options.min_speed, options.max_jitter), (0.005, 0.05));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// How derivatives and the input are taken from the samples.
+    pub scheme: Scheme,
+    /// Fit a Coulomb friction force `F sign(v)` on each cart: a `sign(v1)`
+    /// column in stage 1 (`F1`) and a `sign(v2)` column in stage 2 (`F2`),
+    /// each stage then using only the rows where its cart clearly moves
+    /// (see [`min_speed`](Self::min_speed)). The estimates' `coulomb` holds
+    /// the forces.
+    ///
+    /// Use it with [`Scheme::Central`]: the lab's backward-difference
+    /// velocity is half a sample late, and the friction columns absorb that
+    /// lag (on the simulated rig: `F1` −21 %, `b1` +6 %, `b2` −6 %, against
+    /// +0.4 %, −0.1 %, +0.1 % with Central). Without the column, a rig with dry
+    /// friction gives viscous frictions far too high (there `b1` +31 %,
+    /// `b2` +71 %, `k2` +3.7 %).
+    pub coulomb: bool,
+    /// With [`coulomb`](Self::coulomb): the speed, m/s, a cart must exceed
+    /// for a row to be used (≥ 0; default [`DEFAULT_MIN_SPEED`]). Unused
+    /// without Coulomb friction.
+    ///
+    /// Why rows are dropped: `sign(v)` is undefined at rest, and a cart
+    /// that sticks is held by whatever static friction balances the other
+    /// forces, anywhere within ±its breakaway force, so its equation holds
+    /// for no particular `F`; a row whose window holds a stop or a reversal
+    /// sees a friction force that changes within it. Both would bias `F`
+    /// and, through it, the other parameters.
+    ///
+    /// The row at `k` (window `[t(k−1), t(k+1)]`) is used when the cart
+    /// moves the same way faster than `min_speed` over the sampling interval
+    /// just before the window, `[t(k−3), t(k−2)]`, and the one just after
+    /// it, `[t(k+2), t(k+3)]`: moving the same way 10 ms apart (at 2 ms),
+    /// it has neither stopped nor reversed in between (that would take two
+    /// reversals, far above the plant's modes). Those samples are not the
+    /// row's own, so the choice does not depend on the row's measurement
+    /// noise: choosing by the speeds at the window's ends, from the row's
+    /// own samples, selects rows by the noise in their second difference,
+    /// which biased `K` by +0.2 % and the springs by up to −0.3 % on the
+    /// simulated rig. Rows within three samples of a segment's ends are
+    /// not used. The default, 5 mm/s, is just above one encoder count per
+    /// 2 ms sample (4.9 mm/s), so a cart at rest whose count flickers by
+    /// one does not count as moving.
+    pub min_speed: f64,
+    /// Largest deviation of a sampling interval from the median interval,
+    /// as a fraction of it, that rows may difference across (default
+    /// [`DEFAULT_MAX_JITTER`], 5 %; at most `GAP_RATIO − 1`, 0.5); the
+    /// recording is split at any interval further off. Within a segment
+    /// every row uses the segment's mean period, so jitter acts as noise on
+    /// the differences, and as a small bias: with sampling instants up to
+    /// 2.5 % of a period late, `b2` +0.15 to +0.35 % and `K` +0.1 to
+    /// +0.2 % (5 %: +0.4 % and +0.2 %).
+    pub max_jitter: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            scheme: Scheme::Central,
+            coulomb: false,
+            min_speed: DEFAULT_MIN_SPEED,
+            max_jitter: DEFAULT_MAX_JITTER,
+        }
+    }
+}
+
+impl Options {
+    /// The options of [`identify`](super::identify) and [`identify_separate_springs`](super::identify_separate_springs): the
+    /// defaults with `scheme`.
+    pub(super) fn with_scheme(scheme: Scheme) -> Self {
+        Self {
+            scheme,
+            ..Self::default()
+        }
+    }
+
+    pub(super) fn validate(&self) -> Result<(), Error> {
+        if !(self.min_speed.is_finite() && self.min_speed >= 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "min_speed",
+                value: self.min_speed,
+                reason: "must be finite and ≥ 0 m/s",
+            });
+        }
+        if !(self.max_jitter >= 0.0 && self.max_jitter <= GAP_RATIO - 1.0) {
+            return Err(Error::InvalidParameter {
+                name: "max_jitter",
+                value: self.max_jitter,
+                reason: "must be within 0 … 0.5 (GAP_RATIO − 1) of the period",
+            });
+        }
+        Ok(())
+    }
+}
