@@ -110,7 +110,7 @@ fn backend_kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> 
             };
             sim.validate()?;
             Ok(BackendKind::Simulated {
-                sim,
+                sim: Box::new(sim),
                 real_time: args.real_time,
             })
         }

@@ -52,7 +52,10 @@ pub struct Backend {
 pub enum BackendKind {
     /// The register-level simulated card with `sim` inside (`--truth`),
     /// virtual or real time.
-    Simulated { sim: SimulatedRig, real_time: bool },
+    Simulated {
+        sim: Box<SimulatedRig>,
+        real_time: bool,
+    },
     /// The real PC104 card on a parallel port.
     #[cfg(all(feature = "ppdev", target_os = "linux"))]
     Card(std::path::PathBuf),
@@ -133,7 +136,7 @@ impl Backend {
                     seed,
                     truth: truth.unwrap_or(sim.truth),
                     period: PERIOD,
-                    ..sim.clone()
+                    ..(**sim).clone()
                 };
                 let clock = if *real_time {
                     Clock::RealTime
@@ -481,11 +484,11 @@ pub fn identification(
             let truth = MassSpring { k2: t.k1, ..t };
             let run_backend = Backend {
                 kind: BackendKind::Simulated {
-                    sim: SimulatedRig {
+                    sim: Box::new(SimulatedRig {
                         coulomb_friction: [0.0; 2],
                         stiction: [0.0; 2],
                         ..sim.clone()
-                    },
+                    }),
                     real_time: backend.real_time(),
                 },
                 realtime: backend.realtime,
