@@ -4,7 +4,9 @@
 //!
 //! - the plant: [`MassSpring`] (equations (1)–(3), (14)) and [`Cart`];
 //! - the lab's per-millimetre gains,
-//!   [`StateFeedback::from_lab_gains`](crate::StateFeedback::from_lab_gains);
+//!   [`StateFeedback::from_lab_gains`](crate::StateFeedback::from_lab_gains),
+//!   and back, [`StateFeedback::to_lab_gains`](crate::StateFeedback::to_lab_gains)
+//!   into [`LabGains`];
 //! - the identification of equations (4)–(11) from a recording, in
 //!   [`ident`];
 //! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`],
@@ -48,6 +50,7 @@ mod rig;
 mod sensor;
 mod simulated;
 
+pub use gains::LabGains;
 pub use plant::{Cart, MassSpring};
 pub use rig::{Calibration, MassSpringRig};
 pub use sensor::EncoderSensor;
