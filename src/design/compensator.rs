@@ -88,7 +88,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize>
     /// # Errors
     ///
     /// [`Error::NonFinite`] naming `"K"` or `"H"`; [`Error::InvalidParameter`]
-    /// named `"tracking"` as [`IntegralFeedback::new`](crate::design::IntegralFeedback::new).
+    /// named `"tracking"` or `"deadband"` as [`IntegralFeedback::new`](crate::design::IntegralFeedback::new).
     ///
     /// # Examples
     ///
@@ -102,7 +102,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize>
     ///                                  matrix![1.0, 0.0], matrix![0.0], 0.1)?;
     /// let observer = Observer::new(&model, matrix![1.0; 2.0], EstimatorForm::Predictor)?;
     /// let c = ObserverController::new(observer, &matrix![1.0, 1.5, -0.5], matrix![1.0],
-    ///                                 AntiWindup::BackCalculation { tracking: 0.5 })?;
+    ///                                 AntiWindup::BackCalculation { tracking: 0.5, deadband: 0.0 })?;
     /// assert_eq!(c.period(), Some(0.1));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```

@@ -164,7 +164,7 @@ pub fn dlqi<const N: usize, const M: usize, const P: usize, const NA: usize>(
 ///
 /// ```
 /// use ctrlab::design::AntiWindup;
-/// let aw = AntiWindup::BackCalculation { tracking: 0.02 };
+/// let aw = AntiWindup::BackCalculation { tracking: 0.02, deadband: 0.012 };
 /// assert_ne!(aw, AntiWindup::None);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -174,13 +174,22 @@ pub enum AntiWindup {
     None,
     /// Back-calculation: after each sample the integrators are pulled
     /// towards the values that would have asked for the applied input,
-    /// `z ← z + (T / T_t) K_z⁺ (u_asked − u_applied)` (`K_z⁺` the
-    /// pseudo-inverse of the integrators' gain), so that `−K_z z` moves by
-    /// `T / T_t` of the excess each period.
+    /// `z ← z + (T / T_t) K_z⁺ e`, with `K_z⁺` the pseudo-inverse of the
+    /// integrators' gain and `e` the excess `u_asked − u_applied` beyond
+    /// `±deadband` on each input; so `−K_z z` moves by `T / T_t` of the
+    /// excess each period.
+    ///
+    /// The dead band keeps the drive's rounding from being taken for
+    /// saturation: set it to at least half the drive's quantisation step
+    /// (the lab's drive: 24 mV steps, so 0.012 V or more). Without it the
+    /// back-calculation holds the asked input within a step of the applied
+    /// one, the integrators stall, and a count or so of error remains.
     BackCalculation {
         /// The tracking time constant `T_t`, s (finite, at least the
         /// sampling period `T`; `T_t = T` removes the whole excess at once).
         tracking: f64,
+        /// Mismatch per input that is ignored, input unit (finite, ≥ 0).
+        deadband: f64,
     },
 }
 
@@ -192,6 +201,8 @@ pub(crate) struct IntegralLaw<const N: usize, const M: usize, const I: usize> {
     kz: SMatrix<f64, M, I>,
     /// `(T / T_t) K_z⁺`, zero without anti-windup.
     back: SMatrix<f64, I, M>,
+    /// Mismatch per input that the back-calculation ignores.
+    deadband: f64,
     /// `T D_i`: the integrated outputs' feedthrough of the applied input.
     feedthrough: SMatrix<f64, I, M>,
     period: f64,
@@ -212,9 +223,16 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
         check_finite("K", gain)?;
         let kx = gain.fixed_view::<M, N>(0, 0).into_owned();
         let kz = gain.fixed_view::<M, I>(0, N).into_owned();
-        let back = match anti_windup {
-            AntiWindup::None => SMatrix::zeros(),
-            AntiWindup::BackCalculation { tracking } => {
+        let (back, deadband) = match anti_windup {
+            AntiWindup::None => (SMatrix::zeros(), 0.0),
+            AntiWindup::BackCalculation { tracking, deadband } => {
+                if !(deadband.is_finite() && deadband >= 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name: "deadband",
+                        value: deadband,
+                        reason: "the anti-windup dead band must be finite and >= 0",
+                    });
+                }
                 if !(tracking.is_finite() && tracking >= period * (1.0 - 1e-12)) {
                     return Err(Error::InvalidParameter {
                         name: "tracking",
@@ -229,13 +247,15 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
                         operation: "pseudo-inverse of the integral gain",
                         iterations: 0,
                     })?;
-                SMatrix::<f64, I, M>::from_fn(|i, j| pinv[(i, j)] * period / tracking)
+                let back = SMatrix::<f64, I, M>::from_fn(|i, j| pinv[(i, j)] * period / tracking);
+                (back, deadband)
             }
         };
         Ok(Self {
             kx,
             kz,
             back,
+            deadband,
             feedthrough: d * period,
             period,
             z: SVector::zeros(),
@@ -261,7 +281,9 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
     #[inline]
     pub(crate) fn applied(&mut self, u: &SVector<f64, M>) {
         self.z -= self.feedthrough * u;
-        self.z += self.back * (self.asked - u);
+        let band = self.deadband;
+        let excess = (self.asked - u).map(|e| e - e.clamp(-band, band));
+        self.z += self.back * excess;
     }
 
     pub(crate) fn reset(&mut self) {
@@ -303,7 +325,7 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
 /// let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
 /// let sol = dlqi(&plant, &q, &matrix![1.0])?;
-/// let mut c = IntegralFeedback::new(&plant, &sol.gain, AntiWindup::BackCalculation { tracking: 0.01 })?;
+/// let mut c = IntegralFeedback::new(&plant, &sol.gain, AntiWindup::BackCalculation { tracking: 0.01, deadband: 0.0 })?;
 ///
 /// // Run the loop on the model: x2 settles exactly at the setpoint.
 /// let mut x = vector![0.0, 0.0, 0.0, 0.0];
@@ -331,7 +353,8 @@ impl<const N: usize, const M: usize, const I: usize> IntegralFeedback<N, M, I> {
     ///
     /// [`Error::NonFinite`] naming `"K"` for a non-finite gain;
     /// [`Error::InvalidParameter`] named `"tracking"` for a back-calculation
-    /// time constant that is not finite or shorter than the period.
+    /// time constant that is not finite or shorter than the period,
+    /// `"deadband"` for a negative or non-finite dead band.
     ///
     /// # Examples
     ///
