@@ -182,6 +182,58 @@ fn state_feedback_update_allocates_nothing() {
 }
 
 #[test]
+fn observer_and_integral_controllers_allocate_nothing() {
+    use ctrlab::design::{
+        AntiWindup, EstimatorForm, IntegralFeedback, Observer, ObserverController, SelectOutputs,
+        dlqe, dlqi,
+    };
+    use ctrlab::{Controller, lab};
+    use nalgebra::{SMatrix, matrix};
+    let model = MassSpring::nominal()
+        .state_space(Cart::Two)
+        .unwrap()
+        .with_output(lab::positions(), matrix![0.0; 0.0])
+        .unwrap()
+        .discretize(0.002, Method::Zoh)
+        .unwrap();
+    let h = matrix![0.0, 1.0];
+    let tracked = model.with_output(h * model.c(), matrix![0.0]).unwrap();
+    let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e10]);
+    let lqi = dlqi(&tracked, &q, &matrix![1.0]).unwrap();
+    let rn = SMatrix::<f64, 2, 2>::identity() * 1e-11;
+    let kf = dlqe(&model, model.b(), &matrix![10.0], &rn).unwrap();
+    let observer = Observer::new(&model, kf.gain, EstimatorForm::Current).unwrap();
+    let anti_windup = AntiWindup::BackCalculation {
+        tracking: 0.01,
+        deadband: 0.024,
+    };
+    let compensator = ObserverController::new(observer, &lqi.gain, h, anti_windup).unwrap();
+    let mut on_positions = SelectOutputs::new(compensator, lab::positions()).unwrap();
+    let mut full_state = IntegralFeedback::new(&tracked, &lqi.gain, anti_windup).unwrap();
+    let mut x = SVector::<f64, 4>::zeros();
+    let mut x_full = SVector::<f64, 4>::zeros();
+    let n = allocations(|| {
+        // Through trait objects, as a hardware loop would hold them.
+        let observed: &mut dyn Controller<4, 1, 1> = &mut on_positions;
+        let integral: &mut dyn Controller<4, 1, 1> = &mut full_state;
+        let r = vector![0.030];
+        for _ in 0..1000 {
+            let u = observed.update(&x, &r).map(|u| u.clamp(-24.0, 24.0));
+            observed.applied(&u);
+            x = model.advance(&x, &u);
+            let u = integral.update(&x_full, &r).map(|u| u.clamp(-24.0, 24.0));
+            integral.applied(&u);
+            x_full = model.advance(&x_full, &u);
+        }
+        observed.reset();
+        integral.reset();
+    });
+    assert_eq!(n, 0);
+    // The loops did something: cart 2 moved towards the setpoint.
+    assert!(x[2] > 0.02 && x_full[2] > 0.02, "{x} {x_full}");
+}
+
+#[test]
 fn rls_update_allocates_nothing() {
     let mut rls = ctrlab::Rls::<4>::new(0.99, 1e3).unwrap();
     let mut err = 0.0;

@@ -1,0 +1,104 @@
+//! Design and control-update costs: the observer + LQI controller's
+//! per-period update (the 2 ms loop's work), the full-state integral
+//! controller's, and the design functions (`place` for 4 states and
+//! 2 inputs, `dlqe`, `dlqi`).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use ctrlab::design::{
+    AntiWindup, EstimatorForm, IntegralFeedback, Observer, ObserverController, SelectOutputs, dlqe,
+    dlqi, place,
+};
+use ctrlab::{Cart, Controller, MassSpring, Method, StateSpace, lab};
+use nalgebra::{Complex, SMatrix, matrix, vector};
+use std::hint::black_box;
+
+fn benches(c: &mut Criterion) {
+    let model = MassSpring::nominal()
+        .state_space(Cart::Two)
+        .unwrap()
+        .with_output(lab::positions(), matrix![0.0; 0.0])
+        .unwrap()
+        .discretize(0.002, Method::Zoh)
+        .unwrap();
+    let h = matrix![0.0, 1.0];
+    let tracked = model.with_output(h * model.c(), matrix![0.0]).unwrap();
+    let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e10]);
+    let r = matrix![1.0];
+    let lqi = dlqi(&tracked, &q, &r).unwrap();
+    let rn = SMatrix::<f64, 2, 2>::identity() * 1e-11;
+    let qn = matrix![10.0];
+    let kf = dlqe(&model, model.b(), &qn, &rn).unwrap();
+    let anti_windup = AntiWindup::BackCalculation {
+        tracking: 0.01,
+        deadband: 0.024,
+    };
+    let observer = Observer::new(&model, kf.gain, EstimatorForm::Current).unwrap();
+    let compensator = ObserverController::new(observer, &lqi.gain, h, anti_windup).unwrap();
+
+    c.bench_function(
+        "observer + LQI update and applied (4 states, positions of 4 measurements)",
+        |b| {
+            let mut ctrl = SelectOutputs::new(compensator, lab::positions()).unwrap();
+            let y = vector![0.0101, 0.0, 0.0297, 0.0];
+            let setpoint = vector![0.030];
+            b.iter(|| {
+                let u = ctrl.update(black_box(&y), black_box(&setpoint));
+                ctrl.applied(black_box(&u));
+                u
+            })
+        },
+    );
+
+    c.bench_function(
+        "integral state feedback update and applied (4 states)",
+        |b| {
+            let mut ctrl = IntegralFeedback::new(&tracked, &lqi.gain, anti_windup).unwrap();
+            let x = vector![0.0101, 0.01, 0.0297, -0.02];
+            let setpoint = vector![0.030];
+            b.iter(|| {
+                let u = ctrl.update(black_box(&x), black_box(&setpoint));
+                ctrl.applied(black_box(&u));
+                u
+            })
+        },
+    );
+
+    // The two carts with a force on each: 4 states, 2 inputs, a complex
+    // pair and a repeated pole.
+    let (m1, m2, k1, k2) = (1.3, 0.7, 1000.0, 1000.0);
+    let a = matrix![0.0, 1.0, 0.0, 0.0;
+                    -(k1 + k2) / m1, 0.0, k2 / m1, 0.0;
+                    0.0, 0.0, 0.0, 1.0;
+                    k2 / m2, 0.0, -k2 / m2, 0.0];
+    let b2 = matrix![0.0, 0.0; 1.0 / m1, 0.0; 0.0, 0.0; 0.0, 1.0 / m2];
+    let two_inputs =
+        StateSpace::continuous(a, b2, matrix![0.0, 0.0, 1.0, 0.0], matrix![0.0, 0.0]).unwrap();
+    let targets = [
+        Complex::new(-20.0, 20.0),
+        Complex::new(-20.0, -20.0),
+        Complex::new(-40.0, 0.0),
+        Complex::new(-40.0, 0.0),
+    ];
+    c.bench_function("place (4 states, 2 inputs, pair + repeated pole)", |b| {
+        b.iter(|| place(black_box(&two_inputs), black_box(&targets)).unwrap())
+    });
+    let distinct = [
+        Complex::new(-10.0, 30.0),
+        Complex::new(-10.0, -30.0),
+        Complex::new(-15.0, 15.0),
+        Complex::new(-15.0, -15.0),
+    ];
+    c.bench_function("place (4 states, 2 inputs, two pairs)", |b| {
+        b.iter(|| place(black_box(&two_inputs), black_box(&distinct)).unwrap())
+    });
+
+    c.bench_function("dlqe (4 states, 2 positions)", |b| {
+        b.iter(|| dlqe(black_box(&model), model.b(), &qn, &rn).unwrap())
+    });
+    c.bench_function("dlqi (4 states + 1 integrator)", |b| {
+        b.iter(|| dlqi(black_box(&tracked), &q, &r).unwrap())
+    });
+}
+
+criterion_group!(design, benches);
+criterion_main!(design);
