@@ -13,32 +13,26 @@ use nalgebra::{Complex, SMatrix, matrix, vector};
 use std::hint::black_box;
 
 fn benches(c: &mut Criterion) {
-    let model = MassSpring::nominal()
-        .state_space(Cart::Two)
-        .unwrap()
-        .with_output(lab::positions(), matrix![0.0; 0.0])
-        .unwrap()
-        .discretize(0.002, Method::Zoh)
+    // The tests' controller: LQI on cart 2, Kalman filter on both positions.
+    let metres_per_count = 0.080 / 8192.0;
+    let model = common::position_model();
+    let tracked = model
+        .with_output(matrix![0.0, 1.0] * model.c(), matrix![0.0])
         .unwrap();
-    let h = matrix![0.0, 1.0];
-    let tracked = model.with_output(h * model.c(), matrix![0.0]).unwrap();
     let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e10]);
     let r = matrix![1.0];
     let lqi = dlqi(&tracked, &q, &r).unwrap();
-    let rn = SMatrix::<f64, 2, 2>::identity() * 1e-11;
+    let rn = SMatrix::<f64, 2, 2>::identity() * (metres_per_count * metres_per_count / 12.0);
     let qn = matrix![10.0];
-    let kf = dlqe(&model, model.b(), &qn, &rn).unwrap();
     let anti_windup = AntiWindup::BackCalculation {
         tracking: 0.01,
         deadband: 0.024,
     };
-    let observer = Observer::new(&model, kf.gain, EstimatorForm::Current).unwrap();
-    let compensator = ObserverController::new(observer, &lqi.gain, h, anti_windup).unwrap();
 
     c.bench_function(
         "observer + LQI update and applied (4 states, positions of 4 measurements)",
         |b| {
-            let mut ctrl = SelectOutputs::new(compensator, lab::positions()).unwrap();
+            let mut ctrl = common::positions_lqi(metres_per_count);
             let y = vector![0.0101, 0.0, 0.0297, 0.0];
             let setpoint = vector![0.030];
             b.iter(|| {

@@ -3,6 +3,8 @@
 //! This file is its own test binary, so the allocator sees only these tests;
 //! the count is per thread, so tests running in parallel do not disturb it.
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -183,32 +185,21 @@ fn state_feedback_update_allocates_nothing() {
 
 #[test]
 fn observer_and_integral_controllers_allocate_nothing() {
-    use ctrlab::design::{
-        AntiWindup, EstimatorForm, IntegralFeedback, Observer, ObserverController, SelectOutputs,
-        dlqe, dlqi,
-    };
-    use ctrlab::{Controller, lab};
+    use ctrlab::Controller;
+    use ctrlab::design::{AntiWindup, IntegralFeedback, dlqi};
     use nalgebra::{SMatrix, matrix};
-    let model = MassSpring::nominal()
-        .state_space(Cart::Two)
-        .unwrap()
-        .with_output(lab::positions(), matrix![0.0; 0.0])
-        .unwrap()
-        .discretize(0.002, Method::Zoh)
+    // The observer + LQI controller on positions the closed-loop tests run.
+    let mut on_positions = common::positions_lqi(0.080 / 8192.0);
+    let model = common::position_model();
+    let tracked = model
+        .with_output(matrix![0.0, 1.0] * model.c(), matrix![0.0])
         .unwrap();
-    let h = matrix![0.0, 1.0];
-    let tracked = model.with_output(h * model.c(), matrix![0.0]).unwrap();
     let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e10]);
     let lqi = dlqi(&tracked, &q, &matrix![1.0]).unwrap();
-    let rn = SMatrix::<f64, 2, 2>::identity() * 1e-11;
-    let kf = dlqe(&model, model.b(), &matrix![10.0], &rn).unwrap();
-    let observer = Observer::new(&model, kf.gain, EstimatorForm::Current).unwrap();
     let anti_windup = AntiWindup::BackCalculation {
         tracking: 0.01,
         deadband: 0.024,
     };
-    let compensator = ObserverController::new(observer, &lqi.gain, h, anti_windup).unwrap();
-    let mut on_positions = SelectOutputs::new(compensator, lab::positions()).unwrap();
     let mut full_state = IntegralFeedback::new(&tracked, &lqi.gain, anti_windup).unwrap();
     let mut x = SVector::<f64, 4>::zeros();
     let mut x_full = SVector::<f64, 4>::zeros();

@@ -172,25 +172,39 @@ fn place_refuses_a_pole_repeated_more_often_than_there_are_inputs() {
 
 // ---- lqe / dlqe ----------------------------------------------------------------
 
-fn check_lqe<const N: usize, const W: usize, const P: usize>(name: &str) {
+/// An `lqe` case (`dt = None`) or a `dlqe` case at period `dt`; python-control's
+/// discrete gain is the predictor's, the current estimator's was computed
+/// from its `P` by NumPy.
+fn check_lqe<const N: usize, const W: usize, const P: usize>(name: &str, dt: Option<f64>) {
     let all = fixtures();
-    let c = case(&all, "lqe", name);
-    let a = matrix::<N, N>(&c["a"]);
-    let sys = StateSpace::continuous(
-        a,
-        SMatrix::<f64, N, 1>::zeros(),
-        matrix::<P, N>(&c["c"]),
-        SMatrix::zeros(),
-    )
-    .unwrap();
-    let kf = lqe(
-        &sys,
-        &matrix::<N, W>(&c["g"]),
-        &matrix::<W, W>(&c["qn"]),
-        &matrix::<P, P>(&c["rn"]),
-    )
+    let c = case(&all, if dt.is_some() { "dlqe" } else { "lqe" }, name);
+    let (a, cm) = (matrix::<N, N>(&c["a"]), matrix::<P, N>(&c["c"]));
+    let (g, qn, rn) = (
+        matrix::<N, W>(&c["g"]),
+        matrix::<W, W>(&c["qn"]),
+        matrix::<P, P>(&c["rn"]),
+    );
+    let b = SMatrix::<f64, N, 1>::zeros();
+    let kf = match dt {
+        None => lqe(
+            &StateSpace::continuous(a, b, cm, SMatrix::zeros()).unwrap(),
+            &g,
+            &qn,
+            &rn,
+        ),
+        Some(dt) => dlqe(
+            &StateSpace::discrete(a, b, cm, SMatrix::zeros(), dt).unwrap(),
+            &g,
+            &qn,
+            &rn,
+        ),
+    }
     .unwrap();
     assert_almost(name, &kf.gain, &matrix(&c["gain"]), 7);
+    match kf.current_gain {
+        Some(m) => assert_almost(name, &m, &matrix(&c["current_gain"]), 7),
+        None => assert!(dt.is_none()),
+    }
     assert_almost(name, &kf.covariance, &matrix(&c["covariance"]), 7);
     assert_poles(name, &kf.poles, &complex_list(&c["poles"]), 7);
     assert!(kf.residual < 1e-9, "{name}: residual {}", kf.residual);
@@ -198,48 +212,16 @@ fn check_lqe<const N: usize, const W: usize, const P: usize>(name: &str) {
 
 #[test]
 fn lqe_matches_python_control() {
-    check_lqe::<1, 1, 1>("python_control_scalar");
-    check_lqe::<3, 2, 2>("three_states_two_outputs");
-    check_lqe::<4, 1, 2>("lab_positions");
-}
-
-fn check_dlqe<const N: usize, const W: usize, const P: usize>(name: &str, dt: f64) {
-    let all = fixtures();
-    let c = case(&all, "dlqe", name);
-    let sys = StateSpace::discrete(
-        matrix::<N, N>(&c["a"]),
-        SMatrix::<f64, N, 1>::zeros(),
-        matrix::<P, N>(&c["c"]),
-        SMatrix::zeros(),
-        dt,
-    )
-    .unwrap();
-    let kf = dlqe(
-        &sys,
-        &matrix::<N, W>(&c["g"]),
-        &matrix::<W, W>(&c["qn"]),
-        &matrix::<P, P>(&c["rn"]),
-    )
-    .unwrap();
-    // python-control's gain is the predictor's; the current estimator's
-    // was computed from its P by NumPy.
-    assert_almost(name, &kf.gain, &matrix(&c["gain"]), 7);
-    assert_almost(
-        name,
-        &kf.current_gain.unwrap(),
-        &matrix(&c["current_gain"]),
-        7,
-    );
-    assert_almost(name, &kf.covariance, &matrix(&c["covariance"]), 7);
-    assert_poles(name, &kf.poles, &complex_list(&c["poles"]), 7);
-    assert!(kf.residual < 1e-9, "{name}: residual {}", kf.residual);
+    check_lqe::<1, 1, 1>("python_control_scalar", None);
+    check_lqe::<3, 2, 2>("three_states_two_outputs", None);
+    check_lqe::<4, 1, 2>("lab_positions", None);
 }
 
 #[test]
 fn dlqe_matches_python_control() {
-    check_dlqe::<3, 2, 2>("three_states_two_outputs", 0.1);
-    check_dlqe::<4, 1, 2>("lab_positions", 0.002);
-    check_dlqe::<4, 1, 2>("lab_positions_noisy_force", 0.002);
+    check_lqe::<3, 2, 2>("three_states_two_outputs", Some(0.1));
+    check_lqe::<4, 1, 2>("lab_positions", Some(0.002));
+    check_lqe::<4, 1, 2>("lab_positions_noisy_force", Some(0.002));
 }
 
 #[test]

@@ -4,34 +4,19 @@
 //! setpoint to within an encoder count despite Coulomb friction, where the
 //! lab's own law cannot.
 
-use ctrlab::data::Recording;
-use ctrlab::design::{
-    AntiWindup, EstimatorForm, IntegralFeedback, Observer, ObserverController, SelectOutputs, dlqe,
-    dlqi,
+mod common;
+
+use common::{
+    PERIOD, last, position_model as model, positions_lqi, run_on_rig, saturated, simulate_on,
 };
-use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-use ctrlab::lab::{self, SimulatedRig};
+use ctrlab::data::Recording;
+use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqi};
+use ctrlab::lab::SimulatedRig;
 use ctrlab::sim::run_sampled;
-use ctrlab::{Cart, Controller, Discrete, MassSpring, Method, StateFeedback, StateSpace};
+use ctrlab::{Cart, Controller, MassSpring, StateFeedback};
 use nalgebra::{SMatrix, SVector, matrix, vector};
 
-const PERIOD: f64 = 0.002;
 const SETPOINT: f64 = 0.030;
-
-/// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.
-fn model() -> StateSpace<4, 1, 2, Discrete> {
-    MassSpring::nominal()
-        .state_space(Cart::Two)
-        .unwrap()
-        .with_output(lab::positions(), matrix![0.0; 0.0])
-        .unwrap()
-        .discretize(PERIOD, Method::Zoh)
-        .unwrap()
-}
-
-fn last(rec: &Recording, name: &str) -> f64 {
-    *rec.channel(name).unwrap().last().unwrap()
-}
 
 fn peak(rec: &Recording, name: &str) -> f64 {
     rec.channel(name)
@@ -39,14 +24,6 @@ fn peak(rec: &Recording, name: &str) -> f64 {
         .iter()
         .copied()
         .fold(f64::MIN, f64::max)
-}
-
-fn saturated(rec: &Recording) -> usize {
-    rec.channel("u")
-        .unwrap()
-        .iter()
-        .filter(|u| u.abs() >= 24.0)
-        .count()
 }
 
 // ---- anti-windup ---------------------------------------------------------------
@@ -106,67 +83,6 @@ fn back_calculation_cuts_the_overshoot_that_windup_causes() {
 
 // ---- the observer-based controller on the rig, positions only ---------------------
 
-/// LQI on cart 2 with a Kalman filter on both positions, on the nominal
-/// model; it sees only `[x1, x2]` of the rig's `[x1, v1, x2, v2]`.
-type PositionsLqi = SelectOutputs<ObserverController<4, 1, 2, 1>, 4, 2>;
-
-fn positions_lqi(sim: &SimulatedRig) -> PositionsLqi {
-    let model = model();
-    // Integrate x2, the second measured position.
-    let h = matrix![0.0, 1.0];
-    let tracked = model.with_output(h * model.c(), matrix![0.0]).unwrap();
-    let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e10]);
-    let lqi = dlqi(&tracked, &q, &matrix![1.0]).unwrap();
-    // Force disturbances of a few newtons (the friction is 1 and 2 N);
-    // each position read to an encoder count, uniform rounding error.
-    let count = sim.metres_per_count();
-    let rn = SMatrix::<f64, 2, 2>::identity() * (count * count / 12.0);
-    let kf = dlqe(&model, model.b(), &matrix![10.0], &rn).unwrap();
-    let observer = Observer::new(&model, kf.gain, EstimatorForm::Current).unwrap();
-    let controller = ObserverController::new(
-        observer,
-        &lqi.gain,
-        h,
-        AntiWindup::BackCalculation {
-            tracking: 0.01,
-            deadband: 0.024,
-        },
-    )
-    .unwrap();
-    SelectOutputs::new(controller, lab::positions()).unwrap()
-}
-
-fn simulate<C: Controller<4, 1, 1>>(sim: &SimulatedRig, controller: C, duration: f64) -> Recording {
-    run_sampled(
-        sim.plant(),
-        sim.sensor(),
-        controller,
-        |_| vector![SETPOINT],
-        SVector::zeros(),
-        &sim.sampled_config(duration),
-    )
-    .unwrap()
-}
-
-fn on_rig<C: Controller<4, 1, 1>>(sim: &SimulatedRig, controller: C, duration: f64) -> Recording {
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration,
-        ..LoopConfig::default()
-    };
-    let out = hw::run(
-        rig,
-        controller,
-        |_| vector![SETPOINT],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .unwrap();
-    assert_eq!(out.stats.overruns, 0);
-    out.recording
-}
-
 /// The largest |x2 − setpoint| over the last `window` seconds.
 fn final_error(rec: &Recording, window: f64) -> f64 {
     let x2 = rec.channel("x2").unwrap();
@@ -190,13 +106,23 @@ fn observer_lqi_on_positions_reaches_the_setpoint_within_a_count_despite_frictio
     for (path, ours, theirs) in [
         (
             "run_sampled",
-            simulate(&sim, positions_lqi(&sim), duration),
-            simulate(&sim, lab_law, duration),
+            simulate_on(
+                &sim,
+                positions_lqi(sim.metres_per_count()),
+                SETPOINT,
+                duration,
+            ),
+            simulate_on(&sim, lab_law, SETPOINT, duration),
         ),
         (
             "hw::run on the simulated rig",
-            on_rig(&sim, positions_lqi(&sim), duration),
-            on_rig(&sim, lab_law, duration),
+            run_on_rig(
+                &sim,
+                positions_lqi(sim.metres_per_count()),
+                SETPOINT,
+                duration,
+            ),
+            run_on_rig(&sim, lab_law, SETPOINT, duration),
         ),
     ] {
         let (e_ours, e_lab) = (final_error(&ours, 0.5), final_error(&theirs, 0.5));
@@ -229,7 +155,7 @@ fn with_time_the_integrator_unsticks_the_cart_onto_the_setpoints_count() {
         coulomb_friction: [1.0, 2.0],
         ..Default::default()
     };
-    let rec = simulate(&sim, positions_lqi(&sim), 6.0);
+    let rec = simulate_on(&sim, positions_lqi(sim.metres_per_count()), SETPOINT, 6.0);
     assert!(final_error(&rec, 0.2) < 0.5 * sim.metres_per_count());
 }
 
@@ -318,14 +244,14 @@ fn the_compensator_forgets_its_run_and_claims_the_models_period() {
         truth: MassSpring::nominal(),
         ..Default::default()
     };
-    let mut c = positions_lqi(&sim);
+    let mut c = positions_lqi(sim.metres_per_count());
     assert_eq!(c.period(), Some(PERIOD));
-    let first = simulate(&sim, &mut c, 0.5);
+    let first = simulate_on(&sim, &mut c, SETPOINT, 0.5);
     assert_ne!(c.inner().integrators()[0], 0.0);
     assert_ne!(*c.inner().observer().estimate(), SVector::<f64, 4>::zeros());
     c.reset();
     assert_eq!(c.inner().integrators()[0], 0.0);
     assert_eq!(*c.inner().observer().estimate(), SVector::<f64, 4>::zeros());
     // The loop resets it too: the same run again, bit for bit.
-    assert_eq!(simulate(&sim, &mut c, 0.5), first);
+    assert_eq!(simulate_on(&sim, &mut c, SETPOINT, 0.5), first);
 }
