@@ -3,12 +3,12 @@
 //! controller's, and the design functions (`place` for 4 states and
 //! 2 inputs, `dlqe`, `dlqi`).
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use criterion::{Criterion, criterion_group, criterion_main};
-use ctrlab::design::{
-    AntiWindup, EstimatorForm, IntegralFeedback, Observer, ObserverController, SelectOutputs, dlqe,
-    dlqi, place,
-};
-use ctrlab::{Cart, Controller, MassSpring, Method, StateSpace, lab};
+use ctrlab::design::{AntiWindup, IntegralFeedback, dlqe, dlqi, place};
+use ctrlab::{Controller, StateSpace};
 use nalgebra::{Complex, SMatrix, matrix, vector};
 use std::hint::black_box;
 

@@ -113,8 +113,8 @@ proptest! {
         prop_assume!(k[cart.state_index()].abs() > 1e-3);
         let law = StateFeedback::new(SMatrix::<f64, 1, 4>::from_row_slice(&k), vector![n]).unwrap();
         let back = law.to_lab_gains(cart).unwrap().state_feedback().unwrap();
-        for i in 0..4 {
-            prop_assert!(close(back.gain()[i], k[i]));
+        for (got, want) in back.gain().iter().zip(k) {
+            prop_assert!(close(*got, want));
         }
         let n_back = back.reference_gain()[0];
         prop_assert!((n_back - n).abs() <= 8.0 * f64::EPSILON * n.abs(), "{} vs {}", n_back, n);
