@@ -164,14 +164,27 @@ pub(crate) fn eigenvalues<const N: usize>(
         return Ok(out);
     }
     let iterations = ITERATIONS_PER_DIM * N;
-    let schur = DMatrix::from_fn(N, N, |r, c| a[(r, c)])
-        .try_schur(f64::EPSILON, iterations)
-        .ok_or(Error::NoConvergence {
-            operation: "Schur decomposition (eigenvalues)",
-            iterations,
-        })?;
-    for (o, e) in out.iter_mut().zip(schur.complex_eigenvalues().iter()) {
-        *o = *e;
+    match DMatrix::from_fn(N, N, |r, c| a[(r, c)]).try_schur(f64::EPSILON, iterations) {
+        Some(schur) => {
+            for (o, e) in out.iter_mut().zip(schur.complex_eigenvalues().iter()) {
+                *o = *e;
+            }
+        }
+        None => {
+            // nalgebra's Francis iteration has no exceptional shifts and can
+            // stall on a matrix with a repeated, non-defective eigenvalue
+            // (a closed loop with a pole placed twice or three times);
+            // faer's eigenvalue solver has them.
+            let values = faer::Mat::<f64>::from_fn(N, N, |r, c| a[(r, c)])
+                .eigenvalues()
+                .map_err(|_| Error::NoConvergence {
+                    operation: "Schur decomposition (eigenvalues)",
+                    iterations,
+                })?;
+            for (o, e) in out.iter_mut().zip(values.iter()) {
+                *o = Complex::new(e.re, e.im);
+            }
+        }
     }
     if out.iter().any(|p| !(p.re.is_finite() && p.im.is_finite())) {
         return Err(Error::Overflow {

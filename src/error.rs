@@ -92,6 +92,33 @@ pub enum Error {
         /// Number of states (the full rank).
         states: usize,
     },
+    /// The pair (A, C) is not observable to working precision (an observer
+    /// cannot place its poles, or a Kalman filter has no stabilising
+    /// solution).
+    #[error("unobservable: observability matrix has rank {rank} of {states}")]
+    Unobservable {
+        /// Numerical rank of the observability matrix.
+        rank: usize,
+        /// Number of states (the full rank).
+        states: usize,
+    },
+    /// Pole placement computed a gain whose closed-loop pole is not where it
+    /// was asked for (beyond the documented tolerance): the target set is
+    /// too ill-conditioned to assign in floating point.
+    #[error(
+        "pole placement: target pole {target_re} + {target_im}i was placed at \
+         {achieved_re} + {achieved_im}i"
+    )]
+    PoleNotPlaced {
+        /// Real part of the target.
+        target_re: f64,
+        /// Imaginary part of the target.
+        target_im: f64,
+        /// Real part of the nearest achieved pole.
+        achieved_re: f64,
+        /// Imaginary part of the nearest achieved pole.
+        achieved_im: f64,
+    },
     /// Data handed to an algorithm are malformed: non-finite samples, a
     /// non-increasing time axis, too few samples.
     #[error("invalid data `{what}` at index {index}: {reason}")]

@@ -28,7 +28,12 @@
 //!   observability.
 //! - [`design`]: the [`Controller`] trait (measurements and reference in,
 //!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
-//!   [`acker`], [`lqr`], [`dlqr`].
+//!   [`acker`], [`place`], [`lqr`], [`dlqr`]; integral action
+//!   ([`lqi`](design::lqi), [`IntegralFeedback`](design::IntegralFeedback)
+//!   with anti-windup), observers and Kalman filters
+//!   ([`place_observer`](design::place_observer), [`lqe`](design::lqe),
+//!   [`dlqe`](design::dlqe), [`Observer`](design::Observer)) and the
+//!   observer-based [`ObserverController`](design::ObserverController).
 //! - [`metrics`]: [`step_info`] / [`step_info_of`] (rise and settling time,
 //!   overshoot, steady state) with interpolated crossing times.
 //! - `plot` (feature `plot`, on by default): SVG figures of time responses.
@@ -104,7 +109,7 @@ pub use nalgebra;
 
 pub use analysis::Damping;
 pub use data::{Channel, Recording, Schema};
-pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr};
+pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place};
 pub use discretize::Method;
 pub use error::Error;
 pub use ident::{LeastSquares, LeastSquaresFit, Rls};

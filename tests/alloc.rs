@@ -3,6 +3,8 @@
 //! This file is its own test binary, so the allocator sees only these tests;
 //! the count is per thread, so tests running in parallel do not disturb it.
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -179,6 +181,47 @@ fn state_feedback_update_allocates_nothing() {
     assert_eq!(n, 0);
     // The loop did something: cart 2 moved towards the setpoint.
     assert!(x[2] > 0.02 && x[2] < 0.035);
+}
+
+#[test]
+fn observer_and_integral_controllers_allocate_nothing() {
+    use ctrlab::Controller;
+    use ctrlab::design::{AntiWindup, IntegralFeedback, dlqi};
+    use nalgebra::{SMatrix, matrix};
+    // The observer + LQI controller on positions the closed-loop tests run.
+    let mut on_positions = common::positions_lqi(0.080 / 8192.0);
+    let model = common::position_model();
+    let tracked = model
+        .with_output(matrix![0.0, 1.0] * model.c(), matrix![0.0])
+        .unwrap();
+    let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e10]);
+    let lqi = dlqi(&tracked, &q, &matrix![1.0]).unwrap();
+    let anti_windup = AntiWindup::BackCalculation {
+        tracking: 0.01,
+        deadband: 0.024,
+    };
+    let mut full_state = IntegralFeedback::new(&tracked, &lqi.gain, anti_windup).unwrap();
+    let mut x = SVector::<f64, 4>::zeros();
+    let mut x_full = SVector::<f64, 4>::zeros();
+    let n = allocations(|| {
+        // Through trait objects, as a hardware loop would hold them.
+        let observed: &mut dyn Controller<4, 1, 1> = &mut on_positions;
+        let integral: &mut dyn Controller<4, 1, 1> = &mut full_state;
+        let r = vector![0.030];
+        for _ in 0..1000 {
+            let u = observed.update(&x, &r).map(|u| u.clamp(-24.0, 24.0));
+            observed.applied(&u);
+            x = model.advance(&x, &u);
+            let u = integral.update(&x_full, &r).map(|u| u.clamp(-24.0, 24.0));
+            integral.applied(&u);
+            x_full = model.advance(&x_full, &u);
+        }
+        observed.reset();
+        integral.reset();
+    });
+    assert_eq!(n, 0);
+    // The loops did something: cart 2 moved towards the setpoint.
+    assert!(x[2] > 0.02 && x_full[2] > 0.02, "{x} {x_full}");
 }
 
 #[test]

@@ -1,12 +1,16 @@
 //! The seams of issue 8: one controller object runs unchanged in the
 //! sampled-data simulator (`sim::run_sampled`) and on the simulated rig
 //! through the whole driver stack (`hw::run` → `MassSpringRig` → `Pc104` →
-//! `SimulatedCard`), and both agree to within one encoder count; controllers
-//! written outside the crate (an integrator with anti-windup, an observer)
-//! plug into both; and the rig's recording survives a CSV round trip.
+//! `SimulatedCard`), and both agree to within one encoder count; the
+//! library's integral controller with anti-windup, and a controller written
+//! outside the crate around the library's observer, plug into both; and the
+//! rig's recording survives a CSV round trip.
 
+mod common;
+
+use common::{last, run_on_rig, saturated, simulate_on};
 use ctrlab::data::Recording;
-use ctrlab::design::dlqr;
+use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqe, dlqi};
 use ctrlab::hw::{self, Clock, HwErrorKind, LoopConfig, VirtualClock};
 use ctrlab::lab::{self, SimulatedRig};
 use ctrlab::sim::run_sampled;
@@ -49,36 +53,13 @@ fn realistic_noiseless_rig() -> SimulatedRig {
 /// `controller` toward `SETPOINT` for `DURATION` seconds through the
 /// sampled-data simulator with `sim`'s plant, sensor and drive.
 fn simulate<C: Controller<4, 1, 1>>(sim: &SimulatedRig, controller: C) -> Recording {
-    run_sampled(
-        sim.plant(),
-        sim.sensor(),
-        controller,
-        |_| vector![SETPOINT],
-        SVector::zeros(),
-        &sim.sampled_config(DURATION),
-    )
-    .unwrap()
+    simulate_on(sim, controller, SETPOINT, DURATION)
 }
 
 /// `controller` toward `SETPOINT` for `DURATION` seconds on `sim`'s rig
 /// (card, driver, 2 ms loop) over a fresh virtual clock.
 fn on_rig<C: Controller<4, 1, 1>>(sim: &SimulatedRig, controller: C) -> Recording {
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration: DURATION,
-        ..LoopConfig::default()
-    };
-    let out = hw::run(
-        rig,
-        controller,
-        |_| vector![SETPOINT],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .unwrap();
-    assert_eq!(out.stats.overruns, 0);
-    out.recording
+    run_on_rig(sim, controller, SETPOINT, DURATION)
 }
 
 /// The two recordings have the same layout and times, cart positions within
@@ -106,20 +87,6 @@ fn assert_agree(sim: &SimulatedRig, simulated: &Recording, measured: &Recording)
             );
         }
     }
-}
-
-/// Last value of channel `name`.
-fn last(rec: &Recording, name: &str) -> f64 {
-    *rec.channel(name).unwrap().last().unwrap()
-}
-
-/// Number of samples where the applied input is at the drive's limit.
-fn saturated(rec: &Recording) -> usize {
-    rec.channel("u")
-        .unwrap()
-        .iter()
-        .filter(|u| u.abs() >= 24.0)
-        .count()
 }
 
 // ---- 1. sim vs rig: the lab's state feedback ----------------------------------
@@ -185,83 +152,25 @@ fn the_lab_state_feedback_agrees_on_the_realistic_rig_without_noise() {
 
 // ---- 1. sim vs rig: a controller with an integrator ---------------------------
 
-/// State feedback plus integral action on cart 2's position, written outside
-/// the crate: `u = −K x + ki ∫(r − x2) dt`, sampled every `period`. The
-/// integral is advanced in `update`; anti-windup by back-calculation: when
-/// the drive applies less than was asked (saturation, duty quantisation),
-/// `applied` bleeds the integral term by `(applied − asked) T / Tt`.
-#[derive(Debug, Clone)]
-struct PiStateFeedback {
-    /// State gain, V per SI state unit.
-    k: SMatrix<f64, 1, 4>,
-    /// Integral gain, V per m·s.
-    ki: f64,
-    /// Back-calculation tracking time constant, s.
-    tracking: f64,
-    /// Sampling period, s.
-    period: f64,
-    /// `∫(r − x2) dt` so far, m·s.
-    integral: f64,
-    /// The input asked for in the last `update`, V.
-    asked: f64,
-}
-
-impl PiStateFeedback {
-    /// A discrete LQR design on the nominal plant's ZOH model at `PERIOD`,
-    /// augmented with the integral of cart 2's error `z_{k+1} = z_k + T (r −
-    /// x2_k)`: weights 1e7 on x2 (m²), 1e11 on z (m²·s²), 1 on u (V²).
-    /// Stiff enough that the drive saturates at the start, so the
-    /// anti-windup has work to do.
-    fn design() -> Self {
-        let d = plant_model();
-        let mut a = SMatrix::<f64, 5, 5>::zeros();
-        a.fixed_view_mut::<4, 4>(0, 0).copy_from(d.a());
-        a[(4, 2)] = -PERIOD;
-        a[(4, 4)] = 1.0;
-        let mut b = SMatrix::<f64, 5, 1>::zeros();
-        b.fixed_view_mut::<4, 1>(0, 0).copy_from(d.b());
-        let augmented = StateSpace::discrete(
-            a,
-            b,
-            SMatrix::<f64, 1, 5>::zeros(),
-            SMatrix::<f64, 1, 1>::zeros(),
-            PERIOD,
-        )
-        .unwrap();
-        let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e11]);
-        let lqr = dlqr(&augmented, &q, &matrix![1.0]).unwrap();
-        Self {
-            k: lqr.gain.fixed_view::<1, 4>(0, 0).into_owned(),
-            // u = −K_aug [x; z] = −K x − k_z z: ki = −k_z.
-            ki: -lqr.gain[4],
-            tracking: 0.05,
-            period: PERIOD,
-            integral: 0.0,
-            asked: 0.0,
-        }
-    }
-}
-
-impl Controller<4, 1, 1> for PiStateFeedback {
-    fn update(&mut self, y: &SVector<f64, 4>, r: &SVector<f64, 1>) -> SVector<f64, 1> {
-        let u = -(self.k * y)[0] + self.ki * self.integral;
-        self.integral += (r[0] - y[2]) * self.period;
-        self.asked = u;
-        vector![u]
-    }
-
-    fn applied(&mut self, u: &SVector<f64, 1>) {
-        self.integral += (u[0] - self.asked) * self.period / (self.ki * self.tracking);
-    }
-
-    fn reset(&mut self) {
-        self.integral = 0.0;
-        self.asked = 0.0;
-    }
-
-    fn period(&self) -> Option<f64> {
-        Some(self.period)
-    }
+/// State feedback plus integral action on cart 2's position, by the
+/// library: a discrete LQI design on the nominal plant's ZOH model at
+/// `PERIOD`, augmented with the integral of cart 2's error `z_{k+1} = z_k +
+/// T (r − x2_k)`: weights 1e7 on x2 (m²), 1e11 on z (m²·s²), 1 on u (V²).
+/// Stiff enough that the drive saturates at the start, so the anti-windup
+/// (back-calculation, tracking time 0.05 s) has work to do. Returns the
+/// controller and its gain `[K_x K_z]`.
+fn integral_feedback() -> (IntegralFeedback<4, 1, 1>, SMatrix<f64, 1, 5>) {
+    let tracked = plant_model();
+    let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e11]);
+    let gain = dlqi(&tracked, &q, &matrix![1.0]).unwrap().gain;
+    let anti_windup = AntiWindup::BackCalculation {
+        tracking: 0.05,
+        deadband: 0.0,
+    };
+    (
+        IntegralFeedback::new(&tracked, &gain, anti_windup).unwrap(),
+        gain,
+    )
 }
 
 /// The nominal plant's ZOH model at the rig's period (input V = N at 1 N/V).
@@ -278,16 +187,17 @@ fn the_integral_controller_is_stable_on_the_nominal_plant_as_the_rig_measures_it
     // The loop as it runs, without saturation and quantisation: state
     // [x (4), z, x1 and x2 one period ago], the controller seeing positions
     // and backward-difference speeds, as the rig's encoders give them.
-    let c = PiStateFeedback::design();
+    let (_, gain) = integral_feedback();
     let d = plant_model();
-    let (k, t) = (c.k, PERIOD);
+    // u = −K x + ki z.
+    let (k, ki, t) = (gain.fixed_view::<1, 4>(0, 0), -gain[4], PERIOD);
     // u = F ξ.
     let f = [
         -k[0] - k[1] / t,
         0.0,
         -k[2] - k[3] / t,
         0.0,
-        c.ki,
+        ki,
         k[1] / t,
         k[3] / t,
     ];
@@ -316,8 +226,8 @@ fn the_integral_controller_is_stable_on_the_nominal_plant_as_the_rig_measures_it
 #[test]
 fn the_integral_controller_agrees_in_simulation_and_on_the_rig_and_reaches_the_setpoint() {
     let sim = nominal_rig([0.0, 0.0]);
-    let simulated = simulate(&sim, PiStateFeedback::design());
-    let measured = on_rig(&sim, PiStateFeedback::design());
+    let simulated = simulate(&sim, integral_feedback().0);
+    let measured = on_rig(&sim, integral_feedback().0);
     assert_agree(&sim, &simulated, &measured);
     // The drive saturates at the start (the anti-windup is exercised) ...
     assert!(saturated(&measured) > 0);
@@ -334,68 +244,65 @@ fn the_integral_controller_agrees_in_simulation_and_on_the_rig_and_reaches_the_s
 
 // ---- 2. a controller with an observer, written outside the crate --------------
 
-/// The lab's cart-2 law with the speeds estimated instead of differenced: a
-/// Luenberger observer of the nominal plant's state from the two measured
-/// positions (`y[0]`, `y[2]`) and the voltage actually applied, in
-/// prediction form `x̂⁺ = A x̂ + B u_applied + L (y_pos − C x̂)`. The law
-/// is `u = N r − K [x1, v̂1, x2, v̂2]`.
+/// The lab's cart-2 law with the speeds estimated instead of differenced,
+/// written outside the crate around the library's [`Observer`] of the
+/// nominal plant's state from the two measured positions (`y[0]`, `y[2]`)
+/// and the voltage actually applied, in prediction form
+/// `x̂⁺ = A x̂ + B u_applied + L (y_pos − C x̂)`. The law is
+/// `u = N r − K [x1, v̂1, x2, v̂2]`.
 #[derive(Debug, Clone)]
 struct ObserverFeedback {
     law: StateFeedback<4, 1>,
-    model: StateSpace<4, 1, 1, ctrlab::Discrete>,
-    /// Observer gain, 4 × 2 (on the innovations of x1 and x2).
-    gain: SMatrix<f64, 4, 2>,
+    observer: Observer<4, 1, 2>,
     period: f64,
-    /// The predicted state for the coming sample.
-    estimate: SVector<f64, 4>,
-    /// The innovation of the last sample, `y_pos − C x̂`, m.
-    innovation: SVector<f64, 2>,
 }
 
 impl ObserverFeedback {
-    /// The lab law with an observer designed (as the dual of a discrete LQR
-    /// problem) on the nominal plant's model, claiming sampling period
-    /// `period` (the model is always the 2 ms one).
+    /// The lab law with a steady-state Kalman filter (noise on every state,
+    /// `QN = diag(1, 100, 1, 100)`, `RN = 1e-4 I`) on the nominal plant's
+    /// model, claiming sampling period `period` (the model is always the
+    /// 2 ms one).
     fn new(period: f64) -> Self {
-        let model = plant_model();
-        // Dual system (Aᵀ, Cᵀ) with C picking the two positions.
-        let c = matrix![1.0, 0.0, 0.0, 0.0; 0.0, 0.0, 1.0, 0.0];
-        let dual = StateSpace::discrete(
-            model.a().transpose(),
-            c.transpose(),
-            SMatrix::<f64, 1, 4>::zeros(),
-            SMatrix::<f64, 1, 2>::zeros(),
-            PERIOD,
-        )
-        .unwrap();
-        let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1.0, 100.0, 1.0, 100.0]);
-        let r = SMatrix::<f64, 2, 2>::identity() * 1e-4;
-        let gain = dlqr(&dual, &q, &r).unwrap().gain.transpose();
+        let model = plant_model()
+            .with_output(lab::positions(), matrix![0.0; 0.0])
+            .unwrap();
         Self {
             law: lab_law(),
-            model,
-            gain,
+            observer: Observer::new(&model, Self::gain(), EstimatorForm::Predictor).unwrap(),
             period,
-            estimate: SVector::zeros(),
-            innovation: SVector::zeros(),
         }
+    }
+
+    fn estimate(&self) -> SVector<f64, 4> {
+        *self.observer.estimate()
+    }
+
+    /// The Kalman gain `L` the observer runs with.
+    fn gain() -> SMatrix<f64, 4, 2> {
+        let model = plant_model()
+            .with_output(lab::positions(), matrix![0.0; 0.0])
+            .unwrap();
+        let qn = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1.0, 100.0, 1.0, 100.0]);
+        let rn = SMatrix::<f64, 2, 2>::identity() * 1e-4;
+        dlqe(&model, &SMatrix::<f64, 4, 4>::identity(), &qn, &rn)
+            .unwrap()
+            .gain
     }
 }
 
 impl Controller<4, 1, 1> for ObserverFeedback {
     fn update(&mut self, y: &SVector<f64, 4>, r: &SVector<f64, 1>) -> SVector<f64, 1> {
-        self.innovation = vector![y[0] - self.estimate[0], y[2] - self.estimate[2]];
-        let x = vector![y[0], self.estimate[1], y[2], self.estimate[3]];
+        let estimate = self.observer.correct(&vector![y[0], y[2]]);
+        let x = vector![y[0], estimate[1], y[2], estimate[3]];
         self.law.update(&x, r)
     }
 
     fn applied(&mut self, u: &SVector<f64, 1>) {
-        self.estimate = self.model.advance(&self.estimate, u) + self.gain * self.innovation;
+        self.observer.predict(u);
     }
 
     fn reset(&mut self) {
-        self.estimate = SVector::zeros();
-        self.innovation = SVector::zeros();
+        self.observer.reset();
     }
 
     fn period(&self) -> Option<f64> {
@@ -405,10 +312,12 @@ impl Controller<4, 1, 1> for ObserverFeedback {
 
 #[test]
 fn the_observer_is_stable() {
+    // Observer::new refuses an estimator whose error dynamics A − L C do
+    // not decay; check the poles here as the hand-written test did.
     let c = ObserverFeedback::new(PERIOD);
-    let positions = matrix![1.0, 0.0, 0.0, 0.0; 0.0, 0.0, 1.0, 0.0];
+    let model = c.observer.model();
     let error_dynamics = StateSpace::discrete(
-        c.model.a() - c.gain * positions,
+        model.a() - ObserverFeedback::gain() * model.c(),
         SMatrix::<f64, 4, 1>::zeros(),
         SMatrix::<f64, 1, 4>::zeros(),
         SMatrix::zeros(),
@@ -424,19 +333,19 @@ fn one_observer_controller_runs_unchanged_in_simulation_and_on_the_rig() {
     let mut c = ObserverFeedback::new(PERIOD);
     let simulated = simulate(&sim, &mut c);
     assert_ne!(
-        c.estimate,
+        c.estimate(),
         SVector::<f64, 4>::zeros(),
         "the run left the observer's state"
     );
     c.reset();
-    assert_eq!(c.estimate, SVector::<f64, 4>::zeros());
-    assert_eq!(c.innovation, SVector::<f64, 2>::zeros());
+    assert_eq!(c.estimate(), SVector::<f64, 4>::zeros());
     let measured = on_rig(&sim, &mut c);
     assert_agree(&sim, &simulated, &measured);
     // The observer tracks: at the end its speed estimate is still, and its
     // position estimate within two counts of what the encoder reads.
-    assert!(c.estimate[3].abs() < 1e-3, "v2 estimate {}", c.estimate[3]);
-    assert!((c.estimate[2] - last(&measured, "x2")).abs() < 2.0 * sim.metres_per_count());
+    let estimate = c.estimate();
+    assert!(estimate[3].abs() < 1e-3, "v2 estimate {}", estimate[3]);
+    assert!((estimate[2] - last(&measured, "x2")).abs() < 2.0 * sim.metres_per_count());
     // The loops reset it themselves: simulating again after the rig run,
     // without a reset of our own, gives the first simulation exactly.
     let again = simulate(&sim, &mut c);

@@ -120,7 +120,7 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
     q: &SMatrix<f64, N, N>,
     r: &SMatrix<f64, M, M>,
 ) -> Result<Lqr<N, M>, Error> {
-    check_weights(q, r)?;
+    check_weights(q, r, ["Q", "R"])?;
     let (a, b) = (*sys.a(), *sys.b());
     let r_lu = Lu::new(r, "LQR (R)")?;
     let r_inv_bt = r_lu.solve(&b.transpose());
@@ -214,7 +214,7 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
     q: &SMatrix<f64, N, N>,
     r: &SMatrix<f64, M, M>,
 ) -> Result<Lqr<N, M>, Error> {
-    check_weights(q, r)?;
+    check_weights(q, r, ["Q", "R"])?;
     let (a, b) = (*sys.a(), *sys.b());
     let r_inv_bt = Lu::new(r, "LQR (R)")?.solve(&b.transpose());
     let g = symmetric(&(b * r_inv_bt));
@@ -397,41 +397,45 @@ fn relative(err: f64, terms: &[f64]) -> f64 {
     if scale > 0.0 { err / scale } else { err }
 }
 
-fn symmetric<const N: usize>(m: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+pub(crate) fn symmetric<const N: usize>(m: &SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
     (m + m.transpose()) * 0.5
 }
 
-/// `Q` symmetric positive semidefinite, `R` symmetric positive definite.
-fn check_weights<const N: usize, const M: usize>(
+/// `Q` symmetric positive semidefinite, `R` symmetric positive definite;
+/// errors name them as `names` (`["Q", "R"]`, or `["QN", "RN"]` for a
+/// Kalman filter's noise covariances).
+pub(crate) fn check_weights<const N: usize, const M: usize>(
     q: &SMatrix<f64, N, N>,
     r: &SMatrix<f64, M, M>,
+    names: [&'static str; 2],
 ) -> Result<(), Error> {
-    check_finite("Q", q)?;
-    check_finite("R", r)?;
+    let [q_name, r_name] = names;
+    check_finite(q_name, q)?;
+    check_finite(r_name, r)?;
     let symmetric_enough = |asym: f64, norm: f64| asym <= 1e-12 * norm;
     if !symmetric_enough((q - q.transpose()).norm(), q.norm()) {
         return Err(Error::InvalidMatrix {
-            matrix: "Q",
+            matrix: q_name,
             reason: "must be symmetric",
         });
     }
     if !symmetric_enough((r - r.transpose()).norm(), r.norm()) {
         return Err(Error::InvalidMatrix {
-            matrix: "R",
+            matrix: r_name,
             reason: "must be symmetric",
         });
     }
     let min_q = min_symmetric_eigenvalue(&DMatrix::from_fn(N, N, |i, j| q[(i, j)]))?;
     if min_q < -1e-12 * q.norm() {
         return Err(Error::InvalidMatrix {
-            matrix: "Q",
+            matrix: q_name,
             reason: "must be positive semidefinite",
         });
     }
     let min_r = min_symmetric_eigenvalue(&DMatrix::from_fn(M, M, |i, j| r[(i, j)]))?;
     if min_r <= f64::EPSILON * M as f64 * r.norm() || M == 0 {
         return Err(Error::InvalidMatrix {
-            matrix: "R",
+            matrix: r_name,
             reason: "must be positive definite",
         });
     }

@@ -1,6 +1,20 @@
 //! Controllers and their design: the [`Controller`] trait that simulation and
 //! hardware both drive, [`OpenLoop`], [`StateFeedback`] (`u = N r − K x`),
-//! pole placement by [`acker`], and optimal gains by [`lqr`] / [`dlqr`].
+//! pole placement by [`acker`] (one input) and [`place`] (any number of
+//! inputs, robust), and optimal gains by [`lqr`] / [`dlqr`].
+//!
+//! Beyond static state feedback:
+//!
+//! - integral action: [`augment_integral`], the linear-quadratic-integral
+//!   designs [`lqi`] / [`dlqi`], and the controller [`IntegralFeedback`]
+//!   with [`AntiWindup`];
+//! - observers: [`place_observer`] (Luenberger, by placement on the dual),
+//!   the steady-state Kalman filters [`lqe`] / [`dlqe`], and [`Observer`]
+//!   in predictor or current-estimator form ([`EstimatorForm`]);
+//! - output feedback: [`ObserverController`] (observer, state feedback and
+//!   integrators on measured outputs), and [`SelectOutputs`] to run it on
+//!   some of a loop's measurements (the rig's positions, not its
+//!   differenced speeds).
 //!
 //! The lab's per-millimetre gains are a named conversion in the lab module,
 //! [`StateFeedback::from_lab_gains`](crate::lab).
@@ -23,12 +37,22 @@
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
+mod compensator;
 mod controller;
 mod feedback;
+mod integral;
+mod kalman;
 mod lqr;
+mod observer;
 mod place;
+mod robust_place;
 
+pub use compensator::{ObserverController, SelectOutputs};
 pub use controller::{Controller, OpenLoop};
 pub use feedback::StateFeedback;
+pub use integral::{AntiWindup, IntegralFeedback, augment_integral, dlqi, lqi};
+pub use kalman::{Lqe, dlqe, lqe};
 pub use lqr::{Lqr, dlqr, lqr};
+pub use observer::{EstimatorForm, Observer};
 pub use place::acker;
+pub use robust_place::{place, place_observer};

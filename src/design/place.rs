@@ -1,4 +1,5 @@
-//! Pole placement for single-input systems: Ackermann's formula.
+//! Pole placement for single-input systems, Ackermann's formula, and the
+//! validation of target poles that [`place`](super::place) shares.
 
 use nalgebra::{Complex, DMatrix, SMatrix};
 
@@ -93,6 +94,40 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
 /// Monic real polynomial with the given roots, highest power first
 /// (`N + 1` coefficients, returned in a `Vec`: design time, not a hot loop).
 fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>, Error> {
+    let paired = conjugate_pairs(poles)?;
+    let mut coeffs = vec![1.0];
+    let mul = |coeffs: &mut Vec<f64>, factor: &[f64]| {
+        let mut out = vec![0.0; coeffs.len() + factor.len() - 1];
+        for (i, &c) in coeffs.iter().enumerate() {
+            for (j, &f) in factor.iter().enumerate() {
+                out[i + j] += c * f;
+            }
+        }
+        *coeffs = out;
+    };
+    let mut i = 0;
+    while i < N {
+        let p = paired[i];
+        if p.im == 0.0 {
+            mul(&mut coeffs, &[1.0, -p.re]);
+            i += 1;
+        } else {
+            // (s − p)(s − p̄) = s² − 2 Re p s + |p|².
+            mul(&mut coeffs, &[1.0, -2.0 * p.re, p.norm_sqr()]);
+            i += 2;
+        }
+    }
+    Ok(coeffs)
+}
+
+/// The targets validated and arranged for a real gain: all finite, closed
+/// under conjugation (a partner matched to 1e-10 relative). Real targets
+/// come out with an imaginary part of exactly 0; each complex pair comes out
+/// adjacent, the one with positive imaginary part first and its exact
+/// conjugate second.
+pub(crate) fn conjugate_pairs<const N: usize>(
+    poles: &[Complex<f64>; N],
+) -> Result<[Complex<f64>; N], Error> {
     let bad = |value: f64, reason| Error::InvalidParameter {
         name: "poles",
         value,
@@ -108,16 +143,8 @@ fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>
         ));
     }
     let mut used = [false; N];
-    let mut coeffs = vec![1.0];
-    let mul = |coeffs: &mut Vec<f64>, factor: &[f64]| {
-        let mut out = vec![0.0; coeffs.len() + factor.len() - 1];
-        for (i, &c) in coeffs.iter().enumerate() {
-            for (j, &f) in factor.iter().enumerate() {
-                out[i + j] += c * f;
-            }
-        }
-        *coeffs = out;
-    };
+    let mut out = [Complex::new(0.0, 0.0); N];
+    let mut next = 0;
     for i in 0..N {
         if used[i] {
             continue;
@@ -126,7 +153,8 @@ fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>
         let p = poles[i];
         let scale = p.norm().max(f64::MIN_POSITIVE);
         if p.im.abs() <= CONJUGATE_RTOL * scale {
-            mul(&mut coeffs, &[1.0, -p.re]);
+            out[next] = Complex::new(p.re, 0.0);
+            next += 1;
             continue;
         }
         // Closest unused partner to the conjugate.
@@ -145,8 +173,10 @@ fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>
             ));
         };
         used[j] = true;
-        // (s − p)(s − p̄) = s² − 2 Re p s + |p|².
-        mul(&mut coeffs, &[1.0, -2.0 * p.re, p.norm_sqr()]);
+        let upper = Complex::new(p.re, p.im.abs());
+        out[next] = upper;
+        out[next + 1] = upper.conj();
+        next += 2;
     }
-    Ok(coeffs)
+    Ok(out)
 }

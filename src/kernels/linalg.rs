@@ -2,7 +2,7 @@
 //! typenum bounds for a generic `N` (its `lu()` needs `Const<N>: DimMin`).
 //! Keeping them here lets the public API take plain `const N: usize`.
 
-use nalgebra::SMatrix;
+use nalgebra::{Complex, SMatrix};
 
 use crate::error::Error;
 
@@ -89,6 +89,27 @@ impl<const N: usize> Lu<N> {
         norm1(a) * norm1(&inv)
     }
 
+    /// The determinant of the factored matrix: the product of the pivots,
+    /// signed by the row permutation.
+    pub(crate) fn det(&self) -> f64 {
+        let mut det: f64 = (0..N).map(|i| self.lu[(i, i)]).product();
+        // The permutation's sign from its cycle decomposition.
+        let mut seen = [false; N];
+        for start in 0..N {
+            let mut i = start;
+            let mut length = 0;
+            while !seen[i] {
+                seen[i] = true;
+                i = self.perm[i];
+                length += 1;
+            }
+            if length % 2 == 0 && length > 0 {
+                det = -det;
+            }
+        }
+        det
+    }
+
     /// Solves `X A = B` for `X` (a row-vector system), via `Aᵀ Xᵀ = Bᵀ`.
     pub(crate) fn solve_right<const K: usize>(
         a: &SMatrix<f64, N, N>,
@@ -99,6 +120,55 @@ impl<const N: usize> Lu<N> {
             .solve(&b.transpose())
             .transpose())
     }
+}
+
+/// The full unitary factor `Q` (N × N) of a Householder QR of the first
+/// `k` columns of `a` (`a[:, ..k] = Q R`): its last `N − k` columns are an
+/// orthonormal basis of the orthogonal complement of those columns' span
+/// (or of a subspace of it when they are dependent: a zero column is
+/// skipped). Complex, so it serves complex eigenvector bases too.
+pub(crate) fn householder_q<const N: usize>(
+    a: &SMatrix<Complex<f64>, N, N>,
+    k: usize,
+) -> SMatrix<Complex<f64>, N, N> {
+    let mut r = *a;
+    let mut q = SMatrix::<Complex<f64>, N, N>::identity();
+    let mut v = [Complex::new(0.0, 0.0); N];
+    for j in 0..k.min(N) {
+        let norm = (j..N).map(|i| r[(i, j)].norm_sqr()).sum::<f64>().sqrt();
+        if norm == 0.0 {
+            continue;
+        }
+        // v = x − α e₁ with α = −e^{i arg x₀} ‖x‖: no cancellation.
+        let x0 = r[(j, j)];
+        let phase = if x0.norm() > 0.0 {
+            x0 / x0.norm()
+        } else {
+            Complex::new(1.0, 0.0)
+        };
+        for i in j..N {
+            v[i] = r[(i, j)];
+        }
+        v[j] += phase * norm;
+        let v_norm = (j..N).map(|i| v[i].norm_sqr()).sum::<f64>().sqrt();
+        for vi in &mut v[j..] {
+            *vi /= v_norm;
+        }
+        // R ← H R and Q ← Q H with H = I − 2 v vᴴ.
+        for c in 0..N {
+            let dot: Complex<f64> = (j..N).map(|i| v[i].conj() * r[(i, c)]).sum();
+            for i in j..N {
+                r[(i, c)] -= v[i] * dot * 2.0;
+            }
+        }
+        for row in 0..N {
+            let dot: Complex<f64> = (j..N).map(|i| q[(row, i)] * v[i]).sum();
+            for i in j..N {
+                q[(row, i)] -= dot * v[i].conj() * 2.0;
+            }
+        }
+    }
+    q
 }
 
 /// The 1-norm (largest column sum of magnitudes).
@@ -131,6 +201,33 @@ mod tests {
         assert!((x - x_true).norm() < 1e-14);
         let xr = Lu::solve_right(&a, &x_true.transpose(), "test").unwrap();
         assert!((xr * a - x_true.transpose()).norm() < 1e-14);
+    }
+
+    #[test]
+    fn determinant_with_row_swaps() {
+        let a = matrix![0.0, 2.0, 1.0; 1.0, 1.0, 0.0; 3.0, 0.0, 1.0];
+        // Expanded by the first row: 0 − 2 (1 − 0) + 1 (0 − 3) = −5.
+        assert!((Lu::new(&a, "test").unwrap().det() + 5.0).abs() < 1e-14);
+        let swap = matrix![0.0, 1.0; 1.0, 0.0];
+        assert_eq!(Lu::new(&swap, "test").unwrap().det(), -1.0);
+    }
+
+    #[test]
+    fn householder_q_is_unitary_and_spans_the_complement() {
+        let c = |re, im| Complex::new(re, im);
+        let a = matrix![c(1.0, 1.0), c(0.0, 2.0), c(0.0, 0.0);
+                        c(2.0, 0.0), c(1.0, -1.0), c(0.0, 0.0);
+                        c(0.5, 0.0), c(3.0, 0.0), c(0.0, 0.0)];
+        let q = householder_q(&a, 2);
+        assert!((q.adjoint() * q - SMatrix::<Complex<f64>, 3, 3>::identity()).norm() < 1e-14);
+        // The last column is orthogonal to the two factored columns.
+        let last = q.column(2);
+        for j in 0..2 {
+            assert!(last.dotc(&a.column(j)).norm() < 1e-14);
+        }
+        // A zero column is skipped, not divided by.
+        let q0 = householder_q(&SMatrix::<Complex<f64>, 3, 3>::zeros(), 3);
+        assert_eq!(q0, SMatrix::<Complex<f64>, 3, 3>::identity());
     }
 
     #[test]

@@ -1,5 +1,6 @@
 //! The lab's per-millimetre gains: the one place millimetres become metres
-//! in a controller.
+//! in a controller, and back ([`LabGains`]), so a law designed in SI can be
+//! typed into the lab's Simulink model.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -49,5 +50,128 @@ impl StateFeedback<4, 1> {
         check_finite("K", &k)?;
         let n = SVector::<f64, 1>::new(k[cart.state_index()]);
         Self::new(k, n)
+    }
+}
+
+/// A state-feedback law in the lab's units, `u = Kf (G r − x_mm)` (LAB.md,
+/// Figure 8): what is typed into the lab's Simulink model.
+///
+/// `kf` is per millimetre of position and per mm/s of speed
+/// (`[Kf1, Kf2, Kf3, Kf4]` on `[x1, v1, x2, v2]`); `g` is the column that
+/// maps the setpoint (mm) to a reference state (mm, mm/s), dimensionless:
+/// the lab's `G` is `[0, 0, 1, 0]` for cart 2 and `[1, 0, 0, 0]` for cart 1.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Cart, StateFeedback, lab::LabGains};
+///
+/// let law = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
+/// let lab = law.to_lab_gains(Cart::Two)?;
+/// assert_eq!(lab, LabGains { kf: [0.0, 0.0, 10.0, 0.1], g: [0.0, 0.0, 1.0, 0.0] });
+/// assert_eq!(lab.state_feedback()?, law);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LabGains {
+    /// `[Kf1, Kf2, Kf3, Kf4]`: input unit per mm and per mm/s.
+    pub kf: [f64; 4],
+    /// The reference column `G` (dimensionless).
+    pub g: [f64; 4],
+}
+
+impl LabGains {
+    /// The same law in SI, `u = N r − K x` with `K = 1000 Kf` (per metre)
+    /// and `N = K G` (per metre of setpoint): the general form of
+    /// [`StateFeedback::from_lab_gains`], whose `G` selects a cart.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::NonFinite`] naming `"K"` or `"N"` for a non-finite gain.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Controller, lab::LabGains};
+    /// use nalgebra::vector;
+    ///
+    /// // Cart 2 toward 1.05 times the setpoint, as a prefilter would ask.
+    /// let lab = LabGains { kf: [0.0, 0.0, 1.0, 0.01], g: [0.0, 0.0, 1.05, 0.0] };
+    /// let mut law = lab.state_feedback()?;
+    /// // u = Kf (G r − x) in mm: 1 · (1.05 · 30 − 20) = 11.5.
+    /// let u = law.update(&vector![0.0, 0.0, 0.020, 0.0], &vector![0.030]);
+    /// assert!((u[0] - 11.5).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn state_feedback(&self) -> Result<StateFeedback<4, 1>, Error> {
+        let k = SMatrix::<f64, 1, 4>::from_row_slice(&self.kf) * MM_PER_M;
+        check_finite("K", &k)?;
+        let g = SVector::<f64, 4>::from_row_slice(&self.g);
+        StateFeedback::new(k, k * g)
+    }
+}
+
+impl StateFeedback<4, 1> {
+    /// The inverse of [`from_lab_gains`](Self::from_lab_gains): this SI law
+    /// `u = N r − K x` in the lab's units, `Kf = K / 1000` per mm (and
+    /// per mm/s), with `G` the column of `cart` scaled so that `Kf G` gives
+    /// back `N`: `G = (N / K_cart) e_cart`, where `K_cart` is the gain on
+    /// that cart's position. For a law from `from_lab_gains` on the same
+    /// cart, `G` is the lab's selection column; for one with a prefilter
+    /// ([`with_prefilter`](Self::with_prefilter), an LQR design) it is the
+    /// setpoint scaling the lab's Simulink model needs to reproduce it.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] named `"K"` when the gain on `cart`'s
+    /// position is zero (no `G` on that cart reproduces `N`, unless `N` is
+    /// zero too, when `G = 0`); [`Error::Overflow`] for a non-finite `G`.
+    ///
+    /// # Examples
+    ///
+    /// An LQR design with a prefilter, carried to the lab's units:
+    ///
+    /// ```
+    /// use ctrlab::{Cart, MassSpring, StateFeedback, lqr};
+    /// use nalgebra::{SMatrix, matrix, vector};
+    ///
+    /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+    /// let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0]);
+    /// let law = StateFeedback::with_prefilter(&plant, lqr(&plant, &q, &matrix![1.0])?.gain)?;
+    /// let lab = law.to_lab_gains(Cart::Two)?;
+    /// // Kf3 per mm is K3 per metre / 1000; G scales the setpoint.
+    /// assert!((lab.kf[2] - law.gain()[2] / 1000.0).abs() < 1e-15);
+    /// assert!(lab.g[2] > 1.0 && lab.g[0] == 0.0);
+    /// // Back in SI it is the same law.
+    /// let again = lab.state_feedback()?;
+    /// assert!((again.reference_gain()[0] - law.reference_gain()[0]).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn to_lab_gains(&self, cart: Cart) -> Result<LabGains, Error> {
+        let (k, n) = (self.gain(), self.reference_gain()[0]);
+        let k_cart = k[cart.state_index()];
+        let scale = if n == 0.0 {
+            0.0
+        } else if k_cart == 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "K",
+                value: k_cart,
+                reason: "the gain on the chosen cart's position is zero: no G on that cart \
+                         reproduces the reference gain",
+            });
+        } else {
+            n / k_cart
+        };
+        if !scale.is_finite() {
+            return Err(Error::Overflow {
+                operation: "lab gains (G = N / K_cart)",
+            });
+        }
+        let mut g = [0.0; 4];
+        g[cart.state_index()] = scale;
+        Ok(LabGains {
+            kf: [0, 1, 2, 3].map(|i| k[i] / MM_PER_M),
+            g,
+        })
     }
 }

@@ -4,7 +4,9 @@
 //!
 //! - the plant: [`MassSpring`] (equations (1)–(3), (14)) and [`Cart`];
 //! - the lab's per-millimetre gains,
-//!   [`StateFeedback::from_lab_gains`](crate::StateFeedback::from_lab_gains);
+//!   [`StateFeedback::from_lab_gains`](crate::StateFeedback::from_lab_gains),
+//!   and back, [`StateFeedback::to_lab_gains`](crate::StateFeedback::to_lab_gains)
+//!   into [`LabGains`];
 //! - the identification of equations (4)–(11) from a recording, in
 //!   [`ident`];
 //! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`],
@@ -50,12 +52,34 @@ mod sensor;
 mod simulated;
 
 pub use calibration::Calibration;
+pub use gains::LabGains;
 pub use plant::{Cart, MassSpring};
 pub use rig::MassSpringRig;
 pub use sensor::EncoderSensor;
 pub use simulated::{FrictionPlant, SimulatedRig};
 
+use nalgebra::SMatrix;
+
 use crate::data::{Channel, Schema};
+
+/// The output matrix that picks both carts' positions `[x1, x2]` out of the
+/// state `[x1, v1, x2, v2]`: what the encoders really measure (the rig's
+/// speeds are differenced positions). For an observer's model
+/// ([`StateSpace::with_output`](crate::StateSpace::with_output)) and to
+/// select the measurements an observer-based controller uses
+/// ([`SelectOutputs`](crate::design::SelectOutputs)).
+///
+/// # Examples
+///
+/// ```
+/// use nalgebra::{matrix, vector};
+/// let c = ctrlab::lab::positions();
+/// assert_eq!(c, matrix![1.0, 0.0, 0.0, 0.0; 0.0, 0.0, 1.0, 0.0]);
+/// assert_eq!(c * vector![0.01, 0.5, 0.02, -0.1], vector![0.01, 0.02]);
+/// ```
+pub fn positions() -> SMatrix<f64, 2, 4> {
+    SMatrix::<f64, 2, 4>::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+}
 
 /// The lab's recording layout: input `u` in V, measurements `x1` (m),
 /// `v1` (m/s), `x2` (m), `v2` (m/s), the state `[x1, v1, x2, v2]` the rig
