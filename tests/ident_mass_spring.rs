@@ -447,7 +447,11 @@ fn bad_inputs_are_typed_errors() {
     let mut jitter = rec;
     jitter.time_mut()[100] += 0.1 * DT;
     let timing = identify(&jitter, 1.3, 0.7, Scheme::Central).unwrap().timing;
-    assert_eq!((timing.jittered, timing.unused_samples), (2, 1), "{timing:?}");
+    assert_eq!(
+        (timing.jittered, timing.unused_samples),
+        (2, 1),
+        "{timing:?}"
+    );
 }
 
 #[test]
