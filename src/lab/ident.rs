@@ -21,6 +21,7 @@ use super::{Cart, MassSpring};
 use crate::data::Recording;
 use crate::error::Error;
 use crate::ident::{DEFAULT_MAX_CONDITION, LeastSquaresFit, solve_augmented};
+use crate::kernels::reduce::pow2_floor;
 use crate::model::{Continuous, StateSpace};
 
 /// How derivatives and the input are taken from the samples.
@@ -167,6 +168,91 @@ impl MassSpringEstimate {
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.plant().state_space(Cart::Two)
     }
+
+    /// Warning-level checks of the inputs (empty when all is plausible): a
+    /// cart mass outside [`PLAUSIBLE_MASS_KG`] is most likely in grams or
+    /// tonnes, and every estimate scales with it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// assert!(identify(&rec, 1.3, 0.7, Scheme::Lab)?.warnings().is_empty());
+    /// assert_eq!(identify(&rec, 1300.0, 700.0, Scheme::Lab)?.warnings().len(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn warnings(&self) -> Vec<Warning> {
+        mass_warnings(self.m1, self.m2)
+    }
+}
+
+/// The range of cart masses (kg) the lab's identification takes as
+/// plausible; a mass outside it is most likely in the wrong unit (grams,
+/// tonnes) and is reported by [`MassSpringEstimate::warnings`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::PLAUSIBLE_MASS_KG;
+/// let (lo, hi) = PLAUSIBLE_MASS_KG;
+/// assert!(lo < 0.7 && 1.3 < hi && hi < 700.0);
+/// ```
+pub const PLAUSIBLE_MASS_KG: (f64, f64) = (0.01, 100.0);
+
+/// A warning-level finding about an identification's inputs: the numbers
+/// were computed, but a value is implausible for the lab and probably in
+/// the wrong unit.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, lab::ident::{identify, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// // Cart 1's mass given in grams.
+/// let est = identify(&rec, 1300.0, 0.7, Scheme::Central)?;
+/// let w = &est.warnings()[0];
+/// assert_eq!((w.parameter, w.value), ("m1", 1300.0));
+/// assert!(w.to_string().contains("grams"));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Warning {
+    /// The parameter (`"m1"`, `"m2"`).
+    pub parameter: &'static str,
+    /// Its value, in the unit the API documents (kg for masses).
+    pub value: f64,
+    /// What is implausible and the likely mix-up.
+    pub reason: &'static str,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "`{}` = {}: {}", self.parameter, self.value, self.reason)
+    }
+}
+
+/// Warnings for cart masses outside [`PLAUSIBLE_MASS_KG`].
+fn mass_warnings(m1: f64, m2: f64) -> Vec<Warning> {
+    let (lo, hi) = PLAUSIBLE_MASS_KG;
+    [("m1", m1), ("m2", m2)]
+        .into_iter()
+        .filter_map(|(parameter, value)| {
+            let reason = if value > hi {
+                "implausibly heavy for a lab cart: masses are in kg (was it given in grams?)"
+            } else if value < lo {
+                "implausibly light for a lab cart: masses are in kg (was it given in tonnes?)"
+            } else {
+                return None;
+            };
+            Some(Warning {
+                parameter,
+                value,
+                reason,
+            })
+        })
+        .collect()
 }
 
 /// The parameters identified by [`identify_separate_springs`] (`k1 ≠ k2`).
@@ -249,6 +335,23 @@ impl SeparateSpringsEstimate {
     /// ```
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.plant().state_space(Cart::Two)
+    }
+
+    /// Warning-level checks of the inputs (empty when all is plausible): a
+    /// cart mass outside [`PLAUSIBLE_MASS_KG`] is most likely in grams or
+    /// tonnes, and every estimate scales with it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// assert!(identify_separate_springs(&rec, 1.3, 0.7, Scheme::Lab)?.warnings().is_empty());
+    /// assert_eq!(identify_separate_springs(&rec, 1300.0, 700.0, Scheme::Lab)?.warnings().len(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn warnings(&self) -> Vec<Warning> {
+        mass_warnings(self.m1, self.m2)
     }
 }
 
@@ -630,15 +733,20 @@ impl Spread {
     ///
     /// # Errors
     ///
-    /// [`Error::TooFewSamples`] for fewer than two values.
+    /// [`Error::TooFewSamples`] for fewer than two values;
+    /// [`Error::InvalidData`] for a NaN or infinite value;
+    /// [`Error::Overflow`] when the standard deviation exceeds `f64::MAX`.
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::lab::ident::Spread;
+    /// # use ctrlab::{Error, lab::ident::Spread};
     /// let s = Spread::of(&[948.0, 950.0, 952.0])?;
     /// assert_eq!((s.mean, s.std_dev), (950.0, 2.0));
     /// assert!(Spread::of(&[1.0]).is_err());
+    /// // Values near f64::MAX do not overflow on the way.
+    /// assert_eq!(Spread::of(&[1e308, 1e308])?.mean, 1e308);
+    /// assert!(matches!(Spread::of(&[f64::NAN, 1.0]), Err(Error::InvalidData { index: 0, .. })));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn of(values: &[f64]) -> Result<Self, Error> {
@@ -649,17 +757,32 @@ impl Spread {
                 got: values.len(),
             });
         }
-        Ok(spread(values.iter().copied(), values.len()))
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::InvalidData {
+                what: "values",
+                index,
+                reason: "value is not finite",
+            });
+        }
+        spread(values.iter().copied(), values.len())
     }
 }
 
-fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Spread {
-    let mean = values.clone().sum::<f64>() / n as f64;
-    let var = values.map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
-    Spread {
-        mean,
-        std_dev: var.sqrt(),
+/// Mean and sample standard deviation of `n ≥ 2` finite values, computed
+/// on the values divided by a power of two near their largest magnitude so
+/// that neither the sum nor the squares overflow or underflow.
+fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Result<Spread, Error> {
+    let scale = pow2_floor(values.clone().fold(0.0f64, |m, v| m.max(v.abs())));
+    let scaled = values.map(|v| v / scale);
+    let mean = scaled.clone().sum::<f64>() / n as f64;
+    let var = scaled.map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
+    let (mean, std_dev) = (mean * scale, var.sqrt() * scale);
+    if !std_dev.is_finite() {
+        return Err(Error::Overflow {
+            operation: "sample standard deviation",
+        });
     }
+    Ok(Spread { mean, std_dev })
 }
 
 /// Mean and sample standard deviation of each parameter over repeated runs
@@ -668,7 +791,7 @@ fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Spread {
 /// # Errors
 ///
 /// [`Error::TooFewSamples`] for fewer than two runs (a sample standard
-/// deviation needs two).
+/// deviation needs two); [`Error::Overflow`] for a spread beyond `f64::MAX`.
 ///
 /// # Examples
 ///
@@ -686,10 +809,10 @@ pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Error> 
         });
     }
     Ok(MassSpringAverage {
-        k12: spread(runs.iter().map(|r| r.k12.value), n),
-        b1: spread(runs.iter().map(|r| r.b1.value), n),
-        gain: spread(runs.iter().map(|r| r.gain.value), n),
-        b2: spread(runs.iter().map(|r| r.b2.value), n),
+        k12: spread(runs.iter().map(|r| r.k12.value), n)?,
+        b1: spread(runs.iter().map(|r| r.b1.value), n)?,
+        gain: spread(runs.iter().map(|r| r.gain.value), n)?,
+        b2: spread(runs.iter().map(|r| r.b2.value), n)?,
         runs: n,
     })
 }
