@@ -145,13 +145,20 @@ fn singular_values(m: &DMatrix<f64>, name: &'static str) -> Result<Vec<f64>, Err
         return Ok(Vec::new());
     }
     let iterations = ITERATIONS_PER_DIM * m.nrows().max(m.ncols());
+    // Unordered: the ordered variant panics on a NaN singular value, which
+    // entries near f64::MAX can produce inside the iteration.
     let svd = m
         .clone()
-        .try_svd(false, false, f64::EPSILON, iterations)
+        .try_svd_unordered(false, false, f64::EPSILON, iterations)
         .ok_or(Error::NoConvergence {
             operation: "singular value decomposition",
             iterations,
         })?;
+    if svd.singular_values.iter().any(|s| !s.is_finite()) {
+        return Err(Error::Overflow {
+            operation: "singular value decomposition",
+        });
+    }
     Ok(svd.singular_values.iter().copied().collect())
 }
 
@@ -578,7 +585,10 @@ fn componentwise_tolerance<const N: usize>(a: &SMatrix<f64, N, N>, p: Complex<f6
         Complex::new(a[(i, j)], 0.0) - if i == j { p } else { Complex::new(0.0, 0.0) }
     });
     let iterations = ITERATIONS_PER_DIM * N;
-    let svd = shifted.try_svd(true, true, f64::EPSILON, iterations)?;
+    let svd = shifted.try_svd_unordered(true, true, f64::EPSILON, iterations)?;
+    if svd.singular_values.iter().any(|s| !s.is_finite()) {
+        return None;
+    }
     let (u, v_t) = (svd.u?, svd.v_t?);
     let k = svd.singular_values.imin();
     let x = v_t.row(k).adjoint();

@@ -169,6 +169,11 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
     let norm = (0..N)
         .map(|i| x.row(i).abs().sum() + y.row(i).abs().sum())
         .fold(0.0f64, f64::max);
+    if !norm.is_finite() {
+        // Row sums beyond f64::MAX: 2^1024 and more halvings would be
+        // needed, and the squarings could not be accurate anyway.
+        return Err(Error::Overflow { operation: OP });
+    }
     let squarings = if norm > 0.5 {
         // 2 + floor(log2 ‖W‖) halvings bring the norm below ½.
         (norm.log2().floor() as i32 + 2).max(0)

@@ -388,7 +388,7 @@ pub(crate) fn solve_augmented(
     }
     let iterations = 200 * p;
     let sv = rmat
-        .try_svd(false, false, f64::EPSILON, iterations)
+        .try_svd_unordered(false, false, f64::EPSILON, iterations)
         .ok_or(Error::NoConvergence {
             operation: "least squares (singular values of R)",
             iterations,
