@@ -20,7 +20,9 @@ fuzz_target!(|data: &[u8]| {
                 for e in [est.k12, est.b1, est.gain, est.b2] {
                     assert!(e.value.is_finite() && e.std_error.is_finite(), "{est:?}");
                 }
-                assert!(est.first.r_squared.is_finite() || est.first.r_squared == f64::NEG_INFINITY);
+                assert!(
+                    est.first.r_squared.is_finite() || est.first.r_squared == f64::NEG_INFINITY
+                );
                 let _ = est.warnings();
                 let _ = est.state_space();
             }
@@ -33,7 +35,10 @@ fuzz_target!(|data: &[u8]| {
     }
     for channel in rec.schema().channels() {
         if let Ok(info) = step_info_channel(&rec, &channel.name, &StepInfoOptions::default()) {
-            assert!(info.overshoot.is_finite() && info.settling_time.is_finite(), "{info:?}");
+            assert!(
+                info.overshoot.is_finite() && info.settling_time.is_finite(),
+                "{info:?}"
+            );
         }
     }
 });

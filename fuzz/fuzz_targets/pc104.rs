@@ -30,20 +30,30 @@ impl EppPort for FuzzPort<'_> {
     fn read_data(&mut self) -> Result<u8, HwError> {
         let b = self.next();
         if b & 0xc0 == 0xc0 && self.next() & 1 == 1 {
-            return Err(HwError::Timeout { cycle: CycleKind::DataRead, register: Some(self.address) });
+            return Err(HwError::Timeout {
+                cycle: CycleKind::DataRead,
+                register: Some(self.address),
+            });
         }
         Ok(b)
     }
     fn write_data(&mut self, _value: u8) -> Result<(), HwError> {
         if self.next() == 0xff {
-            return Err(HwError::Timeout { cycle: CycleKind::DataWrite, register: Some(self.address) });
+            return Err(HwError::Timeout {
+                cycle: CycleKind::DataWrite,
+                register: Some(self.address),
+            });
         }
         Ok(())
     }
 }
 
 fuzz_target!(|data: &[u8]| {
-    let mut card = Pc104::new(FuzzPort { data, at: 0, address: 0 });
+    let mut card = Pc104::new(FuzzPort {
+        data,
+        at: 0,
+        address: 0,
+    });
     let _ = card.read_id();
     let _ = card.probe_id(0x5a);
     for round in 0..4u8 {
