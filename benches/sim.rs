@@ -1,8 +1,9 @@
 //! Inner loops of simulation: the discrete step, a 5000-step closed loop
-//! (against a plain hand-written nalgebra loop), one RK4 step, and ZOH.
+//! (against a plain hand-written nalgebra loop), one RK4 step, ZOH, and a
+//! 40 001-sample step response (target < 1 ms: one discretisation).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ctrlab::sim::simulate_discrete_feedback;
+use ctrlab::sim::{simulate_discrete_feedback, step_response};
 use ctrlab::{Cart, Integrator, MassSpring, Method, Rk4};
 use nalgebra::{SMatrix, SVector, vector};
 use std::hint::black_box;
@@ -65,6 +66,11 @@ fn benches(c: &mut Criterion) {
 
     c.bench_function("ZOH discretisation (4 states)", |b| {
         b.iter(|| black_box(&sys).discretize(black_box(0.002), Method::Zoh))
+    });
+
+    c.bench_function("step_response_40001", |b| {
+        // 20 s at 0.5 ms: the grid of Table 2's fixture.
+        b.iter(|| step_response(black_box(&sys), black_box(20.0), black_box(0.0005)))
     });
 }
 

@@ -23,6 +23,7 @@ use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::Error;
 use crate::kernels::linalg::{Lu, boundary_tolerance};
+use crate::kernels::reduce::pow2_floor;
 use crate::model::{Domain, StateSpace, period_of};
 
 /// Iteration cap for the Schur and SVD iterations, per matrix dimension.
@@ -144,13 +145,20 @@ fn singular_values(m: &DMatrix<f64>, name: &'static str) -> Result<Vec<f64>, Err
         return Ok(Vec::new());
     }
     let iterations = ITERATIONS_PER_DIM * m.nrows().max(m.ncols());
+    // Unordered: the ordered variant panics on a NaN singular value, which
+    // entries near f64::MAX can produce inside the iteration.
     let svd = m
         .clone()
-        .try_svd(false, false, f64::EPSILON, iterations)
+        .try_svd_unordered(false, false, f64::EPSILON, iterations)
         .ok_or(Error::NoConvergence {
             operation: "singular value decomposition",
             iterations,
         })?;
+    if svd.singular_values.iter().any(|s| !s.is_finite()) {
+        return Err(Error::Overflow {
+            operation: "singular value decomposition",
+        });
+    }
     Ok(svd.singular_values.iter().copied().collect())
 }
 
@@ -217,6 +225,47 @@ fn krylov<const N: usize, const K: usize>(
         block = a * block;
     }
     Ok(out)
+}
+
+/// The numerical rank of the Krylov matrix `[M, A M, …, A^(N−1) M]`,
+/// independent of the units of the states, inputs and time: the rank of
+/// `R C S` with `C` the Krylov matrix and `R`, `S` diagonal (powers of two),
+/// which does not change the exact rank. Each column `A^k m` is scaled by
+/// the size of the terms it sums, the matching column of
+/// `[|M|, |A| |M|, …]` (so rounding noise in a column that cancels to
+/// nearly zero stays noise, while a column that is small because of the
+/// units is brought to size), and each row by that magnitude's largest
+/// entry in it (a state in µm next to one in km). Powers are scaled as they
+/// are formed, so nothing overflows.
+pub(crate) fn scaled_krylov_rank<const N: usize, const K: usize>(
+    a: &SMatrix<f64, N, N>,
+    m: &SMatrix<f64, N, K>,
+) -> Result<usize, Error> {
+    let abs_a = a.abs();
+    let mut out = DMatrix::zeros(N, N * K);
+    let mut size = DMatrix::zeros(N, N * K);
+    for c in 0..K {
+        let (mut v, mut w) = (m.column(c).into_owned(), m.column(c).abs());
+        for p in 0..N {
+            let f = 1.0 / pow2_floor(w.amax());
+            v *= f;
+            w *= f;
+            if v.iter().chain(w.iter()).any(|x| !x.is_finite()) {
+                return Err(Error::Overflow {
+                    operation: "Krylov matrix (rank test)",
+                });
+            }
+            out.column_mut(p * K + c).copy_from(&v);
+            size.column_mut(p * K + c).copy_from(&w);
+            v = a * v;
+            w = abs_a * w;
+        }
+    }
+    for i in 0..N {
+        let f = 1.0 / pow2_floor(size.row(i).amax());
+        out.row_mut(i).scale_mut(f);
+    }
+    rank(&out, None)
 }
 
 impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M, P, D> {
@@ -296,11 +345,16 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     }
 
     /// True when the controllability matrix has full rank `N` by
-    /// [`rank`] with the default relative tolerance.
+    /// [`rank`] with the default relative tolerance, after scaling its rows
+    /// and columns so that the answer does not depend on the units of the
+    /// states, input or time (a chain of integrators coupled by 10⁶ is
+    /// controllable; its raw controllability matrix has singular values
+    /// from 1 to 10¹⁸).
     ///
     /// # Errors
     ///
-    /// As [`controllability`](Self::controllability) and [`rank`].
+    /// [`Error::Overflow`] if scaled powers of `A` overflow (not seen for
+    /// finite `A`); [`Error::NoConvergence`] if the SVD fails.
     ///
     /// # Examples
     ///
@@ -315,15 +369,16 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_controllable(&self) -> Result<bool, Error> {
-        Ok(rank(&self.controllability()?, None)? == N)
+        Ok(scaled_krylov_rank(self.a(), self.b())? == N)
     }
 
     /// True when the observability matrix has full rank `N` by [`rank`] with
-    /// the default relative tolerance.
+    /// the default relative tolerance, scaled as in
+    /// [`is_controllable`](Self::is_controllable).
     ///
     /// # Errors
     ///
-    /// As [`observability`](Self::observability) and [`rank`].
+    /// As [`is_controllable`](Self::is_controllable).
     ///
     /// # Examples
     ///
@@ -335,15 +390,17 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_observable(&self) -> Result<bool, Error> {
-        Ok(rank(&self.observability()?, None)? == N)
+        Ok(scaled_krylov_rank(&self.a().transpose(), &self.c().transpose())? == N)
     }
 }
 
 impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M, P, D> {
     /// True when every pole is strictly inside the stability region by more
-    /// than rounding: `Re s < −tol` in continuous time, `|z| < 1 − tol` in
-    /// discrete time, with `tol = 100 N ε max(1, ‖A‖₁)` (see
-    /// [`unstable_pole`](Self::unstable_pole)).
+    /// than its rounding error: `Re s < −tol` in continuous time,
+    /// `|z| < 1 − tol` in discrete time, with `tol` the pole's own error
+    /// bound (see [`unstable_pole`](Self::unstable_pole)), so that the
+    /// answer does not depend on the units of the states:
+    /// `diag(−1e−3, −1e12)` is stable.
     ///
     /// A pole on the boundary (an integrator, an undamped oscillator, a
     /// rigid-body mode computed from physical parameters) is not stable.
@@ -376,9 +433,17 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// crate's one stability test: [`is_stable`](Self::is_stable), step
     /// metrics and the LQR checks all use it.
     ///
-    /// "On" the boundary means within `tol = 100 N ε max(1, ‖A‖₁)` of it
-    /// (eigenvalues are computed to about `ε ‖A‖`): `Re s ≥ −tol` in
-    /// continuous time, `|z| ≥ 1 − tol` in discrete time.
+    /// "On" the boundary means within the pole's rounding error `tol` of
+    /// it: `Re s ≥ −tol` in continuous time, `|z| ≥ 1 − tol` in discrete
+    /// time. `tol` is the smaller of the normwise bound
+    /// `100 N ε max(1, ‖A‖₁)` (eigenvalues are computed to about `ε ‖A‖`)
+    /// and the componentwise bound `100 N ε |y|ᵀ|A||x| / |yᴴx|` (`x`, `y`
+    /// the pole's right and left eigenvectors), the error of a pole of a
+    /// matrix whose entries are each known to a relative ε. The second does
+    /// not change with the units of the states (it is the bound of the
+    /// balanced matrix), so a slow pole next to a fast one stays stable,
+    /// while a rigid-body mode computed from physical parameters stays on
+    /// the boundary.
     ///
     /// # Errors
     ///
@@ -407,10 +472,11 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// [`Error::Singular`] for a pole at `s = 0` / `z = 1` to working
     /// precision (the gain is infinite or undefined, and is reported instead
-    /// of returned as inf/NaN): refused when the condition number of `A`
-    /// (or `I − A`) exceeds `1 / (10⁴ ε)`, i.e. fewer than about four digits
-    /// of the gain would be right; [`Error::Overflow`] for a gain that
-    /// overflows.
+    /// of returned as inf/NaN): refused when the Skeel condition number
+    /// `‖ |A⁻¹| |A| ‖∞` of `A` (or `I − A`) exceeds `1 / (10⁴ ε)`, i.e. fewer
+    /// than about four digits of the gain would be right (a measure that
+    /// does not depend on the units of the states: `diag(−1, −1e12)` is
+    /// fine); [`Error::Overflow`] for a gain that overflows.
     ///
     /// # Examples
     ///
@@ -492,32 +558,92 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
 /// The crate's one stability test: the first of `poles` (eigenvalues of `a`)
 /// on or outside the stability boundary of the domain with sampling period
 /// `period` (`None`: continuous), within rounding of `a`.
+///
+/// A pole is on the boundary when it is within its own rounding error of
+/// it: the smaller of the normwise bound `100 N ε max(1, ‖A‖₁)` and the
+/// componentwise one `100 N ε |y|ᵀ|A||x| / |yᴴx|` (`x`, `y` its right and
+/// left eigenvectors), which is what the pole's error is when `A`'s entries
+/// are known to a relative ε. The componentwise bound does not change under
+/// a diagonal change of state units (it is the bound of the balanced
+/// matrix), so `diag(−1e−3, −1e12)` is stable, while a rigid-body mode
+/// computed from physical parameters stays on the boundary. It is computed
+/// only for poles the normwise bound leaves in doubt.
 pub(crate) fn first_unstable<const N: usize>(
     poles: &[Complex<f64>; N],
     a: &SMatrix<f64, N, N>,
     period: Option<f64>,
 ) -> Option<Complex<f64>> {
-    let tol = boundary_tolerance(a);
-    poles.iter().copied().find(|p| match period {
+    let normwise = boundary_tolerance(a);
+    let outside = |p: &Complex<f64>, tol: f64| match period {
         None => p.re >= -tol,
         Some(_) => p.norm() >= 1.0 - tol,
+    };
+    let strictly_inside = |p: &Complex<f64>| match period {
+        None => p.re < 0.0,
+        Some(_) => p.norm() < 1.0,
+    };
+    poles.iter().copied().find(|p| {
+        outside(p, normwise)
+            && !(strictly_inside(p)
+                && componentwise_tolerance(a, *p).is_some_and(|tol| !outside(p, tol)))
     })
+}
+
+/// `100 N ε |y|ᵀ|A||x| / |yᴴx|`, the rounding error of the eigenvalue `p`
+/// of `a` under relative perturbations of its entries, with `x`, `y` the
+/// right and left singular vectors of `A − p I` for its smallest singular
+/// value (its eigenvectors). `None` when the SVD fails.
+fn componentwise_tolerance<const N: usize>(a: &SMatrix<f64, N, N>, p: Complex<f64>) -> Option<f64> {
+    let shifted = DMatrix::from_fn(N, N, |i, j| {
+        Complex::new(a[(i, j)], 0.0) - if i == j { p } else { Complex::new(0.0, 0.0) }
+    });
+    let iterations = ITERATIONS_PER_DIM * N;
+    let svd = shifted.try_svd_unordered(true, true, f64::EPSILON, iterations)?;
+    if svd.singular_values.iter().any(|s| !s.is_finite()) {
+        return None;
+    }
+    let (u, v_t) = (svd.u?, svd.v_t?);
+    let k = svd.singular_values.imin();
+    let x = v_t.row(k).adjoint();
+    let y = u.column(k);
+    let mut weighted = 0.0;
+    for i in 0..N {
+        for j in 0..N {
+            weighted += y[i].norm() * a[(i, j)].abs() * x[j].norm();
+        }
+    }
+    let overlap = y.dotc(&x).norm();
+    let tol = 100.0 * N as f64 * f64::EPSILON * weighted / overlap;
+    tol.is_finite().then_some(tol)
 }
 
 /// Solves `m x = b` for a DC gain, refusing an `m` so ill-conditioned that
 /// the gain would have fewer than about four correct digits: a pole at
 /// s = 0 / z = 1 that rounding moved slightly off it must be reported, not
-/// turned into a huge, meaningless number.
+/// turned into a huge, meaningless number. The equations are first scaled
+/// by powers of two (each row's largest entry in [1, 2)), and the test is
+/// the Skeel condition number `‖ |m⁻¹| |m| ‖∞`, which no such scaling
+/// changes: `diag(−1, −1e12)` is perfectly conditioned.
 fn gain_solve<const N: usize, const M: usize>(
     m: &SMatrix<f64, N, N>,
     b: &SMatrix<f64, N, M>,
     operation: &'static str,
 ) -> Result<SMatrix<f64, N, M>, Error> {
-    let lu = Lu::new(m, operation)?;
-    if lu.condition(m) * f64::EPSILON > 1e-4 {
+    let (mut m, mut b) = (*m, *b);
+    for i in 0..N {
+        let f = 1.0 / pow2_floor(m.row(i).amax());
+        m.row_mut(i).scale_mut(f);
+        b.row_mut(i).scale_mut(f);
+    }
+    let lu = Lu::new(&m, operation)?;
+    let skeel = (lu.solve(&SMatrix::<f64, N, N>::identity()).abs() * m.abs())
+        .row_iter()
+        .map(|r| r.sum())
+        .fold(0.0, f64::max);
+    if !skeel.is_finite() || skeel * f64::EPSILON > 1e-4 {
         return Err(Error::Singular { operation });
     }
-    Ok(lu.solve(b))
+    Ok(lu.solve(&b))
 }
 
 fn finite_gain<const P: usize, const M: usize>(

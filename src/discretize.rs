@@ -48,7 +48,10 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     /// - [`Error::Singular`] when Tustin or backward Euler meets a singular
     ///   `I − α h A` (a pole exactly at `1/(α h)`);
     /// - [`Error::Overflow`] when `dt` is so large for the dynamics that the
-    ///   result is not representable.
+    ///   result is not representable;
+    /// - [`Error::IllConditioned`] (ZOH) when the rounding error of the
+    ///   matrix exponential may exceed [`EXPM_MAX_ERROR`] (a lightly damped
+    ///   mode over millions of its periods).
     ///
     /// # Examples
     ///
@@ -111,6 +114,28 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
 /// *Matrix Computations*, §11.3).
 const PADE_Q: usize = 6;
 
+/// Largest estimated relative error of a ZOH discretisation or [`expm`]
+/// that is returned; above it the result is refused with
+/// [`Error::IllConditioned`]. Scaling and squaring loses accuracy only
+/// when the squarings amplify rounding (about `ε ‖A h‖` for a lightly
+/// damped or rotating mode: a rotation by 10¹⁵ rad cannot be computed).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, discretize::{EXPM_MAX_ERROR, expm}};
+/// use nalgebra::matrix;
+///
+/// let r = expm(&matrix![0.0, -1e3; 1e3, 0.0])?; // error about 1e-13
+/// assert!((r[(1, 0)] - 1e3f64.sin()).abs() < 1e-10);
+/// match expm(&matrix![0.0, -1e15; 1e15, 0.0]) {
+///     Err(Error::IllConditioned { error, limit, .. }) => assert!(error > limit && limit == EXPM_MAX_ERROR),
+///     other => panic!("{other:?}"),
+/// }
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub const EXPM_MAX_ERROR: f64 = 1e-8;
+
 /// Exact ZOH: `Ad = exp(A h)`, `Bd = ∫₀ʰ exp(A s) ds · B`.
 ///
 /// Both come out of `exp(W)` with `W = [[A, B], [0, 0]] h`, computed by
@@ -118,7 +143,17 @@ const PADE_Q: usize = 6;
 /// triangular with a zero lower-right block, so every polynomial in it is
 /// `[[p(X), r(X) Y], [0, p(0) I]]` with `X = A h`, `Y = B h`; the algorithm runs
 /// on the N×N and N×M blocks alone (no (N+M)-sized matrix, which const
-/// generics cannot spell) and squares by `[[E, G], [0, I]]² = [[E², E G + G], [0, I]]`.
+/// generics cannot spell).
+///
+/// The squarings `[[E, G], [0, I]]² = [[E², E G + G], [0, I]]` amplify
+/// rounding: by about `2^s ε` for a mode that neither decays nor grows
+/// much (a rotation by 10¹⁵ rad cannot be computed), and for the slow modes
+/// of a stiff model under a step far longer than its fastest time constant
+/// (`exp` of a slow mode after many halvings is `1` plus less than `ε`).
+/// When the squarings are many enough for that to matter
+/// (`2^s (N + 2) ε > `[`EXPM_MAX_ERROR`]) a componentwise bound on the
+/// rounding error is carried along, and a result whose bound exceeds the
+/// limit is refused rather than returned wrong.
 pub(crate) fn zoh<const N: usize, const M: usize>(
     a: &SMatrix<f64, N, N>,
     b: &SMatrix<f64, N, M>,
@@ -134,6 +169,11 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
     let norm = (0..N)
         .map(|i| x.row(i).abs().sum() + y.row(i).abs().sum())
         .fold(0.0f64, f64::max);
+    if !norm.is_finite() {
+        // Row sums beyond f64::MAX: 2^1024 and more halvings would be
+        // needed, and the squarings could not be accurate anyway.
+        return Err(Error::Overflow { operation: OP });
+    }
     let squarings = if norm > 0.5 {
         // 2 + floor(log2 ‖W‖) halvings bring the norm below ½.
         (norm.log2().floor() as i32 + 2).max(0)
@@ -166,9 +206,58 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
     let lu = Lu::new(&dx, OP)?;
     let mut e = lu.solve(&nx);
     let mut g = lu.solve(&(ny - dy));
-    for _ in 0..squarings {
-        g = e * g + g;
-        e = e * e;
+    let unit = (N + 2) as f64 * f64::EPSILON;
+    if 2f64.powi(squarings) * unit <= EXPM_MAX_ERROR {
+        for _ in 0..squarings {
+            g = e * g + g;
+            e = e * e;
+        }
+    } else {
+        // Componentwise error bounds: the solve's to start (ε-relative to
+        // the magnitudes that made E and G: |D⁻¹| (|N| + |D| |E|)), then
+        // δ(E²) = δE E + E δE and δ(E G + G) = (E + I) δG + δE G, plus each
+        // step's rounding. E is judged at every step against max(|E|, 1) (a
+        // decaying mode's tiny entries need no relative accuracy; a
+        // rotation whose rounding has made it decay must not pass), G at
+        // the end.
+        let inv = lu.solve(&id).abs();
+        let mut de = inv * (nx.abs() + dx.abs() * e.abs()) * unit;
+        let mut dg = inv * ((ny - dy).abs() + dx.abs() * g.abs()) * unit;
+        // A bound that overflowed (NaN from inf · 0 included) is no bound.
+        let largest = |m: &[f64]| {
+            m.iter().fold(
+                0.0f64,
+                |w, &v| {
+                    if v.is_nan() { f64::INFINITY } else { w.max(v) }
+                },
+            )
+        };
+        let mut error = 0.0f64;
+        for _ in 0..squarings {
+            let ea = e.abs();
+            error = error.max(largest(de.as_slice()) / ea.amax().max(1.0));
+            if error.is_nan() || error > EXPM_MAX_ERROR {
+                break;
+            }
+            let ga = g.abs();
+            dg = (ea + id) * dg + de * ga + (ea * ga + ga) * unit;
+            de = de * ea + ea * de + ea * ea * unit;
+            g = e * g + g;
+            e = e * e;
+        }
+        error = error.max(largest(de.as_slice()) / e.abs().amax().max(1.0));
+        if g.amax() > 0.0 {
+            error = error.max(largest(dg.as_slice()) / g.amax());
+        }
+        if error.is_nan() || error > EXPM_MAX_ERROR {
+            return Err(Error::IllConditioned {
+                operation: "matrix exponential (scaling and squaring amplifies rounding \
+                            past the result: a fast rotation, or a step far longer than \
+                            the fastest time constant)",
+                error,
+                limit: EXPM_MAX_ERROR,
+            });
+        }
     }
     if e.iter().chain(g.iter()).any(|v| !v.is_finite()) {
         return Err(Error::Overflow { operation: OP });
@@ -182,7 +271,8 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
 /// # Errors
 ///
 /// [`Error::NonFinite`] for a NaN or infinite entry; [`Error::Overflow`]
-/// when the result is not representable.
+/// when the result is not representable; [`Error::IllConditioned`] when
+/// its estimated rounding error exceeds [`EXPM_MAX_ERROR`] (see there).
 ///
 /// # Examples
 ///

@@ -60,10 +60,15 @@ pub enum Error {
         operation: &'static str,
     },
     /// A response did not settle inside its band before the end of the
-    /// record (or diverged), so its step metrics are not defined.
+    /// record, so its step metrics are not defined; `cause` says whether it
+    /// diverges, oscillates, or was still converging (the message adds a
+    /// hint for each).
     #[error(
-        "response not settled: it is outside the settling band at t = {last_outside} s, \
-         after the start of the final window at t = {window_start} s"
+        "response not settled ({cause}): it is outside the settling band at t = {} s, \
+         after the start of the final window at t = {} s; {}",
+        Short(*last_outside),
+        Short(*window_start),
+        cause.hint()
     )]
     NotSettled {
         /// Time (s, from the first sample) at which the response last enters
@@ -72,6 +77,8 @@ pub enum Error {
         /// Start (s, from the first sample) of the final window the response
         /// has to stay inside the band for.
         window_start: f64,
+        /// What the final window looks like.
+        cause: SettleFailure,
     },
     /// A model is unstable where a stable one is needed (step metrics of a
     /// model, a Riccati solution that does not stabilise).
@@ -226,6 +233,45 @@ pub enum Error {
         /// The parser's message, naming the field.
         message: String,
     },
+    /// An index is past the end of what it indexes (an output channel of a
+    /// response, …).
+    #[error("{what} index {index} is out of range: there are {len}")]
+    OutOfRange {
+        /// What was indexed (`"output"`, …).
+        what: &'static str,
+        /// The index asked for.
+        index: usize,
+        /// How many there are (valid indices are `0..len`).
+        len: usize,
+    },
+    /// A result was computed but fails the accuracy check the operation
+    /// applies to it: the problem is too ill-conditioned for double
+    /// precision (a pole placement whose poles land elsewhere, a matrix
+    /// exponential whose rounding errors grow past the result).
+    #[error(
+        "{operation}: too ill-conditioned for double precision \
+         (estimated relative error {error:.1e}, limit {limit:.0e})"
+    )]
+    IllConditioned {
+        /// The operation (`"Ackermann pole placement"`, …).
+        operation: &'static str,
+        /// The relative error found or estimated.
+        error: f64,
+        /// The largest relative error the operation accepts.
+        limit: f64,
+    },
+    /// A target pole handed to a pole-placement routine is unusable.
+    #[error("target pole {index} ({re} + {im}i): {reason}")]
+    InvalidPole {
+        /// Zero-based index of the pole in the targets.
+        index: usize,
+        /// Its real part.
+        re: f64,
+        /// Its imaginary part.
+        im: f64,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
     /// Reading or writing a file failed. Holds the error kind and message
     /// rather than `std::io::Error` so that `Error` stays `Clone + PartialEq`.
     #[error("{context}: {message}")]
@@ -237,6 +283,93 @@ pub enum Error {
         /// The I/O error's message.
         message: String,
     },
+}
+
+/// Why a response did not settle ([`Error::NotSettled`]), judged from its
+/// final window: a hint at what to change, not a proof.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, StepInfoOptions, metrics::{SettleFailure, step_info}};
+///
+/// let t: Vec<f64> = (0..=100).map(|k| k as f64 * 0.01).collect();
+/// let growing: Vec<f64> = t.iter().map(|t| (4.0 * t).exp() - 1.0).collect();
+/// match step_info(&t, &growing, &StepInfoOptions::default()) {
+///     Err(Error::NotSettled { cause, .. }) => assert_eq!(cause, SettleFailure::Diverging),
+///     other => panic!("{other:?}"),
+/// }
+/// assert!(SettleFailure::TooShort.hint().contains("longer"));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum SettleFailure {
+    /// The deviation from the final value keeps growing (an unstable loop,
+    /// a ramp).
+    Diverging,
+    /// The response keeps crossing the final value without decaying (an
+    /// undamped or barely damped oscillation).
+    Oscillating,
+    /// The response is still converging when the record ends.
+    TooShort,
+}
+
+impl SettleFailure {
+    /// What to check or change, in a few words.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::metrics::SettleFailure;
+    /// assert!(SettleFailure::Diverging.hint().contains("unstable"));
+    /// ```
+    pub fn hint(self) -> &'static str {
+        match self {
+            SettleFailure::Diverging => {
+                "the deviation keeps growing: is the loop unstable (check its poles)?"
+            }
+            SettleFailure::Oscillating => {
+                "it keeps oscillating about the final value: the loop is undamped or \
+                 barely damped (check the damping of its poles)"
+            }
+            SettleFailure::TooShort => {
+                "it is still converging: use a longer record (a larger t_end) or a wider \
+                 settling band"
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for SettleFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SettleFailure::Diverging => "diverging",
+            SettleFailure::Oscillating => "oscillating",
+            SettleFailure::TooShort => "record too short",
+        })
+    }
+}
+
+/// A time printed to six significant digits, without the float noise of
+/// the shortest round-trip form (`0.475`, not `0.47500000000000003`).
+struct Short(f64);
+
+impl std::fmt::Display for Short {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let v = self.0;
+        if v == 0.0 || !v.is_finite() {
+            return write!(f, "{v}");
+        }
+        let digits = 5 - v.abs().log10().floor() as i32;
+        let p = 10f64.powi(digits.abs());
+        let rounded = if digits >= 0 {
+            (v * p).round() / p
+        } else {
+            (v / p).round() * p
+        };
+        // Fall back to the value itself where the scaling over- or underflows.
+        write!(f, "{}", if rounded.is_finite() { rounded } else { v })
+    }
 }
 
 impl Error {

@@ -53,6 +53,7 @@
 
 use crate::data::Recording;
 use crate::error::Error;
+pub use crate::error::SettleFailure;
 use crate::model::{Continuous, StateSpace};
 use crate::sim::step_response;
 
@@ -189,7 +190,10 @@ impl StepInfoOptions {
 ///   the upper rise level;
 /// - [`Error::InvalidParameter`] for bad options;
 /// - [`Error::NotSettled`] when `y` is outside the band anywhere in the final
-///   window (unsettled or diverging).
+///   window, with its [`SettleFailure`] (diverging, oscillating, or a
+///   record too short);
+/// - [`Error::Overflow`] when a figure is not representable (an overshoot
+///   of 10³⁰⁰ % of a tiny step, times spanning more than `f64::MAX` s).
 ///
 /// # Examples
 ///
@@ -234,11 +238,16 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
     let y0 = options.initial_value.unwrap_or(y[0]);
     let yf = match options.final_value {
         Some(v) => v,
-        None => y[window_start..].iter().sum::<f64>() / window as f64,
+        None => mean(&y[window_start..]),
     };
     let delta = yf - y0;
+    if !delta.is_finite() {
+        return Err(Error::Overflow {
+            operation: "step metrics (the step y∞ − y₀ exceeds f64::MAX)",
+        });
+    }
     let scale = y0.abs().max(yf.abs());
-    if !delta.is_finite() || delta.abs() <= 4.0 * f64::EPSILON * scale || delta == 0.0 {
+    if delta.abs() <= 4.0 * f64::EPSILON * scale || delta == 0.0 {
         return Err(Error::InvalidData {
             what: "y",
             index: 0,
@@ -251,12 +260,15 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
         // towards its end (it moves with it), so also ask for no trend: the
         // two halves of the final window agree to a quarter of the band.
         let half = window / 2;
-        let first = y[window_start..window_start + half].iter().sum::<f64>() / half as f64;
-        let second = y[n - half..].iter().sum::<f64>() / half as f64;
-        if (second - first).abs() > 0.25 * band {
+        let first = mean(&y[window_start..window_start + half]);
+        let second = mean(&y[n - half..]);
+        // Halved before subtracting: the difference of two finite means
+        // can overflow, and then the response certainly trends.
+        if (0.5 * second - 0.5 * first).abs() > 0.125 * band {
             return Err(Error::NotSettled {
                 last_outside: t[n - 1] - t0,
                 window_start: t[window_start] - t0,
+                cause: settle_failure(y, yf, window_start),
             });
         }
     }
@@ -270,6 +282,7 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
             return Err(Error::NotSettled {
                 last_outside: t[n - 1] - t0,
                 window_start: t[window_start] - t0,
+                cause: settle_failure(y, yf, window_start),
             });
         }
         Some(j) => {
@@ -279,6 +292,7 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
                 return Err(Error::NotSettled {
                     last_outside: ts,
                     window_start: t[window_start] - t0,
+                    cause: settle_failure(y, yf, window_start),
                 });
             }
             ts
@@ -323,7 +337,7 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
     let peak_i = y.iter().position(|&v| v == peak).unwrap_or(0);
     let (peak_p, min_p) = (progress(peak), progress(wrong_way));
     let (s_min, s_max) = extremes(&y[i_hi..]);
-    Ok(StepInfo {
+    let info = StepInfo {
         rise_time: t_hi - t_lo,
         settling_time,
         settling_min: s_min,
@@ -335,7 +349,93 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
         peak_time: t[peak_i] - t0,
         steady_state_value: yf,
         steady_state_error: options.reference.map(|r| r - yf),
-    })
+    };
+    check_figures(&info)?;
+    Ok(info)
+}
+
+/// Every figure must be a finite number: a peak a googol of steps away,
+/// or times spanning more than `f64::MAX` seconds, are errors, not `inf`.
+fn check_figures(info: &StepInfo) -> Result<(), Error> {
+    let figures = [
+        (info.rise_time, "step metrics: rise time overflows"),
+        (info.settling_time, "step metrics: settling time overflows"),
+        (info.peak_time, "step metrics: peak time overflows"),
+        (
+            info.overshoot,
+            "step metrics: overshoot overflows (a peak far beyond a tiny step)",
+        ),
+        (
+            info.undershoot,
+            "step metrics: undershoot overflows (a dip far beyond a tiny step)",
+        ),
+        (
+            info.steady_state_error.unwrap_or(0.0),
+            "step metrics: steady-state error overflows",
+        ),
+    ];
+    match figures.iter().find(|(v, _)| !v.is_finite()) {
+        Some(&(_, operation)) => Err(Error::Overflow { operation }),
+        None => Ok(()),
+    }
+}
+
+/// Mean of finite samples that cannot overflow: the plain sum when it is
+/// finite (the common case, and bit-for-bit the straightforward mean), else
+/// the sum of the samples divided first.
+fn mean(y: &[f64]) -> f64 {
+    let n = y.len() as f64;
+    let sum = y.iter().sum::<f64>();
+    if sum.is_finite() {
+        sum / n
+    } else {
+        y.iter().map(|v| v / n).sum()
+    }
+}
+
+/// Why `y` is not settled about `yf`, from its final window (from
+/// `window_start`) and the stretch of equal length before it: a growing
+/// deviation is [`SettleFailure::Diverging`], repeated crossings of `yf`
+/// without decay [`SettleFailure::Oscillating`], anything else (a decaying
+/// error) [`SettleFailure::TooShort`].
+#[cold]
+fn settle_failure(y: &[f64], yf: f64, window_start: usize) -> SettleFailure {
+    let window = &y[window_start..];
+    let half = window.len() / 2;
+    // Largest deviation from yf, halved so that it cannot overflow.
+    let amplitude = |s: &[f64]| {
+        s.iter()
+            .fold(0.0f64, |m, v| m.max((0.5 * v - 0.5 * yf).abs()))
+    };
+    let crossings = window
+        .windows(2)
+        .filter(|w| (w[0] > yf) != (w[1] > yf))
+        .count();
+    if half >= 1 && crossings >= 2 {
+        let (first, second) = (amplitude(&window[..half]), amplitude(&window[half..]));
+        return if second > 1.1 * first {
+            SettleFailure::Diverging
+        } else if second >= 0.9 * first {
+            SettleFailure::Oscillating
+        } else {
+            SettleFailure::TooShort
+        };
+    }
+    // No oscillation: compare the drift over the window with the drift over
+    // the stretch before it; a drift that does not slow down diverges.
+    let len = window.len();
+    if len < 2 || window_start < len {
+        return SettleFailure::TooShort;
+    }
+    // (A ramp drifts equally; a decay with a time constant 100 windows long
+    // would look the same, and then the record is far too short anyway.)
+    let drift = |s: &[f64]| (0.5 * s[s.len() - 1] - 0.5 * s[0]).abs();
+    let before = &y[window_start - len..window_start];
+    if drift(window) >= 0.99 * drift(before) && drift(window) > 0.0 {
+        SettleFailure::Diverging
+    } else {
+        SettleFailure::TooShort
+    }
 }
 
 /// The first non-finite sample or non-increasing time, as an error.

@@ -73,6 +73,28 @@ impl<'a> Series<'a> {
     }
 }
 
+/// An axis range that holds `[lo, hi]` (finite, `lo ≤ hi`) and that the
+/// tick search can work with: padded by `pad` of the span on each side,
+/// at least `1e-9` of the values' magnitude (and 1e-250) wide, so that a
+/// constant or nearly constant series still has ticks to find, and at most
+/// `f64::MAX` wide, so that its width is a number. `None` when the points
+/// themselves span more than `f64::MAX`.
+fn axis(lo: f64, hi: f64, pad: f64) -> Option<(f64, f64)> {
+    let span = hi - lo;
+    if !span.is_finite() {
+        return None;
+    }
+    let min_span = (1e-9 * lo.abs().max(hi.abs())).max(1e-250);
+    let (lo, hi, span) = if span < min_span {
+        let centre = 0.5 * lo + 0.5 * hi;
+        (centre - 0.5 * min_span, centre + 0.5 * min_span, min_span)
+    } else {
+        (lo, hi, span)
+    };
+    let pad = (pad * span).min(0.5 * (f64::MAX - span));
+    Some(((lo - pad).max(-f64::MAX), (hi + pad).min(f64::MAX)))
+}
+
 /// Writes every series on one pair of axes to an SVG file at `path`, with a
 /// title, axis labels and a legend. Axis ranges cover all finite points;
 /// non-finite points are skipped; a series longer than [`MAX_POINTS`] is
@@ -81,7 +103,8 @@ impl<'a> Series<'a> {
 /// # Errors
 ///
 /// [`Error::LengthMismatch`] if a series' `t` and `y` differ in length;
-/// [`Error::InvalidData`] if there is no finite point at all;
+/// [`Error::InvalidData`] if there is no finite point at all, or the points
+/// span more than `f64::MAX` (`y` from −1e308 to 1e308);
 /// [`Error::Plot`] if the file cannot be written.
 ///
 /// # Examples
@@ -131,15 +154,13 @@ pub fn responses_svg(
             reason: "no finite point to plot",
         });
     }
-    if x1 <= x0 {
-        x1 = x0 + 1.0;
-    }
-    let pad = if y1 > y0 {
-        0.05 * (y1 - y0)
-    } else {
-        0.5 * y0.abs().max(1.0)
+    let too_wide = |what| Error::InvalidData {
+        what,
+        index: 0,
+        reason: "the points span more than f64::MAX: no axis can hold them",
     };
-    let (y0, y1) = (y0 - pad, y1 + pad);
+    let (x0, x1) = axis(x0, x1, 0.0).ok_or_else(|| too_wide("series t"))?;
+    let (y0, y1) = axis(y0, y1, 0.05).ok_or_else(|| too_wide("series y"))?;
 
     let plot_err = |e: &dyn std::fmt::Display| Error::Plot {
         path: path.display().to_string(),

@@ -214,12 +214,12 @@ fn acker_refuses_uncontrollable_plants_and_unpaired_targets() {
     ];
     assert!(matches!(
         acker(&plant, &unpaired),
-        Err(Error::InvalidParameter { name: "poles", .. })
+        Err(Error::InvalidPole { index: 0, .. })
     ));
     let nan = [Complex::new(f64::NAN, 0.0); 4];
     assert!(matches!(
         acker(&plant, &nan),
-        Err(Error::InvalidParameter { name: "poles", .. })
+        Err(Error::InvalidPole { index: 0, .. })
     ));
 }
 

@@ -595,6 +595,14 @@ fn a_stalled_real_time_tick_leaves_a_gap_and_the_rest_identifies() {
                 refusals.push(got);
                 continue;
             }
+            // Split into many short segments, what is left may not
+            // determine every parameter (a Coulomb column with no moving
+            // row): as busy a machine, the same answer.
+            Err(Error::RankDeficient { rank, .. }) => {
+                println!("attempt {attempt}: the rows left determine only {rank} parameters");
+                refusals.push(rank);
+                continue;
+            }
             Err(e) => panic!("{e}"),
         };
         println!("timing tolerated: {:?}", e.timing);
@@ -624,13 +632,31 @@ fn a_stalled_real_time_tick_leaves_a_gap_and_the_rest_identifies() {
             e.timing.rows + 2 * e.timing.segments + e.timing.unused_samples,
             rec.len()
         );
-        // One second is a fifth of an identification run: loose bars.
-        for (got, want) in [
-            (e.k1.value, truth.k1),
-            (e.k2.value, truth.k2),
-            (e.gain.value, truth.gain),
-        ] {
-            assert!(rel(got, want) < 0.05, "{got} vs {want}");
+        // One second is a fifth of an identification run: loose bars. They
+        // hold when the loop kept its time; on a machine so busy that its
+        // p99 lateness passes half a period, what is left after the splits
+        // is too little to hold them, and that run counts as a busy one.
+        let misses: Vec<String> = [
+            ("k1", e.k1.value, truth.k1),
+            ("k2", e.k2.value, truth.k2),
+            ("K", e.gain.value, truth.gain),
+        ]
+        .iter()
+        .filter(|(_, got, want)| rel(*got, *want) >= 0.05)
+        .map(|(name, got, want)| format!("{name} {got} vs {want}"))
+        .collect();
+        if !misses.is_empty() {
+            assert!(
+                out.stats.lateness_p99 > 0.5 * DT,
+                "the loop kept time (p99 {} s) and still: {misses:?}",
+                out.stats.lateness_p99
+            );
+            println!(
+                "attempt {attempt}: busy machine (p99 lateness {} s): {misses:?}",
+                out.stats.lateness_p99
+            );
+            refusals.push(e.timing.rows);
+            continue;
         }
         return;
     }

@@ -75,7 +75,7 @@ fn closed_loop_feedback_sees_the_current_state() {
         StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.5).unwrap();
     let r = simulate_discrete_feedback(&d, vector![1.0], 5, |k, x| vector![k as f64] - x);
     // u = k - x drives x[k+1] = k.
-    assert_eq!(r.output(0), vec![1.0, 0.0, 1.0, 2.0, 3.0]);
+    assert_eq!(r.output(0).unwrap(), vec![1.0, 0.0, 1.0, 2.0, 3.0]);
     assert_eq!(r.t, vec![0.0, 0.5, 1.0, 1.5, 2.0]);
 }
 

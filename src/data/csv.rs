@@ -213,6 +213,10 @@ impl Recording {
         if headers.is_empty() || headers.iter().all(str::is_empty) {
             return Err(csv_error(1, "empty input: expected a header line"));
         }
+        // The header's own line: the parser skips blank lines before it
+        // (and reports the header's position as line 1), so take the line
+        // the reader is on after it, less the header's line break.
+        let header_line = rdr.position().line().saturating_sub(1).max(1);
         let found = || headers.iter().collect::<Vec<_>>().join(",");
 
         // (column index, divisor) of time, and of each channel in order.
@@ -224,14 +228,14 @@ impl Recording {
             if matches!(channel.name.as_str(), "t" | "time") && channel.unit == "s" {
                 if time.is_some() {
                     return Err(csv_error(
-                        1,
+                        header_line,
                         format!("two time columns in header `{}`", found()),
                     ));
                 }
                 time = Some((i, divisor));
             } else if matches!(channel.name.as_str(), "t" | "time") {
                 return Err(csv_error(
-                    1,
+                    header_line,
                     format!(
                         "column `{header}` has no time unit: name it t_s or t_ms (header `{}`)",
                         found()
@@ -245,7 +249,7 @@ impl Recording {
         }
         let Some((time_index, time_divisor)) = time else {
             return Err(csv_error(
-                1,
+                header_line,
                 format!(
                     "missing a time column t_s (or t_ms, t [s]); the header is `{}`",
                     found()
@@ -256,7 +260,7 @@ impl Recording {
             inputs.iter().map(|c| c.0.clone()).collect(),
             measurements.iter().map(|c| c.0.clone()).collect(),
         )
-        .map_err(|e| csv_error(1, format!("{e} (header `{}`)", found())))?;
+        .map_err(|e| csv_error(header_line, format!("{e} (header `{}`)", found())))?;
         let slots: Vec<(usize, f64, &str)> = std::iter::once((time_index, time_divisor, "t"))
             .chain(
                 inputs
@@ -269,7 +273,7 @@ impl Recording {
         let mut cols: Vec<Vec<f64>> = vec![Vec::new(); slots.len()];
         let mut lines: Vec<u64> = Vec::new();
         let mut record = csv::StringRecord::new();
-        let mut last_line = 1u64;
+        let mut last_line = header_line;
         loop {
             match rdr.read_record(&mut record) {
                 Ok(false) => break,

@@ -6,6 +6,7 @@ use nalgebra::{Complex, DMatrix, SMatrix};
 use crate::analysis::{eigenvalues, first_unstable};
 use crate::error::{Error, check_finite};
 use crate::kernels::linalg::Lu;
+use crate::kernels::reduce::pow2_floor;
 use crate::model::{Continuous, Discrete, StateSpace};
 
 /// Doubling steps allowed; quadratic convergence needs far fewer (about
@@ -121,6 +122,7 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
     r: &SMatrix<f64, M, M>,
 ) -> Result<Lqr<N, M>, Error> {
     check_weights(q, r, ["Q", "R"])?;
+    let (q, r, weight) = &balance_weights(q, r);
     let (a, b) = (*sys.a(), *sys.b());
     let r_lu = Lu::new(r, "LQR (R)")?;
     let r_inv_bt = r_lu.solve(&b.transpose());
@@ -183,7 +185,15 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
         },
     );
     let gain = r_inv_bt * x;
-    finish(gain, x, &(a - b * gain), residual, iterations, None)
+    finish(
+        gain,
+        x,
+        *weight,
+        &(a - b * gain),
+        residual,
+        iterations,
+        None,
+    )
 }
 
 /// Discrete-time LQR: the gain `K = (R + Bᵀ X B)⁻¹ Bᵀ X A` minimising
@@ -215,6 +225,7 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
     r: &SMatrix<f64, M, M>,
 ) -> Result<Lqr<N, M>, Error> {
     check_weights(q, r, ["Q", "R"])?;
+    let (q, r, weight) = &balance_weights(q, r);
     let (a, b) = (*sys.a(), *sys.b());
     let r_inv_bt = Lu::new(r, "LQR (R)")?.solve(&b.transpose());
     let g = symmetric(&(b * r_inv_bt));
@@ -238,6 +249,7 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
     finish(
         gain,
         x,
+        *weight,
         &(a - b * gain),
         residual,
         iterations,
@@ -277,9 +289,30 @@ fn sda<const N: usize>(
     })
 }
 
+/// `Q` and `R` times one power of two `c` that brings the geometric mean of
+/// their largest entries near 1 (the LQR problem does not change when both
+/// weights are scaled alike: `X` scales with them, `K` not at all), and
+/// `c`. Weights of 1e308 then neither overflow nor make `R⁻¹` underflow.
+fn balance_weights<const N: usize, const M: usize>(
+    q: &SMatrix<f64, N, N>,
+    r: &SMatrix<f64, M, M>,
+) -> (SMatrix<f64, N, N>, SMatrix<f64, M, M>, f64) {
+    let (sq, sr) = (pow2_floor(q.amax()), pow2_floor(r.amax()));
+    // 1 / √(sq sr), rounded to a power of two, without forming sq sr.
+    let c = if q.amax() > 0.0 {
+        1.0 / pow2_floor(sq.sqrt() * sr.sqrt())
+    } else {
+        1.0 / sr
+    };
+    (q * c, r * c, c)
+}
+
+/// The solution: `riccati` is of the weights scaled by `weight` (see
+/// [`balance_weights`]) and is scaled back here.
 fn finish<const N: usize, const M: usize>(
     gain: SMatrix<f64, M, N>,
     riccati: SMatrix<f64, N, N>,
+    weight: f64,
     a_cl: &SMatrix<f64, N, N>,
     residual: f64,
     iterations: usize,
@@ -288,6 +321,12 @@ fn finish<const N: usize, const M: usize>(
     if gain.iter().any(|v| !v.is_finite()) {
         return Err(Error::Overflow {
             operation: "LQR gain",
+        });
+    }
+    let riccati = riccati / weight;
+    if riccati.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Overflow {
+            operation: "LQR Riccati solution (X exceeds f64::MAX for these weights)",
         });
     }
     let poles = eigenvalues(a_cl)?;
@@ -412,6 +451,9 @@ pub(crate) fn check_weights<const N: usize, const M: usize>(
     let [q_name, r_name] = names;
     check_finite(q_name, q)?;
     check_finite(r_name, r)?;
+    // Scaled to unit largest entry first: the norm of weights near
+    // f64::MAX must not overflow.
+    let (q, r) = (&(q / pow2_floor(q.amax())), &(r / pow2_floor(r.amax())));
     let symmetric_enough = |asym: f64, norm: f64| asym <= 1e-12 * norm;
     if !symmetric_enough((q - q.transpose()).norm(), q.norm()) {
         return Err(Error::InvalidMatrix {

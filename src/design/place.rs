@@ -1,11 +1,12 @@
 //! Pole placement for single-input systems, Ackermann's formula, and the
 //! validation of target poles that [`place`](super::place) shares.
 
-use nalgebra::{Complex, DMatrix, SMatrix};
+use nalgebra::{Complex, SMatrix};
 
-use crate::analysis::rank;
+use crate::analysis::{eigenvalues, scaled_krylov_rank};
 use crate::error::Error;
 use crate::kernels::linalg::Lu;
+use crate::kernels::reduce::pow2_floor;
 use crate::model::{Domain, StateSpace};
 
 /// Relative distance within which two targets count as a conjugate pair.
@@ -25,9 +26,12 @@ const CONJUGATE_RTOL: f64 = 1e-10;
 /// # Errors
 ///
 /// [`Error::Uncontrollable`] with the numerical rank when `(A, B)` is not
-/// controllable ([`rank`] with its default tolerance);
-/// [`Error::InvalidParameter`] named `"poles"` for a non-finite target or
-/// targets not closed under conjugation.
+/// controllable (the test of [`is_controllable`](StateSpace::is_controllable),
+/// independent of units); [`Error::InvalidPole`] naming a non-finite target
+/// or one without its conjugate; [`Error::IllConditioned`] when the poles of
+/// `A − B K`, computed back, miss the targets by more than 0.1 % of the
+/// largest (the problem is too ill-conditioned for the formula in double
+/// precision: eight states with spread-out poles, say).
 ///
 /// # Examples
 ///
@@ -53,21 +57,29 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
 ) -> Result<SMatrix<f64, 1, N>, Error> {
     let coeffs = real_polynomial(poles)?;
     let (a, b) = (sys.a(), sys.b());
-    // Controllability matrix [B, A B, …, A^(N−1) B].
+    let r = scaled_krylov_rank(a, b)?;
+    if r < N {
+        return Err(Error::Uncontrollable { rank: r, states: N });
+    }
+    // Controllability matrix [B, A B, …, A^(N−1) B], each new column
+    // divided by a power of two s_j as it is formed (so that it cannot
+    // overflow, and the LU's pivot test sees no units): 𝒞 = 𝒞̃ S with
+    // S = diag(s₀, s₀s₁, …), so the last row of 𝒞⁻¹ = S⁻¹ 𝒞̃⁻¹ is that of
+    // 𝒞̃⁻¹ divided by s₀ s₁ … s_(N−1).
     let mut ctrb = SMatrix::<f64, N, N>::zeros();
     let mut col = *b;
+    let mut last_scale = 1.0;
     for j in 0..N {
+        let s = pow2_floor(col.amax());
+        col /= s;
         ctrb.set_column(j, &col);
+        last_scale = if j == 0 { s } else { last_scale * s };
         col = a * col;
     }
     if ctrb.iter().any(|v| !v.is_finite()) {
         return Err(Error::Overflow {
             operation: "controllability matrix",
         });
-    }
-    let r = rank(&DMatrix::from_fn(N, N, |i, j| ctrb[(i, j)]), None)?;
-    if r < N {
-        return Err(Error::Uncontrollable { rank: r, states: N });
     }
     // φ(A) by Horner: coeffs are monic, highest power first.
     let mut phi = SMatrix::<f64, N, N>::identity();
@@ -81,12 +93,54 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
     // The rank test passed, so a failure here is the LU's stricter pivot
     // test on a nearly uncontrollable pair: say so, not "rank N of N".
     let row = Lu::solve_right(&ctrb, &last, "Ackermann (controllability matrix)")?;
-    let k = row * phi;
-    if k.iter().all(|v| v.is_finite()) {
-        Ok(k)
-    } else {
-        Err(Error::Overflow {
+    let k = (row * phi) / last_scale;
+    if !k.iter().all(|v| v.is_finite()) {
+        return Err(Error::Overflow {
             operation: "Ackermann gain",
+        });
+    }
+    check_placement(&(a - b * k), poles)?;
+    Ok(k)
+}
+
+/// Largest distance, relative to the largest target, between the poles of
+/// `A − B K` as computed and the targets they were placed at, above which
+/// [`acker`] refuses its gain.
+const PLACEMENT_RTOL: f64 = 1e-3;
+
+/// Checks that the closed loop's poles, as [`StateSpace::poles`] computes
+/// them, are the targets: Ackermann's formula is exact in exact arithmetic,
+/// but for many states or targets far from the open-loop poles the closed
+/// loop is so sensitive that the gain's rounding moves its poles by tens
+/// of percent. Such a gain is refused, not returned.
+fn check_placement<const N: usize>(
+    a_cl: &SMatrix<f64, N, N>,
+    targets: &[Complex<f64>; N],
+) -> Result<(), Error> {
+    let got = eigenvalues(a_cl)?;
+    let scale = targets.iter().map(|t| t.norm()).fold(0.0, f64::max);
+    // Each target against its nearest computed pole not used yet.
+    let mut used = [false; N];
+    let mut worst = 0.0f64;
+    for t in targets {
+        let nearest = (0..N)
+            .filter(|&j| !used[j])
+            .min_by(|&x, &y| (got[x] - t).norm().total_cmp(&(got[y] - t).norm()));
+        if let Some(j) = nearest {
+            used[j] = true;
+            worst = worst.max((got[j] - t).norm());
+        }
+    }
+    let error = if scale > 0.0 { worst / scale } else { worst };
+    if error <= PLACEMENT_RTOL {
+        Ok(())
+    } else {
+        Err(Error::IllConditioned {
+            operation: "Ackermann pole placement (the closed-loop poles miss their \
+                        targets; try fewer states, targets nearer the open-loop \
+                        poles, or lqr)",
+            error,
+            limit: PLACEMENT_RTOL,
         })
     }
 }
@@ -128,19 +182,17 @@ fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>
 pub(crate) fn conjugate_pairs<const N: usize>(
     poles: &[Complex<f64>; N],
 ) -> Result<[Complex<f64>; N], Error> {
-    let bad = |value: f64, reason| Error::InvalidParameter {
-        name: "poles",
-        value,
+    let bad = |index: usize, reason| Error::InvalidPole {
+        index,
+        re: poles[index].re,
+        im: poles[index].im,
         reason,
     };
-    if let Some(p) = poles
+    if let Some(i) = poles
         .iter()
-        .find(|p| !(p.re.is_finite() && p.im.is_finite()))
+        .position(|p| !(p.re.is_finite() && p.im.is_finite()))
     {
-        return Err(bad(
-            if p.re.is_finite() { p.im } else { p.re },
-            "target poles must be finite",
-        ));
+        return Err(bad(i, "target poles must be finite"));
     }
     let mut used = [false; N];
     let mut out = [Complex::new(0.0, 0.0); N];
@@ -168,8 +220,8 @@ pub(crate) fn conjugate_pairs<const N: usize>(
             .filter(|&j| (poles[j] - p.conj()).norm() <= CONJUGATE_RTOL * scale);
         let Some(j) = partner else {
             return Err(bad(
-                p.im,
-                "complex target poles must come in conjugate pairs",
+                i,
+                "complex target poles must come in conjugate pairs, and this one has no partner",
             ));
         };
         used[j] = true;

@@ -6,7 +6,7 @@ use faer::{MatMut, Par};
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::Error;
-use crate::kernels::reduce::{first_non_finite, sum_by};
+use crate::kernels::reduce::{first_non_finite, max_abs, pow2_floor, sum_by};
 
 /// Default limit on the column-equilibrated condition number (10¹⁰, i.e.
 /// more than ten of the sixteen significant digits lost): above it a
@@ -327,31 +327,31 @@ pub(crate) fn solve_augmented(
             got: m,
         });
     }
-    let non_finite = |j: usize, col: &[f64]| {
-        first_non_finite(col).map(|i| Error::NonFinite {
-            matrix: "regressor",
-            row: i,
-            col: j,
-            value: col[i],
-        })
-    };
-
-    for (j, col) in a.chunks_exact(m).take(p).enumerate() {
-        if let Some(e) = non_finite(j, col) {
-            return Err(e);
+    // Equilibrate every column (λ too) by a power of two, so that its
+    // largest entry is in [1, 2): exact, and then no norm, product or
+    // square in the QR or the statistics below can overflow or underflow,
+    // whatever the units (a column of 1e308, another of 1e-200). The
+    // results are unscaled at the end.
+    let mut exponents = vec![0i32; p + 1];
+    for (j, (col, e)) in a.chunks_exact_mut(m).zip(exponents.iter_mut()).enumerate() {
+        if let Some(i) = first_non_finite(col) {
+            return Err(Error::NonFinite {
+                matrix: "regressor",
+                row: i,
+                col: j,
+                value: col[i],
+            });
+        }
+        *e = binary_exponent(max_abs(col));
+        if *e != 0 {
+            let f = pow2(-*e);
+            col.iter_mut().for_each(|v| *v *= f);
         }
     }
-    // Spread of λ about its mean, before QR overwrites it. A non-finite sum
-    // means a non-finite entry (or overflow, which the exact check tells
-    // apart).
+    let e_lambda = exponents[p];
+    // Spread of λ about its mean, before QR overwrites it.
     let lam = &a[p * m..];
-    let total = sum_by(lam, |v| v);
-    if !total.is_finite()
-        && let Some(e) = non_finite(p, lam)
-    {
-        return Err(e);
-    }
-    let mean = total / m as f64;
+    let mean = sum_by(lam, |v| v) / m as f64;
     let sst = sum_by(lam, |v| (v - mean) * (v - mean));
 
     let n = p + 1;
@@ -386,7 +386,14 @@ pub(crate) fn solve_augmented(
             rmat.column_mut(j).unscale_mut(norm);
         }
     }
-    let sv = rmat.singular_values();
+    let iterations = 200 * p;
+    let sv = rmat
+        .try_svd_unordered(false, false, f64::EPSILON, iterations)
+        .ok_or(Error::NoConvergence {
+            operation: "least squares (singular values of R)",
+            iterations,
+        })?
+        .singular_values;
     let smax = sv.max();
     let smin = sv.min();
     let condition = if smin > 0.0 {
@@ -421,8 +428,8 @@ pub(crate) fn solve_augmented(
     }
     let ssr = r(p, p) * r(p, p);
     let sigma2 = ssr / (m - p) as f64;
-    let covariance = &rinv * rinv.transpose() * sigma2;
-    let std_errors = covariance.diagonal().map(f64::sqrt);
+    let mut covariance = &rinv * rinv.transpose() * sigma2;
+    let mut std_errors = covariance.diagonal().map(f64::sqrt);
     let (r_squared, fit_percent) = if sst > 0.0 {
         (1.0 - ssr / sst, (1.0 - (ssr / sst).sqrt()) * 100.0)
     } else if ssr == 0.0 {
@@ -430,14 +437,53 @@ pub(crate) fn solve_augmented(
     } else {
         (f64::NEG_INFINITY, f64::NEG_INFINITY)
     };
+    // Undo the equilibration: θ_j and its standard error in λ's units per
+    // column j's, the covariance in their products.
+    for j in 0..p {
+        let d = e_lambda - exponents[j];
+        theta[j] = scale_pow2(theta[j], d);
+        std_errors[j] = scale_pow2(std_errors[j], d);
+        for i in 0..p {
+            covariance[(i, j)] =
+                scale_pow2(scale_pow2(covariance[(i, j)], d), e_lambda - exponents[i]);
+        }
+    }
+    let residual_rms = scale_pow2((ssr / m as f64).sqrt(), e_lambda);
+    let finite = |v: &[f64]| v.iter().all(|v| v.is_finite());
+    if !(finite(theta.as_slice())
+        && finite(std_errors.as_slice())
+        && finite(covariance.as_slice())
+        && residual_rms.is_finite())
+    {
+        return Err(Error::Overflow {
+            operation: "least squares (the estimate or its covariance exceeds f64::MAX)",
+        });
+    }
     Ok(LeastSquaresFit {
         theta,
         covariance,
         std_errors,
-        residual_rms: (ssr / m as f64).sqrt(),
+        residual_rms,
         r_squared,
         fit_percent,
         condition,
         rows: m,
     })
+}
+
+/// `e` with `2^e ≤ x < 2^(e+1)` for a finite `x > 0` (0 for `x = 0`).
+fn binary_exponent(x: f64) -> i32 {
+    pow2_floor(x).log2() as i32
+}
+
+/// `2^e` for `|e| ≤ 1022`, exactly.
+fn pow2(e: i32) -> f64 {
+    2f64.powi(e)
+}
+
+/// `v · 2^d` for `|d| ≤ 2046`, in two exact halves: no intermediate
+/// overflows unless the result does.
+fn scale_pow2(v: f64, d: i32) -> f64 {
+    let half = d / 2;
+    v * pow2(half) * pow2(d - half)
 }

@@ -3,6 +3,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::error::Error;
+use crate::kernels::reduce::pow2_floor;
 
 /// Recursive least squares for `P` parameters, with forgetting factor `μ`:
 /// each [`update`](Self::update) with a row `φᵀ θ = y` costs O(P²), uses
@@ -155,14 +156,37 @@ impl<const P: usize> Rls<P> {
             });
         }
         let e = y - phi.dot(&self.theta);
+        // With φ = s φ̃ (s a power of two, max |φ̃| in [1, 2)) the update is
+        // g e = P φ̃ (e s) / (μ + s² φ̃ᵀPφ̃) and P ← (P − P φ̃ φ̃ᵀ P c) / μ with
+        // c = s² / (μ + s² φ̃ᵀPφ̃): the same algebra, but φᵀPφ cannot
+        // overflow (φ = 1e200 would make the gain 0) or underflow. For
+        // s > 1 numerator and denominator are divided by s².
+        let s = pow2_floor(phi.amax());
+        let phi = phi * (1.0 / s);
         let p_phi = self.p * phi;
-        let denom = self.forgetting + phi.dot(&p_phi);
-        let gain = p_phi / denom;
-        let theta = self.theta + gain * e;
+        let q = phi.dot(&p_phi);
+        let (step, c) = if s > 1.0 {
+            let denom = self.forgetting / s / s + q;
+            // Both terms underflowed: φ̃ᵀPφ̃ = 0, so Pφ̃ = 0 (P is positive
+            // semidefinite) and there is nothing to learn along φ.
+            if denom == 0.0 {
+                (0.0, 0.0)
+            } else {
+                (e / s / denom, 1.0 / denom)
+            }
+        } else {
+            let s2 = s * s;
+            let denom = self.forgetting + s2 * q;
+            (e * s / denom, s2 / denom)
+        };
+        let theta = self.theta + p_phi * step;
         // P is symmetric, so φᵀP = (Pφ)ᵀ; symmetrise to stop round-off drift.
-        let mut p = (self.p - gain * p_phi.transpose()) / self.forgetting;
+        let mut p = (self.p - p_phi * (p_phi.transpose() * c)) / self.forgetting;
         p = (p + p.transpose()) * 0.5;
-        if !(theta.iter().all(|v| v.is_finite()) && p.iter().all(|v| v.is_finite())) {
+        if !(e.is_finite()
+            && theta.iter().all(|v| v.is_finite())
+            && p.iter().all(|v| v.is_finite()))
+        {
             return Err(Error::Overflow {
                 operation: "RLS update",
             });

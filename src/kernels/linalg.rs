@@ -82,13 +82,6 @@ impl<const N: usize> Lu<N> {
         x
     }
 
-    /// The 1-norm condition number `‖A‖₁ ‖A⁻¹‖₁` of the factored matrix `a`
-    /// (computed exactly from the inverse: N is small).
-    pub(crate) fn condition(&self, a: &SMatrix<f64, N, N>) -> f64 {
-        let inv = self.solve(&SMatrix::<f64, N, N>::identity());
-        norm1(a) * norm1(&inv)
-    }
-
     /// The determinant of the factored matrix: the product of the pivots,
     /// signed by the row permutation.
     pub(crate) fn det(&self) -> f64 {

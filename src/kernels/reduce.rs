@@ -51,6 +51,37 @@ pub(crate) fn max_step_deviation(x: &[f64], step: f64) -> f64 {
     worst
 }
 
+/// `max |x|` with eight independent lanes (0 for an empty slice). NaN
+/// values are ignored, so check finiteness separately.
+#[inline]
+pub(crate) fn max_abs(x: &[f64]) -> f64 {
+    let mut acc = [0.0f64; LANES];
+    let chunks = x.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for i in 0..LANES {
+            let v = c[i].abs();
+            acc[i] = if v > acc[i] { v } else { acc[i] };
+        }
+    }
+    let worst = acc.iter().fold(0.0f64, |m, &v| m.max(v));
+    rest.iter().fold(worst, |m, v| m.max(v.abs()))
+}
+
+/// The power of two `s` with `s ≤ x < 2 s`, from the exponent bits of a
+/// finite `x > 0` (no `log2`: cheap enough for inner loops); the smallest
+/// normal number for a subnormal `x`, and 1 for `x = 0`. Dividing by it is
+/// exact, so it equilibrates a vector or matrix (largest entry in [1, 2))
+/// without changing any digit.
+#[inline]
+pub(crate) fn pow2_floor(x: f64) -> f64 {
+    if x == 0.0 {
+        return 1.0;
+    }
+    let s = f64::from_bits(x.abs().to_bits() & 0x7ff0_0000_0000_0000);
+    if s == 0.0 { f64::MIN_POSITIVE } else { s }
+}
+
 /// Index of the first non-finite value, if any. The fast path is one
 /// vectorised pass (`0 · x` is NaN exactly for NaN and ±∞).
 #[inline]
@@ -78,6 +109,14 @@ mod tests {
             assert_eq!(first_non_finite(&y), Some(13));
         }
         assert_eq!(first_non_finite(&[]), None);
+        assert_eq!(max_abs(&x), 21.0);
+        assert_eq!(max_abs(&[-3.0, 2.0]), 3.0);
+        assert_eq!(max_abs(&[]), 0.0);
+        assert_eq!(pow2_floor(3.0), 2.0);
+        assert_eq!(pow2_floor(-0.75), 0.5);
+        assert_eq!(pow2_floor(f64::MAX), 2f64.powi(1023));
+        assert_eq!(pow2_floor(1e-320), f64::MIN_POSITIVE);
+        assert_eq!(pow2_floor(0.0), 1.0);
         let mut t: Vec<f64> = (0..21).map(|k| f64::from(k) * 0.5).collect();
         assert_eq!(max_step_deviation(&t, 0.5), 0.0);
         t[17] += 0.125; // intervals 16→17 and 17→18 are off by 0.125

@@ -220,14 +220,17 @@ impl MassSpring {
     /// # Errors
     ///
     /// [`Error::InvalidParameter`] for invalid parameters, a zero spring (no
-    /// rest position) or a non-finite force.
+    /// rest position) or a non-finite force; [`Error::Overflow`] for a
+    /// deflection beyond `f64::MAX` m (a spring of 1e-320 N/m).
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::MassSpring;
+    /// # use ctrlab::{Error, MassSpring};
     /// let (x1, x2) = MassSpring::nominal().static_deflection(50.0)?;
     /// assert!((x1 - 0.05).abs() < 1e-15 && (x2 - 0.10).abs() < 1e-15);
+    /// let soft = MassSpring { k1: 1e-320, ..MassSpring::nominal() };
+    /// assert!(matches!(soft.static_deflection(1.0), Err(Error::Overflow { .. })));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn static_deflection(&self, force: f64) -> Result<(f64, f64), Error> {
@@ -249,7 +252,13 @@ impl MassSpring {
             }
         }
         let x1 = force / self.k1;
-        Ok((x1, x1 + force / self.k2))
+        let x2 = x1 + force / self.k2;
+        if !x2.is_finite() {
+            return Err(Error::Overflow {
+                operation: "static deflection (force / spring exceeds f64::MAX m)",
+            });
+        }
+        Ok((x1, x2))
     }
 }
 

@@ -19,12 +19,31 @@ pub use sampled::{SampledConfig, Sensor, run_sampled};
 use crate::discretize::zoh;
 use crate::error::{Error, check_dt};
 use crate::integrate::{Integrator, Rk4};
+use crate::kernels::reduce::max_step_deviation;
 use crate::model::{Continuous, Discrete, StateSpace};
 
 /// Largest number of samples a simulation will allocate for (10⁷, about
 /// 0.5 GB for the lab's 4-state plant); a longer request is almost certainly
 /// a unit mistake (ms for s) and is refused rather than exhausting memory.
 pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// Largest number of RK4 steps one simulation will take, over all its
+/// intervals (10⁸, seconds of work for a small plant): more sub-steps than
+/// that are a mistake, refused rather than run for hours.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, StateSpace, sim::{MAX_RK4_STEPS, Solver, simulate}};
+/// use nalgebra::{matrix, vector};
+///
+/// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+/// let solver = Solver::Rk4 { substeps: MAX_RK4_STEPS + 1 };
+/// let err = simulate(&sys, &[0.0, 1.0], vector![0.0], |_| vector![1.0], solver).unwrap_err();
+/// assert!(matches!(err, Error::InvalidParameter { name: "substeps", .. }));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub const MAX_RK4_STEPS: usize = 100_000_000;
 
 /// A simulated time response: sample times (s), states and outputs, in the
 /// model's units (SI for the crate's own models). All three have one entry
@@ -78,16 +97,44 @@ impl<const N: usize, const P: usize> Response<N, P> {
 
     /// Output channel `i` as a plain vector, e.g. to hand to step metrics.
     ///
+    /// # Errors
+    ///
+    /// [`Error::OutOfRange`] unless `i < P`.
+    ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{MassSpring, Cart, sim::step_response};
+    /// # use ctrlab::{Error, MassSpring, Cart, sim::step_response};
     /// let r = step_response(&MassSpring::nominal().state_space(Cart::Two)?, 1.0, 0.01)?;
-    /// assert_eq!(r.output(0).len(), r.len());
+    /// assert_eq!(r.output(0)?.len(), r.len());
+    /// assert!(matches!(r.output(1), Err(Error::OutOfRange { index: 1, len: 1, .. })));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
-    pub fn output(&self, i: usize) -> Vec<f64> {
-        self.y.iter().map(|y| y[i]).collect()
+    pub fn output(&self, i: usize) -> Result<Vec<f64>, Error> {
+        if i >= P {
+            return Err(Error::OutOfRange {
+                what: "output",
+                index: i,
+                len: P,
+            });
+        }
+        Ok(self.y.iter().map(|y| y[i]).collect())
+    }
+
+    /// The first sample with a non-finite state or output, as the error a
+    /// simulation reports for it.
+    fn check_finite(&self, operation: &'static str) -> Result<(), Error> {
+        let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
+        if self
+            .x
+            .iter()
+            .zip(&self.y)
+            .all(|(x, y)| finite(x.as_slice()) & finite(y.as_slice()))
+        {
+            Ok(())
+        } else {
+            Err(Error::Overflow { operation })
+        }
     }
 }
 
@@ -99,7 +146,8 @@ pub enum Solver {
     /// length (once for a uniform grid).
     #[default]
     Zoh,
-    /// `substeps` RK4 steps per grid interval (≥ 1).
+    /// `substeps` RK4 steps per grid interval (≥ 1; at most
+    /// [`MAX_RK4_STEPS`] over the whole grid).
     Rk4 {
         /// RK4 steps per interval.
         substeps: usize,
@@ -148,13 +196,17 @@ pub fn time_grid(t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
 /// The input is sampled at each grid time and held until the next, as a
 /// digital controller applies it; use a finer grid for a smooth input.
 /// [`Solver::Zoh`] is exact for that input, [`Solver::Rk4`] integrates it.
+/// A grid whose intervals agree to within the rounding of its times (any
+/// `k·dt` or accumulated grid) is simulated with one discretisation.
 ///
 /// # Errors
 ///
 /// [`Error::InvalidParameter`] named `"t"` for an empty, non-finite or
 /// non-increasing grid (or more than [`MAX_SAMPLES`] points), named
-/// `"substeps"` for zero RK4 sub-steps, named `"input"` for a non-finite input
-/// sample; errors of [`discretize`](StateSpace::discretize).
+/// `"substeps"` for zero RK4 sub-steps or more than [`MAX_RK4_STEPS`] in all,
+/// named `"input"` for a non-finite input sample; [`Error::Overflow`] when
+/// the response diverges past `f64::MAX`; errors of
+/// [`discretize`](StateSpace::discretize).
 ///
 /// # Examples
 ///
@@ -179,15 +231,27 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
 ) -> Result<Response<N, P>, Error> {
     check_grid(t)?;
     crate::error::check_finite("x0", &x0)?;
-    if let Solver::Rk4 { substeps: 0 } = solver {
-        return Err(Error::InvalidParameter {
+    if let Solver::Rk4 { substeps } = solver {
+        let bad = |reason| Error::InvalidParameter {
             name: "substeps",
-            value: 0.0,
-            reason: "RK4 needs at least one sub-step per interval",
-        });
+            value: substeps as f64,
+            reason,
+        };
+        if substeps == 0 {
+            return Err(bad("RK4 needs at least one sub-step per interval"));
+        }
+        match substeps.checked_mul(t.len() - 1) {
+            Some(total) if total <= MAX_RK4_STEPS => {}
+            _ => return Err(bad("more than sim::MAX_RK4_STEPS RK4 steps in all")),
+        }
     }
     let mut out = Response::with_capacity(t.len());
     let mut x = x0;
+    // Intervals that differ by no more than the rounding of the grid's
+    // times are one interval: a uniform grid is one discretisation with its
+    // mean step (no drift), however its times were rounded.
+    let tol = grid_rounding(t);
+    let uniform = uniform_step(t, tol);
     // ZOH matrices, recomputed only when the interval length changes.
     let mut cached: Option<(f64, StateSpace<N, M, P, Discrete>)> = None;
     for (k, &tk) in t.iter().enumerate() {
@@ -207,10 +271,10 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
         out.x.push(x);
         out.y.push(sys.output(&x, &u));
         let Some(&next) = t.get(k + 1) else { break };
-        let h = next - tk;
+        let h = uniform.unwrap_or(next - tk);
         match solver {
             Solver::Zoh => {
-                let same = matches!(&cached, Some((hc, _)) if (hc - h).abs() <= 1e-12 * h);
+                let same = matches!(&cached, Some((hc, _)) if (hc - h).abs() <= tol);
                 if !same {
                     let (ad, bd) = zoh(sys.a(), sys.b(), h)?;
                     let d = StateSpace::from_computed(ad, bd, *sys.c(), *sys.d(), h, "ZOH")?;
@@ -228,7 +292,24 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
             }
         }
     }
+    out.check_finite("simulation (the response diverged past f64::MAX)")?;
     Ok(out)
+}
+
+/// How far apart two of the grid's intervals may be and still be the same
+/// interval: `2 ε max|t|`, two units in the last place of its largest time
+/// (each time is rounded once, `k·dt` or `t + dt`, so each interval is off
+/// by at most one such unit).
+fn grid_rounding(t: &[f64]) -> f64 {
+    let (first, last) = (t[0], t[t.len() - 1]);
+    2.0 * f64::EPSILON * first.abs().max(last.abs())
+}
+
+/// The grid's mean step when every interval is within `tol` of it.
+fn uniform_step(t: &[f64], tol: f64) -> Option<f64> {
+    let n = t.len().checked_sub(1).filter(|&n| n > 0)?;
+    let mean = (t[n] - t[0]) / n as f64;
+    (mean.is_finite() && max_step_deviation(t, mean) <= tol).then_some(mean)
 }
 
 fn check_grid(t: &[f64]) -> Result<(), Error> {
@@ -264,7 +345,7 @@ fn check_grid(t: &[f64]) -> Result<(), Error> {
 ///
 /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
 /// let r = simulate_discrete(&sys, vector![0.0], &[vector![1.0]; 3]);
-/// assert_eq!(r.output(0), vec![0.0, 1.0, 1.5]);
+/// assert_eq!(r.output(0)?, vec![0.0, 1.0, 1.5]);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
@@ -290,7 +371,7 @@ pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
 /// // x[k+1] = x + u with u = -0.5 x halves the state every sample.
 /// let sys = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
 /// let r = simulate_discrete_feedback(&sys, vector![8.0], 4, |_k, x| -0.5 * x);
-/// assert_eq!(r.output(0), vec![8.0, 4.0, 2.0, 1.0]);
+/// assert_eq!(r.output(0)?, vec![8.0, 4.0, 2.0, 1.0]);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize>(

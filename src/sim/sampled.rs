@@ -10,7 +10,7 @@ use crate::integrate::{Integrator, Rk4};
 use crate::model::Dynamics;
 use crate::signal::Rng;
 
-use super::MAX_SAMPLES;
+use super::{MAX_RK4_STEPS, MAX_SAMPLES};
 
 /// What a simulated plant's sensors report: the measurements `y` (`P`
 /// values) at time `t` (s) from the true state `x`.
@@ -195,6 +195,14 @@ impl<const M: usize, const P: usize> SampledConfig<M, P> {
                 "max_substep",
                 self.max_substep,
                 "more than 10^6 sub-steps per period",
+            ));
+        }
+        // And a bound on the whole run's work, as for `simulate`.
+        if samples * (self.period / self.max_substep).ceil() > MAX_RK4_STEPS as f64 {
+            return Err(bad(
+                "max_substep",
+                self.max_substep,
+                "more than sim::MAX_RK4_STEPS RK4 steps in all",
             ));
         }
         if !(self.input_delay.is_finite()

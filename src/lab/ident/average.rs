@@ -2,6 +2,7 @@
 
 use super::MassSpringEstimate;
 use crate::error::Error;
+use crate::kernels::reduce::pow2_floor;
 
 /// Mean and sample standard deviation (divisor `n − 1`) of one parameter
 /// over repeated runs.
@@ -50,19 +51,24 @@ pub struct MassSpringAverage {
 
 impl Spread {
     /// Mean and sample standard deviation of `values` (e.g. one parameter of
-    /// [`SeparateSpringsEstimate`](super::SeparateSpringsEstimate) over several runs).
+    /// [`SeparateSpringsEstimate`] over several runs).
     ///
     /// # Errors
     ///
-    /// [`Error::TooFewSamples`] for fewer than two values.
+    /// [`Error::TooFewSamples`] for fewer than two values;
+    /// [`Error::InvalidData`] for a NaN or infinite value;
+    /// [`Error::Overflow`] when the standard deviation exceeds `f64::MAX`.
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::lab::ident::Spread;
+    /// # use ctrlab::{Error, lab::ident::Spread};
     /// let s = Spread::of(&[948.0, 950.0, 952.0])?;
     /// assert_eq!((s.mean, s.std_dev), (950.0, 2.0));
     /// assert!(Spread::of(&[1.0]).is_err());
+    /// // Values near f64::MAX do not overflow on the way.
+    /// assert_eq!(Spread::of(&[1e308, 1e308])?.mean, 1e308);
+    /// assert!(matches!(Spread::of(&[f64::NAN, 1.0]), Err(Error::InvalidData { index: 0, .. })));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn of(values: &[f64]) -> Result<Self, Error> {
@@ -73,17 +79,32 @@ impl Spread {
                 got: values.len(),
             });
         }
-        Ok(spread(values.iter().copied(), values.len()))
+        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+            return Err(Error::InvalidData {
+                what: "values",
+                index,
+                reason: "value is not finite",
+            });
+        }
+        spread(values.iter().copied(), values.len())
     }
 }
 
-fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Spread {
-    let mean = values.clone().sum::<f64>() / n as f64;
-    let var = values.map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
-    Spread {
-        mean,
-        std_dev: var.sqrt(),
+/// Mean and sample standard deviation of `n ≥ 2` finite values, computed
+/// on the values divided by a power of two near their largest magnitude so
+/// that neither the sum nor the squares overflow or underflow.
+fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Result<Spread, Error> {
+    let scale = pow2_floor(values.clone().fold(0.0f64, |m, v| m.max(v.abs())));
+    let scaled = values.map(|v| v / scale);
+    let mean = scaled.clone().sum::<f64>() / n as f64;
+    let var = scaled.map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
+    let (mean, std_dev) = (mean * scale, var.sqrt() * scale);
+    if !std_dev.is_finite() {
+        return Err(Error::Overflow {
+            operation: "sample standard deviation",
+        });
     }
+    Ok(Spread { mean, std_dev })
 }
 
 /// Mean and sample standard deviation of each parameter over repeated runs
@@ -92,7 +113,7 @@ fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Spread {
 /// # Errors
 ///
 /// [`Error::TooFewSamples`] for fewer than two runs (a sample standard
-/// deviation needs two).
+/// deviation needs two); [`Error::Overflow`] for a spread beyond `f64::MAX`.
 ///
 /// # Examples
 ///
@@ -110,10 +131,10 @@ pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Error> 
         });
     }
     Ok(MassSpringAverage {
-        k12: spread(runs.iter().map(|r| r.k12.value), n),
-        b1: spread(runs.iter().map(|r| r.b1.value), n),
-        gain: spread(runs.iter().map(|r| r.gain.value), n),
-        b2: spread(runs.iter().map(|r| r.b2.value), n),
+        k12: spread(runs.iter().map(|r| r.k12.value), n)?,
+        b1: spread(runs.iter().map(|r| r.b1.value), n)?,
+        gain: spread(runs.iter().map(|r| r.gain.value), n)?,
+        b2: spread(runs.iter().map(|r| r.b2.value), n)?,
         runs: n,
     })
 }

@@ -84,6 +84,23 @@ pub struct MassSpringEstimate {
 }
 
 impl MassSpringEstimate {
+    /// Warning-level checks of the inputs (empty when all is plausible): a
+    /// cart mass outside [`PLAUSIBLE_MASS_KG`] is most likely in grams or
+    /// tonnes, and every estimate scales with it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// assert!(identify(&rec, 1.3, 0.7, Scheme::Lab)?.warnings().is_empty());
+    /// assert_eq!(identify(&rec, 1300.0, 700.0, Scheme::Lab)?.warnings().len(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn warnings(&self) -> Vec<Warning> {
+        mass_warnings(self.m1, self.m2)
+    }
+
     /// The identified plant as [`MassSpring`] parameters.
     ///
     /// # Examples
@@ -176,6 +193,23 @@ pub struct SeparateSpringsEstimate {
 }
 
 impl SeparateSpringsEstimate {
+    /// Warning-level checks of the inputs (empty when all is plausible): a
+    /// cart mass outside [`PLAUSIBLE_MASS_KG`] is most likely in grams or
+    /// tonnes, and every estimate scales with it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// assert!(identify_separate_springs(&rec, 1.3, 0.7, Scheme::Lab)?.warnings().is_empty());
+    /// assert_eq!(identify_separate_springs(&rec, 1300.0, 700.0, Scheme::Lab)?.warnings().len(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn warnings(&self) -> Vec<Warning> {
+        mass_warnings(self.m1, self.m2)
+    }
+
     /// The identified plant as [`MassSpring`] parameters.
     ///
     /// # Examples
@@ -217,4 +251,72 @@ impl SeparateSpringsEstimate {
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.plant().state_space(Cart::Two)
     }
+}
+
+/// The range of cart masses (kg) the lab's identification takes as
+/// plausible; a mass outside it is most likely in the wrong unit (grams,
+/// tonnes) and is reported by [`MassSpringEstimate::warnings`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::PLAUSIBLE_MASS_KG;
+/// let (lo, hi) = PLAUSIBLE_MASS_KG;
+/// assert!(lo < 0.7 && 1.3 < hi && hi < 700.0);
+/// ```
+pub const PLAUSIBLE_MASS_KG: (f64, f64) = (0.01, 100.0);
+
+/// A warning-level finding about an identification's inputs: the numbers
+/// were computed, but a value is implausible for the lab and probably in
+/// the wrong unit.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Recording, lab::ident::{identify, Scheme}};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// // Cart 1's mass given in grams.
+/// let est = identify(&rec, 1300.0, 0.7, Scheme::Central)?;
+/// let w = &est.warnings()[0];
+/// assert_eq!((w.parameter, w.value), ("m1", 1300.0));
+/// assert!(w.to_string().contains("grams"));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Warning {
+    /// The parameter (`"m1"`, `"m2"`).
+    pub parameter: &'static str,
+    /// Its value, in the unit the API documents (kg for masses).
+    pub value: f64,
+    /// What is implausible and the likely mix-up.
+    pub reason: &'static str,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "`{}` = {}: {}", self.parameter, self.value, self.reason)
+    }
+}
+
+/// Warnings for cart masses outside [`PLAUSIBLE_MASS_KG`].
+fn mass_warnings(m1: f64, m2: f64) -> Vec<Warning> {
+    let (lo, hi) = PLAUSIBLE_MASS_KG;
+    [("m1", m1), ("m2", m2)]
+        .into_iter()
+        .filter_map(|(parameter, value)| {
+            let reason = if value > hi {
+                "implausibly heavy for a lab cart: masses are in kg (was it given in grams?)"
+            } else if value < lo {
+                "implausibly light for a lab cart: masses are in kg (was it given in tonnes?)"
+            } else {
+                return None;
+            };
+            Some(Warning {
+                parameter,
+                value,
+                reason,
+            })
+        })
+        .collect()
 }

@@ -47,7 +47,9 @@ mod regressors;
 mod timing;
 
 pub use average::{MassSpringAverage, Spread, average};
-pub use estimates::{Estimate, MassSpringEstimate, SeparateSpringsEstimate};
+pub use estimates::{
+    Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, SeparateSpringsEstimate, Warning,
+};
 pub use options::{DEFAULT_MIN_SPEED, Options};
 pub use timing::{DEFAULT_MAX_JITTER, GAP_RATIO, Timing};
 
