@@ -10,9 +10,7 @@ use ctrlab::ident::{LeastSquares, Rls};
 use ctrlab::lab::ident::{Scheme, Spread, average, identify, identify_separate_springs};
 use ctrlab::metrics::step_info_channel;
 use ctrlab::sim::{SampledConfig, Solver, run_sampled, simulate, step_response, time_grid};
-use ctrlab::{
-    Error, MassSpring, Method, Recording, StateSpace, StepInfoOptions, step_info, step_info_of,
-};
+use ctrlab::{MassSpring, Method, Recording, StateSpace, StepInfoOptions, step_info, step_info_of};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use proptest::prelude::*;
 
@@ -332,7 +330,7 @@ proptest! {
         match responses_svg(&path, "p", "t", "y", &[Series::new("s", &t[..n], &y[..n])]) {
             Ok(()) => prop_assert!(std::fs::read_to_string(&path).unwrap().contains("<svg")),
             Err(e) => {
-                let expected = matches!(e, Error::InvalidData { .. } | Error::LengthMismatch { .. } | Error::Plot { .. });
+                let expected = matches!(e, ctrlab::Error::InvalidData { .. } | ctrlab::Error::LengthMismatch { .. } | ctrlab::Error::Plot { .. });
                 prop_assert!(expected, "{}", e);
             }
         }
