@@ -51,7 +51,7 @@ pub struct MassSpringAverage {
 
 impl Spread {
     /// Mean and sample standard deviation of `values` (e.g. one parameter of
-    /// [`SeparateSpringsEstimate`] over several runs).
+    /// [`SeparateSpringsEstimate`](super::SeparateSpringsEstimate) over several runs).
     ///
     /// # Errors
     ///
