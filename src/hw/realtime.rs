@@ -100,7 +100,9 @@ pub(crate) fn enter(rt: &RealTime) -> Result<Guard, HwError> {
             param
         })
     };
+    // SAFETY: both take a policy constant and touch no memory.
     let min = unsafe { libc::sched_get_priority_min(libc::SCHED_FIFO) };
+    // SAFETY: as above.
     let max = unsafe { libc::sched_get_priority_max(libc::SCHED_FIFO) };
     if !(min..=max).contains(&rt.priority) {
         return Err(HwError::InvalidConfig {
