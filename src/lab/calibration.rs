@@ -136,14 +136,19 @@ impl Calibration {
                 "must be at least 1",
             ));
         }
-        let [e1, e2] = self.encoder_channels;
-        if e1 >= ENCODER_CHANNELS || e2 >= ENCODER_CHANNELS || e1 == e2 {
-            return Err(HwError::invalid_config(
-                "encoder_channels",
-                e2 as f64,
-                "must be two distinct channels 0–3",
-            ));
-        }
-        Ok(())
+        check_encoder_channels(self.encoder_channels)
     }
+}
+
+/// The carts' encoder channels must be two distinct channels 0–3 (shared by
+/// [`Calibration::validate`] and the simulated rig's validation).
+pub(super) fn check_encoder_channels([e1, e2]: [usize; 2]) -> Result<(), HwError> {
+    if e1 >= ENCODER_CHANNELS || e2 >= ENCODER_CHANNELS || e1 == e2 {
+        return Err(HwError::invalid_config(
+            "encoder_channels",
+            e2 as f64,
+            "must be two distinct channels 0–3",
+        ));
+    }
+    Ok(())
 }

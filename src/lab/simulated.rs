@@ -648,14 +648,7 @@ impl SimulatedRig {
                 }
             }
         }
-        let [e1, e2] = self.encoder_channels;
-        if e1 >= ENCODER_CHANNELS || e2 >= ENCODER_CHANNELS || e1 == e2 {
-            return Err(HwError::InvalidConfig {
-                name: "encoder_channels",
-                value: e2 as f64,
-                reason: "must be two distinct channels 0–3",
-            });
-        }
+        super::calibration::check_encoder_channels(self.encoder_channels)?;
         self.card_config().validate()
     }
 }
