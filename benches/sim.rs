@@ -28,7 +28,8 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             let r = simulate_discrete_feedback(black_box(&d), SVector::zeros(), STEPS, |_k, x| {
                 k * (target - x)
-            });
+            })
+            .unwrap();
             black_box(r)
         })
     });

@@ -91,7 +91,7 @@ fn assert_drive_off(rig: &mut LoggedRig, clock: &Clock) {
         Clock::RealTime => std::thread::sleep(Duration::from_secs_f64(delay * 4.0)),
     }
     let card = rig.card_mut().port_mut().inner_mut();
-    card.sync();
+    card.sync().unwrap();
     assert_eq!(card.pwm_duty(0), 0, "the card applies the halt");
 }
 
@@ -429,7 +429,7 @@ fn a_flipped_counter_bit_is_a_bus_fault_not_a_measurement() {
     assert_eq!(writes.last(), Some(&(0, 0)));
     clock.advance(SimulatedRig::default().pwm_delay).unwrap();
     let card = &mut rig.card_mut().port_mut().inner_mut().inner;
-    card.sync();
+    card.sync().unwrap();
     assert_eq!(card.pwm_duty(0), 0);
 }
 

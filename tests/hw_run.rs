@@ -241,7 +241,7 @@ fn a_travel_limit_breach_halts_and_keeps_the_recording() {
     );
     // The halt was written; the drive takes it the PWM delay later.
     clock.advance(SimulatedRig::default().pwm_delay).unwrap();
-    rig.card_mut().port_mut().sync();
+    rig.card_mut().port_mut().sync().unwrap();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
 
@@ -301,10 +301,10 @@ fn a_dead_port_leaves_the_motor_to_the_watchdog() {
     // 49's latch at 98 ms, so the watchdog trips at 198 ms.
     clock.advance(0.097).unwrap();
     let card = rig.card_mut().port_mut().inner_mut();
-    card.sync();
+    card.sync().unwrap();
     assert_eq!(card.pwm_duty(0), 250, "not yet at 197 ms");
     clock.advance(0.002).unwrap();
-    card.sync();
+    card.sync().unwrap();
     assert_eq!(card.pwm_duty(0), 0, "the watchdog zeroed the PWM");
 }
 

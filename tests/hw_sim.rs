@@ -581,7 +581,7 @@ fn travel_limit_breach_halts_the_rig() {
     // The halt was written; the drive takes it the PWM delay later.
     assert_eq!(rig.card().port().pwm_duty(0), 1000, "24 V until then");
     clock.advance(SimulatedRig::default().pwm_delay).unwrap();
-    rig.card_mut().port_mut().sync();
+    rig.card_mut().port_mut().sync().unwrap();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
 
@@ -609,7 +609,7 @@ fn read_state_kicks_the_watchdog_and_stopping_trips_it() {
     assert_eq!(rig.card().port().pwm_duty(0), 50);
     // The loop stops: 100 ms later the card has zeroed the PWM by itself.
     clock.advance(0.101).unwrap();
-    rig.card_mut().port_mut().sync();
+    rig.card_mut().port_mut().sync().unwrap();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
 

@@ -1,17 +1,17 @@
 //! Issue 11's reproducers, one test each (numbered as in the issue): bad
 //! input never panics, hangs, or comes back as a non-finite number inside
 //! `Ok`, and answers do not depend on the units a model is written in.
-//! Item 5 (the simulated card after a long clock jump) is tested with the
-//! hardware layer.
 
 use ctrlab::design::{acker, lqr};
 use ctrlab::discretize::expm;
+use ctrlab::hw::{Clock, HwErrorKind, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
 use ctrlab::ident::{LeastSquares, Rls};
+use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{Scheme, Spread, identify};
 use ctrlab::metrics::SettleFailure;
 use ctrlab::sim::{Solver, simulate, step_response, time_grid};
 use ctrlab::{Error, MassSpring, Recording, StateSpace, StepInfoOptions, step_info, step_info_of};
-use nalgebra::{Complex, SMatrix, matrix, vector};
+use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 
 /// The CSV of reproducer 1: positions near f64::MAX / 2, accepted by the
 /// reader.
@@ -150,6 +150,70 @@ fn plots_of_huge_ranges_finish() {
         let err = responses_svg(&path, "wide", "t", "y", &[Series::new("s", t, y)]).unwrap_err();
         assert!(matches!(err, Error::InvalidData { .. }), "{err}");
     }
+}
+
+// 5. The virtual clock and the simulated card after a long jump.
+
+#[test]
+fn the_virtual_clock_never_runs_backwards() {
+    let clock = VirtualClock::new();
+    clock.advance(1.0).unwrap();
+    // u64::MAX ns is 1.8e10 s: a jump past it is refused, time unchanged.
+    clock.advance(1e10).unwrap();
+    let err = clock.advance(1e10).unwrap_err();
+    assert_eq!(err.kind(), HwErrorKind::InvalidCommand);
+    assert_eq!(clock.now_nanos(), 10_000_000_001_000_000_000);
+    clock.advance_nanos(u64::MAX);
+    assert_eq!(clock.now_nanos(), u64::MAX);
+    clock.advance_nanos(5);
+    assert_eq!(clock.now_nanos(), u64::MAX);
+}
+
+#[test]
+fn the_simulated_card_bounds_its_work_after_a_long_jump() {
+    let clock = VirtualClock::new();
+    let mut pc104 = Pc104::new(
+        SimulatedRig::default()
+            .card(&Clock::Virtual(clock.clone()))
+            .unwrap(),
+    );
+    pc104.latch().unwrap();
+    // 1e6 s at 0.25 ms would be 4e9 RK4 steps for one register read.
+    clock.advance(1e6).unwrap();
+    let err = pc104.latch().unwrap_err();
+    assert_eq!(err.kind(), HwErrorKind::Simulation);
+    assert!(err.to_string().contains("RK4 sub-steps"), "{err}");
+    assert_eq!(pc104.port().time(), 0.0);
+    // Within the bound, the card catches up.
+    let clock = VirtualClock::new();
+    let mut pc104 = Pc104::new(
+        SimulatedRig::default()
+            .card(&Clock::Virtual(clock.clone()))
+            .unwrap(),
+    );
+    clock.advance(100.0).unwrap();
+    pc104.latch().unwrap();
+    assert_eq!(pc104.port().time(), 100.0);
+}
+
+#[test]
+fn a_diverging_simulated_plant_is_an_error_not_zero_counts() {
+    let blow_up = |_t: f64, x: &SVector<f64, 1>, _u: &SVector<f64, 1>| vector![x[0] * x[0]];
+    let config = SimulatedCardConfig::<1> {
+        encoders: [Some(0), None, None, None],
+        initial_state: vector![1.0],
+        ..Default::default()
+    };
+    let clock = VirtualClock::new();
+    let mut pc104 =
+        Pc104::new(SimulatedCard::new(blow_up, config, Clock::Virtual(clock.clone())).unwrap());
+    // x' = x² from 1 blows up at t = 1 s.
+    clock.advance(2.0).unwrap();
+    let err = pc104.latch().unwrap_err();
+    assert_eq!(err.kind(), HwErrorKind::Simulation);
+    assert!(err.to_string().contains("diverged"), "{err}");
+    assert_eq!(pc104.port().time(), 0.0);
+    assert!(pc104.port().true_state()[0].is_finite());
 }
 
 // 6. Non-finite numbers inside Ok.
@@ -525,11 +589,42 @@ fn step_response_on_a_long_grid_matches_the_discrete_model() {
         &d,
         nalgebra::SVector::zeros(),
         &vec![vector![1.0]; r.len()],
-    );
+    )
+    .unwrap();
     let worst =
         r.y.iter()
             .zip(&disc.y)
             .map(|(a, b)| (a - b).norm())
             .fold(0.0, f64::max);
     assert!(worst < 1e-15, "{worst}");
+}
+
+// 6 (continued). The discrete simulators refuse what they cannot answer.
+
+#[test]
+fn discrete_simulation_is_finite_or_an_error() {
+    let d =
+        StateSpace::discrete(matrix![2.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();
+    // x doubles every sample: 1e300 · 2^k passes f64::MAX within 30 samples.
+    let err = ctrlab::sim::simulate_discrete(&d, vector![1e300], &[vector![0.0]; 40]).unwrap_err();
+    assert!(matches!(err, Error::Overflow { .. }), "{err}");
+    let err =
+        ctrlab::sim::simulate_discrete(&d, vector![f64::NAN], &[vector![0.0]; 2]).unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidParameter { name: "x0", .. }),
+        "{err}"
+    );
+    let err =
+        ctrlab::sim::simulate_discrete(&d, vector![0.0], &[vector![f64::INFINITY]]).unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidParameter { name: "input", .. }),
+        "{err}"
+    );
+    let err =
+        ctrlab::sim::simulate_discrete_feedback(&d, vector![0.0], usize::MAX, |_, _| vector![0.0])
+            .unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidParameter { name: "steps", .. }),
+        "{err}"
+    );
 }

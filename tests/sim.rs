@@ -59,7 +59,7 @@ fn discrete_simulation_matches_the_continuous_one_at_the_samples() {
     let sys = MassSpring::nominal().state_space(Cart::One).unwrap();
     let d = sys.discretize(0.002, Method::Zoh).unwrap();
     let inputs = vec![vector![5.0]; 500];
-    let disc = simulate_discrete(&d, SVector::zeros(), &inputs);
+    let disc = simulate_discrete(&d, SVector::zeros(), &inputs).unwrap();
     let t = time_grid(0.998, 0.002).unwrap();
     let cont = simulate(&sys, &t, SVector::zeros(), |_| vector![5.0], Solver::Zoh).unwrap();
     assert_eq!(disc.len(), cont.len());
@@ -73,7 +73,7 @@ fn discrete_simulation_matches_the_continuous_one_at_the_samples() {
 fn closed_loop_feedback_sees_the_current_state() {
     let d =
         StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.5).unwrap();
-    let r = simulate_discrete_feedback(&d, vector![1.0], 5, |k, x| vector![k as f64] - x);
+    let r = simulate_discrete_feedback(&d, vector![1.0], 5, |k, x| vector![k as f64] - x).unwrap();
     // u = k - x drives x[k+1] = k.
     assert_eq!(r.output(0).unwrap(), vec![1.0, 0.0, 1.0, 2.0, 3.0]);
     assert_eq!(r.t, vec![0.0, 0.5, 1.0, 1.5, 2.0]);

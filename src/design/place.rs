@@ -57,10 +57,6 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
 ) -> Result<SMatrix<f64, 1, N>, Error> {
     let coeffs = real_polynomial(poles)?;
     let (a, b) = (sys.a(), sys.b());
-    let r = scaled_krylov_rank(a, b)?;
-    if r < N {
-        return Err(Error::Uncontrollable { rank: r, states: N });
-    }
     // Controllability matrix [B, A B, …, A^(N−1) B], each new column
     // divided by a power of two s_j as it is formed (so that it cannot
     // overflow, and the LU's pivot test sees no units): 𝒞 = 𝒞̃ S with
@@ -90,9 +86,21 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
     if N > 0 {
         last[N - 1] = 1.0;
     }
-    // The rank test passed, so a failure here is the LU's stricter pivot
-    // test on a nearly uncontrollable pair: say so, not "rank N of N".
-    let row = Lu::solve_right(&ctrb, &last, "Ackermann (controllability matrix)")?;
+    // The scale-free rank test costs an SVD, so it runs only when the LU's
+    // pivot test (the stricter of the two) refuses: a rank below N is an
+    // uncontrollable pair; a full rank, a nearly uncontrollable one the LU
+    // cannot invert accurately (its own error, not "rank N of N").
+    let row = match Lu::solve_right(&ctrb, &last, "Ackermann (controllability matrix)") {
+        Ok(row) => row,
+        Err(lu) => {
+            let rank = scaled_krylov_rank(a, b)?;
+            return Err(if rank < N {
+                Error::Uncontrollable { rank, states: N }
+            } else {
+                lu
+            });
+        }
+    };
     let k = (row * phi) / last_scale;
     if !k.iter().all(|v| v.is_finite()) {
         return Err(Error::Overflow {

@@ -104,8 +104,9 @@ impl VirtualClock {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidCommand`] when `dt` is negative or not finite (time
-    /// is left unchanged).
+    /// [`HwError::InvalidCommand`] when `dt` is negative or not finite, or
+    /// when the clock would pass `u64::MAX` ns (584 years); time is then
+    /// left unchanged.
     ///
     /// # Examples
     ///
@@ -115,23 +116,34 @@ impl VirtualClock {
     /// clock.advance(0.25)?;
     /// assert_eq!(clock.now_nanos(), 250_000_000);
     /// assert_eq!(clock.advance(-1.0).unwrap_err().kind(), HwErrorKind::InvalidCommand);
+    /// // Never wraps around to the past (u64::MAX ns is 1.8e10 s).
+    /// clock.advance(1e10)?;
+    /// assert!(clock.advance(1e10).is_err());
+    /// assert_eq!(clock.now(), 1e10 + 0.25);
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
     pub fn advance(&self, dt: f64) -> Result<(), HwError> {
         let nanos = dt * 1e9;
+        let refuse = |now: u64| HwError::InvalidCommand {
+            what: "clock advance (s)",
+            channel: None,
+            value: dt,
+            limit: (u64::MAX - now) as f64 * 1e-9,
+        };
         if !(nanos.is_finite() && nanos >= 0.0 && nanos < u64::MAX as f64) {
-            return Err(HwError::InvalidCommand {
-                what: "clock advance (s)",
-                channel: None,
-                value: dt,
-                limit: u64::MAX as f64 * 1e-9,
-            });
+            return Err(refuse(self.now_nanos()));
         }
-        self.advance_nanos(nanos.round() as u64);
-        Ok(())
+        let step = nanos.round() as u64;
+        self.nanos
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |now| {
+                now.checked_add(step)
+            })
+            .map(|_| ())
+            .map_err(refuse)
     }
 
-    /// Moves time forward by `dt` nanoseconds (u64 nanoseconds last 584 years).
+    /// Moves time forward by `dt` nanoseconds, saturating at `u64::MAX` ns
+    /// (584 years) rather than wrapping around to the past.
     ///
     /// # Examples
     ///
@@ -142,8 +154,16 @@ impl VirtualClock {
     ///     clock.advance_nanos(2_000_000);
     /// }
     /// assert_eq!(clock.now(), 1.0);
+    /// clock.advance_nanos(u64::MAX);
+    /// clock.advance_nanos(1);
+    /// assert_eq!(clock.now_nanos(), u64::MAX);
     /// ```
     pub fn advance_nanos(&self, dt: u64) {
-        self.nanos.fetch_add(dt, Ordering::AcqRel);
+        // The closure always returns `Some`, so the update cannot fail.
+        let _ = self
+            .nanos
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |now| {
+                Some(now.saturating_add(dt))
+            });
     }
 }

@@ -82,6 +82,10 @@ pub enum HwErrorKind {
     /// Real-time scheduling (SCHED_FIFO, memory locking, CPU affinity) was
     /// asked for but could not be set up.
     RealTime,
+    /// A simulated card cannot go on: its plant state left the finite
+    /// numbers, or its clock jumped further ahead than it can catch up
+    /// within a bounded amount of work.
+    Simulation,
 }
 
 /// Everything that can go wrong in the `hw` module. Each variant carries the
@@ -257,6 +261,15 @@ pub enum HwError {
         /// How to grant it.
         hint: &'static str,
     },
+    /// A simulated card cannot go on (see [`HwErrorKind::Simulation`]); its
+    /// time and plant state are left where they were before the access.
+    #[error("simulated card at t = {at:.4} s: {reason}")]
+    Simulation {
+        /// What went wrong, with the numbers.
+        reason: String,
+        /// The card's time, s.
+        at: f64,
+    },
 }
 
 fn register_suffix(register: Option<u8>) -> String {
@@ -292,6 +305,7 @@ impl HwError {
             HwError::BusFault { .. } => HwErrorKind::BusFault,
             HwError::NotResponding { .. } => HwErrorKind::NotResponding,
             HwError::RealTime { .. } => HwErrorKind::RealTime,
+            HwError::Simulation { .. } => HwErrorKind::Simulation,
         }
     }
 

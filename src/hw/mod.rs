@@ -73,6 +73,6 @@ pub use ppdev::{Ppdev, ioctl};
 pub use realtime::RealTime;
 pub use rig::Rig;
 pub use run::{LoopConfig, LoopStats, RunError, RunOutcome, run};
-pub use sim_card::SimulatedCard;
+pub use sim_card::{MAX_CATCH_UP_STEPS, SimulatedCard};
 pub use sim_config::{SIMULATED_CARD_ID, SimulatedCardConfig};
 pub use stop::StopSignal;

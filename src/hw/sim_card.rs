@@ -11,6 +11,20 @@ use crate::integrate::{Integrator, Rk4};
 use crate::model::Dynamics;
 use crate::signal::Rng;
 
+/// The most RK4 sub-steps one access of a [`SimulatedCard`] takes to catch
+/// its plant up with its clock (at the default `max_substep` of 0.25 ms,
+/// 2500 s of plant time): a bound on the work of any single register
+/// access. A card further behind refuses with [`HwError::Simulation`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{MAX_CATCH_UP_STEPS, SimulatedCardConfig};
+/// let config = SimulatedCardConfig::<4>::default();
+/// assert_eq!(MAX_CATCH_UP_STEPS as f64 * config.max_substep, 2500.0);
+/// ```
+pub const MAX_CATCH_UP_STEPS: u64 = 10_000_000;
+
 /// What lives at an address of the simulated card.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Reg {
@@ -215,7 +229,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// let mut card = SimulatedRig::default().card(&Clock::Virtual(clock.clone()))?;
     /// clock.advance(0.002)?;
     /// assert_eq!(card.time(), 0.0);
-    /// card.sync();
+    /// card.sync()?;
     /// assert_eq!(card.time(), 0.002);
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
@@ -225,23 +239,62 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
 
     /// Advances the plant to the current time without a bus access.
     ///
+    /// # Errors
+    ///
+    /// [`HwError::Simulation`] when the clock is more than
+    /// [`MAX_CATCH_UP_STEPS`] sub-steps of `max_substep` ahead (at the
+    /// default 0.25 ms, 2500 s: a clock advanced by hand far past a card
+    /// nobody read), or when the plant's state stops being finite. Time,
+    /// state and outputs are then left as they were, and every later access
+    /// fails alike.
+    ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::{Clock, VirtualClock}, lab::SimulatedRig};
+    /// use ctrlab::{hw::{Clock, HwErrorKind, VirtualClock}, lab::SimulatedRig};
     /// let clock = VirtualClock::new();
     /// let mut card = SimulatedRig::default().card(&Clock::Virtual(clock.clone()))?;
     /// clock.advance(1.0)?;
-    /// card.sync();
+    /// card.sync()?;
+    /// assert_eq!(card.time(), 1.0);
+    /// // A million seconds would be four billion RK4 steps: refused, not run.
+    /// clock.advance(1e6)?;
+    /// assert_eq!(card.sync().unwrap_err().kind(), HwErrorKind::Simulation);
     /// assert_eq!(card.time(), 1.0);
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
-    pub fn sync(&mut self) {
+    pub fn sync(&mut self) -> Result<(), HwError> {
         let now = match &self.time {
             Time::Virtual(clock) => clock.now_nanos(),
             Time::Real(start) => u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX),
         };
+        let behind = now.saturating_sub(self.t_nanos) as f64 * 1e-9;
+        if behind / self.config.max_substep > MAX_CATCH_UP_STEPS as f64 {
+            return Err(HwError::Simulation {
+                reason: format!(
+                    "its clock is {behind:.6e} s ahead, more than the {:.6e} s it catches up in \
+                     at most {MAX_CATCH_UP_STEPS} RK4 sub-steps of {} s",
+                    MAX_CATCH_UP_STEPS as f64 * self.config.max_substep,
+                    self.config.max_substep
+                ),
+                at: self.time(),
+            });
+        }
+        let before = (self.t_nanos, self.state, self.duty, self.pending);
         self.advance_to(now);
+        if let Some(i) = self.state.iter().position(|v| !v.is_finite()) {
+            let (value, at) = (self.state[i], self.time());
+            (self.t_nanos, self.state, self.duty, self.pending) = before;
+            return Err(HwError::Simulation {
+                reason: format!(
+                    "plant state {i} became {value} on the way to this time (the model \
+                     diverged); the card stays at t = {:.4} s",
+                    self.time()
+                ),
+                at,
+            });
+        }
+        Ok(())
     }
 
     /// The true plant state at [`time`](Self::time): what the encoders
@@ -396,13 +449,13 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
 
 impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
     fn write_address(&mut self, address: u8) -> Result<(), HwError> {
-        self.sync();
+        self.sync()?;
         self.address = address;
         Ok(())
     }
 
     fn read_data(&mut self) -> Result<u8, HwError> {
-        self.sync();
+        self.sync()?;
         Ok(match self.decode[usize::from(self.address)] {
             Reg::Id => self.config.card_id,
             Reg::Encoder(n, i) => self.latched[n].to_le_bytes()[i],
@@ -411,7 +464,7 @@ impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
     }
 
     fn write_data(&mut self, value: u8) -> Result<(), HwError> {
-        self.sync();
+        self.sync()?;
         match self.decode[usize::from(self.address)] {
             Reg::Control => {
                 let map = self.config.map;

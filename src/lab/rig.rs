@@ -53,7 +53,7 @@ use crate::hw::{Clock, EppPort, HwError, MAX_DUTY, Pc104, Rig};
 /// assert!(x[2] > 0.0 && x[2] < 0.05);
 /// assert!(rig.apply_voltage(f64::NAN).is_err());
 /// clock.advance(0.001)?; // past the PWM delay
-/// rig.card_mut().port_mut().sync();
+/// rig.card_mut().port_mut().sync()?;
 /// assert_eq!(rig.card().port().pwm_duty(0), 0); // halted
 /// # Ok::<(), ctrlab::hw::HwError>(())
 /// ```

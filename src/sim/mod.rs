@@ -256,17 +256,7 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
     let mut cached: Option<(f64, StateSpace<N, M, P, Discrete>)> = None;
     for (k, &tk) in t.iter().enumerate() {
         let u = input(tk);
-        if u.iter().any(|v| !v.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "input",
-                value: u
-                    .iter()
-                    .copied()
-                    .find(|v| !v.is_finite())
-                    .unwrap_or(f64::NAN),
-                reason: "input samples must be finite",
-            });
-        }
+        check_input(&u)?;
         out.t.push(tk);
         out.x.push(x);
         out.y.push(sys.output(&x, &u));
@@ -333,9 +323,27 @@ fn check_grid(t: &[f64]) -> Result<(), Error> {
     Ok(())
 }
 
+/// What a discrete simulation that overflows reports.
+const DIVERGED: &str = "discrete simulation (the response diverged past f64::MAX)";
+
+/// Refuses a non-finite input sample.
+fn check_input<const M: usize>(u: &SVector<f64, M>) -> Result<(), Error> {
+    match u.iter().find(|v| !v.is_finite()) {
+        Some(&value) => Err(Error::InvalidParameter {
+            name: "input",
+            value,
+            reason: "input samples must be finite",
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Simulates a discrete model open loop: one sample per input, `t[k] = k dt`,
-/// `y[k] = C x[k] + D u[k]`, then `x[k+1] = A x[k] + B u[k]` (at most
-/// [`MAX_SAMPLES`] samples).
+/// `y[k] = C x[k] + D u[k]`, then `x[k+1] = A x[k] + B u[k]`.
+///
+/// # Errors
+///
+/// As [`simulate_discrete_feedback`].
 ///
 /// # Examples
 ///
@@ -344,7 +352,7 @@ fn check_grid(t: &[f64]) -> Result<(), Error> {
 /// use nalgebra::{matrix, vector};
 ///
 /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
-/// let r = simulate_discrete(&sys, vector![0.0], &[vector![1.0]; 3]);
+/// let r = simulate_discrete(&sys, vector![0.0], &[vector![1.0]; 3])?;
 /// assert_eq!(r.output(0)?, vec![0.0, 1.0, 1.5]);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
@@ -352,26 +360,35 @@ pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
     sys: &StateSpace<N, M, P, Discrete>,
     x0: SVector<f64, N>,
     inputs: &[SVector<f64, M>],
-) -> Response<N, P> {
+) -> Result<Response<N, P>, Error> {
     simulate_discrete_feedback(sys, x0, inputs.len(), |k, _x| inputs[k])
 }
 
 /// Simulates a discrete model for `steps` samples with the input computed
 /// from the current sample index and state, `u[k] = control(k, &x[k])`: a
-/// closed loop around any controller. At most [`MAX_SAMPLES`] samples are
-/// simulated (a longer request is cut there, and the response is shorter:
-/// check `len()`).
+/// closed loop around any controller.
+///
+/// # Errors
+///
+/// [`Error::InvalidParameter`] named `"steps"` for more than
+/// [`MAX_SAMPLES`] samples, `"x0"` for a non-finite initial state, `"input"`
+/// for a non-finite input sample; [`Error::Overflow`] when the response
+/// diverges past `f64::MAX`.
 ///
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{StateSpace, sim::simulate_discrete_feedback};
+/// use ctrlab::{Error, StateSpace, sim::simulate_discrete_feedback};
 /// use nalgebra::{matrix, vector};
 ///
 /// // x[k+1] = x + u with u = -0.5 x halves the state every sample.
 /// let sys = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
-/// let r = simulate_discrete_feedback(&sys, vector![8.0], 4, |_k, x| -0.5 * x);
+/// let r = simulate_discrete_feedback(&sys, vector![8.0], 4, |_k, x| -0.5 * x)?;
 /// assert_eq!(r.output(0)?, vec![8.0, 4.0, 2.0, 1.0]);
+/// // u = x doubles the state every sample: past f64::MAX within 30 samples
+/// // from 1e300, an error, not infinities.
+/// let diverging = simulate_discrete_feedback(&sys, vector![1e300], 40, |_k, x| *x);
+/// assert!(matches!(diverging, Err(Error::Overflow { .. })));
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize>(
@@ -379,19 +396,39 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
     x0: SVector<f64, N>,
     steps: usize,
     mut control: impl FnMut(usize, &SVector<f64, N>) -> SVector<f64, M>,
-) -> Response<N, P> {
-    let steps = steps.min(MAX_SAMPLES);
+) -> Result<Response<N, P>, Error> {
+    if steps > MAX_SAMPLES {
+        return Err(Error::InvalidParameter {
+            name: "steps",
+            value: steps as f64,
+            reason: "more samples than MAX_SAMPLES",
+        });
+    }
+    if let Some(&value) = x0.iter().find(|v| !v.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: "x0",
+            value,
+            reason: "the initial state must be finite",
+        });
+    }
     let dt = sys.dt();
     let mut out = Response::with_capacity(steps);
     let mut x = x0;
     for k in 0..steps {
         let u = control(k, &x);
+        check_input(&u)?;
         out.t.push(k as f64 * dt);
         out.x.push(x);
         out.y.push(sys.output(&x, &u));
         sys.advance_mut(&mut x, &u);
+        // Stop at the first overflow: a controller would otherwise see
+        // infinities and the error would blame its input.
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Overflow { operation: DIVERGED });
+        }
     }
-    out
+    out.check_finite(DIVERGED)?;
+    Ok(out)
 }
 
 /// The unit step response of a single-input continuous model from rest, on
