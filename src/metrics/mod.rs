@@ -1,0 +1,182 @@
+//! Step-response figures: rise time, settling time, overshoot, peak and
+//! steady state, from sampled data ([`step_info`]) or from a model
+//! ([`step_info_of`]).
+//!
+//! ```
+//! use ctrlab::{StateSpace, StepInfoOptions, step_info_of};
+//! use nalgebra::matrix;
+//!
+//! // A first-order lag, τ = 0.1 s: rise time τ ln 9, 2 % settling τ ln 50.
+//! let lag = StateSpace::continuous(matrix![-10.0], matrix![10.0], matrix![1.0], matrix![0.0])?;
+//! let info = step_info_of(&lag, 2.0, 0.01, &StepInfoOptions::default())?;
+//! assert!((info.rise_time - 0.1 * 9f64.ln()).abs() < 1e-3);
+//! assert!((info.settling_time - 0.1 * 50f64.ln()).abs() < 1e-3);
+//! # Ok::<(), ctrlab::Error>(())
+//! ```
+//!
+//! # Definitions
+//!
+//! With `y₀` the initial value, `y∞` the final value and `Δ = y∞ − y₀`
+//! (the step, of either sign), and every time measured from the first sample
+//! `t[0]` (the step instant):
+//!
+//! - **rise time**: from the first crossing of `y₀ + lo·Δ` to the first
+//!   later crossing of `y₀ + hi·Δ` (default 10 % and 90 %);
+//! - **settling time**: when `y` enters the band `|y − y∞| ≤ band·|Δ|`
+//!   (default 2 %) for the last time;
+//! - **overshoot**: `100 · (peak − y∞) / Δ` in percent, at least 0;
+//! - **undershoot**: `100 · (y₀ − y)/Δ` at its largest, in percent, at least 0
+//!   (how far the response first goes the wrong way);
+//! - **peak**, **peak time**: the sample farthest from `y₀` in the step's
+//!   direction, and its time;
+//! - **settling min / max**: extremes of `y` from the upper rise crossing on.
+//!
+//! Measuring everything from `y₀` and `Δ` makes the figures independent of
+//! an offset in the data (a position that starts at 5 mm).
+//!
+//! # Differences from MATLAB `stepinfo` and python-control `step_info`
+//!
+//! - Crossing times (rise and settling) are **interpolated linearly**
+//!   between the two samples around the crossing; MATLAB and python-control
+//!   snap them to a sample, so they differ by up to one sample period.
+//! - The settling band is relative to `|Δ|` (python-control: to `|y∞|`,
+//!   the same for a step from 0; MATLAB: to the peak error).
+//! - `peak` is the signed sample value (python-control and MATLAB report
+//!   `max |y|`; they agree for a positive step from 0).
+//! - A response that is not inside its band over the final window (by
+//!   default the last 5 % of the record), or that diverges, is an
+//!   [`Error::NotSettled`], never a number; python-control returns figures
+//!   of whatever the record holds. When the final value is estimated from
+//!   the data (the window's mean), the response must also show no trend
+//!   there: the means of the window's two halves must agree to a quarter of
+//!   the band.
+
+mod of_model;
+mod step_info;
+
+use crate::error::Error;
+pub use crate::error::SettleFailure;
+pub use of_model::{step_info_channel, step_info_of};
+pub use step_info::step_info;
+
+/// Step-response figures; see the [module docs](self) for the exact
+/// definitions. Times in seconds from the first sample, values in the units
+/// of `y`, overshoot and undershoot in percent.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::metrics::{StepInfoOptions, step_info};
+///
+/// let t: Vec<f64> = (0..=400).map(|k| k as f64 * 0.01).collect();
+/// let y: Vec<f64> = t.iter().map(|t| 1.0 - (-t / 0.2f64).exp()).collect();
+/// let info = step_info(&t, &y, &StepInfoOptions::default())?;
+/// assert!((info.rise_time - 0.2 * 9f64.ln()).abs() < 1e-3);
+/// assert!((info.settling_time - 0.2 * 50f64.ln()).abs() < 1e-3);
+/// // No overshoot (bar the hair between the final window's mean and 1).
+/// assert!(info.overshoot < 1e-6);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepInfo {
+    /// Time from the lower to the upper rise level, s.
+    pub rise_time: f64,
+    /// Time after which `y` stays inside the settling band, s.
+    pub settling_time: f64,
+    /// Smallest `y` from the upper rise crossing on.
+    pub settling_min: f64,
+    /// Largest `y` from the upper rise crossing on.
+    pub settling_max: f64,
+    /// Percent by which the peak exceeds the final value, relative to the
+    /// step `Δ`; 0 if it never does.
+    pub overshoot: f64,
+    /// Percent by which `y` goes the wrong way from `y₀`, relative to `Δ`.
+    pub undershoot: f64,
+    /// The sample farthest from `y₀` in the step's direction.
+    pub peak: f64,
+    /// Time of [`peak`](Self::peak), s (a sample time).
+    pub peak_time: f64,
+    /// The final value `y∞` used for every figure.
+    pub steady_state_value: f64,
+    /// `reference − y∞` when a reference was given.
+    pub steady_state_error: Option<f64>,
+}
+
+/// Options for [`step_info`]. `Default` gives a 2 % band, 10–90 % rise,
+/// initial value from the first sample, final value from the last 5 % of the
+/// record, no reference.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::metrics::StepInfoOptions;
+///
+/// let o = StepInfoOptions { settling_band: 0.05, reference: Some(0.030), ..Default::default() };
+/// assert_eq!(o.rise_limits, (0.1, 0.9));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepInfoOptions {
+    /// Half-width of the settling band as a fraction of `|Δ|`, in (0, 1).
+    pub settling_band: f64,
+    /// Rise levels as fractions of `Δ`, `0 ≤ lo < hi ≤ 1`.
+    pub rise_limits: (f64, f64),
+    /// `y₀`; `None` takes the first sample.
+    pub initial_value: Option<f64>,
+    /// `y∞`; `None` takes the mean of the final window ([`step_info_of`]
+    /// uses the model's DC gain instead).
+    pub final_value: Option<f64>,
+    /// The setpoint, for [`StepInfo::steady_state_error`].
+    pub reference: Option<f64>,
+    /// The final window as a fraction of the samples, in (0, 1]: `y` must
+    /// stay inside the band over it, and its mean is the default `y∞`.
+    pub final_window: f64,
+}
+
+impl Default for StepInfoOptions {
+    fn default() -> Self {
+        Self {
+            settling_band: 0.02,
+            rise_limits: (0.1, 0.9),
+            initial_value: None,
+            final_value: None,
+            reference: None,
+            final_window: 0.05,
+        }
+    }
+}
+
+impl StepInfoOptions {
+    pub(crate) fn validate(&self) -> Result<(), Error> {
+        let bad = |name, value, reason| {
+            Err(Error::InvalidParameter {
+                name,
+                value,
+                reason,
+            })
+        };
+        let b = self.settling_band;
+        if !(b > 0.0 && b < 1.0) {
+            return bad("settling_band", b, "must be in (0, 1)");
+        }
+        let (lo, hi) = self.rise_limits;
+        if !(lo >= 0.0 && lo < hi && hi <= 1.0) {
+            return bad("rise_limits", lo, "must satisfy 0 <= lo < hi <= 1");
+        }
+        let w = self.final_window;
+        if !(w > 0.0 && w <= 1.0) {
+            return bad("final_window", w, "must be in (0, 1]");
+        }
+        for (name, v) in [
+            ("initial_value", self.initial_value),
+            ("final_value", self.final_value),
+            ("reference", self.reference),
+        ] {
+            if let Some(v) = v
+                && !v.is_finite()
+            {
+                return bad(name, v, "must be finite");
+            }
+        }
+        Ok(())
+    }
+}
