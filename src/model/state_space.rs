@@ -388,6 +388,42 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
         })
     }
 
+    /// The single-input model from input `j`: column `j` of `B` and `D`,
+    /// the rest unchanged (python-control's `sys[:, j]`). The step and
+    /// impulse responses of [`sim`](crate::sim) take one input.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::OutOfRange`] unless `j < M`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Error, StateSpace};
+    /// # use nalgebra::matrix;
+    /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0, 2.0], matrix![1.0], matrix![0.0, 0.5])?;
+    /// let second = sys.select_input(1)?;
+    /// assert_eq!((second.b()[(0, 0)], second.d()[(0, 0)]), (2.0, 0.5));
+    /// assert!(matches!(sys.select_input(2), Err(Error::OutOfRange { index: 2, len: 2, .. })));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn select_input(&self, j: usize) -> Result<StateSpace<N, 1, P, D>, Error> {
+        if j >= M {
+            return Err(Error::OutOfRange {
+                what: "input",
+                index: j,
+                len: M,
+            });
+        }
+        Ok(StateSpace {
+            a: self.a,
+            b: self.b.column(j).into_owned(),
+            c: self.c,
+            d: self.d.column(j).into_owned(),
+            domain: self.domain,
+        })
+    }
+
     /// Builds a model from parts already known to be finite (crate-internal:
     /// discretisation output is checked by its caller).
     pub(crate) fn from_parts_unchecked(

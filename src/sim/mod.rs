@@ -1,6 +1,7 @@
 //! Time responses: continuous simulation on a time grid ([`simulate`]),
 //! discrete simulation open or closed loop ([`simulate_discrete`],
-//! [`simulate_discrete_feedback`]), the unit [`step_response`], and the
+//! [`simulate_discrete_feedback`]), a model's [`step_response`],
+//! [`impulse_response`] and [`initial_response`] in either time domain, and the
 //! sampled-data simulator [`run_sampled`]: any continuous plant under a
 //! discrete [`Controller`](crate::Controller) with zero-order hold, input
 //! delay, saturation and measurement quantisation and noise, producing the
@@ -12,8 +13,10 @@
 
 use nalgebra::SVector;
 
+mod responses;
 mod sampled;
 
+pub use responses::{impulse_response, initial_response, step_response};
 pub use sampled::{SampledConfig, Sensor, run_sampled};
 
 use crate::discretize::zoh;
@@ -429,40 +432,4 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
     }
     out.check_finite(DIVERGED)?;
     Ok(out)
-}
-
-/// The unit step response of a single-input continuous model from rest, on
-/// the grid [`time_grid`]`(t_end, dt)`, computed exactly (ZOH is exact for a
-/// step).
-///
-/// # Errors
-///
-/// As [`time_grid`] and [`discretize`](StateSpace::discretize).
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::{StateSpace, sim::step_response};
-/// use nalgebra::matrix;
-///
-/// // First-order lag, τ = 0.5 s: y(τ) = 1 - e^-1.
-/// let sys = StateSpace::continuous(matrix![-2.0], matrix![2.0], matrix![1.0], matrix![0.0])?;
-/// let r = step_response(&sys, 1.0, 0.5)?;
-/// assert!((r.y[1][0] - (1.0 - (-1.0f64).exp())).abs() < 1e-14);
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-#[doc(alias = "step")]
-pub fn step_response<const N: usize, const P: usize>(
-    sys: &StateSpace<N, 1, P, Continuous>,
-    t_end: f64,
-    dt: f64,
-) -> Result<Response<N, P>, Error> {
-    let t = time_grid(t_end, dt)?;
-    simulate(
-        sys,
-        &t,
-        SVector::zeros(),
-        |_| SVector::from_element(1.0),
-        Solver::Zoh,
-    )
 }
