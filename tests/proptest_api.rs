@@ -9,7 +9,11 @@ use ctrlab::discretize::expm;
 use ctrlab::ident::{LeastSquares, Rls};
 use ctrlab::lab::ident::{Scheme, Spread, average, identify, identify_separate_springs};
 use ctrlab::metrics::step_info_channel;
-use ctrlab::sim::{SampledConfig, Solver, run_sampled, simulate, step_response, time_grid};
+use ctrlab::metrics::{Definition, step_info_mimo};
+use ctrlab::sim::{
+    SampledConfig, Solver, impulse_response, initial_response, run_sampled, simulate,
+    step_response, time_grid,
+};
 use ctrlab::{MassSpring, Method, Recording, StateSpace, StepInfoOptions, step_info, step_info_of};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use proptest::prelude::*;
@@ -178,17 +182,20 @@ proptest! {
         y in proptest::collection::vec(wild(), 0..30),
         band in wild(), lo in wild(), hi in wild(), window in wild(),
         initial in proptest::option::of(wild()), fin in proptest::option::of(wild()), reference in proptest::option::of(wild()),
+        matlab in any::<bool>(),
     ) {
         let options = StepInfoOptions {
             settling_band: band, rise_limits: (lo, hi), initial_value: initial,
             final_value: fin, reference, final_window: window,
+            definition: if matlab { Definition::Matlab } else { Definition::Ctrlab },
         };
         let n = t.len().min(y.len());
-        for opts in [options, StepInfoOptions::default()] {
+        for opts in [options, StepInfoOptions::default(), StepInfoOptions::matlab()] {
             for (t, y) in [(&t[..n], &y[..n]), (&t[..], &y[..])] {
                 if let Ok(info) = step_info(t, y, &opts) {
                     prop_assert!(finite_all(&[
-                        info.rise_time, info.settling_time, info.settling_min, info.settling_max,
+                        info.rise_time, info.settling_time, info.transient_time,
+                        info.settling_min, info.settling_max,
                         info.overshoot, info.undershoot, info.peak, info.peak_time,
                         info.steady_state_value, info.steady_state_error.unwrap_or(0.0),
                     ]));
@@ -210,8 +217,47 @@ proptest! {
     #[test]
     fn step_metrics_of_models(a in matrix::<3, 3>(finite()), b in matrix::<3, 1>(finite()), c in matrix::<1, 3>(finite()), t_end in 0.0..50.0f64, dt in 0.01..1.0f64) {
         let Some(sys) = model(a, b, c) else { return Ok(()) };
-        if let Ok(info) = step_info_of(&sys, t_end, dt, &StepInfoOptions::default()) {
-            prop_assert!(finite_all(&[info.rise_time, info.settling_time, info.overshoot, info.peak, info.steady_state_value]));
+        for options in [StepInfoOptions::default(), StepInfoOptions::matlab()] {
+            if let Ok(info) = step_info_of(&sys, t_end, dt, &options) {
+                prop_assert!(finite_all(&[info.rise_time, info.settling_time, info.transient_time, info.overshoot, info.peak, info.steady_state_value]));
+            }
+            if let Ok(all) = step_info_mimo(&sys, t_end, dt, &options) {
+                prop_assert_eq!(&all[0][0], &step_info_of(&sys, t_end, dt, &options));
+            }
+            // The same model sampled at dt: its own grid.
+            if let Ok(d) = sys.discretize(dt, Method::Zoh)
+                && let Ok(info) = step_info_of(&d, t_end, dt, &options)
+            {
+                prop_assert!(finite_all(&[info.rise_time, info.settling_time, info.transient_time, info.overshoot, info.peak]));
+            }
+        }
+    }
+
+    #[test]
+    fn impulse_and_initial_responses(
+        a in matrix::<3, 3>(finite()), b in matrix::<3, 1>(finite()),
+        x0 in matrix::<3, 1>(wild()), t_end in wild(), dt in wild(),
+    ) {
+        let Some(sys) = model(a, b, SMatrix::from_element(1.0)) else { return Ok(()) };
+        // Bounded work, as for the step response.
+        let samples = t_end / dt;
+        if !(samples.is_finite() && samples.abs() <= 2000.0) {
+            return Ok(());
+        }
+        let finite_response = |y: &[SVector<f64, 1>]| y.iter().all(|y| finite_all(y.as_slice()));
+        if let Ok(r) = impulse_response(&sys, t_end, dt) {
+            prop_assert!(finite_response(&r.y));
+        }
+        if let Ok(r) = initial_response(&sys, t_end, dt, x0) {
+            prop_assert!(finite_response(&r.y));
+        }
+        if let Ok(d) = StateSpace::discrete(a, b, SMatrix::from_element(1.0), SMatrix::zeros(), dt) {
+            if let Ok(r) = impulse_response(&d, t_end, dt) {
+                prop_assert!(finite_response(&r.y));
+            }
+            if let Ok(r) = initial_response(&d, t_end, dt, x0) {
+                prop_assert!(finite_response(&r.y));
+            }
         }
     }
 

@@ -1,6 +1,9 @@
-//! Step-response figures: rise time, settling time, overshoot, peak and
-//! steady state, from sampled data ([`step_info`]) or from a model
-//! ([`step_info_of`]).
+//! Step-response figures: rise time, settling and transient time,
+//! overshoot, undershoot, peak and steady state, from sampled data
+//! ([`step_info`], [`step_info_channel`]) or from a model, continuous or
+//! discrete ([`step_info_of`] for one input and output,
+//! [`step_info_mimo`] for every channel of a MIMO model), under the crate's
+//! definitions or MATLAB's ([`Definition`]).
 //!
 //! ```
 //! use ctrlab::{StateSpace, StepInfoOptions, step_info_of};
@@ -11,6 +14,10 @@
 //! let info = step_info_of(&lag, 2.0, 0.01, &StepInfoOptions::default())?;
 //! assert!((info.rise_time - 0.1 * 9f64.ln()).abs() < 1e-3);
 //! assert!((info.settling_time - 0.1 * 50f64.ln()).abs() < 1e-3);
+//!
+//! // The same figures under MATLAB's stepinfo definitions.
+//! let m = step_info_of(&lag, 2.0, 0.01, &StepInfoOptions::matlab())?;
+//! assert!((m.settling_time - info.settling_time).abs() < 1e-9);
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 //!
@@ -24,6 +31,10 @@
 //!   later crossing of `y₀ + hi·Δ` (default 10 % and 90 %);
 //! - **settling time**: when `y` enters the band `|y − y∞| ≤ band·|Δ|`
 //!   (default 2 %) for the last time;
+//! - **transient time**: when `|y − y∞|` falls below `band` times its own
+//!   largest value for the last time (MATLAB's `TransientTime`; the same as
+//!   the settling time unless `y` starts away from `y₀` or overshoots by
+//!   more than `Δ`);
 //! - **overshoot**: `100 · (peak − y∞) / Δ` in percent, at least 0;
 //! - **undershoot**: `100 · (y₀ − y)/Δ` at its largest, in percent, at least 0
 //!   (how far the response first goes the wrong way);
@@ -34,29 +45,57 @@
 //! Measuring everything from `y₀` and `Δ` makes the figures independent of
 //! an offset in the data (a position that starts at 5 mm).
 //!
-//! # Differences from MATLAB `stepinfo` and python-control `step_info`
+//! Crossing times (rise, settling, transient) are **interpolated linearly**
+//! between the two samples around the crossing, for sampled data and for a
+//! continuous model. A discrete model's response is a sequence, not samples
+//! of a curve: there a level is reached at the first sample that reaches it,
+//! and the response settles at the sample after the last one outside the
+//! band (MATLAB does the same for discrete models).
 //!
-//! - Crossing times (rise and settling) are **interpolated linearly**
-//!   between the two samples around the crossing; MATLAB and python-control
-//!   snap them to a sample, so they differ by up to one sample period.
-//! - The settling band is relative to `|Δ|` (python-control: to `|y∞|`,
-//!   the same for a step from 0; MATLAB: to the peak error).
-//! - `peak` is the signed sample value (python-control and MATLAB report
-//!   `max |y|`; they agree for a positive step from 0).
-//! - A response that is not inside its band over the final window (by
-//!   default the last 5 % of the record), or that diverges, is an
-//!   [`Error::NotSettled`], never a number; python-control returns figures
-//!   of whatever the record holds. When the final value is estimated from
-//!   the data (the window's mean), the response must also show no trend
-//!   there: the means of the window's two halves must agree to a quarter of
-//!   the band.
+//! These are [`Definition::Ctrlab`], the default. [`Definition::Matlab`]
+//! ([`StepInfoOptions::matlab`]) follows MATLAB's documented `stepinfo`
+//! instead; the two differ only in:
+//!
+//! | | `Ctrlab` (default) | `Matlab` |
+//! |---|---|---|
+//! | `y₀` when not given | the first sample (`D` for a model) | 0, the output before the step |
+//! | `y∞` when not given | the mean of the final window (a model: its DC gain) | the last sample (a model: its DC gain) |
+//! | `peak` | the signed sample farthest from `y₀` along the step | `max |y − y₀|`, a magnitude (MATLAB's "peak absolute value" for `y₀ = 0`) |
+//! | settled when | inside the band over the whole final window, with no trend there when `y∞` is estimated | the last sample is inside the band |
+//!
+//! so a model with a feedthrough `D`, or data with an offset, gives other
+//! figures under the two: MATLAB measures the step from 0 (channel (2, 1)
+//! of MATLAB's MIMO example starts at `D = 0.06` against a final value of
+//! −0.54: an 11.1 % undershoot). `tests/metrics_matlab.rs` checks the
+//! MATLAB definitions against the figures printed on MATLAB's own
+//! reference pages.
+//!
+//! # Errors instead of numbers
+//!
+//! A response that is not inside its band at the end (over the final
+//! window by default, by default the last 5 % of the record; at the last
+//! sample under MATLAB's definitions), or that diverges, is an
+//! [`Error::NotSettled`], never a number (MATLAB reports `NaN`,
+//! python-control figures of whatever the record holds). When the default
+//! definitions estimate the final value from the data (the window's mean),
+//! the response must also show no trend there: the means of the window's
+//! two halves must agree to a quarter of the band.
+//!
+//! # Differences from python-control `step_info`
+//!
+//! - python-control snaps crossing times to a sample, so its times differ
+//!   from these (and from MATLAB's) by up to one sample period.
+//! - Its settling band is relative to `|y∞|` (the same as `|Δ|` for a step
+//!   from 0) and its `Peak` is `max |y|`.
 
+mod matlab;
 mod of_model;
 mod step_info;
 
 use crate::error::Error;
 pub use crate::error::SettleFailure;
-pub use of_model::{step_info_channel, step_info_of};
+pub use matlab::Definition;
+pub use of_model::{step_info_channel, step_info_mimo, step_info_of};
 pub use step_info::step_info;
 
 /// Step-response figures; see the [module docs](self) for the exact
@@ -83,6 +122,9 @@ pub struct StepInfo {
     pub rise_time: f64,
     /// Time after which `y` stays inside the settling band, s.
     pub settling_time: f64,
+    /// Time after which `|y − y∞|` stays below the band's fraction of its
+    /// largest value, s (MATLAB's `TransientTime`).
+    pub transient_time: f64,
     /// Smallest `y` from the upper rise crossing on.
     pub settling_min: f64,
     /// Largest `y` from the upper rise crossing on.
@@ -92,7 +134,8 @@ pub struct StepInfo {
     pub overshoot: f64,
     /// Percent by which `y` goes the wrong way from `y₀`, relative to `Δ`.
     pub undershoot: f64,
-    /// The sample farthest from `y₀` in the step's direction.
+    /// The sample farthest from `y₀` in the step's direction; under
+    /// [`Definition::Matlab`], the largest `|y − y₀|` (non-negative).
     pub peak: f64,
     /// Time of [`peak`](Self::peak), s (a sample time).
     pub peak_time: f64,
@@ -102,9 +145,10 @@ pub struct StepInfo {
     pub steady_state_error: Option<f64>,
 }
 
-/// Options for [`step_info`]. `Default` gives a 2 % band, 10–90 % rise,
-/// initial value from the first sample, final value from the last 5 % of the
-/// record, no reference.
+/// Options for [`step_info`] and the model variants. `Default` gives the
+/// crate's definitions with a 2 % band, 10–90 % rise, initial value from the
+/// first sample, final value from the last 5 % of the record, no reference;
+/// [`matlab`](Self::matlab) MATLAB's `stepinfo` defaults.
 ///
 /// # Examples
 ///
@@ -120,16 +164,21 @@ pub struct StepInfoOptions {
     pub settling_band: f64,
     /// Rise levels as fractions of `Δ`, `0 ≤ lo < hi ≤ 1`.
     pub rise_limits: (f64, f64),
-    /// `y₀`; `None` takes the first sample.
+    /// `y₀`; `None` takes the first sample (under [`Definition::Matlab`]:
+    /// 0).
     pub initial_value: Option<f64>,
-    /// `y∞`; `None` takes the mean of the final window ([`step_info_of`]
-    /// uses the model's DC gain instead).
+    /// `y∞`; `None` takes the mean of the final window (under
+    /// [`Definition::Matlab`]: the last sample; the model variants use the
+    /// model's DC gain instead).
     pub final_value: Option<f64>,
     /// The setpoint, for [`StepInfo::steady_state_error`].
     pub reference: Option<f64>,
     /// The final window as a fraction of the samples, in (0, 1]: `y` must
-    /// stay inside the band over it, and its mean is the default `y∞`.
+    /// stay inside the band over it, and its mean is the default `y∞`
+    /// (checked but not used under [`Definition::Matlab`]).
     pub final_window: f64,
+    /// Whose definitions: the crate's (default) or MATLAB's.
+    pub definition: Definition,
 }
 
 impl Default for StepInfoOptions {
@@ -141,6 +190,7 @@ impl Default for StepInfoOptions {
             final_value: None,
             reference: None,
             final_window: 0.05,
+            definition: Definition::Ctrlab,
         }
     }
 }

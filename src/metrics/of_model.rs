@@ -1,16 +1,22 @@
-//! Step figures of a model ([`step_info_of`]) and of a recording's channel
-//! ([`step_info_channel`]).
+//! Step figures of a model ([`step_info_of`], [`step_info_mimo`]) and of a
+//! recording's channel ([`step_info_channel`]).
 
+use super::step_info::{Crossings, figures};
 use super::{StepInfo, StepInfoOptions, step_info};
 use crate::data::Recording;
 use crate::error::Error;
-use crate::model::{Continuous, StateSpace};
+use crate::model::{Domain, StateSpace, period_of};
 use crate::sim::step_response;
 
-/// Step-response figures of a stable single-input single-output continuous
-/// model: its unit step response from rest on [`time_grid`](crate::sim::time_grid)`(t_end, dt)`
-/// (exact ZOH), with the final value the model's DC gain unless
-/// `options.final_value` says otherwise, and `y₀ = D`.
+/// Step-response figures of a stable single-input single-output model,
+/// continuous or discrete: its unit step response from rest on
+/// [`time_grid`](crate::sim::time_grid)`(t_end, dt)` (see
+/// [`step_response`]: exact for a continuous model; for a discrete one `dt`
+/// must be its period `sys.dt()`), with the final value the model's DC gain
+/// unless `options.final_value` says otherwise. The initial value is `D`
+/// (the first sample) under the crate's definitions, 0 (the output before
+/// the step) under MATLAB's. A discrete model's crossing times are sample
+/// times (see the [module docs](super#definitions)).
 ///
 /// # Errors
 ///
@@ -21,21 +27,99 @@ use crate::sim::step_response;
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Cart, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
+/// use ctrlab::{MassSpring, Cart, Method, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?.closed_loop(&plant)?;
 /// let info = step_info_of(&cl, 2.0, 0.0005, &StepInfoOptions { reference: Some(1.0), ..Default::default() })?;
 /// // Table 2, row [0 0 10 0.1]: about 5 % overshoot, settled in about 0.2 s.
 /// assert!((info.overshoot - 5.03).abs() < 0.5 && (info.settling_time - 0.2).abs() < 0.01);
+///
+/// // The same loop sampled every 2 ms: its figures are sample times.
+/// let d = cl.discretize(0.002, Method::Zoh)?;
+/// let di = step_info_of(&d, 2.0, d.dt(), &StepInfoOptions::default())?;
+/// assert!((di.settling_time / 0.002 - (di.settling_time / 0.002).round()).abs() < 1e-9);
+/// assert!((di.settling_time - info.settling_time).abs() <= 0.002);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn step_info_of<const N: usize>(
-    sys: &StateSpace<N, 1, 1, Continuous>,
+pub fn step_info_of<const N: usize, D: Domain>(
+    sys: &StateSpace<N, 1, 1, D>,
     t_end: f64,
     dt: f64,
     options: &StepInfoOptions,
 ) -> Result<StepInfo, Error> {
+    let [[info]] = channels(sys, t_end, dt, options)?;
+    info
+}
+
+/// Step-response figures of every channel of a stable model with `M`
+/// inputs and `P` outputs, continuous or discrete (MATLAB's `stepinfo` and
+/// python-control's `step_info` of a MIMO model): `[output][input]`, the
+/// figures of output `i` for a unit step on input `j` alone, from rest,
+/// each against its own DC gain, as [`step_info_of`] computes them.
+///
+/// Each channel has its own `Result`: a channel with no step (a zero DC
+/// gain, as between the blocks of a block-diagonal model) is
+/// [`Error::InvalidData`] while the others have their figures.
+///
+/// # Errors
+///
+/// The outer `Result`: [`Error::InvalidParameter`] for bad options, or for
+/// an `initial_value`, `final_value` or `reference` (one number cannot
+/// serve every channel: use [`step_info`] on one channel's response);
+/// [`Error::Unstable`]; errors of [`dc_gain`](StateSpace::dc_gain) and
+/// [`step_response`]. Each channel's: those of [`step_info`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, StateSpace, StepInfoOptions, metrics::step_info_mimo};
+/// use nalgebra::matrix;
+///
+/// // Two lags, τ = 0.1 s and 1 s, one per input and output.
+/// let sys = StateSpace::continuous(
+///     matrix![-10.0, 0.0; 0.0, -1.0], matrix![10.0, 0.0; 0.0, 1.0],
+///     matrix![1.0, 0.0; 0.0, 1.0], matrix![0.0, 0.0; 0.0, 0.0],
+/// )?;
+/// let info = step_info_mimo(&sys, 10.0, 0.001, &StepInfoOptions::default())?;
+/// let (fast, slow) = (info[0][0].as_ref().unwrap(), info[1][1].as_ref().unwrap());
+/// assert!((fast.rise_time - 0.1 * 9f64.ln()).abs() < 1e-6);
+/// assert!((slow.rise_time - 9f64.ln()).abs() < 1e-6);
+/// // Input 2 does not reach output 1.
+/// assert!(matches!(info[0][1], Err(Error::InvalidData { .. })));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn step_info_mimo<const N: usize, const M: usize, const P: usize, D: Domain>(
+    sys: &StateSpace<N, M, P, D>,
+    t_end: f64,
+    dt: f64,
+    options: &StepInfoOptions,
+) -> Result<[[Result<StepInfo, Error>; M]; P], Error> {
+    for (name, value) in [
+        ("initial_value", options.initial_value),
+        ("final_value", options.final_value),
+        ("reference", options.reference),
+    ] {
+        if let Some(value) = value {
+            return Err(Error::InvalidParameter {
+                name,
+                value,
+                reason: "is one number for every channel: leave it None for \
+                         step_info_mimo (each channel's final value is its DC gain)",
+            });
+        }
+    }
+    channels(sys, t_end, dt, options)
+}
+
+/// The figures of every channel; `options.final_value`, when given, serves
+/// them all (the callers allow it for one channel only).
+fn channels<const N: usize, const M: usize, const P: usize, D: Domain>(
+    sys: &StateSpace<N, M, P, D>,
+    t_end: f64,
+    dt: f64,
+    options: &StepInfoOptions,
+) -> Result<[[Result<StepInfo, Error>; M]; P], Error> {
     options.validate()?;
     if let Some(p) = sys.unstable_pole()? {
         return Err(Error::Unstable {
@@ -44,20 +128,34 @@ pub fn step_info_of<const N: usize>(
             im: p.im,
         });
     }
-    let final_value = match options.final_value {
-        Some(v) => v,
-        None => sys.dc_gain()?[(0, 0)],
+    let gain = match options.final_value {
+        Some(_) => None,
+        None => Some(sys.dc_gain()?),
     };
-    let r = step_response(sys, t_end, dt)?;
-    let y: Vec<f64> = r.y.iter().map(|y| y[0]).collect();
-    step_info(
-        &r.t,
-        &y,
-        &StepInfoOptions {
-            final_value: Some(final_value),
-            ..*options
-        },
-    )
+    let crossings = match period_of(&sys.domain()) {
+        None => Crossings::Interpolated,
+        Some(_) => Crossings::AtSamples,
+    };
+    let mut responses = Vec::with_capacity(M);
+    for j in 0..M {
+        responses.push(step_response(&sys.select_input(j)?, t_end, dt)?);
+    }
+    Ok(core::array::from_fn(|i| {
+        core::array::from_fn(|j| {
+            let r = &responses[j];
+            let y: Vec<f64> = r.y.iter().map(|y| y[i]).collect();
+            let final_value = options.final_value.or(gain.map(|g| g[(i, j)]));
+            figures(
+                &r.t,
+                &y,
+                &StepInfoOptions {
+                    final_value,
+                    ..*options
+                },
+                crossings,
+            )
+        })
+    }))
 }
 
 /// [`step_info`] of channel `channel` of a recording (from the rig's loop or

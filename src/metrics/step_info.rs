@@ -1,10 +1,12 @@
 //! [`step_info`]: the figures of sampled data.
 
-use super::{SettleFailure, StepInfo, StepInfoOptions};
+use super::{Definition, SettleFailure, StepInfo, StepInfoOptions};
 use crate::error::Error;
 
 /// Step-response figures of sampled data `y` at times `t` (s, strictly
-/// increasing). One pass over the data for each figure; allocates nothing.
+/// increasing), under the definitions `options.definition` names (see the
+/// [module docs](super#definitions)); crossing times are interpolated. One
+/// pass over the data for each figure; allocates nothing.
 ///
 /// # Errors
 ///
@@ -14,8 +16,8 @@ use crate::error::Error;
 ///   the upper rise level;
 /// - [`Error::InvalidParameter`] for bad options;
 /// - [`Error::NotSettled`] when `y` is outside the band anywhere in the final
-///   window, with its [`SettleFailure`] (diverging, oscillating, or a
-///   record too short);
+///   window (under [`Definition::Matlab`]: at the last sample), with its
+///   [`SettleFailure`] (diverging, oscillating, or a record too short);
 /// - [`Error::Overflow`] when a figure is not representable (an overshoot
 ///   of 10³⁰⁰ % of a tiny step, times spanning more than `f64::MAX` s).
 ///
@@ -30,6 +32,26 @@ use crate::error::Error;
 /// assert!(matches!(err, Error::NotSettled { .. }));
 /// ```
 pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<StepInfo, Error> {
+    figures(t, y, options, Crossings::Interpolated)
+}
+
+/// How a crossing time between two samples is found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Crossings {
+    /// Samples of a curve: interpolated linearly between them.
+    Interpolated,
+    /// A sequence (a discrete model's response): a level is reached at the
+    /// first sample that reaches it.
+    AtSamples,
+}
+
+/// [`step_info`] with the crossing rule of the data's kind.
+pub(super) fn figures(
+    t: &[f64],
+    y: &[f64],
+    options: &StepInfoOptions,
+    crossings: Crossings,
+) -> Result<StepInfo, Error> {
     options.validate()?;
     if y.len() != t.len() {
         return Err(Error::LengthMismatch {
@@ -56,13 +78,24 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
     }
 
     let t0 = t[0];
-    // Final window: the last ⌈w·n⌉ samples, at least one.
-    let window = ((options.final_window * n as f64).ceil() as usize).clamp(1, n);
+    let matlab = options.definition == Definition::Matlab;
+    // Final window: the last ⌈w·n⌉ samples, at least one; MATLAB asks only
+    // for the last sample.
+    let window = if matlab {
+        1
+    } else {
+        ((options.final_window * n as f64).ceil() as usize).clamp(1, n)
+    };
     let window_start = n - window;
-    let y0 = options.initial_value.unwrap_or(y[0]);
-    let yf = match options.final_value {
-        Some(v) => v,
-        None => mean(&y[window_start..]),
+    let y0 = match (options.initial_value, matlab) {
+        (Some(v), _) => v,
+        (None, true) => 0.0,
+        (None, false) => y[0],
+    };
+    let yf = match (options.final_value, matlab) {
+        (Some(v), _) => v,
+        (None, true) => y[n - 1],
+        (None, false) => mean(&y[window_start..]),
     };
     let delta = yf - y0;
     if !delta.is_finite() {
@@ -79,6 +112,11 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
         });
     }
     let band = options.settling_band * delta.abs();
+    let not_settled = |last_outside: f64| Error::NotSettled {
+        last_outside,
+        window_start: t[window_start] - t0,
+        cause: settle_failure(y, yf, window_start),
+    };
     if options.final_value.is_none() && window >= 2 {
         // An estimated final value cannot reveal a response still creeping
         // towards its end (it moves with it), so also ask for no trend: the
@@ -89,45 +127,50 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
         // Halved before subtracting: the difference of two finite means
         // can overflow, and then the response certainly trends.
         if (0.5 * second - 0.5 * first).abs() > 0.125 * band {
-            return Err(Error::NotSettled {
-                last_outside: t[n - 1] - t0,
-                window_start: t[window_start] - t0,
-                cause: settle_failure(y, yf, window_start),
-            });
+            return Err(not_settled(t[n - 1] - t0));
         }
     }
     // Progress along the step, 0 at y₀ and 1 at y∞.
     let progress = |v: f64| (v - y0) / delta;
 
-    // Settling: last sample outside the band.
-    let settling_time = match y.iter().rposition(|&v| (v - yf).abs() > band) {
-        None => 0.0,
-        Some(j) if j + 1 >= n => {
-            return Err(Error::NotSettled {
-                last_outside: t[n - 1] - t0,
-                window_start: t[window_start] - t0,
-                cause: settle_failure(y, yf, window_start),
-            });
+    // When |y − y∞| enters [0, threshold] for good: after the last sample
+    // outside, which must come before the final window.
+    let settles = |threshold: f64| -> Result<f64, Error> {
+        let Some(j) = y.iter().rposition(|&v| (v - yf).abs() > threshold) else {
+            return Ok(0.0);
+        };
+        if j + 1 >= n {
+            return Err(not_settled(t[n - 1] - t0));
         }
-        Some(j) => {
-            let edge = if y[j] > yf { yf + band } else { yf - band };
-            let ts = crossing(t[j], y[j], t[j + 1], y[j + 1], edge) - t0;
-            if j + 1 > window_start {
-                return Err(Error::NotSettled {
-                    last_outside: ts,
-                    window_start: t[window_start] - t0,
-                    cause: settle_failure(y, yf, window_start),
-                });
+        let ts = match crossings {
+            Crossings::AtSamples => t[j + 1],
+            Crossings::Interpolated => {
+                let edge = if y[j] > yf {
+                    yf + threshold
+                } else {
+                    yf - threshold
+                };
+                crossing(t[j], y[j], t[j + 1], y[j + 1], edge)
             }
-            ts
+        } - t0;
+        if j + 1 > window_start {
+            return Err(not_settled(ts));
         }
+        Ok(ts)
     };
+    let settling_time = settles(band)?;
+    // Largest error, halved so that it cannot overflow (y∞ was checked
+    // against y₀, not against every sample).
+    let half_error = y
+        .iter()
+        .fold(0.0f64, |m, v| m.max((0.5 * v - 0.5 * yf).abs()));
+    let transient_time = settles((options.settling_band * half_error * 2.0).min(f64::MAX))?;
 
     // Rise: first crossings of the two levels.
     let (lo, hi) = options.rise_limits;
     let cross = |level: f64, from: usize| -> Option<(usize, f64)> {
         let i = (from..n).find(|&i| progress(y[i]) >= level)?;
-        if i == 0 || progress(y[i - 1]) >= level {
+        if i == 0 || progress(y[i - 1]) >= level || crossings == Crossings::AtSamples {
             return Some((i, t[i]));
         }
         let target = y0 + level * delta;
@@ -153,17 +196,33 @@ pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<Step
             })
     };
     let (y_min, y_max) = extremes(y);
-    let (peak, wrong_way) = if delta > 0.0 {
+    let (along, wrong_way) = if delta > 0.0 {
         (y_max, y_min)
     } else {
         (y_min, y_max)
     };
-    let peak_i = y.iter().position(|&v| v == peak).unwrap_or(0);
-    let (peak_p, min_p) = (progress(peak), progress(wrong_way));
+    // MATLAB's peak is the largest |y − y₀|, which may lie the wrong way.
+    let peak = if matlab {
+        (along - y0).abs().max((wrong_way - y0).abs())
+    } else {
+        along
+    };
+    let peak_i = y
+        .iter()
+        .position(|&v| {
+            if matlab {
+                (v - y0).abs() == peak
+            } else {
+                v == peak
+            }
+        })
+        .unwrap_or(0);
+    let (peak_p, min_p) = (progress(along), progress(wrong_way));
     let (s_min, s_max) = extremes(&y[i_hi..]);
     let info = StepInfo {
         rise_time: t_hi - t_lo,
         settling_time,
+        transient_time,
         settling_min: s_min,
         settling_max: s_max,
         overshoot: (100.0 * (peak_p - 1.0)).max(0.0),
@@ -184,7 +243,12 @@ fn check_figures(info: &StepInfo) -> Result<(), Error> {
     let figures = [
         (info.rise_time, "step metrics: rise time overflows"),
         (info.settling_time, "step metrics: settling time overflows"),
+        (
+            info.transient_time,
+            "step metrics: transient time overflows",
+        ),
         (info.peak_time, "step metrics: peak time overflows"),
+        (info.peak, "step metrics: peak |y − y₀| overflows"),
         (
             info.overshoot,
             "step metrics: overshoot overflows (a peak far beyond a tiny step)",
