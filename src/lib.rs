@@ -15,7 +15,8 @@
 //! - [`discretize`]: ZOH (exact), Tustin, forward and backward Euler, and
 //!   [`expm`](discretize::expm).
 //! - [`integrate`]: the [`Rk4`] and [`Euler`] steppers.
-//! - [`sim`]: continuous and discrete simulation, step responses, and the
+//! - [`sim`]: continuous and discrete simulation, step, impulse and
+//!   initial-condition responses in either time domain, and the
 //!   sampled-data simulator [`run_sampled`] (a continuous plant under a
 //!   discrete controller, with hold, delay, saturation, quantisation and
 //!   noise).
@@ -34,8 +35,10 @@
 //!   ([`place_observer`](design::place_observer), [`lqe`](design::lqe),
 //!   [`dlqe`](design::dlqe), [`Observer`](design::Observer)) and the
 //!   observer-based [`ObserverController`](design::ObserverController).
-//! - [`metrics`]: [`step_info`] / [`step_info_of`] (rise and settling time,
-//!   overshoot, steady state) with interpolated crossing times.
+//! - [`metrics`]: [`step_info`] / [`step_info_of`] / [`step_info_mimo`]
+//!   (rise, settling and transient time, overshoot, steady state) of data
+//!   or of any model, with interpolated crossing times, under the crate's
+//!   definitions or MATLAB's.
 //! - `plot` (feature `plot`, on by default): SVG figures of time responses.
 //!
 //! Data and identification:
