@@ -16,12 +16,7 @@ use nalgebra::{Complex, SMatrix};
 use serde_json::Value;
 
 fn fixtures() -> Value {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/design_fixtures.json"
-    ))
-    .expect("fixture tests/data/design_fixtures.json is readable");
-    serde_json::from_str(&text).expect("fixture is valid JSON")
+    common::fixture("design_fixtures.json")
 }
 
 fn case<'a>(all: &'a Value, kind: &str, name: &str) -> &'a Value {

@@ -200,13 +200,7 @@ fn second_order(zeta: f64, wn: f64, t: f64) -> f64 {
 #[test]
 fn second_order_model_overshoot_is_the_textbook_value() {
     let (zeta, wn) = (0.3, 20.0);
-    let sys = StateSpace::continuous(
-        matrix![0.0, 1.0; -wn * wn, -2.0 * zeta * wn],
-        matrix![0.0; wn * wn],
-        matrix![1.0, 0.0],
-        matrix![0.0],
-    )
-    .unwrap();
+    let sys = common::second_order(zeta, wn);
     let info = step_info_of(
         &sys,
         3.0,

@@ -18,15 +18,6 @@ use ctrlab::{Domain, Error, Method, Response, StateSpace};
 use nalgebra::{SVector, matrix, vector};
 use serde_json::Value;
 
-fn fixtures() -> Value {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/response_fixtures.json"
-    ))
-    .expect("fixture tests/data/response_fixtures.json is readable");
-    serde_json::from_str(&text).expect("fixture is valid JSON")
-}
-
 fn series(v: &Value) -> Vec<f64> {
     v.as_array()
         .unwrap()
@@ -85,7 +76,7 @@ fn check_case<const N: usize, const M: usize, const P: usize, D: Domain>(
 }
 
 fn run_case<const N: usize, const M: usize, const P: usize>(name: &str) {
-    let all = fixtures();
+    let all = common::fixture("response_fixtures.json");
     let case = all["cases"]
         .as_array()
         .unwrap()
@@ -173,13 +164,7 @@ fn python_control_hand_written_arrays() {
 fn first_order_responses_are_analytic() {
     // τ ẏ = −y + u: step 1 − e^{−t/τ}, impulse e^{−t/τ}/τ, free y0 e^{−t/τ}.
     let tau = 0.25;
-    let sys = StateSpace::continuous(
-        matrix![-1.0 / tau],
-        matrix![1.0 / tau],
-        matrix![1.0],
-        matrix![0.0],
-    )
-    .unwrap();
+    let sys = common::lag(tau, 1.0);
     let (t_end, dt) = (2.0, 0.01);
     let step = step_response(&sys, t_end, dt).unwrap();
     let impulse = impulse_response(&sys, t_end, dt).unwrap();
@@ -217,13 +202,7 @@ fn second_order_impulse_and_free_response_are_analytic() {
     // ωn² / (s² + 2ζωn s + ωn²): impulse (ωn/√(1−ζ²)) e^{−ζωn t} sin ωd t;
     // from x = (1, 0) with no input, e^{−ζωn t}(cos ωd t + ζ/√(1−ζ²) sin ωd t).
     let (zeta, wn) = (0.2, 5.0);
-    let sys = StateSpace::continuous(
-        matrix![0.0, 1.0; -wn * wn, -2.0 * zeta * wn],
-        matrix![0.0; wn * wn],
-        matrix![1.0, 0.0],
-        matrix![0.0],
-    )
-    .unwrap();
+    let sys = common::second_order(zeta, wn);
     let root = (1.0 - zeta * zeta).sqrt();
     let wd = wn * root;
     let impulse = impulse_response(&sys, 4.0, 0.001).unwrap();

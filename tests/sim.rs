@@ -1,6 +1,8 @@
 //! Simulation: solvers agree with each other and with analytic responses;
 //! bad grids and inputs are errors.
 
+mod common;
+
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{
     Solver, simulate, simulate_discrete, simulate_discrete_feedback, step_response, time_grid,
@@ -40,13 +42,7 @@ fn rk4_and_zoh_simulations_agree() {
 #[test]
 fn first_order_step_response_is_analytic() {
     let tau = 0.25;
-    let sys = StateSpace::continuous(
-        matrix![-1.0 / tau],
-        matrix![3.0 / tau],
-        matrix![1.0],
-        matrix![0.0],
-    )
-    .unwrap();
+    let sys = common::lag(tau, 3.0);
     let r = step_response(&sys, 2.0, 0.01).unwrap();
     for (t, y) in r.t.iter().zip(&r.y) {
         let want = 3.0 * (1.0 - (-t / tau).exp());

@@ -1,17 +1,42 @@
 //! Shared helpers for the integration tests: loading the reference fixtures.
 #![allow(dead_code)]
 
-use nalgebra::SMatrix;
+use nalgebra::{SMatrix, matrix};
 use serde_json::Value;
+
+/// A JSON fixture from `tests/data/`.
+pub fn fixture(file: &str) -> Value {
+    let path = format!("{}/tests/data/{file}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("fixture {path} is readable: {e}"));
+    serde_json::from_str(&text).expect("fixture is valid JSON")
+}
 
 /// The python-control / SciPy fixture for the nominal plant.
 pub fn nominal_fixture() -> Value {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/mass_spring_nominal.json"
-    ))
-    .expect("fixture tests/data/mass_spring_nominal.json is readable");
-    serde_json::from_str(&text).expect("fixture is valid JSON")
+    fixture("mass_spring_nominal.json")
+}
+
+/// The lag `gain / (τ s + 1)`: `τ ẏ = −y + gain · u`.
+pub fn lag(tau: f64, gain: f64) -> StateSpace<1, 1, 1> {
+    StateSpace::continuous(
+        matrix![-1.0 / tau],
+        matrix![gain / tau],
+        matrix![1.0],
+        matrix![0.0],
+    )
+    .expect("a finite lag")
+}
+
+/// `ωn² / (s² + 2ζωn s + ωn²)` with the position as the output.
+pub fn second_order(zeta: f64, wn: f64) -> StateSpace<2, 1, 1> {
+    StateSpace::continuous(
+        matrix![0.0, 1.0; -wn * wn, -2.0 * zeta * wn],
+        matrix![0.0; wn * wn],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+    )
+    .expect("a finite second-order model")
 }
 
 /// A fixed-size matrix from a JSON array of rows.
