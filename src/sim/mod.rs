@@ -424,7 +424,9 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
         // Stop at the first overflow: a controller would otherwise see
         // infinities and the error would blame its input.
         if x.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Overflow { operation: DIVERGED });
+            return Err(Error::Overflow {
+                operation: DIVERGED,
+            });
         }
     }
     out.check_finite(DIVERGED)?;
