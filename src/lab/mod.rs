@@ -44,6 +44,7 @@
 //! ```
 
 mod calibration;
+mod file;
 mod gains;
 pub mod ident;
 mod plant;
