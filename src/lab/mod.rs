@@ -44,6 +44,7 @@
 //! ```
 
 mod calibration;
+mod config;
 mod file;
 mod gains;
 pub mod ident;
@@ -53,6 +54,7 @@ mod sensor;
 mod simulated;
 
 pub use calibration::Calibration;
+pub use config::RigConfig;
 pub use gains::LabGains;
 pub use plant::{Cart, MassSpring};
 pub use rig::MassSpringRig;
