@@ -293,6 +293,7 @@ mod ppdev {
         assert_eq!(ioctl::PPRELEASE, 0x0000_708c);
         assert_eq!(ioctl::PPEXCL, 0x0000_708f);
         assert_eq!(ioctl::PPGETMODES, 0x8004_7097);
+        assert_eq!(ioctl::PPWCONTROL, 0x4001_7084);
     }
 
     #[test]
@@ -310,6 +311,10 @@ mod ppdev {
         assert_eq!(ioctl::PPCLAIM as libc::Ioctl, libc::_IO(p, 0x8b));
         assert_eq!(ioctl::PPRELEASE as libc::Ioctl, libc::_IO(p, 0x8c));
         assert_eq!(ioctl::PPEXCL as libc::Ioctl, libc::_IO(p, 0x8f));
+        assert_eq!(
+            ioctl::PPWCONTROL as libc::Ioctl,
+            libc::_IOW::<libc::c_uchar>(p, 0x84)
+        );
     }
 
     #[test]
@@ -317,6 +322,29 @@ mod ppdev {
         assert_eq!(ioctl::IEEE1284_MODE_EPP, 0x40);
         assert_eq!(ioctl::IEEE1284_ADDR, 0x2000);
         assert_eq!(ioctl::PARPORT_MODE_EPP, 0x04);
+        assert_eq!(
+            [
+                ioctl::PARPORT_MODE_PCSPP,
+                ioctl::PARPORT_MODE_TRISTATE,
+                ioctl::PARPORT_MODE_EPP,
+                ioctl::PARPORT_MODE_ECP,
+                ioctl::PARPORT_MODE_COMPAT,
+                ioctl::PARPORT_MODE_DMA,
+                ioctl::PARPORT_MODE_SAFEININT,
+            ],
+            [0x01, 0x02, 0x04, 0x08, 0x10, 0x20, 0x40]
+        );
+        // PARPORT_CONTROL_INIT; EPP wants nothing else set (LinuxCNC's
+        // hm2_7i43 writes the same 0x04 after claiming).
+        assert_eq!(ioctl::PARPORT_CONTROL_INIT, 0x04);
+        assert_eq!(ioctl::EPP_CONTROL, 0x04);
+    }
+
+    #[test]
+    fn modes_of_a_missing_port_is_not_present() {
+        let err = Ppdev::modes_of("/dev/nonexistent").unwrap_err();
+        assert_eq!(err.kind(), HwErrorKind::NotPresent);
+        assert!(err.to_string().contains("modprobe"), "{err}");
     }
 
     #[test]
