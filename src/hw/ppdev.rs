@@ -184,14 +184,7 @@ impl Ppdev {
     /// assert!(err.to_string().contains("PPEXCL"));
     /// ```
     pub fn open(path: impl AsRef<Path>) -> Result<Self, HwError> {
-        let path = path.as_ref();
-        let device = path.display().to_string();
-        let file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .custom_flags(libc::O_NONBLOCK)
-            .open(path)
-            .map_err(|e| port_error(&device, "open", e))?;
+        let (file, device) = open_device(path.as_ref())?;
         ioctl_none(&file, ioctl::PPEXCL).map_err(|e| port_error(&device, "PPEXCL", e))?;
         ioctl_none(&file, ioctl::PPCLAIM).map_err(|e| port_error(&device, "PPCLAIM", e))?;
         let modes = get_modes(&file).map_err(|e| port_error(&device, "PPGETMODES", e))?;
@@ -224,14 +217,7 @@ impl Ppdev {
     /// assert_eq!(err.kind(), HwErrorKind::NotPresent);
     /// ```
     pub fn modes_of(path: impl AsRef<Path>) -> Result<PortModes, HwError> {
-        let path = path.as_ref();
-        let device = path.display().to_string();
-        let file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .custom_flags(libc::O_NONBLOCK)
-            .open(path)
-            .map_err(|e| port_error(&device, "open", e))?;
+        let (file, device) = open_device(path.as_ref())?;
         get_modes(&file).map_err(|e| port_error(&device, "PPGETMODES", e))
     }
 
@@ -242,7 +228,7 @@ impl Ppdev {
     /// ```no_run
     /// use ctrlab::hw::Ppdev;
     /// let port = Ppdev::open("/dev/parport0")?;
-    /// assert!(port.modes().epp()); // open refuses a port without
+    /// assert!(port.modes().epp); // open refuses a port without
     /// println!("{}: {}", port.device(), port.modes()); // PCSPP,TRISTATE,EPP,ECP,COMPAT
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
@@ -356,6 +342,20 @@ impl Drop for Ppdev {
         // file (which follows) releases the port in the kernel as well.
         if ioctl_none(&self.file, ioctl::PPRELEASE).is_err() {}
     }
+}
+
+/// Opens the device at `path` for reading and writing, non-blocking (a
+/// read or write the card does not answer is a timeout, not a hang); the
+/// file and the path as errors name it.
+fn open_device(path: &Path) -> Result<(File, String), HwError> {
+    let device = path.display().to_string();
+    let file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(|e| port_error(&device, "open", e))?;
+    Ok((file, device))
 }
 
 /// The port's hardware modes (`PPGETMODES`, which needs no claim).

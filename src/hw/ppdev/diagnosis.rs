@@ -8,34 +8,47 @@ use std::io;
 use super::ioctl;
 use crate::hw::HwError;
 
+/// Every `PARPORT_MODE_*` bit of `linux/parport.h`.
+const KNOWN: u32 = ioctl::PARPORT_MODE_PCSPP
+    | ioctl::PARPORT_MODE_TRISTATE
+    | ioctl::PARPORT_MODE_EPP
+    | ioctl::PARPORT_MODE_ECP
+    | ioctl::PARPORT_MODE_COMPAT
+    | ioctl::PARPORT_MODE_DMA
+    | ioctl::PARPORT_MODE_SAFEININT;
+
 /// A port's hardware modes: the `PARPORT_MODE_*` bits that `PPGETMODES`
-/// reports (`linux/parport.h`), as the kernel logs them when it finds the
-/// port (`parport0: PC-style at 0x378, … [PCSPP,TRISTATE,COMPAT,EPP,ECP]`).
+/// reports (`linux/parport.h`), decoded, as the kernel logs them when it
+/// finds the port (`parport0: PC-style at 0x378, … [PCSPP,TRISTATE,COMPAT,EPP,ECP]`).
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::hw::PortModes;
 /// let modes = PortModes::from_bits(0x1f); // a typical on-board port, set to EPP+ECP
-/// assert!(modes.epp() && modes.ecp() && !modes.dma());
+/// assert!(modes.epp && modes.ecp && !modes.dma);
 /// assert_eq!(modes.to_string(), "PCSPP,TRISTATE,EPP,ECP,COMPAT");
 /// assert_eq!(PortModes::from_bits(0).to_string(), "none");
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct PortModes {
-    bits: u32,
+    /// `PCSPP`: the IBM PC registers are there (a PC-style port).
+    pub pcspp: bool,
+    /// `TRISTATE`: the data lines can be turned round (bidirectional).
+    pub tristate: bool,
+    /// `EPP`: hardware EPP, which the card needs.
+    pub epp: bool,
+    /// `ECP`: hardware ECP (an ECP port's EPP is its mode 4).
+    pub ecp: bool,
+    /// `COMPAT`: the hardware does the printer protocol by itself.
+    pub compat: bool,
+    /// `DMA`: the port can use DMA.
+    pub dma: bool,
+    /// `SAFEININT`: the SPP registers may be accessed in an interrupt.
+    pub safe_in_interrupt: bool,
+    /// Bits this crate does not know (none in `linux/parport.h` today).
+    pub unknown: u32,
 }
-
-/// Each mode's bit and the kernel's name for it, in bit order.
-const NAMES: [(u32, &str); 7] = [
-    (ioctl::PARPORT_MODE_PCSPP, "PCSPP"),
-    (ioctl::PARPORT_MODE_TRISTATE, "TRISTATE"),
-    (ioctl::PARPORT_MODE_EPP, "EPP"),
-    (ioctl::PARPORT_MODE_ECP, "ECP"),
-    (ioctl::PARPORT_MODE_COMPAT, "COMPAT"),
-    (ioctl::PARPORT_MODE_DMA, "DMA"),
-    (ioctl::PARPORT_MODE_SAFEININT, "SAFEININT"),
-];
 
 impl PortModes {
     /// The modes from `PPGETMODES`' bits.
@@ -44,103 +57,50 @@ impl PortModes {
     ///
     /// ```
     /// use ctrlab::hw::{PortModes, ioctl};
-    /// assert!(PortModes::from_bits(ioctl::PARPORT_MODE_EPP).epp());
+    /// assert!(PortModes::from_bits(ioctl::PARPORT_MODE_EPP).epp);
+    /// assert_eq!(PortModes::from_bits(0x100).unknown, 0x100);
     /// ```
-    pub const fn from_bits(bits: u32) -> Self {
-        Self { bits }
+    pub fn from_bits(bits: u32) -> Self {
+        let has = |bit: u32| bits & bit != 0;
+        Self {
+            pcspp: has(ioctl::PARPORT_MODE_PCSPP),
+            tristate: has(ioctl::PARPORT_MODE_TRISTATE),
+            epp: has(ioctl::PARPORT_MODE_EPP),
+            ecp: has(ioctl::PARPORT_MODE_ECP),
+            compat: has(ioctl::PARPORT_MODE_COMPAT),
+            dma: has(ioctl::PARPORT_MODE_DMA),
+            safe_in_interrupt: has(ioctl::PARPORT_MODE_SAFEININT),
+            unknown: bits & !KNOWN,
+        }
     }
 
-    /// The raw bits.
+    /// The known modes and the kernel's names for them, in bit order.
+    fn named(self) -> [(bool, &'static str); 7] {
+        [
+            (self.pcspp, "PCSPP"),
+            (self.tristate, "TRISTATE"),
+            (self.epp, "EPP"),
+            (self.ecp, "ECP"),
+            (self.compat, "COMPAT"),
+            (self.dma, "DMA"),
+            (self.safe_in_interrupt, "SAFEININT"),
+        ]
+    }
+
+    /// The bits again (the inverse of [`from_bits`](Self::from_bits)).
     ///
     /// # Examples
     ///
     /// ```
     /// use ctrlab::hw::PortModes;
-    /// assert_eq!(PortModes::from_bits(0x45).bits(), 0x45);
+    /// assert_eq!(PortModes::from_bits(0x145).bits(), 0x145);
     /// ```
-    pub const fn bits(self) -> u32 {
-        self.bits
-    }
-
-    const fn has(self, bit: u32) -> bool {
-        self.bits & bit != 0
-    }
-
-    /// `PCSPP`: the IBM PC registers are there (a PC-style port).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// assert!(ctrlab::hw::PortModes::from_bits(0x01).pcspp());
-    /// ```
-    pub const fn pcspp(self) -> bool {
-        self.has(ioctl::PARPORT_MODE_PCSPP)
-    }
-
-    /// `TRISTATE`: the data lines can be turned round (bidirectional).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// assert!(ctrlab::hw::PortModes::from_bits(0x02).tristate());
-    /// ```
-    pub const fn tristate(self) -> bool {
-        self.has(ioctl::PARPORT_MODE_TRISTATE)
-    }
-
-    /// `EPP`: hardware EPP, which the card needs.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// assert!(!ctrlab::hw::PortModes::from_bits(0x1b).epp());
-    /// ```
-    pub const fn epp(self) -> bool {
-        self.has(ioctl::PARPORT_MODE_EPP)
-    }
-
-    /// `ECP`: hardware ECP (an ECP port's EPP is its mode 4).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// assert!(ctrlab::hw::PortModes::from_bits(0x08).ecp());
-    /// ```
-    pub const fn ecp(self) -> bool {
-        self.has(ioctl::PARPORT_MODE_ECP)
-    }
-
-    /// `COMPAT`: the hardware does the printer protocol by itself.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// assert!(ctrlab::hw::PortModes::from_bits(0x10).compat());
-    /// ```
-    pub const fn compat(self) -> bool {
-        self.has(ioctl::PARPORT_MODE_COMPAT)
-    }
-
-    /// `DMA`: the port can use DMA.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// assert!(ctrlab::hw::PortModes::from_bits(0x20).dma());
-    /// ```
-    pub const fn dma(self) -> bool {
-        self.has(ioctl::PARPORT_MODE_DMA)
-    }
-
-    /// `SAFEININT`: the SPP registers may be accessed in an interrupt.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// assert!(ctrlab::hw::PortModes::from_bits(0x40).safe_in_interrupt());
-    /// ```
-    pub const fn safe_in_interrupt(self) -> bool {
-        self.has(ioctl::PARPORT_MODE_SAFEININT)
+    pub fn bits(self) -> u32 {
+        self.named()
+            .iter()
+            .enumerate()
+            .filter(|(_, (set, _))| *set)
+            .fold(self.unknown, |bits, (i, _)| bits | 1 << i)
     }
 }
 
@@ -148,14 +108,14 @@ impl PortModes {
 /// `none` for no bit.
 impl fmt::Display for PortModes {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let mut names: Vec<String> = NAMES
+        let mut names: Vec<String> = self
+            .named()
             .iter()
-            .filter(|(bit, _)| self.has(*bit))
+            .filter(|(set, _)| *set)
             .map(|(_, name)| (*name).to_owned())
             .collect();
-        let known = NAMES.iter().fold(0, |all, (bit, _)| all | bit);
-        if self.bits & !known != 0 {
-            names.push(format!("{:#x}", self.bits & !known));
+        if self.unknown != 0 {
+            names.push(format!("{:#x}", self.unknown));
         }
         if names.is_empty() {
             f.write_str("none")
@@ -167,7 +127,7 @@ impl fmt::Display for PortModes {
 
 /// Refuses a port without hardware EPP, saying what to check.
 pub(super) fn require_epp(device: &str, modes: PortModes) -> Result<(), HwError> {
-    if modes.epp() {
+    if modes.epp {
         return Ok(());
     }
     Err(HwError::NotPresent {
@@ -235,42 +195,40 @@ mod tests {
         port_error(PORT, operation, io::Error::from_raw_os_error(errno))
     }
 
+    /// Checks `e` is of `kind` and its message says every one of `hints`.
+    fn says(e: &HwError, kind: HwErrorKind, hints: &[&str]) {
+        assert_eq!(e.kind(), kind, "{e}");
+        let text = e.to_string();
+        for hint in hints {
+            assert!(text.contains(hint), "{hint} missing from: {text}");
+        }
+    }
+
     #[test]
     fn another_driver_holding_the_port_says_how_to_free_it() {
-        for (operation, errno) in [
-            ("PPEXCL", libc::ENXIO),
-            ("PPCLAIM", libc::ENXIO),
-            ("PPCLAIM", libc::EBUSY),
-            ("PPEXCL", libc::EBUSY),
-        ] {
-            let e = error(operation, errno);
-            assert_eq!(e.kind(), HwErrorKind::Busy, "{operation} {errno}");
-            let text = e.to_string();
-            for hint in [
-                PORT,
-                operation,
-                "`lp`",
-                "sudo rmmod lp",
-                "cups",
-                "blacklist lp",
-                "/etc/modprobe.d",
-                "fuser",
-            ] {
-                assert!(text.contains(hint), "{hint} missing from: {text}");
+        let hints = [
+            PORT,
+            "`lp`",
+            "sudo rmmod lp",
+            "cups",
+            "blacklist lp",
+            "/etc/modprobe.d",
+            "fuser",
+        ];
+        for operation in ["PPEXCL", "PPCLAIM"] {
+            for errno in [libc::ENXIO, libc::EBUSY] {
+                says(&error(operation, errno), HwErrorKind::Busy, &hints);
+                says(&error(operation, errno), HwErrorKind::Busy, &[operation]);
             }
         }
     }
 
     #[test]
     fn no_permission_explains_the_lp_group() {
+        let hints = [PORT, "`lp` group", "sudo usermod -aG lp $USER", "log out"];
         for operation in ["open", "PPCLAIM"] {
             for errno in [libc::EACCES, libc::EPERM] {
-                let e = error(operation, errno);
-                assert_eq!(e.kind(), HwErrorKind::Permission);
-                let text = e.to_string();
-                for hint in [PORT, "`lp` group", "sudo usermod -aG lp $USER", "log out"] {
-                    assert!(text.contains(hint), "{hint} missing from: {text}");
-                }
+                says(&error(operation, errno), HwErrorKind::Permission, &hints);
             }
         }
     }
@@ -283,29 +241,22 @@ mod tests {
             ("open", libc::ENXIO),
             ("PPGETMODES", libc::ENODEV),
         ] {
-            let e = error(operation, errno);
-            assert_eq!(e.kind(), HwErrorKind::NotPresent, "{operation} {errno}");
-            let text = e.to_string();
-            assert!(text.contains(operation) && text.contains("modprobe parport_pc ppdev"));
+            let hints = [operation, "modprobe parport_pc ppdev"];
+            says(&error(operation, errno), HwErrorKind::NotPresent, &hints);
         }
     }
 
     #[test]
     fn anything_else_is_an_io_error_naming_the_step() {
-        let e = error("PPEXCL", libc::ENOTTY);
-        assert_eq!(e.kind(), HwErrorKind::Io);
-        assert!(e.to_string().contains("PPEXCL on /dev/parport0"), "{e}");
-        assert_eq!(error("read", libc::EIO).kind(), HwErrorKind::Io);
+        let hints = ["PPEXCL on /dev/parport0"];
+        says(&error("PPEXCL", libc::ENOTTY), HwErrorKind::Io, &hints);
+        says(&error("read", libc::EIO), HwErrorKind::Io, &["read"]);
     }
 
     #[test]
     fn a_port_without_hardware_epp_lists_the_likely_causes() {
         // An on-board port left in the BIOS's default "ECP" mode.
-        let modes = PortModes::from_bits(0x1b);
-        let e = require_epp(PORT, modes).unwrap_err();
-        assert_eq!(e.kind(), HwErrorKind::NotPresent);
-        let text = e.to_string();
-        for hint in [
+        let hints = [
             "PCSPP,TRISTATE,ECP,COMPAT",
             "BIOS",
             "EPP+ECP",
@@ -314,30 +265,34 @@ mod tests {
             "CONFIG_PARPORT_1284",
             "software",
             "too slow",
-        ] {
-            assert!(text.contains(hint), "{hint} missing from: {text}");
-        }
+        ];
+        let e = require_epp(PORT, PortModes::from_bits(0x1b)).unwrap_err();
+        says(&e, HwErrorKind::NotPresent, &hints);
         assert!(require_epp(PORT, PortModes::from_bits(0x1f)).is_ok());
     }
 
     #[test]
     fn modes_decode_every_bit_of_linux_parport_h() {
         let all = PortModes::from_bits(0x7f);
-        assert!(
-            all.pcspp()
-                && all.tristate()
-                && all.epp()
-                && all.ecp()
-                && all.compat()
-                && all.dma()
-                && all.safe_in_interrupt()
+        assert_eq!(
+            all,
+            PortModes {
+                pcspp: true,
+                tristate: true,
+                epp: true,
+                ecp: true,
+                compat: true,
+                dma: true,
+                safe_in_interrupt: true,
+                unknown: 0,
+            }
         );
         assert_eq!(
             all.to_string(),
             "PCSPP,TRISTATE,EPP,ECP,COMPAT,DMA,SAFEININT"
         );
-        for (i, (bit, _)) in NAMES.iter().enumerate() {
-            assert_eq!(*bit, 1 << i);
+        for bits in [0, 0x01, 0x04, 0x1f, 0x40, 0x7f, 0x104, 0xffff_ffff] {
+            assert_eq!(PortModes::from_bits(bits).bits(), bits, "{bits:#x}");
         }
         assert_eq!(PortModes::from_bits(0x104).to_string(), "EPP,0x100");
     }
