@@ -1,62 +1,7 @@
 //! [`RigConfig`]: a real card's register map and the rig's calibration in
 //! one TOML file, the "card file" (`card.toml`).
 //!
-//! The probe (`cargo run --example probe --features ppdev -- --port
-//! /dev/parport0`) measures a card and writes its card file;
-//! `lab5 --port /dev/parport0 --card card.toml` drives the rig from it. The
-//! built-in [`RegisterMap::default`] and [`Calibration::default`] describe
-//! the *simulated* card; a real card is driven from its card file only.
-//!
-//! # The file
-//!
-//! Two tables, every key required. Units: m, V, s, m/s; addresses, bit
-//! masks and the ID may be written in hex (`0x20`) or decimal.
-//!
-//! ```
-//! use ctrlab::lab::RigConfig;
-//!
-//! let config = RigConfig::from_toml(r#"
-//!     ## Where the card's registers are (EPP addresses, one byte each).
-//!     [map]
-//!     id = 0x00                         # card ID register (read)
-//!     control = 0x01                    # control register (write): strobes below
-//!     latch_bit = 0x01                  # latches all four counters at once
-//!     clear_bit = 0x02                  # clears all four counters
-//!     watchdog_bit = 0x04               # kicks the watchdog
-//!     pwm_low = [0x10, 0x12, 0x14, 0x16]  # PWM channel 0-3, duty bits 0-7
-//!     pwm_high = [0x11, 0x13, 0x15, 0x17] # duty bits 8-9, bit 7 direction; applies the duty
-//!     encoder = [0x20, 0x24, 0x28, 0x2c]  # 32-bit counter 0-3, little-endian, 4 addresses each
-//!
-//!     ## How counts and volts map to SI, and what is wired where.
-//!     [calibration]
-//!     metres_per_count = 9.765625e-6    # m per encoder count (80 mm per 8192 counts)
-//!     sign = [1.0, -1.0]                # +1: counting up moves the cart away from the wall
-//!     volts_full_scale = 24.0           # V at 100 % duty; commands saturate at ± this
-//!     pwm_channel = 0                   # the motor's PWM channel (0-3)
-//!     encoder_channels = [0, 1]         # cart 1's and cart 2's encoder (0-3, distinct)
-//!     travel_limits = [0.04, 0.05]      # m, ± about where the counters were cleared
-//!     card_id = 0x3c                    # what the ID register must read
-//!     watchdog_timeout = 0.1            # s, or "none" for a card without one
-//!     max_speed = 2.0                   # m/s: a faster count change is a bus fault
-//!     stall_volts = 6.0                 # V of new drive that must move an encoder
-//!     stall_time = 0.5                  # s the carts may take to answer it
-//!     stall_counts = 3                  # counts that answer it
-//! "#)?;
-//! assert_eq!((config.calibration.card_id, config.map.encoder[1]), (0x3c, 0x24));
-//! assert_eq!(config.calibration.sign[1], -1.0);
-//! # Ok::<(), ctrlab::Error>(())
-//! ```
-//!
-//! # Why every key is required
-//!
-//! [`SimulatedRig`](super::SimulatedRig)'s file fills the fields it lacks
-//! with defaults: it describes a simulation. A card file describes hardware
-//! that moves: a key left out would silently take the simulated card's value
-//! (its ID `0xa5`, its register addresses, its 100 ms watchdog), and the
-//! driver would write registers nobody checked on this card. So a missing
-//! key is refused, like an unknown one (a typo) and a value of the wrong
-//! type, and the values are checked on load: each error names the key, as
-//! `calibration.travel_limits` or `map.encoder[2]`.
+//! The file is documented on [`RigConfig`].
 
 use std::fmt;
 use std::path::Path;
@@ -65,8 +10,65 @@ use super::{Calibration, file};
 use crate::error::Error;
 use crate::hw::{HwError, RegisterMap};
 
-/// A rig's card file: where the card's registers are and how the rig's
-/// counts and volts map to SI. See [the module docs](self) for the file.
+/// A rig's card file (`card.toml`): where the card's registers are and how
+/// the rig's counts and volts map to SI.
+///
+/// The probe (`cargo run --example probe --features ppdev -- --port
+/// /dev/parport0`) measures a card and writes its card file;
+/// `lab5 --port /dev/parport0 --card card.toml` drives the rig from it. The
+/// built-in [`RegisterMap::default`] and [`Calibration::default`] describe
+/// the *simulated* card; a real card is driven from its card file only.
+///
+/// # The file
+///
+/// Two tables, every key required. Units: m, V, s, m/s; addresses, bit
+/// masks and the ID may be written in hex (`0x20`) or decimal.
+///
+/// ```
+/// use ctrlab::lab::RigConfig;
+///
+/// let config = RigConfig::from_toml(r#"
+///     ## Where the card's registers are (EPP addresses, one byte each).
+///     [map]
+///     id = 0x00                         # card ID register (read)
+///     control = 0x01                    # control register (write): strobes below
+///     latch_bit = 0x01                  # latches all four counters at once
+///     clear_bit = 0x02                  # clears all four counters
+///     watchdog_bit = 0x04               # kicks the watchdog
+///     pwm_low = [0x10, 0x12, 0x14, 0x16]  # PWM channel 0-3, duty bits 0-7
+///     pwm_high = [0x11, 0x13, 0x15, 0x17] # duty bits 8-9, bit 7 direction; applies the duty
+///     encoder = [0x20, 0x24, 0x28, 0x2c]  # 32-bit counter 0-3, little-endian, 4 addresses each
+///
+///     ## How counts and volts map to SI, and what is wired where.
+///     [calibration]
+///     metres_per_count = 9.765625e-6    # m per encoder count (80 mm per 8192 counts)
+///     sign = [1.0, -1.0]                # +1: counting up moves the cart away from the wall
+///     volts_full_scale = 24.0           # V at 100 % duty; commands saturate at ± this
+///     pwm_channel = 0                   # the motor's PWM channel (0-3)
+///     encoder_channels = [0, 1]         # cart 1's and cart 2's encoder (0-3, distinct)
+///     travel_limits = [0.04, 0.05]      # m, ± about where the counters were cleared
+///     card_id = 0x3c                    # what the ID register must read
+///     watchdog_timeout = 0.1            # s, or "none" for a card without one
+///     max_speed = 2.0                   # m/s: a faster count change is a bus fault
+///     stall_volts = 6.0                 # V of new drive that must move an encoder
+///     stall_time = 0.5                  # s the carts may take to answer it
+///     stall_counts = 3                  # counts that answer it
+/// "#)?;
+/// assert_eq!((config.calibration.card_id, config.map.encoder[1]), (0x3c, 0x24));
+/// assert_eq!(config.calibration.sign[1], -1.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+///
+/// # Why every key is required
+///
+/// [`SimulatedRig`](super::SimulatedRig)'s file fills the fields it lacks
+/// with defaults: it describes a simulation. A card file describes hardware
+/// that moves: a key left out would silently take the simulated card's value
+/// (its ID `0xa5`, its register addresses, its 100 ms watchdog), and the
+/// driver would write registers nobody checked on this card. So a missing
+/// key is refused, like an unknown one (a typo) and a value of the wrong
+/// type, and the values are checked on load: each error names the key, as
+/// `calibration.travel_limits` or `map.encoder[2]`.
 ///
 /// # Examples
 ///

@@ -9,7 +9,9 @@
 //!   into [`LabGains`];
 //! - the identification of equations (4)–(11) from a recording, in
 //!   [`ident`];
-//! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`],
+//! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`]
+//!   (a real card's register map and calibration come from its card file,
+//!   [`RigConfig`]),
 //!   and in simulation [`SimulatedRig`] (the plant with stick–slip
 //!   [`FrictionPlant`] inside the register-level card, in one call), with
 //!   its [`EncoderSensor`] for the sampled-data simulator;
