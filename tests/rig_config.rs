@@ -193,6 +193,11 @@ fn an_unknown_key_is_refused_and_named() {
         let bad = text.replace(&header, &format!("{header}{typo} = 1\n"));
         let (named, message) = refused_key(&bad);
         assert_eq!(named, Some(format!("{section}.{typo}")), "{message}");
+        let line = bad.lines().position(|l| l.starts_with(typo)).unwrap() + 1;
+        assert!(
+            message.starts_with(&format!("TOML line {line},")),
+            "{message}"
+        );
     }
     let (named, message) = refused_key(&format!("period = 0.002\n{text}"));
     assert_eq!(named.as_deref(), Some("period"), "{message}");

@@ -104,6 +104,9 @@ pub enum HwErrorKind {
 /// let e = HwError::TravelLimit { axis: 2, position: 0.16, limit: 0.15 };
 /// assert_eq!(e.kind(), HwErrorKind::TravelLimit);
 /// assert!(e.to_string().contains("axis 2"));
+/// let busy = HwError::Busy { device: "/dev/parport0".into(), reason: "lp holds it".into() };
+/// assert_eq!(busy.kind(), HwErrorKind::Busy);
+/// assert!(busy.to_string().starts_with("/dev/parport0 is held by another driver"));
 /// ```
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]

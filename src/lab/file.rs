@@ -35,8 +35,15 @@ fn key_of(path: &str, message: &str) -> Option<String> {
 }
 
 fn toml_error(text: &str, key: Option<String>, e: &toml::de::Error) -> Error {
-    let start = e.span().map(|span| span.start.min(text.len()));
-    let line = start.map(|start| text[..start].lines().count().max(1));
+    // The line is one more than the newlines before the fault (a span at
+    // the start of a line included).
+    let line = e.span().map(|span| {
+        text.bytes()
+            .take(span.start)
+            .filter(|&b| b == b'\n')
+            .count()
+            + 1
+    });
     let mut message = e.message().trim_end().to_owned();
     // A syntax error names no key: quote the line it is on instead.
     if let (None, Some(line)) = (&key, line)
