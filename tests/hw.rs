@@ -127,6 +127,53 @@ fn golden_rig_iteration() {
     );
 }
 
+/// Mode switches a ppdev port makes for `log`: one `PPSETMODE` each time
+/// the cycle kind changes between address and data, starting in data mode
+/// (where `Ppdev::open` leaves it, and where every tick ends).
+fn mode_switches(log: &[Cycle]) -> usize {
+    let mut address = false;
+    let mut switches = 0;
+    for cycle in log {
+        let is_address = matches!(cycle, Cycle::AddressWrite(_));
+        if is_address != address {
+            switches += 1;
+            address = is_address;
+        }
+    }
+    switches
+}
+
+#[test]
+fn one_rig_tick_costs_22_cycles_and_22_mode_switches() {
+    // One control tick of the lab's rig: read_state (latch and kick, cart 1's
+    // and cart 2's 32-bit counters) and apply_voltage (one PWM duty). Without
+    // auto-increment every byte is an address cycle then a data cycle, so on
+    // ppdev every cycle is a read or write call and every one of them
+    // follows a PPSETMODE: 44 system calls a tick. (Batching address cycles
+    // apart from data cycles would need an auto-incrementing card.)
+    let mut port = RecordingPort::default();
+    port.inner_mut().set(0x00, 0xa5);
+    let mut rig = MassSpringRig::new(Pc104::new(&mut port), Calibration::default(), 0.002).unwrap();
+    rig.card_mut().port_mut().clear_log();
+    for _ in 0..3 {
+        rig.read_state().unwrap();
+        rig.apply_voltage(1.0).unwrap();
+    }
+    let log = rig.card().port().log().to_vec();
+    assert_eq!(log.len(), 3 * 22);
+    assert_eq!(mode_switches(&log), 3 * 22);
+    let tick = &log[..22];
+    let count = |kind: CycleKind| tick.iter().filter(|c| c.kind() == kind).count();
+    assert_eq!(
+        (
+            count(CycleKind::AddressWrite),
+            count(CycleKind::DataRead),
+            count(CycleKind::DataWrite)
+        ),
+        (11, 8, 3)
+    );
+}
+
 #[test]
 fn pwm_bytes_round_trip_every_duty() {
     for duty in -1000..=1000i16 {
@@ -293,6 +340,7 @@ mod ppdev {
         assert_eq!(ioctl::PPRELEASE, 0x0000_708c);
         assert_eq!(ioctl::PPEXCL, 0x0000_708f);
         assert_eq!(ioctl::PPGETMODES, 0x8004_7097);
+        assert_eq!(ioctl::PPWCONTROL, 0x4001_7084);
     }
 
     #[test]
@@ -310,6 +358,10 @@ mod ppdev {
         assert_eq!(ioctl::PPCLAIM as libc::Ioctl, libc::_IO(p, 0x8b));
         assert_eq!(ioctl::PPRELEASE as libc::Ioctl, libc::_IO(p, 0x8c));
         assert_eq!(ioctl::PPEXCL as libc::Ioctl, libc::_IO(p, 0x8f));
+        assert_eq!(
+            ioctl::PPWCONTROL as libc::Ioctl,
+            libc::_IOW::<libc::c_uchar>(p, 0x84)
+        );
     }
 
     #[test]
@@ -317,6 +369,29 @@ mod ppdev {
         assert_eq!(ioctl::IEEE1284_MODE_EPP, 0x40);
         assert_eq!(ioctl::IEEE1284_ADDR, 0x2000);
         assert_eq!(ioctl::PARPORT_MODE_EPP, 0x04);
+        assert_eq!(
+            [
+                ioctl::PARPORT_MODE_PCSPP,
+                ioctl::PARPORT_MODE_TRISTATE,
+                ioctl::PARPORT_MODE_EPP,
+                ioctl::PARPORT_MODE_ECP,
+                ioctl::PARPORT_MODE_COMPAT,
+                ioctl::PARPORT_MODE_DMA,
+                ioctl::PARPORT_MODE_SAFEININT,
+            ],
+            [0x01, 0x02, 0x04, 0x08, 0x10, 0x20, 0x40]
+        );
+        // PARPORT_CONTROL_INIT; EPP wants nothing else set (LinuxCNC's
+        // hm2_7i43 writes the same 0x04 after claiming).
+        assert_eq!(ioctl::PARPORT_CONTROL_INIT, 0x04);
+        assert_eq!(ioctl::EPP_CONTROL, 0x04);
+    }
+
+    #[test]
+    fn modes_of_a_missing_port_is_not_present() {
+        let err = Ppdev::modes_of("/dev/nonexistent").unwrap_err();
+        assert_eq!(err.kind(), HwErrorKind::NotPresent);
+        assert!(err.to_string().contains("modprobe"), "{err}");
     }
 
     #[test]

@@ -19,9 +19,18 @@
 //! cargo run --release --example lab5 -- --truth truth.toml   # another simulated rig
 //! cargo run --release --example lab5 -- --real-time          # wall-clock loop (about two minutes)
 //! cargo run --release --example lab5 -- --real-time --rt-priority 80   # with SCHED_FIFO
-//! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0   # the real card
+//! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml
+//!                                                             # the real card, from its card file
 //! ```
+//!
+//! The real card needs its card file (`--card`, a `ctrlab::lab::RigConfig`,
+//! written by `cargo run --example probe --features ppdev -- --port
+//! /dev/parport0`): lab5 prints what it will do, reads the card's ID (a
+//! read only), and drives nothing unless the card answers with the ID the
+//! file names.
 
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+mod card;
 mod figures;
 #[path = "../common/lab_tables.rs"]
 mod lab_tables;
@@ -38,14 +47,16 @@ use ctrlab::lab::SimulatedRig;
 use report::Report;
 use rig::{Backend, BackendKind, RigResult, RigRow, RigTable, pct};
 
-const USAGE: &str =
-    "usage: lab5 [--out DIR] [--truth FILE] [--real-time] [--rt-priority N] [--port /dev/parportN]
+const USAGE: &str = "usage: lab5 [--out DIR] [--truth FILE] [--real-time] [--rt-priority N]
+            [--port /dev/parportN --card card.toml]
 
   --out DIR         where report.md, the SVGs and runs/*.csv go (default target/lab5)
   --truth FILE      the simulated rig from a TOML file (see ctrlab::lab::SimulatedRig)
   --real-time       run the rig sections on the wall clock instead of virtual time
   --rt-priority N   run the loop with SCHED_FIFO priority N (1-99), memory locked (Linux)
-  --port PATH       run the rig sections on the real PC104 card (feature `ppdev`)";
+  --port PATH       run the rig sections on the real PC104 card (feature `ppdev`)
+  --card FILE       the real card's register map and calibration (ctrlab::lab::RigConfig),
+                    written by the probe; required with --port";
 
 struct Args {
     out: PathBuf,
@@ -53,6 +64,7 @@ struct Args {
     real_time: bool,
     rt_priority: Option<i32>,
     port: Option<PathBuf>,
+    card: Option<PathBuf>,
 }
 
 fn parse_args() -> Result<Option<Args>, String> {
@@ -62,6 +74,7 @@ fn parse_args() -> Result<Option<Args>, String> {
         real_time: false,
         rt_priority: None,
         port: None,
+        card: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -77,6 +90,7 @@ fn parse_args() -> Result<Option<Args>, String> {
                 );
             }
             "--port" => args.port = Some(it.next().ok_or("--port needs a device path")?.into()),
+            "--card" => args.card = Some(it.next().ok_or("--card needs a card file")?.into()),
             "-h" | "--help" => return Ok(None),
             other => return Err(format!("unknown argument `{other}`")),
         }
@@ -89,10 +103,12 @@ fn backend(args: &Args) -> Result<Backend, Box<dyn std::error::Error>> {
         priority,
         ..RealTime::default()
     });
-    // Ctrl-C halts the rig and ends the run with its recording, instead of
-    // killing the process with the motor at its last duty.
-    let stop = StopSignal::on_interrupt()?;
+    // First the backend: before Ctrl-C is caught, so that it still ends the
+    // process during the real card's countdown, before anything is driven.
     let kind = backend_kind(args)?;
+    // Then Ctrl-C halts the rig and ends the run with its recording,
+    // instead of killing the process with the motor at its last duty.
+    let stop = StopSignal::on_interrupt()?;
     Ok(Backend {
         kind,
         realtime,
@@ -104,6 +120,11 @@ fn backend(args: &Args) -> Result<Backend, Box<dyn std::error::Error>> {
 fn backend_kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
     match &args.port {
         None => {
+            if args.card.is_some() {
+                return Err("--card describes a real card: give its port too, \
+                            --port /dev/parportN (feature `ppdev`)"
+                    .into());
+            }
             let sim = match &args.truth {
                 Some(path) => SimulatedRig::read_toml(path)?,
                 None => SimulatedRig::default(),
@@ -115,22 +136,27 @@ fn backend_kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> 
             })
         }
         #[cfg(all(feature = "ppdev", target_os = "linux"))]
-        Some(path) => {
+        Some(port) => {
+            let (file, config) = card::load(port, args.card.as_deref())?;
+            println!("{}", card::plan(port, file, &config, rig::IDENT_VOLTS));
+            let id = card::check_id(port, &config)?;
             println!(
-                "About to run the rig sections on the REAL card at {}:\n\
-                 - 5 open-loop runs of 5 s with a ±8 V square wave on PWM channel 0;\n\
-                 - 24 closed-loop runs of 3 s (Tables 5 and 6), saturated at ±24 V,\n\
-                   halting at ±50 mm of travel; 3 s pauses between runs.\n\
+                "The card answers {id:#04x} at register {:#04x}, as the card file says.\n\
                  Keep a hand on the emergency stop. Starting in 10 s (Ctrl-C to abort).",
-                path.display()
+                config.map.id
             );
             std::thread::sleep(std::time::Duration::from_secs(10));
-            Ok(BackendKind::Card(path.clone()))
+            Ok(BackendKind::Card {
+                port: port.clone(),
+                config,
+            })
         }
         #[cfg(not(all(feature = "ppdev", target_os = "linux")))]
-        Some(_) => Err("--port needs the `ppdev` feature on Linux: \
-                        cargo run --release --example lab5 --features ppdev -- --port /dev/parport0"
-            .into()),
+        Some(_) => Err(
+            "--port needs the `ppdev` feature on Linux: cargo run --release \
+                        --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml"
+                .into(),
+        ),
     }
 }
 

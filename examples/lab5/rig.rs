@@ -31,7 +31,7 @@ pub const M2: f64 = 0.7;
 /// Identification input: ±8 V square wave (about ±9 N, ±18 mm on cart 2:
 /// well clear of the friction, well inside the travel), 0.2 s half period,
 /// 5 s.
-const IDENT_VOLTS: f64 = 8.0;
+pub const IDENT_VOLTS: f64 = 8.0;
 const IDENT_HALF_PERIOD: f64 = 0.2;
 const IDENT_DURATION: f64 = 5.0;
 /// Length of each closed-loop rig run, s.
@@ -56,9 +56,13 @@ pub enum BackendKind {
         sim: Box<SimulatedRig>,
         real_time: bool,
     },
-    /// The real PC104 card on a parallel port.
+    /// The real PC104 card on a parallel port, with its card file's map
+    /// and calibration.
     #[cfg(all(feature = "ppdev", target_os = "linux"))]
-    Card(std::path::PathBuf),
+    Card {
+        port: PathBuf,
+        config: ctrlab::lab::RigConfig,
+    },
 }
 
 impl Backend {
@@ -85,7 +89,7 @@ impl Backend {
                 )
             }
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
-            BackendKind::Card(path) => format!("the PC104 card on {}", path.display()),
+            BackendKind::Card { port, .. } => format!("the PC104 card on {}", port.display()),
         }
     }
 
@@ -94,7 +98,7 @@ impl Backend {
         match &self.kind {
             BackendKind::Simulated { sim, .. } => Some(sim),
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
-            BackendKind::Card(_) => None,
+            BackendKind::Card { .. } => None,
         }
     }
 
@@ -107,7 +111,7 @@ impl Backend {
         match &self.kind {
             BackendKind::Simulated { real_time, .. } => *real_time,
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
-            BackendKind::Card(_) => true,
+            BackendKind::Card { .. } => true,
         }
     }
 
@@ -147,17 +151,11 @@ impl Backend {
                 run(rig, controller, reference, &clock, &loop_config)
             }
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
-            BackendKind::Card(path) => {
+            BackendKind::Card { port, config } => {
                 let _ = (truth, seed); // the real rig has its own
                 // Let the carts come to rest, then make it the zero position.
                 std::thread::sleep(std::time::Duration::from_secs(3));
-                let mut card = ctrlab::hw::Pc104::new(ctrlab::hw::Ppdev::open(path)?);
-                card.clear_counters()?;
-                let rig = ctrlab::lab::MassSpringRig::new(
-                    card,
-                    ctrlab::lab::Calibration::default(),
-                    PERIOD,
-                )?;
+                let rig = crate::card::rig(port, config, PERIOD)?;
                 run(rig, controller, reference, &Clock::RealTime, &loop_config)
             }
         };

@@ -52,6 +52,9 @@ pub enum HwErrorKind {
     NotPresent,
     /// The operating system refused access to the device.
     Permission,
+    /// Another driver or program holds the device (the printer driver `lp`
+    /// on a parallel port).
+    Busy,
     /// Any other operating-system I/O failure.
     Io,
     /// A moving part left its software travel limits; the rig has been halted.
@@ -101,6 +104,9 @@ pub enum HwErrorKind {
 /// let e = HwError::TravelLimit { axis: 2, position: 0.16, limit: 0.15 };
 /// assert_eq!(e.kind(), HwErrorKind::TravelLimit);
 /// assert!(e.to_string().contains("axis 2"));
+/// let busy = HwError::Busy { device: "/dev/parport0".into(), reason: "lp holds it".into() };
+/// assert_eq!(busy.kind(), HwErrorKind::Busy);
+/// assert!(busy.to_string().starts_with("/dev/parport0 is held by another driver"));
 /// ```
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -122,13 +128,24 @@ pub enum HwError {
         reason: String,
     },
     /// The operating system refused access.
-    #[error("permission denied on {device} (is the user in the `lp` group?)")]
+    #[error(
+        "permission denied on {device}: parallel ports belong to the `lp` group; add yourself \
+         with `sudo usermod -aG lp $USER`, then log out and in again (groups are read at login)"
+    )]
     Permission {
         /// The device path.
         device: String,
         /// The operating system's error.
         #[source]
         source: std::io::Error,
+    },
+    /// Another driver or program holds the device.
+    #[error("{device} is held by another driver: {reason}")]
+    Busy {
+        /// The device path.
+        device: String,
+        /// What failed, what probably holds it, and how to free it.
+        reason: String,
     },
     /// Another operating-system I/O failure.
     #[error("{operation} on {device} failed: {source}")]
@@ -295,6 +312,7 @@ impl HwError {
             HwError::Timeout { .. } => HwErrorKind::Timeout,
             HwError::NotPresent { .. } => HwErrorKind::NotPresent,
             HwError::Permission { .. } => HwErrorKind::Permission,
+            HwError::Busy { .. } => HwErrorKind::Busy,
             HwError::Io { .. } => HwErrorKind::Io,
             HwError::TravelLimit { .. } => HwErrorKind::TravelLimit,
             HwError::InvalidCommand { .. } => HwErrorKind::InvalidCommand,

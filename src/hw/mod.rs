@@ -69,7 +69,7 @@ pub use pc104::{
 };
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
-pub use ppdev::{Ppdev, ioctl};
+pub use ppdev::{PortModes, Ppdev, ioctl};
 pub use realtime::RealTime;
 pub use rig::Rig;
 pub use run::{LoopConfig, LoopStats, RunError, RunOutcome, run};

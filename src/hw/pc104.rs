@@ -53,6 +53,11 @@ pub const PWM_DIRECTION_BIT: u8 = 0x80;
 /// described by another [`RegisterMap`] without forking the driver. Every
 /// byte is accessed with its own EPP address cycle (no auto-increment).
 ///
+/// The default is the *simulated* card's map. A real card is driven with
+/// the map its probe measured, read from its card file
+/// ([`lab::RigConfig`](crate::lab::RigConfig)), never with this default
+/// unchecked.
+///
 /// | address | register | access |
 /// |---|---|---|
 /// | `0x00` | card ID | read |

@@ -13,20 +13,27 @@ use std::path::Path;
 
 use super::{CycleKind, EppPort, HwError};
 
-/// The `ppdev` ioctl request numbers and `parport` mode bits this driver
-/// uses, computed like the kernel's `_IO`/`_IOR`/`_IOW` macros for the
-/// target architecture (from `linux/ppdev.h` and `linux/parport.h`).
+mod diagnosis;
+
+pub use diagnosis::PortModes;
+use diagnosis::{port_error, require_epp};
+
+/// The `ppdev` ioctl request numbers and `parport` mode and control bits
+/// this driver uses, computed like the kernel's `_IO`/`_IOR`/`_IOW` macros
+/// for the target architecture (from `linux/ppdev.h` and
+/// `linux/parport.h`).
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::hw::ioctl;
 /// #[cfg(target_arch = "x86_64")]
-/// assert_eq!(ioctl::PPSETMODE, 0x4004_7080);
+/// assert_eq!((ioctl::PPSETMODE, ioctl::PPWCONTROL), (0x4004_7080, 0x4001_7084));
 /// assert_eq!(ioctl::IEEE1284_MODE_EPP | ioctl::IEEE1284_ADDR, 0x2040);
+/// assert_eq!(ioctl::EPP_CONTROL, 0x04);
 /// ```
 pub mod ioctl {
-    use std::ffi::{c_int, c_uint};
+    use std::ffi::{c_int, c_uchar, c_uint};
     use std::mem::size_of;
 
     #[cfg(any(
@@ -76,9 +83,35 @@ pub mod ioctl {
     pub const PPEXCL: u32 = ioc(layout::NONE, 0x8f, 0);
     /// `_IOR('p', 0x97, unsigned int)`: the port's hardware modes.
     pub const PPGETMODES: u32 = ioc(layout::READ, 0x97, size_of::<c_uint>());
+    /// `_IOW('p', 0x84, unsigned char)`: write the control register.
+    pub const PPWCONTROL: u32 = ioc(layout::WRITE, 0x84, size_of::<c_uchar>());
 
+    /// `PARPORT_MODE_PCSPP` in `PPGETMODES`: IBM PC registers available.
+    pub const PARPORT_MODE_PCSPP: c_uint = 1 << 0;
+    /// `PARPORT_MODE_TRISTATE`: the data lines can be tristated.
+    pub const PARPORT_MODE_TRISTATE: c_uint = 1 << 1;
     /// `PARPORT_MODE_EPP` in `PPGETMODES`: the port has hardware EPP.
     pub const PARPORT_MODE_EPP: c_uint = 1 << 2;
+    /// `PARPORT_MODE_ECP`: hardware ECP.
+    pub const PARPORT_MODE_ECP: c_uint = 1 << 3;
+    /// `PARPORT_MODE_COMPAT`: hardware printer protocol.
+    pub const PARPORT_MODE_COMPAT: c_uint = 1 << 4;
+    /// `PARPORT_MODE_DMA`: the hardware can DMA.
+    pub const PARPORT_MODE_DMA: c_uint = 1 << 5;
+    /// `PARPORT_MODE_SAFEININT`: SPP registers accessible in an interrupt.
+    pub const PARPORT_MODE_SAFEININT: c_uint = 1 << 6;
+
+    /// `PARPORT_CONTROL_INIT`, the control register's bit 2 (nInit, not
+    /// inverted on the connector).
+    pub const PARPORT_CONTROL_INIT: c_uchar = 0x04;
+    /// The control register for EPP cycles, written once after claiming
+    /// (`PPWCONTROL`), as LinuxCNC's EPP drivers (`hm2_7i43`) do: nInit
+    /// high (EPP's nReset, not asserted); nStrobe, nAutoFd and nSelectIn
+    /// released (bits 0, 1, 3 clear: EPP's nWrite, nDataStrobe and
+    /// nAddrStrobe, which the port's EPP hardware drives; the kernel leaves
+    /// a claimed port at `0x0c`, nSelectIn asserted); interrupts off; data
+    /// direction forward (bit 5 clear).
+    pub const EPP_CONTROL: c_uchar = PARPORT_CONTROL_INIT;
     /// `IEEE1284_MODE_EPP` for `PPSETMODE`.
     pub const IEEE1284_MODE_EPP: c_int = 1 << 6;
     /// `IEEE1284_ADDR`, or'ed into the mode for address cycles.
@@ -89,14 +122,32 @@ pub mod ioctl {
 ///
 /// [`open`](Self::open) opens `/dev/parportN` non-blocking, registers
 /// exclusively (`PPEXCL`), claims the port (`PPCLAIM`), checks the hardware
-/// has EPP (`PPGETMODES`) and selects EPP data cycles (`PPSETMODE`). Address
-/// cycles switch the mode to EPP | `IEEE1284_ADDR` and back (only when the
-/// cycle kind changes). There is no `PPNEGOT`: the card is not an IEEE 1284
-/// peripheral that negotiates. Dropping the port releases it (`PPRELEASE`).
+/// has EPP (`PPGETMODES`), selects EPP data cycles (`PPSETMODE`) and sets
+/// the control register for EPP ([`ioctl::EPP_CONTROL`], `PPWCONTROL`).
+/// Address cycles switch the mode to EPP | `IEEE1284_ADDR` and back (only
+/// when the cycle kind changes). There is no `PPNEGOT`: the card is not an
+/// IEEE 1284 peripheral that negotiates. Dropping the port releases it
+/// (`PPRELEASE`).
 ///
-/// Errors: a short read or write is [`HwError::Timeout`]; `EACCES`/`EPERM`
-/// are [`HwError::Permission`]; `ENOENT`, `ENODEV` and `ENXIO` are
-/// [`HwError::NotPresent`]; anything else is [`HwError::Io`].
+/// # What a register access costs
+///
+/// Each EPP cycle is one `read` or `write` system call of one byte, and a
+/// change between address and data cycles is one more, a `PPSETMODE`
+/// ioctl. The card does not auto-increment its address, so every register
+/// access is an address cycle then a data cycle, and the mode changes on
+/// every cycle: one tick of the lab's rig
+/// ([`MassSpringRig`](crate::lab::MassSpringRig): latch and kick, two
+/// 32-bit counters, one PWM duty) is 22 EPP cycles and 22 mode switches,
+/// 44 system calls. No batching saves any without auto-increment (see
+/// `tests/hw.rs`, `one_rig_tick_costs_22_cycles_and_22_mode_switches`).
+///
+/// Errors say what is wrong and what to do: a short read or write is
+/// [`HwError::Timeout`]; `EACCES`/`EPERM` are [`HwError::Permission`]
+/// (the `lp` group); `ENXIO`/`EBUSY` when claiming are [`HwError::Busy`]
+/// (the printer driver `lp` holds the port: how to free it); `ENOENT`,
+/// `ENODEV` and `ENXIO` otherwise, and a port without hardware EPP, are
+/// [`HwError::NotPresent`] (with the likely causes); anything else is
+/// [`HwError::Io`] naming the failed step.
 ///
 /// # Examples
 ///
@@ -109,6 +160,7 @@ pub mod ioctl {
 pub struct Ppdev {
     file: File,
     device: String,
+    modes: PortModes,
     /// `Some(true)` in address mode, `Some(false)` in data mode.
     address_mode: Option<bool>,
 }
@@ -118,8 +170,9 @@ impl Ppdev {
     ///
     /// # Errors
     ///
-    /// [`HwError::NotPresent`] (no such device, or no EPP),
-    /// [`HwError::Permission`], [`HwError::Io`] naming the failed step.
+    /// [`HwError::NotPresent`] (no such device, or no hardware EPP),
+    /// [`HwError::Permission`], [`HwError::Busy`] (another driver holds
+    /// the port), [`HwError::Io`] naming the failed step.
     ///
     /// # Examples
     ///
@@ -131,33 +184,56 @@ impl Ppdev {
     /// assert!(err.to_string().contains("PPEXCL"));
     /// ```
     pub fn open(path: impl AsRef<Path>) -> Result<Self, HwError> {
-        let path = path.as_ref();
-        let device = path.display().to_string();
-        let file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .custom_flags(libc::O_NONBLOCK)
-            .open(path)
-            .map_err(|e| os_error(&device, "open", e))?;
-        ioctl_none(&file, ioctl::PPEXCL).map_err(|e| os_error(&device, "PPEXCL", e))?;
-        ioctl_none(&file, ioctl::PPCLAIM).map_err(|e| os_error(&device, "PPCLAIM", e))?;
+        let (file, device) = open_device(path.as_ref())?;
+        ioctl_none(&file, ioctl::PPEXCL).map_err(|e| port_error(&device, "PPEXCL", e))?;
+        ioctl_none(&file, ioctl::PPCLAIM).map_err(|e| port_error(&device, "PPCLAIM", e))?;
+        let modes = get_modes(&file).map_err(|e| port_error(&device, "PPGETMODES", e))?;
         // Claimed: from here on, dropping `port` releases it.
         let mut port = Self {
             file,
             device,
+            modes,
             address_mode: None,
         };
-        let modes = port.get_modes()?;
-        if modes & ioctl::PARPORT_MODE_EPP == 0 {
-            return Err(HwError::NotPresent {
-                device: port.device.clone(),
-                reason: format!(
-                    "the port has no hardware EPP (PPGETMODES = {modes:#x}); enable EPP in the BIOS"
-                ),
-            });
-        }
+        require_epp(&port.device, modes)?;
         port.set_mode(false)?;
+        port.write_control(ioctl::EPP_CONTROL)?;
         Ok(port)
+    }
+
+    /// The modes of the port at `path` (`PPGETMODES`), without claiming it:
+    /// what a port can do, even while another driver holds it or when it
+    /// has no EPP (which [`open`](Self::open) refuses).
+    ///
+    /// # Errors
+    ///
+    /// As [`open`](Self::open), for the `open` and `PPGETMODES` steps.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{HwErrorKind, Ppdev};
+    /// let err = Ppdev::modes_of("/dev/nonexistent").unwrap_err();
+    /// assert_eq!(err.kind(), HwErrorKind::NotPresent);
+    /// ```
+    pub fn modes_of(path: impl AsRef<Path>) -> Result<PortModes, HwError> {
+        let (file, device) = open_device(path.as_ref())?;
+        get_modes(&file).map_err(|e| port_error(&device, "PPGETMODES", e))
+    }
+
+    /// The port's hardware modes (`PPGETMODES`, read when it was opened).
+    ///
+    /// # Examples
+    ///
+    /// ```no_run
+    /// use ctrlab::hw::Ppdev;
+    /// let port = Ppdev::open("/dev/parport0")?;
+    /// assert!(port.modes().epp); // open refuses a port without
+    /// println!("{}: {}", port.device(), port.modes()); // PCSPP,TRISTATE,EPP,ECP,COMPAT
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    pub fn modes(&self) -> PortModes {
+        self.modes
     }
 
     /// The device path.
@@ -174,26 +250,27 @@ impl Ppdev {
         &self.device
     }
 
-    fn get_modes(&self) -> Result<libc::c_uint, HwError> {
-        let mut modes: libc::c_uint = 0;
-        // SAFETY: PPGETMODES writes one `unsigned int` through its pointer
-        // argument; `modes` is a live, aligned c_uint for the whole call, and
-        // the fd is owned by `self.file`, open for the call's duration.
+    /// Writes the port's control register (`PPWCONTROL`).
+    fn write_control(&mut self, value: u8) -> Result<(), HwError> {
+        let value: libc::c_uchar = value;
+        // SAFETY: PPWCONTROL reads one `unsigned char` through its pointer
+        // argument; `value` is a live c_uchar for the whole call, and the fd
+        // is owned by `self.file`, open for the call's duration.
         let rc = unsafe {
             libc::ioctl(
                 self.file.as_raw_fd(),
-                ioctl::PPGETMODES as libc::Ioctl,
-                &mut modes as *mut libc::c_uint,
+                ioctl::PPWCONTROL as libc::Ioctl,
+                &value as *const libc::c_uchar,
             )
         };
         if rc < 0 {
-            return Err(os_error(
+            return Err(port_error(
                 &self.device,
-                "PPGETMODES",
+                "PPWCONTROL",
                 io::Error::last_os_error(),
             ));
         }
-        Ok(modes)
+        Ok(())
     }
 
     /// Selects EPP address (`true`) or data (`false`) cycles, if not already.
@@ -218,7 +295,7 @@ impl Ppdev {
         };
         if rc < 0 {
             self.address_mode = None;
-            return Err(os_error(
+            return Err(port_error(
                 &self.device,
                 "PPSETMODE",
                 io::Error::last_os_error(),
@@ -267,6 +344,40 @@ impl Drop for Ppdev {
     }
 }
 
+/// Opens the device at `path` for reading and writing, non-blocking (a
+/// read or write the card does not answer is a timeout, not a hang); the
+/// file and the path as errors name it.
+fn open_device(path: &Path) -> Result<(File, String), HwError> {
+    let device = path.display().to_string();
+    let file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(|e| port_error(&device, "open", e))?;
+    Ok((file, device))
+}
+
+/// The port's hardware modes (`PPGETMODES`, which needs no claim).
+fn get_modes(file: &File) -> io::Result<PortModes> {
+    let mut modes: libc::c_uint = 0;
+    // SAFETY: PPGETMODES writes one `unsigned int` through its pointer
+    // argument; `modes` is a live, aligned c_uint for the whole call, and the
+    // fd is owned by `file`, open for the call's duration.
+    let rc = unsafe {
+        libc::ioctl(
+            file.as_raw_fd(),
+            ioctl::PPGETMODES as libc::Ioctl,
+            &mut modes as *mut libc::c_uint,
+        )
+    };
+    if rc < 0 {
+        Err(io::Error::last_os_error())
+    } else {
+        Ok(PortModes::from_bits(modes))
+    }
+}
+
 /// An argumentless (`_IO`) ppdev ioctl.
 fn ioctl_none(file: &File, request: u32) -> io::Result<()> {
     // SAFETY: `request` is one of ppdev's `_IO` requests, which take no
@@ -291,7 +402,7 @@ fn timeout(cycle: CycleKind) -> HwError {
 fn transfer_error(device: &str, cycle: CycleKind, e: io::Error) -> HwError {
     match e.raw_os_error() {
         Some(libc::EAGAIN | libc::ETIMEDOUT) => timeout(cycle),
-        _ => os_error(
+        _ => port_error(
             device,
             match cycle {
                 CycleKind::DataRead => "read",
@@ -299,24 +410,5 @@ fn transfer_error(device: &str, cycle: CycleKind, e: io::Error) -> HwError {
             },
             e,
         ),
-    }
-}
-
-/// Maps an OS error to the matching [`HwError`].
-fn os_error(device: &str, operation: &'static str, e: io::Error) -> HwError {
-    match e.raw_os_error() {
-        Some(libc::EACCES | libc::EPERM) => HwError::Permission {
-            device: device.to_owned(),
-            source: e,
-        },
-        Some(libc::ENOENT | libc::ENODEV | libc::ENXIO) => HwError::NotPresent {
-            device: device.to_owned(),
-            reason: format!("{operation}: {e}"),
-        },
-        _ => HwError::Io {
-            device: device.to_owned(),
-            operation,
-            source: e,
-        },
     }
 }

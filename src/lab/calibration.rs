@@ -7,7 +7,9 @@ use crate::hw::{ENCODER_CHANNELS, HwError, PWM_CHANNELS};
 /// where.
 ///
 /// The default is the lab's rig as [`SimulatedRig`](super::SimulatedRig)
-/// models it: 80 mm per 8192 counts (9.765625 µm per count), both encoders
+/// models it (the simulated card's ID and watchdog among it, so it is the
+/// simulated card's calibration only: a real card's is measured by the probe
+/// and read from its card file, [`RigConfig`](super::RigConfig)): 80 mm per 8192 counts (9.765625 µm per count), both encoders
 /// counting up when the carts move away from the wall, 24 V full scale, the
 /// motor on PWM channel 0, cart 1 on encoder 0, cart 2 on encoder 1, travel
 /// limits ±50 mm on both carts, the simulated card's ID `0xa5` and 100 ms
@@ -25,7 +27,8 @@ use crate::hw::{ENCODER_CHANNELS, HwError, PWM_CHANNELS};
 /// let flipped = Calibration { sign: [1.0, -1.0], ..cal };
 /// assert!(flipped.validate().is_ok());
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Calibration {
     /// Cart travel per encoder count, m (> 0).
     pub metres_per_count: f64,
@@ -42,10 +45,14 @@ pub struct Calibration {
     /// the position where the counters were cleared).
     pub travel_limits: [f64; 2],
     /// What the card's ID register must read; the rig checks it when it is
-    /// built (and tells an open bus, `0x00` or `0xff`, from a card).
+    /// built (and tells an open bus, `0x00` or `0xff`, from a card). Neither
+    /// `0x00` nor `0xff`: an ID an open bus also reads proves nothing.
     pub card_id: u8,
     /// The card's watchdog timeout, s, if it has one: the control loop
-    /// halts before half of it passes without a sample.
+    /// halts before half of it passes without a sample. In a TOML file, a
+    /// number of seconds or `"none"` (said explicitly, never by leaving the
+    /// key out).
+    #[serde(with = "watchdog")]
     pub watchdog_timeout: Option<f64>,
     /// The fastest a cart can physically move, m/s (> 0): a count change
     /// implying more is a bus or counter fault, not a measurement.
@@ -129,6 +136,13 @@ impl Calibration {
                 "must be 0–3",
             ));
         }
+        if self.card_id == 0x00 || self.card_id == 0xff {
+            return Err(HwError::invalid_config(
+                "card_id",
+                f64::from(self.card_id),
+                "must be neither 0x00 nor 0xff, which an open bus reads",
+            ));
+        }
         if self.stall_counts < 1 {
             return Err(HwError::invalid_config(
                 "stall_counts",
@@ -151,4 +165,61 @@ pub(super) fn check_encoder_channels([e1, e2]: [usize; 2]) -> Result<(), HwError
         ));
     }
     Ok(())
+}
+
+/// `watchdog_timeout` in a file: a number of seconds, or `"none"` for a card
+/// without a watchdog. A required key either way (no `Option` default), so
+/// a file that forgets it is refused rather than read as "no watchdog".
+mod watchdog {
+    use std::fmt;
+
+    use serde::de::{self, Visitor};
+    use serde::{Deserializer, Serializer};
+
+    /// The word for "no watchdog".
+    const NONE: &str = "none";
+
+    pub fn serialize<S: Serializer>(value: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+        match value {
+            Some(seconds) => s.serialize_f64(*seconds),
+            None => s.serialize_str(NONE),
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
+        d.deserialize_any(Timeout)
+    }
+
+    struct Timeout;
+
+    impl Visitor<'_> for Timeout {
+        type Value = Option<f64>;
+
+        fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            write!(
+                f,
+                "a timeout in seconds, or \"{NONE}\" for a card without a watchdog"
+            )
+        }
+
+        fn visit_f64<E: de::Error>(self, v: f64) -> Result<Self::Value, E> {
+            Ok(Some(v))
+        }
+
+        fn visit_i64<E: de::Error>(self, v: i64) -> Result<Self::Value, E> {
+            Ok(Some(v as f64))
+        }
+
+        fn visit_u64<E: de::Error>(self, v: u64) -> Result<Self::Value, E> {
+            Ok(Some(v as f64))
+        }
+
+        fn visit_str<E: de::Error>(self, v: &str) -> Result<Self::Value, E> {
+            if v == NONE {
+                Ok(None)
+            } else {
+                Err(E::invalid_value(de::Unexpected::Str(v), &self))
+            }
+        }
+    }
 }

@@ -9,7 +9,9 @@
 //!   into [`LabGains`];
 //! - the identification of equations (4)–(11) from a recording, in
 //!   [`ident`];
-//! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`],
+//! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`]
+//!   (a real card's register map and calibration come from its card file,
+//!   [`RigConfig`]),
 //!   and in simulation [`SimulatedRig`] (the plant with stick–slip
 //!   [`FrictionPlant`] inside the register-level card, in one call), with
 //!   its [`EncoderSensor`] for the sampled-data simulator;
@@ -44,6 +46,8 @@
 //! ```
 
 mod calibration;
+mod config;
+mod file;
 mod gains;
 pub mod ident;
 mod plant;
@@ -52,6 +56,7 @@ mod sensor;
 mod simulated;
 
 pub use calibration::Calibration;
+pub use config::RigConfig;
 pub use gains::LabGains;
 pub use plant::{Cart, MassSpring};
 pub use rig::MassSpringRig;

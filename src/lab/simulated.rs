@@ -374,8 +374,8 @@ impl SimulatedRig {
     ///
     /// # Errors
     ///
-    /// [`Error::Toml`] with the line and the parser's message, which names
-    /// the field (an unknown field, a value of the wrong type). The values
+    /// [`Error::Toml`] with the line, the dotted key at fault (an unknown
+    /// field, a value of the wrong type) and the parser's message. The values
     /// themselves are checked when the rig is built
     /// ([`validate`](Self::validate)).
     ///
@@ -384,19 +384,12 @@ impl SimulatedRig {
     /// ```
     /// use ctrlab::lab::SimulatedRig;
     /// assert_eq!(SimulatedRig::from_toml("")?, SimulatedRig::default());
-    /// let err = SimulatedRig::from_toml("seed = \"seven\"").unwrap_err();
-    /// assert!(err.to_string().contains("seed"));
+    /// let err = SimulatedRig::from_toml("[truth]\nm1 = \"heavy\"").unwrap_err();
+    /// assert!(err.to_string().contains("key `truth.m1`"), "{err}");
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn from_toml(text: &str) -> Result<Self, Error> {
-        toml::from_str(text).map_err(|e| Error::Toml {
-            line: e
-                .span()
-                .map(|span| text[..span.start.min(text.len())].lines().count().max(1)),
-            // The full message quotes the offending line, so it names the
-            // field even where the parser's own message does not.
-            message: e.to_string().trim_end().to_string(),
-        })
+        super::file::parse(text)
     }
 
     /// The simulated rig in `path` ([`from_toml`](Self::from_toml)).
@@ -413,10 +406,7 @@ impl SimulatedRig {
     /// assert!(matches!(SimulatedRig::read_toml("no/such/truth.toml"), Err(Error::Io { .. })));
     /// ```
     pub fn read_toml(path: impl AsRef<std::path::Path>) -> Result<Self, Error> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::io(format!("reading {}", path.display()), &e))?;
-        Self::from_toml(&text)
+        Self::from_toml(&super::file::read(path.as_ref())?)
     }
 
     /// The rig as TOML text, every field written; reads back equal.

@@ -1,0 +1,70 @@
+//! The real card (`--port`, feature `ppdev`): nothing is driven until a
+//! card file is given (`--card`, a `ctrlab::lab::RigConfig`) and the card
+//! answers with the ID it names, and what will be done is printed before
+//! any register is written.
+
+use std::path::Path;
+
+use ctrlab::hw::{HwError, Pc104, Ppdev};
+use ctrlab::lab::{MassSpringRig, RigConfig};
+
+/// The card file named by `--card` and its configuration, checked;
+/// without one, how to make it.
+pub fn load<'a>(port: &Path, card: Option<&'a Path>) -> Result<(&'a Path, RigConfig), String> {
+    let Some(card) = card else {
+        return Err(format!(
+            "--port {port} needs the card's register map and calibration: --card card.toml. \
+             The built-in map is the simulated card's, and nothing is driven on a real card \
+             from it. The probe measures the card step by step and writes the card file:\n  \
+             cargo run --example probe --features ppdev -- --port {port}\n\
+             then: cargo run --release --example lab5 --features ppdev -- --port {port} --card card.toml",
+            port = port.display()
+        ));
+    };
+    let config =
+        RigConfig::read_toml(card).map_err(|e| format!("card file {}: {e}", card.display()))?;
+    Ok((card, config))
+}
+
+/// What the run will do, for the person at the rig to check before the
+/// first register access.
+pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> String {
+    let cal = &config.calibration;
+    let what = config
+        .to_string()
+        .lines()
+        .map(|line| format!("  {line}\n"))
+        .collect::<String>();
+    format!(
+        "About to run the rig sections on the REAL card.\n\
+         port: {port}\n\
+         card file: {card}\n\
+         {what}\
+         runs: 5 open-loop runs of 5 s with a ±{ident_volts} V square wave, then 24 closed-loop \
+         runs of 3 s (Tables 5 and 6) saturated at ±{full} V, 3 s pauses between runs; each run \
+         halts the motor at the first fault (travel limit, bus fault, stall, timing, Ctrl-C).\n\
+         Nothing has been written to the card. Next: open the port and read the ID register \
+         {id:#04x} (a read only).",
+        port = port.display(),
+        card = card.display(),
+        full = cal.volts_full_scale,
+        id = config.map.id,
+    )
+}
+
+/// Opens the port with the file's map and reads the card's ID: the first
+/// access, and a read. Dropping the card releases the port.
+pub fn check_id(port: &Path, config: &RigConfig) -> Result<u8, HwError> {
+    let mut card = Pc104::with_map(Ppdev::open(port)?, config.map)?;
+    card.probe_id(config.calibration.card_id)
+}
+
+/// The rig on the card with the file's map and calibration: the ID is
+/// probed (building the rig) before the counters are cleared, the first
+/// write.
+pub fn rig(port: &Path, config: &RigConfig, period: f64) -> Result<MassSpringRig<Ppdev>, HwError> {
+    let card = Pc104::with_map(Ppdev::open(port)?, config.map)?;
+    let mut rig = MassSpringRig::new(card, config.calibration, period)?;
+    rig.card_mut().clear_counters()?;
+    Ok(rig)
+}

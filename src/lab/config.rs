@@ -1,0 +1,487 @@
+//! [`RigConfig`]: a real card's register map and the rig's calibration in
+//! one TOML file, the "card file" (`card.toml`).
+//!
+//! The file is documented on [`RigConfig`].
+
+use std::fmt;
+use std::path::Path;
+
+use super::{Calibration, file};
+use crate::error::Error;
+use crate::hw::{HwError, RegisterMap};
+
+/// A rig's card file (`card.toml`): where the card's registers are and how
+/// the rig's counts and volts map to SI.
+///
+/// The probe (`cargo run --example probe --features ppdev -- --port
+/// /dev/parport0`) measures a card and writes its card file;
+/// `lab5 --port /dev/parport0 --card card.toml` drives the rig from it. The
+/// built-in [`RegisterMap::default`] and [`Calibration::default`] describe
+/// the *simulated* card; a real card is driven from its card file only.
+///
+/// # The file
+///
+/// Two tables, every key required. Units: m, V, s, m/s; addresses, bit
+/// masks and the ID may be written in hex (`0x20`) or decimal.
+///
+/// ```
+/// use ctrlab::lab::RigConfig;
+///
+/// let config = RigConfig::from_toml(r#"
+///     ## Where the card's registers are (EPP addresses, one byte each).
+///     [map]
+///     id = 0x00                         # card ID register (read)
+///     control = 0x01                    # control register (write): strobes below
+///     latch_bit = 0x01                  # latches all four counters at once
+///     clear_bit = 0x02                  # clears all four counters
+///     watchdog_bit = 0x04               # kicks the watchdog
+///     pwm_low = [0x10, 0x12, 0x14, 0x16]  # PWM channel 0-3, duty bits 0-7
+///     pwm_high = [0x11, 0x13, 0x15, 0x17] # duty bits 8-9, bit 7 direction; applies the duty
+///     encoder = [0x20, 0x24, 0x28, 0x2c]  # 32-bit counter 0-3, little-endian, 4 addresses each
+///
+///     ## How counts and volts map to SI, and what is wired where.
+///     [calibration]
+///     metres_per_count = 9.765625e-6    # m per encoder count (80 mm per 8192 counts)
+///     sign = [1.0, -1.0]                # +1: counting up moves the cart away from the wall
+///     volts_full_scale = 24.0           # V at 100 % duty; commands saturate at ± this
+///     pwm_channel = 0                   # the motor's PWM channel (0-3)
+///     encoder_channels = [0, 1]         # cart 1's and cart 2's encoder (0-3, distinct)
+///     travel_limits = [0.04, 0.05]      # m, ± about where the counters were cleared
+///     card_id = 0x3c                    # what the ID register must read
+///     watchdog_timeout = 0.1            # s, or "none" for a card without one
+///     max_speed = 2.0                   # m/s: a faster count change is a bus fault
+///     stall_volts = 6.0                 # V of new drive that must move an encoder
+///     stall_time = 0.5                  # s the carts may take to answer it
+///     stall_counts = 3                  # counts that answer it
+/// "#)?;
+/// assert_eq!((config.calibration.card_id, config.map.encoder[1]), (0x3c, 0x24));
+/// assert_eq!(config.calibration.sign[1], -1.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+///
+/// # Why every key is required
+///
+/// [`SimulatedRig`](super::SimulatedRig)'s file fills the fields it lacks
+/// with defaults: it describes a simulation. A card file describes hardware
+/// that moves: a key left out would silently take the simulated card's value
+/// (its ID `0xa5`, its register addresses, its 100 ms watchdog), and the
+/// driver would write registers nobody checked on this card. So a missing
+/// key is refused, like an unknown one (a typo) and a value of the wrong
+/// type, and the values are checked on load: each error names the key, as
+/// `calibration.travel_limits` or `map.encoder[2]`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, hw::RegisterMap, lab::{Calibration, RigConfig}};
+///
+/// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+/// let text = config.to_toml();
+/// assert_eq!(RigConfig::from_toml(&text)?, config);
+/// // A key left out is refused, and named.
+/// let without = text.replace("card_id = 0xa5", "");
+/// match RigConfig::from_toml(&without) {
+///     Err(Error::Toml { key, .. }) => assert_eq!(key.as_deref(), Some("calibration.card_id")),
+///     other => panic!("{other:?}"),
+/// }
+/// # Ok::<(), Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigConfig {
+    /// Where the card's registers are.
+    pub map: RegisterMap,
+    /// How the rig's counts and volts map to SI, its channels and limits.
+    pub calibration: Calibration,
+}
+
+/// One key of the file: its dotted name, what it means (the comment
+/// [`RigConfig::to_toml`] writes beside it), and whether its values are
+/// addresses, bit masks or IDs, written in hex.
+struct Field {
+    key: &'static str,
+    comment: &'static str,
+    hex: bool,
+}
+
+const fn field(key: &'static str, comment: &'static str, hex: bool) -> Field {
+    Field { key, comment, hex }
+}
+
+/// Every key of the file, in the order [`RigConfig::to_toml`] writes them.
+const FIELDS: [Field; 20] = [
+    field("map.id", "card ID register (read)", true),
+    field(
+        "map.control",
+        "control register (write): the strobes below",
+        true,
+    ),
+    field("map.latch_bit", "latches all four counters at once", true),
+    field("map.clear_bit", "clears all four counters", true),
+    field("map.watchdog_bit", "kicks the watchdog", true),
+    field("map.pwm_low", "PWM channel 0-3: duty bits 0-7", true),
+    field(
+        "map.pwm_high",
+        "duty bits 8-9, bit 7 direction; applies the duty",
+        true,
+    ),
+    field(
+        "map.encoder",
+        "counter 0-3: 32 bits little-endian, 4 addresses each",
+        true,
+    ),
+    field("calibration.metres_per_count", "m per encoder count", false),
+    field(
+        "calibration.sign",
+        "+1: counting up moves the cart away from the wall",
+        false,
+    ),
+    field(
+        "calibration.volts_full_scale",
+        "V at 100 % duty; commands saturate at ± this",
+        false,
+    ),
+    field(
+        "calibration.pwm_channel",
+        "the motor's PWM channel (0-3)",
+        false,
+    ),
+    field(
+        "calibration.encoder_channels",
+        "cart 1's and cart 2's encoder (0-3, distinct)",
+        false,
+    ),
+    field(
+        "calibration.travel_limits",
+        "m, ± about where the counters were cleared",
+        false,
+    ),
+    field(
+        "calibration.card_id",
+        "what the ID register must read (not 0x00 or 0xff)",
+        true,
+    ),
+    field(
+        "calibration.watchdog_timeout",
+        "s, or \"none\" for a card without one",
+        false,
+    ),
+    field(
+        "calibration.max_speed",
+        "m/s: a faster count change is a bus fault",
+        false,
+    ),
+    field(
+        "calibration.stall_volts",
+        "V of new drive that must move an encoder",
+        false,
+    ),
+    field(
+        "calibration.stall_time",
+        "s the carts may take to answer it",
+        false,
+    ),
+    field("calibration.stall_counts", "counts that answer it", false),
+];
+
+/// The [`FIELDS`] entry of `name` in `section`.
+fn lookup(section: &str, name: &str) -> Option<&'static Field> {
+    FIELDS.iter().find(|f| {
+        f.key
+            .strip_prefix(section)
+            .and_then(|rest| rest.strip_prefix('.'))
+            == Some(name)
+    })
+}
+
+/// A validator's error with its field's name made the file's dotted key.
+fn qualify(section: &str, error: HwError) -> HwError {
+    match error {
+        HwError::InvalidConfig {
+            name,
+            value,
+            reason,
+        } => HwError::InvalidConfig {
+            name: lookup(section, name).map_or(name, |f| f.key),
+            value,
+            reason,
+        },
+        other => other,
+    }
+}
+
+/// The one-based line of dotted `key` in `text` (a `key = …` line under its
+/// `[section]` header), if written that way.
+fn line_of(text: &str, key: &str) -> Option<usize> {
+    let (section, name) = key.split_once('.')?;
+    let mut current = "";
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if let Some(header) = line.strip_prefix('[') {
+            current = header.split(']').next().unwrap_or("").trim();
+        } else if current == section && line.split('=').next().map(str::trim) == Some(name) {
+            return Some(i + 1);
+        }
+    }
+    None
+}
+
+/// Every decimal integer in `value` (a TOML integer or array of them)
+/// written in hex.
+fn hex(value: &str) -> String {
+    let mut out = String::with_capacity(value.len() * 2);
+    let mut digits = String::new();
+    for c in value.chars().chain(std::iter::once(' ')) {
+        if c.is_ascii_digit() {
+            digits.push(c);
+            continue;
+        }
+        match digits.parse::<u8>() {
+            Ok(n) => out.push_str(&format!("{n:#04x}")),
+            Err(_) => out.push_str(&digits),
+        }
+        digits.clear();
+        out.push(c);
+    }
+    out.pop(); // the sentinel
+    out
+}
+
+impl RigConfig {
+    /// The card file's `text`, checked ([`validate`](Self::validate)).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Toml`] with the line and the dotted key at fault: a syntax
+    /// error, an unknown or missing key, a value of the wrong type, or a
+    /// value the checks refuse (its message says what it must be).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, hw::RegisterMap, lab::{Calibration, RigConfig}};
+    /// let good = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let bad = good.to_toml().replace("travel_limits = [0.05, 0.05]", "travel_limits = [0.05, -0.05]");
+    /// match RigConfig::from_toml(&bad) {
+    ///     Err(Error::Toml { key, line: Some(_), .. }) => {
+    ///         assert_eq!(key.as_deref(), Some("calibration.travel_limits"))
+    ///     }
+    ///     other => panic!("{other:?}"),
+    /// }
+    /// ```
+    pub fn from_toml(text: &str) -> Result<Self, Error> {
+        let config: Self = file::parse(text)?;
+        config.validate().map_err(|e| match e {
+            HwError::InvalidConfig {
+                name,
+                value,
+                reason,
+            } => {
+                let shown = match FIELDS.iter().find(|f| f.key == name) {
+                    Some(f) if f.hex && (0.0..=255.0).contains(&value) => {
+                        format!("{:#04x}", value as u8)
+                    }
+                    _ => value.to_string(),
+                };
+                Error::Toml {
+                    line: line_of(text, name),
+                    key: Some(name.to_owned()),
+                    message: format!("{shown} is refused: {reason}"),
+                }
+            }
+            other => Error::Toml {
+                line: None,
+                key: None,
+                message: other.to_string(),
+            },
+        })?;
+        Ok(config)
+    }
+
+    /// The card file at `path` ([`from_toml`](Self::from_toml)).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Io`] with the path; the errors of
+    /// [`from_toml`](Self::from_toml).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, lab::RigConfig};
+    /// assert!(matches!(RigConfig::read_toml("no/such/card.toml"), Err(Error::Io { .. })));
+    /// ```
+    pub fn read_toml(path: impl AsRef<Path>) -> Result<Self, Error> {
+        Self::from_toml(&file::read(path.as_ref())?)
+    }
+
+    /// The card file's text: every key, with what it means and its unit in
+    /// a comment, addresses, bit masks and the ID in hex. Reads back equal
+    /// ([`from_toml`](Self::from_toml)) when the configuration is valid.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
+    /// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let text = config.to_toml();
+    /// assert!(text.contains("encoder = [0x20, 0x24, 0x28, 0x2c]"));
+    /// assert!(text.contains("# m per encoder count"));
+    /// assert_eq!(RigConfig::from_toml(&text)?, config);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn to_toml(&self) -> String {
+        // Plain numbers, arrays, a string and two tables: serialisation
+        // cannot fail.
+        let plain = toml::to_string(self).unwrap_or_default();
+        let mut out = String::from(
+            "# A rig's card file (ctrlab::lab::RigConfig): where the card's registers are\n\
+             # ([map]) and how its counts and volts map to SI ([calibration]).\n\
+             # Every key is required. Units: m, V, s, m/s.\n",
+        );
+        let mut section = "";
+        for line in plain.lines().filter(|l| !l.is_empty()) {
+            if let Some(header) = line.strip_prefix('[') {
+                section = header.trim_end_matches(']');
+                out.push('\n');
+                out.push_str(line);
+            } else if let Some((key, value)) = line.split_once(" = ")
+                && let Some(f) = lookup(section, key)
+            {
+                let value = if f.hex { hex(value) } else { value.to_owned() };
+                let assignment = format!("{key} = {value}");
+                out.push_str(&format!("{assignment:<40} # {}", f.comment));
+            } else {
+                out.push_str(line);
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    /// Writes the card file to `path` ([`to_toml`](Self::to_toml)), after
+    /// checking it ([`validate`](Self::validate)): a file it writes loads.
+    /// The file is written whole or not at all (into `path.tmp`, then
+    /// renamed).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Toml`] naming the key of an invalid value (nothing is
+    /// written); [`Error::Io`] with the path.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
+    /// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let path = std::env::temp_dir().join(format!("ctrlab-doc-card-{}.toml", std::process::id()));
+    /// config.write_toml(&path)?;
+    /// assert_eq!(RigConfig::read_toml(&path)?, config);
+    /// # std::fs::remove_file(&path).ok();
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn write_toml(&self, path: impl AsRef<Path>) -> Result<(), Error> {
+        let text = self.to_toml();
+        // The same checks, with the same errors, as reading the file back.
+        Self::from_toml(&text)?;
+        file::write(path.as_ref(), &text)
+    }
+
+    /// Checks the map ([`RegisterMap::validate`]) and the calibration
+    /// ([`Calibration::validate`]).
+    ///
+    /// # Errors
+    ///
+    /// [`HwError::InvalidConfig`] whose name is the file's dotted key
+    /// (`map.encoder`, `calibration.travel_limits`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::{HwError, RegisterMap}, lab::{Calibration, RigConfig}};
+    /// let config = RigConfig {
+    ///     map: RegisterMap { encoder: [0x20, 0x24, 0x28, 0xfe], ..RegisterMap::default() },
+    ///     calibration: Calibration::default(),
+    /// };
+    /// assert!(matches!(config.validate(), Err(HwError::InvalidConfig { name: "map.encoder", .. })));
+    /// ```
+    pub fn validate(&self) -> Result<(), HwError> {
+        self.map.validate().map_err(|e| qualify("map", e))?;
+        self.calibration
+            .validate()
+            .map_err(|e| qualify("calibration", e))
+    }
+}
+
+/// What the rig will use, for a person to check before anything moves: the
+/// ID it expects and where, the motor's channel, registers and voltage
+/// range, the carts' encoders, the travel limits and the watchdog.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
+/// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+/// let text = config.to_string();
+/// assert!(text.contains("register 0x00 must read 0xa5"));
+/// assert!(text.contains("PWM channel 0 (registers 0x10, 0x11), -24 V to +24 V"));
+/// assert!(text.contains("±50.0 mm"));
+/// assert!(text.contains("watchdog: 100 ms"));
+/// ```
+impl fmt::Display for RigConfig {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (map, cal) = (&self.map, &self.calibration);
+        let register = |addresses: &[u8], channel: usize| {
+            addresses.get(channel).map_or_else(
+                || "none: no such channel".to_owned(),
+                |a| format!("{a:#04x}"),
+            )
+        };
+        writeln!(
+            f,
+            "card ID: register {:#04x} must read {:#04x}",
+            map.id, cal.card_id
+        )?;
+        let full = cal.volts_full_scale;
+        writeln!(
+            f,
+            "motor: PWM channel {} (registers {}, {}), -{full} V to +{full} V in 0.1 % duty steps",
+            cal.pwm_channel,
+            register(&map.pwm_low, cal.pwm_channel),
+            register(&map.pwm_high, cal.pwm_channel),
+        )?;
+        for cart in 0..2 {
+            let channel = cal.encoder_channels[cart];
+            writeln!(
+                f,
+                "cart {}: encoder {channel} (registers from {}), {} µm per count, sign {:+}; travel limit ±{:.1} mm",
+                cart + 1,
+                register(&map.encoder, channel),
+                cal.metres_per_count * 1e6,
+                cal.sign[cart],
+                cal.travel_limits[cart] * 1e3,
+            )?;
+        }
+        match cal.watchdog_timeout {
+            Some(timeout) => writeln!(
+                f,
+                "watchdog: {:.0} ms, kicked with every latch (bit {:#04x} of control register {:#04x}); \
+                 the loop halts after {:.0} ms without a sample",
+                timeout * 1e3,
+                map.watchdog_bit,
+                map.control,
+                timeout * 5e2,
+            )?,
+            None => writeln!(
+                f,
+                "watchdog: none; nothing on the card stops the motor if the PC stops driving it"
+            )?,
+        }
+        write!(
+            f,
+            "plausibility: a count change faster than {} m/s is a bus fault; {} V of new drive \
+             that moves no encoder {} counts within {} s is a stalled motor or encoder",
+            cal.max_speed, cal.stall_volts, cal.stall_counts, cal.stall_time
+        )
+    }
+}
