@@ -29,12 +29,20 @@ fuzz_target!(|data: &[u8]| {
             final_value: head[4].is_finite().then_some(head[4]),
             ..StepInfoOptions::default()
         },
+        StepInfoOptions::matlab(),
+        StepInfoOptions {
+            settling_band: head[0],
+            initial_value: head[1].is_finite().then_some(head[1]),
+            final_value: head[4].is_finite().then_some(head[4]),
+            ..StepInfoOptions::matlab()
+        },
     ];
     for opts in &options {
         for times in [&t[..n], &sorted[..]] {
             if let Ok(info) = step_info(times, &y[..n], opts) {
                 for v in [
                     info.rise_time,
+                    info.transient_time,
                     info.settling_time,
                     info.settling_min,
                     info.settling_max,
