@@ -52,6 +52,7 @@ mod pc104;
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 mod ppdev;
+pub mod probe;
 mod realtime;
 mod rig;
 mod run;

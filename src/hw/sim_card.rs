@@ -297,6 +297,40 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
         Ok(())
     }
 
+    /// Puts the plant in state `x` now, as a hand moving the carts would:
+    /// first advances to the current time ([`sync`](Self::sync)), then
+    /// replaces the state. For tests and simulated operators.
+    ///
+    /// # Errors
+    ///
+    /// [`sync`](Self::sync)'s; [`HwError::InvalidCommand`] for a
+    /// non-finite state (the plant is left unchanged).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::Clock, lab::SimulatedRig};
+    /// use nalgebra::vector;
+    /// let mut card = SimulatedRig::default().card(&Clock::RealTime)?;
+    /// card.set_true_state(vector![0.02, 0.0, 0.0, 0.0])?;
+    /// assert_eq!(card.true_state()[0], 0.02);
+    /// assert!(card.set_true_state(vector![f64::NAN, 0.0, 0.0, 0.0]).is_err());
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
+    pub fn set_true_state(&mut self, x: SVector<f64, N>) -> Result<(), HwError> {
+        if let Some(&value) = x.iter().find(|v| !v.is_finite()) {
+            return Err(HwError::InvalidCommand {
+                what: "simulated plant state",
+                channel: None,
+                value,
+                limit: f64::MAX,
+            });
+        }
+        self.sync()?;
+        self.state = x;
+        Ok(())
+    }
+
     /// The true plant state at [`time`](Self::time): what the encoders
     /// measure, before quantisation and noise. For tests.
     ///

@@ -1,0 +1,311 @@
+//! Steps 3 and 4: the motor's PWM registers, its polarity, and the
+//! watchdog, found by short low-duty pulses after the operator confirms.
+
+use super::{Counter, Drive, Hands, Latch, Operator, Probe, ProbeError, RegisterClass};
+use crate::hw::{EppPort, pwm_bytes};
+
+/// How often the probe looks whether the carts have come to rest, s.
+const SETTLE: f64 = 0.25;
+
+/// Longest wait between two kicks during a pulse, s.
+const KICK_EVERY: f64 = 0.02;
+
+/// The watchdog bracket's width at which bisection stops, s.
+const RESOLUTION: f64 = 0.5e-3;
+
+impl<P: EppPort, O: Operator<P>> Probe<P, O> {
+    fn found_encoders(&self, step: &'static str) -> Result<(Latch, [Counter; 2]), ProbeError> {
+        match (self.latch, self.counters) {
+            (Some(latch), Some(counters)) => Ok((latch, counters)),
+            _ => Err(ProbeError::OutOfOrder {
+                step,
+                needs: "the encoder step",
+            }),
+        }
+    }
+
+    /// Every control bit but the latch and the clear: one of them kicks
+    /// the watchdog.
+    fn kick_all(latch: &Latch) -> u8 {
+        !(latch.latch_bit | latch.clear_bit)
+    }
+
+    /// Both counters now (latched), as raw 32-bit counts.
+    fn counts(&mut self, latch: &Latch, counters: &[Counter; 2]) -> Result<[u32; 2], ProbeError> {
+        self.write(latch.control, latch.latch_bit)?;
+        Ok([
+            self.read_u32_le(counters[0].address)?,
+            self.read_u32_le(counters[1].address)?,
+        ])
+    }
+
+    /// Waits until both counters stay within `min_counts` over [`SETTLE`]
+    /// (the carts at rest), at most 40 looks (10 s).
+    fn settle(&mut self, latch: &Latch, counters: &[Counter; 2]) -> Result<(), ProbeError> {
+        let mut before = self.counts(latch, counters)?;
+        for _ in 0..40 {
+            self.operator.wait(&mut self.port, SETTLE);
+            let now = self.counts(latch, counters)?;
+            if self.moved(counters, before, now).is_none() {
+                return Ok(());
+            }
+            before = now;
+        }
+        self.notes
+            .push("the carts did not come to rest between two pulses".to_owned());
+        Ok(())
+    }
+
+    /// Step 3: after the operator confirms, pulses each candidate PWM
+    /// register pair (two consecutive write-only addresses, low byte first)
+    /// at the [`pulse_duties`](super::ProbeOptions::pulse_duties) in turn
+    /// until a cart moves, and checks that positive duty moves it away from
+    /// the wall.
+    ///
+    /// # Errors
+    ///
+    /// [`ProbeError::OutOfOrder`] before [`find_encoders`](Self::find_encoders);
+    /// [`ProbeError::Declined`] without the confirmation (nothing written);
+    /// [`ProbeError::NotFound`] when no pair moves a cart;
+    /// [`ProbeError::ReversedMotor`] when positive duty moves it towards
+    /// the wall (the PWM is zeroed first).
+    pub fn find_drive(&mut self) -> Result<Drive, ProbeError> {
+        let (latch, counters) = self.found_encoders("the drive step")?;
+        let scan = self.scan.ok_or(ProbeError::OutOfOrder {
+            step: "the drive step",
+            needs: "the scan",
+        })?;
+        let [d0, d1, d2] = self.options.pulse_duties;
+        self.operator.tell(&format!(
+            "step 3/4, drive: with the motor supply ON, the probe writes PWM duties of {d0}, \
+             {d1} and {d2} per mille (of full scale) for {} s to each pair of consecutive \
+             write-only registers until a cart moves, kicking the watchdog with bits {:#04x} of \
+             register {:#04x} every {KICK_EVERY} s; the carts must be free to move",
+            self.options.pulse_time,
+            Self::kick_all(&latch),
+            latch.control
+        ));
+        if !self.operator.confirm(
+            "Switch the motor supply ON now. Carts free, hands off, e-stop within reach: \
+             pulse the motor?",
+        ) {
+            return Err(ProbeError::Declined {
+                step: "the drive step",
+            });
+        }
+        self.operator.hands(Hands::Off);
+        self.settle(&latch, &counters)?;
+        let open = |a: u8| scan.class(a) == RegisterClass::Open && a != latch.control;
+        let pairs: Vec<(u8, u8)> = (0..u8::MAX)
+            .map(|a| (a, a + 1))
+            .filter(|&(l, h)| open(l) && open(h))
+            .collect();
+        for (low, high) in pairs {
+            for duty in self.options.pulse_duties {
+                let moved = self.pulse(&latch, &counters, low, high, duty)?;
+                let Some((axis, counts)) = moved else {
+                    continue;
+                };
+                self.settle(&latch, &counters)?;
+                if counts < 0 {
+                    return Err(ProbeError::ReversedMotor { axis, counts });
+                }
+                self.operator.tell(&format!(
+                    "  PWM low byte {low:#04x}, high byte {high:#04x}: {duty} per mille moved \
+                     cart {axis} {counts} counts away from the wall"
+                ));
+                let drive = Drive { low, high, duty };
+                self.drive = Some(drive);
+                return Ok(drive);
+            }
+        }
+        Err(ProbeError::NotFound {
+            what: "the motor's PWM registers",
+            hint: "check that the motor supply is on and the motor connected, and that the carts \
+                   are free to move",
+        })
+    }
+
+    /// One pulse of `duty` on (`low`, `high`), kicked throughout with every
+    /// control bit but the latch and the clear; see [`pulse_with`](Self::pulse_with).
+    fn pulse(
+        &mut self,
+        latch: &Latch,
+        counters: &[Counter; 2],
+        low: u8,
+        high: u8,
+        duty: i16,
+    ) -> Result<Option<(usize, i64)>, ProbeError> {
+        let kick = Self::kick_all(latch);
+        self.write(latch.control, kick)?;
+        let before = self.counts(latch, counters)?;
+        self.pulse_with(latch, counters, (low, high), duty, kick, before)
+    }
+
+    /// Writes `duty` to the (`low`, `high`) pair, kicks with `kick` at
+    /// once and every [`KICK_EVERY`] for the pulse time, and returns the
+    /// cart that moved most since `before` and how far (sign-corrected
+    /// counts), if either moved `min_counts` or more. The PWM is zeroed
+    /// before returning, errors included.
+    fn pulse_with(
+        &mut self,
+        latch: &Latch,
+        counters: &[Counter; 2],
+        (low, high): (u8, u8),
+        duty: i16,
+        kick: u8,
+        before: [u32; 2],
+    ) -> Result<Option<(usize, i64)>, ProbeError> {
+        let result = (|| {
+            let (low_byte, high_byte) = pwm_bytes(duty);
+            self.write(low, low_byte)?;
+            self.write(high, high_byte)?;
+            self.write(latch.control, kick)?;
+            let steps = (self.options.pulse_time / KICK_EVERY).ceil().max(1.0) as usize;
+            for _ in 0..steps {
+                self.operator
+                    .wait(&mut self.port, self.options.pulse_time / steps as f64);
+                self.write(latch.control, kick)?;
+            }
+            let after = self.counts(latch, counters)?;
+            Ok::<_, ProbeError>(self.moved(counters, before, after))
+        })();
+        let stop = self.write(low, 0).and_then(|()| self.write(high, 0));
+        let moved = result?;
+        stop?;
+        Ok(moved)
+    }
+
+    /// The cart that moved most between two readings and how far, counts
+    /// (positive away from the wall), if `min_counts` or more.
+    fn moved(
+        &self,
+        counters: &[Counter; 2],
+        before: [u32; 2],
+        after: [u32; 2],
+    ) -> Option<(usize, i64)> {
+        let delta = |i: usize| {
+            i64::from(after[i].wrapping_sub(before[i]) as i32) * i64::from(counters[i].sign)
+        };
+        let (d1, d2) = (delta(0), delta(1));
+        let (axis, counts) = if d1.abs() >= d2.abs() {
+            (1, d1)
+        } else {
+            (2, d2)
+        };
+        (counts.abs() >= self.options.min_counts).then_some((axis, counts))
+    }
+
+    /// Whether a PWM write `silence` s after kicking with `kick` is obeyed:
+    /// the write, then a pulse kicked with `kick` throughout. Before the
+    /// watchdog trips the write stands and a cart moves; after, the card
+    /// has zeroed it and the kicks that follow do not bring it back, so
+    /// the answer flips sharply at the timeout. The pulse uses the largest
+    /// of the [`pulse_duties`](super::ProbeOptions::pulse_duties), for a
+    /// clear margin over friction, in alternating directions. The PWM is
+    /// zeroed and the watchdog re-armed afterwards, then the carts settle.
+    fn obeyed(&mut self, silence: f64, kick: u8) -> Result<bool, ProbeError> {
+        let (latch, counters) = self.found_encoders("the watchdog step")?;
+        let drive = self.drive.ok_or(ProbeError::OutOfOrder {
+            step: "the watchdog step",
+            needs: "the drive step",
+        })?;
+        let largest = self
+            .options
+            .pulse_duties
+            .iter()
+            .copied()
+            .max()
+            .unwrap_or(drive.duty);
+        // Friction holds a cart where a pulse left it, against its springs,
+        // and a pulse one way may not break it loose: a write counts as
+        // ignored only if neither direction moves a cart.
+        for _ in 0..2 {
+            self.reverse = !self.reverse;
+            let duty = if self.reverse { -largest } else { largest };
+            self.write(latch.control, kick)?;
+            self.operator.wait(&mut self.port, silence);
+            let before = self.counts(&latch, &counters)?;
+            let moved = self.pulse_with(
+                &latch,
+                &counters,
+                (drive.low, drive.high),
+                duty,
+                kick,
+                before,
+            )?;
+            self.write(latch.control, Self::kick_all(&latch))?;
+            self.settle(&latch, &counters)?;
+            if moved.is_some() {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+
+    /// Step 4: whether a PWM write is still obeyed after a silence without
+    /// a kick, bisected to the watchdog timeout (to 0.5 ms), and which
+    /// control bit kicks it.
+    ///
+    /// # Errors
+    ///
+    /// [`ProbeError::OutOfOrder`] before [`find_drive`](Self::find_drive);
+    /// [`ProbeError::NotFound`] when a write 10 ms after a kick is not
+    /// obeyed, or no single bit kicks.
+    pub fn find_watchdog(&mut self) -> Result<Option<f64>, ProbeError> {
+        let (latch, _) = self.found_encoders("the watchdog step")?;
+        let kick_all = Self::kick_all(&latch);
+        let max = self.options.max_watchdog;
+        self.operator.tell(&format!(
+            "step 4/4, watchdog: short pulses of the drive found in step 3, each after a \
+             silence without a kick, from 10 ms to {max} s, to time the watchdog; then each \
+             control bit alone as the kick"
+        ));
+        self.operator.hands(Hands::Off);
+        if !self.obeyed(0.01, kick_all)? {
+            return Err(ProbeError::NotFound {
+                what: "a watchdog kick",
+                hint: "a PWM write 10 ms after writing every control bit but the latch and \
+                       clear was not obeyed",
+            });
+        }
+        if self.obeyed(max, kick_all)? {
+            let bit = kick_all & kick_all.wrapping_neg();
+            self.notes.push(format!(
+                "no watchdog: PWM writes are still obeyed {max} s after the last kick; \
+                 watchdog_bit set to {bit:#04x}, unverified"
+            ));
+            self.operator.tell(&format!("  no watchdog within {max} s"));
+            self.watchdog = Some((bit, None));
+            return Ok(None);
+        }
+        let (mut lo, mut hi) = (0.01, max);
+        // Halving from at most 10 s to 0.5 ms: at most 15 rounds.
+        while hi - lo > RESOLUTION {
+            let mid = 0.5 * (lo + hi);
+            if self.obeyed(mid, kick_all)? {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let timeout = (500.0 * (lo + hi)).round() / 1000.0;
+        self.operator.tell(&format!(
+            "  the watchdog trips between {lo:.4} s and {hi:.4} s without a kick: {timeout} s"
+        ));
+        for bit in (0..8).map(|b| 1u8 << b).filter(|&b| kick_all & b != 0) {
+            // Let the watchdog trip, then kick with this bit alone.
+            self.operator.wait(&mut self.port, hi + KICK_EVERY);
+            if self.obeyed(0.01, bit)? {
+                self.operator
+                    .tell(&format!("  the watchdog is kicked by bit {bit:#04x}"));
+                self.watchdog = Some((bit, Some(timeout)));
+                return Ok(Some(timeout));
+            }
+        }
+        Err(ProbeError::NotFound {
+            what: "the watchdog's kick bit",
+            hint: "no single control bit re-arms the PWM; the card may need several",
+        })
+    }
+}

@@ -1,0 +1,577 @@
+//! Bringing up an unknown card: [`Probe`] finds the card's register map,
+//! encoder signs, motor polarity and watchdog on a live port, one step at a
+//! time, each step saying what it does before doing it.
+//!
+//! No register map of the lab's PC104 card is published. The probe assumes
+//! only the card's *kind* (EPP registers; 32-bit counters latched by a bit
+//! of a control register; 10-bit PWM duties in a low and a high byte, the
+//! high byte applying the duty, as [`RegisterMap`] documents) and finds
+//! *where* everything is:
+//!
+//! 1. **Scan** ([`Probe::scan`]): two read-only scans of all 256 addresses
+//!    tell constant, volatile and open-bus registers apart and find the ID
+//!    register. No card (an open bus, or EPP cycles that time out) stops
+//!    here, before any register is written.
+//! 2. **Encoders** ([`Probe::find_encoders`]): with the motor supply *off*
+//!    (the operator confirms), the user moves each cart by hand while the
+//!    probe searches for the latch (a bit of a write-only register after
+//!    which the counters read new values), the counters (which bytes
+//!    change, and in which order of significance), each encoder's sign
+//!    (the user holds the cart away from the wall) and the clear bit.
+//! 3. **Drive** ([`Probe::find_drive`]): only after the operator confirms
+//!    (motor supply on, e-stop at hand), pulses of about 5 %, then 10 and
+//!    12 % duty for 0.15 s on each candidate register pair until a cart
+//!    moves, checking that positive duty moves it away from the wall.
+//! 4. **Watchdog** ([`Probe::find_watchdog`]): whether a PWM write is still
+//!    obeyed after a silence of T without a kick, bisected to the timeout,
+//!    and which control bit kicks it.
+//!
+//! Channels without a cart or motor on them cannot be observed; the map
+//! places them by the stride of the ones found (say so, in
+//! [`ProbeReport::notes`]).
+//!
+//! The probe talks to the world through an [`Operator`]: a console (the
+//! `probe` example) or a simulated hand
+//! ([`lab::SimulatedOperator`](crate::lab::SimulatedOperator)), with which
+//! the probe rediscovers the simulated card's map exactly.
+//!
+//! Software must not be trusted for safety: keep a hardware e-stop within
+//! reach whenever the motor supply is on.
+
+mod drive;
+mod encoders;
+mod scan;
+
+pub use scan::{OPEN_BUS, RegisterClass, Scan, Snapshot};
+
+use super::{EppPort, HwError, RegisterMap};
+
+/// What the user's hands are doing, as the probe asks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Hands {
+    /// Hands off the carts; let them come to rest.
+    Off,
+    /// Moving this axis (1 or 2: cart 1 or cart 2) back and forth by hand
+    /// over a few centimetres, holding the other axis still.
+    Move(usize),
+    /// Holding this axis a few centimetres away from the wall (its rest
+    /// position), the other axis still.
+    Away(usize),
+}
+
+/// The person at the rig, as the probe sees them: someone to tell what
+/// happens, to ask, and to move the carts; and the passing of time.
+///
+/// The `probe` example implements it on a console; a simulated operator
+/// moves the simulated carts in [`wait`](Self::wait).
+///
+/// # Examples
+///
+/// An operator who says no stops the probe before it writes anything:
+///
+/// ```
+/// use ctrlab::hw::probe::{Hands, Operator, Probe, ProbeError, ProbeOptions};
+/// use ctrlab::hw::testing::{RecordingPort, RegisterFile};
+/// use ctrlab::hw::CycleKind;
+///
+/// struct Careful;
+/// impl<P> Operator<P> for Careful {
+///     fn tell(&mut self, _message: &str) {}
+///     fn confirm(&mut self, _question: &str) -> bool { false }
+///     fn hands(&mut self, _hands: Hands) {}
+///     fn wait(&mut self, _port: &mut P, _seconds: f64) {}
+/// }
+///
+/// let mut card = RegisterFile::new();
+/// card.set(0x00, 0xa5); // an ID register, nothing else
+/// let mut probe = Probe::new(RecordingPort::new(card), Careful, ProbeOptions::default())?;
+/// probe.scan()?;
+/// assert!(matches!(probe.find_encoders(), Err(ProbeError::Declined { .. })));
+/// assert!(probe.port().log().iter().all(|c| c.kind() != CycleKind::DataWrite));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub trait Operator<P> {
+    /// Shows a message: what the probe is about to do, or what it found.
+    fn tell(&mut self, message: &str);
+
+    /// Asks a yes/no question; `true` only for a clear yes.
+    fn confirm(&mut self, question: &str) -> bool;
+
+    /// Asks the user to put their hands as `hands` says, and returns when
+    /// they are ready.
+    fn hands(&mut self, hands: Hands);
+
+    /// Lets `seconds` pass (s, ≥ 0). The port is passed so that a
+    /// simulated world can move its carts meanwhile; a real operator just
+    /// sleeps.
+    fn wait(&mut self, port: &mut P, seconds: f64);
+}
+
+impl<P, O: Operator<P> + ?Sized> Operator<P> for &mut O {
+    fn tell(&mut self, message: &str) {
+        (**self).tell(message);
+    }
+    fn confirm(&mut self, question: &str) -> bool {
+        (**self).confirm(question)
+    }
+    fn hands(&mut self, hands: Hands) {
+        (**self).hands(hands);
+    }
+    fn wait(&mut self, port: &mut P, seconds: f64) {
+        (**self).wait(port, seconds);
+    }
+}
+
+/// How the probe moves and waits.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::probe::ProbeOptions;
+/// let options = ProbeOptions::default();
+/// assert_eq!(options.pulse_duties, [48, 96, 120]); // per mille
+/// assert!(options.validate().is_ok());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProbeOptions {
+    /// PWM duties tried in turn (per mille of full scale, > 0 and ≤ 250):
+    /// the first that moves a cart is used. Each has bits 0, 1 and 7 clear,
+    /// so written by mistake to a *high* byte it commands zero duty.
+    pub pulse_duties: [i16; 3],
+    /// How long each pulse lasts, s (0.01–1).
+    pub pulse_time: f64,
+    /// Samples taken while a cart is moved by hand (4–1000).
+    pub samples: usize,
+    /// Time between those samples, s (0.001–1).
+    pub sample_interval: f64,
+    /// The count change that means a cart moved (≥ 2, above the encoder
+    /// noise).
+    pub min_counts: i64,
+    /// The longest watchdog timeout looked for, s (0.05–10); a PWM write
+    /// still obeyed after this long without a kick means no watchdog.
+    pub max_watchdog: f64,
+}
+
+impl Default for ProbeOptions {
+    fn default() -> Self {
+        Self {
+            pulse_duties: [48, 96, 120],
+            pulse_time: 0.15,
+            samples: 30,
+            sample_interval: 0.1,
+            min_counts: 3,
+            max_watchdog: 2.0,
+        }
+    }
+}
+
+impl ProbeOptions {
+    /// Checks every field.
+    ///
+    /// # Errors
+    ///
+    /// [`HwError::InvalidConfig`] naming the first bad field.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::probe::ProbeOptions;
+    /// let bad = ProbeOptions { pulse_duties: [48, 96, 400], ..Default::default() };
+    /// assert!(bad.validate().is_err());
+    /// ```
+    pub fn validate(&self) -> Result<(), HwError> {
+        if let Some(&d) = self.pulse_duties.iter().find(|&&d| !(1..=250).contains(&d)) {
+            return Err(HwError::invalid_config(
+                "pulse_duties",
+                f64::from(d),
+                "must be 1–250 per mille",
+            ));
+        }
+        let ranges = [
+            ("pulse_time", self.pulse_time, 0.01, 1.0),
+            ("sample_interval", self.sample_interval, 0.001, 1.0),
+            ("max_watchdog", self.max_watchdog, 0.05, 10.0),
+            ("samples", self.samples as f64, 4.0, 1000.0),
+            ("min_counts", self.min_counts as f64, 2.0, 1e6),
+        ];
+        for (name, value, low, high) in ranges {
+            if !(low..=high).contains(&value) {
+                return Err(HwError::invalid_config(name, value, "out of its range"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Why the probe stopped.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::probe::{Operator, Probe, ProbeError, ProbeOptions};
+/// use ctrlab::hw::testing::RegisterFile;
+/// # use ctrlab::hw::probe::Hands;
+/// # struct Nobody;
+/// # impl<P> Operator<P> for Nobody {
+/// #     fn tell(&mut self, _: &str) {}
+/// #     fn confirm(&mut self, _: &str) -> bool { false }
+/// #     fn hands(&mut self, _: Hands) {}
+/// #     fn wait(&mut self, _: &mut P, _: f64) {}
+/// # }
+/// // Every address reads 0: no card.
+/// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+/// let err = probe.scan().unwrap_err();
+/// assert!(matches!(err, ProbeError::NoCard { .. }));
+/// assert!(err.to_string().contains("every address reads 0x00"));
+/// # Ok::<(), ctrlab::hw::HwError>(())
+/// ```
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ProbeError {
+    /// The port failed (a timeout here means no card answers).
+    #[error(transparent)]
+    Hw(#[from] HwError),
+    /// No card answers: every address reads the same idle value, or EPP
+    /// cycles time out. Nothing was written.
+    #[error(
+        "no card: {reason}. Check the cable, the card's power and the BIOS EPP mode; nothing was written to the card"
+    )]
+    NoCard {
+        /// What the scans saw.
+        reason: String,
+    },
+    /// The operator declined a step; the probe stopped before it.
+    #[error("stopped before {step}: not confirmed")]
+    Declined {
+        /// The step not taken.
+        step: &'static str,
+    },
+    /// A step did not find what it looks for.
+    #[error("{what} not found: {hint}")]
+    NotFound {
+        /// What was looked for.
+        what: &'static str,
+        /// What to check or try.
+        hint: &'static str,
+    },
+    /// The card works in a way the crate's driver does not support.
+    #[error("unsupported card: {what}")]
+    Unsupported {
+        /// What is different.
+        what: &'static str,
+    },
+    /// Positive duty moves the cart towards the wall.
+    #[error(
+        "motor polarity reversed: positive duty moved cart {axis} towards the wall ({counts} counts); swap the motor leads"
+    )]
+    ReversedMotor {
+        /// The cart that moved.
+        axis: usize,
+        /// How far, counts (sign-corrected).
+        counts: i64,
+    },
+    /// A step was called before the one it needs.
+    #[error("{step} needs {needs} first")]
+    OutOfOrder {
+        /// The step called.
+        step: &'static str,
+        /// The step it needs.
+        needs: &'static str,
+    },
+}
+
+/// The control register and its latch and clear bits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Latch {
+    /// Address of the control register.
+    pub control: u8,
+    /// Bit that latches the counters.
+    pub latch_bit: u8,
+    /// Bit that clears the counters.
+    pub clear_bit: u8,
+}
+
+/// One encoder counter as found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Counter {
+    /// Address of its least significant byte (little-endian, 4 bytes).
+    pub address: u8,
+    /// +1 when it counts up as the cart moves away from the wall, −1
+    /// otherwise.
+    pub sign: i8,
+}
+
+/// The motor's PWM register pair as found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Drive {
+    /// Low byte address.
+    pub low: u8,
+    /// High byte address.
+    pub high: u8,
+    /// The duty (per mille) that moved the carts.
+    pub duty: i16,
+}
+
+/// Everything the probe found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProbeReport {
+    /// The register map, with channels that could not be observed placed
+    /// by stride (see [`notes`](Self::notes)).
+    pub map: RegisterMap,
+    /// What the ID register reads.
+    pub card_id: u8,
+    /// Cart 1's and cart 2's encoder channel (index into `map.encoder`).
+    pub encoder_channels: [usize; 2],
+    /// Cart 1's and cart 2's encoder sign (+1: counts up away from the
+    /// wall).
+    pub signs: [f64; 2],
+    /// The motor's PWM channel (index into `map.pwm_low`).
+    pub pwm_channel: usize,
+    /// The watchdog timeout, s (the longest silence still obeyed, rounded
+    /// down to the millisecond), or `None` when writes were still obeyed
+    /// after [`ProbeOptions::max_watchdog`].
+    pub watchdog_timeout: Option<f64>,
+    /// What was inferred rather than observed, and anything odd.
+    pub notes: Vec<String>,
+}
+
+/// The bring-up probe on a port, step by step (see the [module
+/// docs](self)). [`run`](Self::run) takes every step in order.
+///
+/// # Examples
+///
+/// The simulated card, probed by a simulated hand that answers "yes" twice,
+/// gives back its own register map:
+///
+/// ```
+/// use ctrlab::hw::probe::{Probe, ProbeOptions};
+/// use ctrlab::hw::{Clock, VirtualClock};
+/// use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+///
+/// let clock = VirtualClock::new();
+/// let rig = SimulatedRig::default();
+/// let card = rig.card(&Clock::Virtual(clock.clone()))?;
+/// let hand = SimulatedOperator::new(clock, [true, true]);
+/// let mut probe = Probe::new(card, hand, ProbeOptions::default())?;
+/// let report = probe.run()?;
+/// assert_eq!(report.map, rig.map);
+/// assert_eq!(report.watchdog_timeout, Some(0.1));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct Probe<P, O> {
+    port: P,
+    operator: O,
+    options: ProbeOptions,
+    scan: Option<Scan>,
+    id: Option<(u8, u8)>,
+    latch: Option<Latch>,
+    counters: Option<[Counter; 2]>,
+    drive: Option<Drive>,
+    watchdog: Option<(u8, Option<f64>)>,
+    /// The direction of the last watchdog test pulse.
+    reverse: bool,
+    notes: Vec<String>,
+}
+
+impl<P: EppPort, O: Operator<P>> Probe<P, O> {
+    /// A probe on `port`, talking to `operator`.
+    ///
+    /// # Errors
+    ///
+    /// [`ProbeOptions::validate`]'s.
+    pub fn new(port: P, operator: O, options: ProbeOptions) -> Result<Self, HwError> {
+        options.validate()?;
+        Ok(Self {
+            port,
+            operator,
+            options,
+            scan: None,
+            id: None,
+            latch: None,
+            counters: None,
+            drive: None,
+            watchdog: None,
+            reverse: false,
+            notes: Vec::new(),
+        })
+    }
+
+    /// The port.
+    pub fn port(&self) -> &P {
+        &self.port
+    }
+
+    /// The port, mutable.
+    pub fn port_mut(&mut self) -> &mut P {
+        &mut self.port
+    }
+
+    /// The operator.
+    pub fn operator(&self) -> &O {
+        &self.operator
+    }
+
+    /// The port and the operator back.
+    pub fn into_parts(self) -> (P, O) {
+        (self.port, self.operator)
+    }
+
+    /// Takes every step in order and assembles the report.
+    ///
+    /// # Errors
+    ///
+    /// The first step's that fails; the steps' own docs say which.
+    pub fn run(&mut self) -> Result<ProbeReport, ProbeError> {
+        self.scan()?;
+        self.find_encoders()?;
+        self.find_drive()?;
+        self.find_watchdog()?;
+        self.report()
+    }
+
+    /// Step 1: two read-only scans of all 256 addresses and the card's ID.
+    ///
+    /// # Errors
+    ///
+    /// [`ProbeError::NoCard`] when EPP cycles time out or no address reads
+    /// a constant other than `0x00`/`0xff`; no register is written.
+    pub fn scan(&mut self) -> Result<&Scan, ProbeError> {
+        self.operator.tell(
+            "step 1/4, scan: reading all 256 addresses twice (read-only), to tell constant, \
+             volatile and open-bus registers apart and find the card's ID register",
+        );
+        let no_card = |e: HwError| match e {
+            HwError::Timeout { .. } => ProbeError::NoCard {
+                reason: format!("EPP cycles time out ({e})"),
+            },
+            other => ProbeError::Hw(other),
+        };
+        let first = scan::snapshot(&mut self.port).map_err(no_card)?;
+        self.operator.wait(&mut self.port, 0.05);
+        let second = scan::snapshot(&mut self.port).map_err(no_card)?;
+        let scan = Scan { first, second };
+        let Some((address, value)) = scan.id() else {
+            let reason = if scan.first.iter().all(|&b| b == scan.first[0]) {
+                format!("every address reads {:#04x} (an idle bus)", scan.first[0])
+            } else {
+                "no address reads a constant other than 0x00 and 0xff (no ID register)".to_owned()
+            };
+            return Err(ProbeError::NoCard { reason });
+        };
+        let others: Vec<String> = scan
+            .id_candidates()
+            .skip(1)
+            .map(|(a, v)| format!("{a:#04x} = {v:#04x}"))
+            .collect();
+        let volatile = scan.addresses(|c| c == RegisterClass::Volatile).count();
+        let open = scan.addresses(|c| c == RegisterClass::Open).count();
+        self.operator.tell(&format!(
+            "  ID register {address:#04x} reads {value:#04x}; {open} open-bus or write-only \
+             addresses, {volatile} volatile"
+        ));
+        if !others.is_empty() {
+            self.notes.push(format!(
+                "other constant registers, not taken as the ID: {}",
+                others.join(", ")
+            ));
+        }
+        self.id = Some((address, value));
+        Ok(self.scan.insert(scan))
+    }
+
+    /// The report of every step taken (all four are needed).
+    ///
+    /// # Errors
+    ///
+    /// [`ProbeError::OutOfOrder`] for a step not taken;
+    /// [`ProbeError::Unsupported`] when the channels inferred by stride
+    /// do not fit in a valid [`RegisterMap`].
+    pub fn report(&self) -> Result<ProbeReport, ProbeError> {
+        let missing = |needs| ProbeError::OutOfOrder {
+            step: "the report",
+            needs,
+        };
+        let (id_address, card_id) = self.id.ok_or(missing("the scan"))?;
+        let latch = self.latch.ok_or(missing("the encoder step"))?;
+        let counters = self.counters.ok_or(missing("the encoder step"))?;
+        let drive = self.drive.ok_or(missing("the drive step"))?;
+        let (watchdog_bit, watchdog_timeout) = self.watchdog.ok_or(missing("the watchdog step"))?;
+        let mut notes = self.notes.clone();
+        // Encoder channels in address order, the unobserved ones continuing
+        // the stride of the two found.
+        let (lo, hi) = if counters[0].address < counters[1].address {
+            (counters[0].address, counters[1].address)
+        } else {
+            (counters[1].address, counters[0].address)
+        };
+        let stride = hi - lo;
+        let encoder = [
+            Some(lo),
+            Some(hi),
+            hi.checked_add(stride),
+            hi.checked_add(stride).and_then(|a| a.checked_add(stride)),
+        ];
+        let pwm = |base: u8, k: u8| base.checked_add(2 * k);
+        let (Some(e2), Some(e3), Some(l1), Some(l2), Some(l3), Some(h1), Some(h2), Some(h3)) = (
+            encoder[2],
+            encoder[3],
+            pwm(drive.low, 1),
+            pwm(drive.low, 2),
+            pwm(drive.low, 3),
+            pwm(drive.high, 1),
+            pwm(drive.high, 2),
+            pwm(drive.high, 3),
+        ) else {
+            return Err(ProbeError::Unsupported {
+                what: "the unobserved channels, placed by stride, run past address 0xff",
+            });
+        };
+        let map = RegisterMap {
+            id: id_address,
+            control: latch.control,
+            latch_bit: latch.latch_bit,
+            clear_bit: latch.clear_bit,
+            watchdog_bit,
+            pwm_low: [drive.low, l1, l2, l3],
+            pwm_high: [drive.high, h1, h2, h3],
+            encoder: [lo, hi, e2, e3],
+        };
+        map.validate()?;
+        notes.push(format!(
+            "encoder channels 2 and 3 ({e2:#04x}, {e3:#04x}) and PWM channels 1–3 (low \
+             {l1:#04x}, {l2:#04x}, {l3:#04x}) are placed by the stride of the channels \
+             found, not observed: nothing is connected to them"
+        ));
+        let channel = |address| usize::from(address != lo);
+        Ok(ProbeReport {
+            map,
+            card_id,
+            encoder_channels: [channel(counters[0].address), channel(counters[1].address)],
+            signs: [f64::from(counters[0].sign), f64::from(counters[1].sign)],
+            pwm_channel: 0,
+            watchdog_timeout,
+            notes,
+        })
+    }
+
+    /// Writes `value` to `address`, saying nothing (the steps say what
+    /// they write before their loops).
+    fn write(&mut self, address: u8, value: u8) -> Result<(), HwError> {
+        self.port.write_register(address, value)
+    }
+
+    fn read_u32_le(&mut self, address: u8) -> Result<u32, HwError> {
+        let mut bytes = [0u8; 4];
+        for (offset, byte) in (0u8..).zip(bytes.iter_mut()) {
+            let a = address.checked_add(offset).ok_or(HwError::InvalidCommand {
+                what: "counter address",
+                channel: None,
+                value: f64::from(address),
+                limit: 252.0,
+            })?;
+            *byte = self.port.read_register(a)?;
+        }
+        Ok(u32::from_le_bytes(bytes))
+    }
+}
