@@ -4,7 +4,7 @@
 use ctrlab::hw::probe::{Hands, Operator, Probe, ProbeError, ProbeOptions};
 use ctrlab::hw::testing::{RecordingPort, RegisterFile};
 use ctrlab::hw::{Clock, CycleKind, RegisterMap, SimulatedCard, VirtualClock};
-use ctrlab::lab::{Calibration, FrictionPlant, SimulatedOperator, SimulatedRig};
+use ctrlab::lab::{Calibration, FrictionPlant, RigConfig, SimulatedOperator, SimulatedRig};
 
 type Card = SimulatedCard<FrictionPlant, 4>;
 
@@ -26,6 +26,17 @@ fn the_probe_rediscovers_the_simulated_cards_map_and_calibration() {
     assert_eq!(report.watchdog_timeout, Some(0.100));
     let calibration = Calibration::from_probe(&report, &Calibration::default());
     assert_eq!(calibration, rig.calibration());
+    // The card file it writes is the one the rest of the crate loads.
+    let file = RigConfig {
+        map: report.map,
+        calibration,
+    }
+    .to_toml();
+    let loaded = RigConfig::from_toml(&file).unwrap();
+    assert_eq!(
+        (loaded.map, loaded.calibration),
+        (rig.map, rig.calibration())
+    );
     // Each step said what it would do before asking or doing it.
     let said = &probe.operator().transcript;
     let at = |needle: &str| said.iter().position(|m| m.contains(needle)).unwrap();

@@ -1,0 +1,239 @@
+//! The card bring-up tool: finds a card's register map, encoder signs,
+//! motor polarity and watchdog, step by step, and writes the card file
+//! (`card.toml`) that `lab5 --port … --card card.toml` drives the rig from.
+//!
+//! ```text
+//! cargo run --example probe -- --simulated                       # the simulated card, a simulated hand
+//! cargo run --example probe --features ppdev -- --port /dev/parport0 --out card.toml
+//! ```
+//!
+//! Each step prints what it will do before doing it. The encoder step asks
+//! you to switch the motor supply off; the drive step pulses the motor only
+//! after you answer `yes`. Keep a hardware e-stop within reach: software
+//! alone must not be trusted for safety.
+
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+use std::io::{BufRead, Write};
+use std::path::PathBuf;
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+use std::time::Duration;
+use std::time::Instant;
+
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+use ctrlab::hw::probe::Hands;
+use ctrlab::hw::probe::{Operator, Probe, ProbeError, ProbeOptions, ProbeReport};
+use ctrlab::hw::{Clock, EppPort, VirtualClock};
+use ctrlab::lab::{Calibration, RigConfig, SimulatedOperator, SimulatedRig};
+
+const USAGE: &str = "usage: probe (--simulated | --port /dev/parportN) [--out FILE] [--metres-per-count M] [--volts V]
+  --simulated           probe the simulated card, moved by a simulated hand
+  --port PATH           probe the card on this parallel port (feature `ppdev`)
+  --out FILE            where the card file goes (default card.toml)
+  --metres-per-count M  cart travel per encoder count, m (default 80 mm / 8192)
+  --volts V             motor voltage at 100 % duty, V (default 24)";
+
+struct Args {
+    simulated: bool,
+    port: Option<PathBuf>,
+    out: PathBuf,
+    base: Calibration,
+}
+
+fn parse() -> Result<Args, String> {
+    let mut args = Args {
+        simulated: false,
+        port: None,
+        out: PathBuf::from("card.toml"),
+        base: Calibration::default(),
+    };
+    let mut it = std::env::args().skip(1);
+    let number = |v: Option<String>, name: &str| -> Result<f64, String> {
+        v.ok_or(format!("{name} needs a value"))?
+            .parse()
+            .map_err(|e| format!("{name}: {e}"))
+    };
+    while let Some(arg) = it.next() {
+        match arg.as_str() {
+            "--simulated" => args.simulated = true,
+            "--port" => args.port = Some(it.next().ok_or("--port needs a device path")?.into()),
+            "--out" => args.out = it.next().ok_or("--out needs a file")?.into(),
+            "--metres-per-count" => {
+                args.base.metres_per_count = number(it.next(), "--metres-per-count")?;
+            }
+            "--volts" => args.base.volts_full_scale = number(it.next(), "--volts")?,
+            "-h" | "--help" => return Err(USAGE.to_owned()),
+            other => return Err(format!("unknown argument {other}\n{USAGE}")),
+        }
+    }
+    if args.simulated == args.port.is_some() {
+        return Err(format!(
+            "give exactly one of --simulated and --port\n{USAGE}"
+        ));
+    }
+    Ok(args)
+}
+
+/// The person at the console.
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+struct Console;
+
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+impl Console {
+    fn line() -> String {
+        let mut line = String::new();
+        // End of input answers "no" and "not ready" alike.
+        let _ = std::io::stdin().lock().read_line(&mut line);
+        line
+    }
+}
+
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+impl<P> Operator<P> for Console {
+    fn tell(&mut self, message: &str) {
+        println!("{message}");
+    }
+
+    fn confirm(&mut self, question: &str) -> bool {
+        print!("{question} [yes/NO] ");
+        let _ = std::io::stdout().flush();
+        matches!(Self::line().trim(), "y" | "yes" | "Y" | "YES")
+    }
+
+    fn hands(&mut self, hands: Hands) {
+        let ask = match hands {
+            Hands::Off => "Take your hands off the carts.".to_owned(),
+            Hands::Move(axis) => format!(
+                "Move cart {axis} back and forth by hand over a few centimetres, and keep \
+                 moving it until asked to stop; hold the other cart still."
+            ),
+            Hands::Away(axis) => {
+                format!("Hold cart {axis} a few centimetres AWAY from the wall and keep it there.")
+            }
+        };
+        print!("{ask} Press Enter when ready. ");
+        let _ = std::io::stdout().flush();
+        Self::line();
+    }
+
+    fn wait(&mut self, _port: &mut P, seconds: f64) {
+        if seconds.is_finite() && seconds > 0.0 {
+            std::thread::sleep(Duration::from_secs_f64(seconds.min(60.0)));
+        }
+    }
+}
+
+/// The time of one register read (an address and a data cycle), µs.
+fn cycle_time<P: EppPort>(port: &mut P) -> Result<f64, ctrlab::hw::HwError> {
+    let start = Instant::now();
+    for _ in 0..1000 {
+        port.read_register(0)?;
+    }
+    Ok(start.elapsed().as_secs_f64() * 1e3)
+}
+
+fn probe<P: EppPort, O: Operator<P>>(port: P, operator: O) -> Result<(ProbeReport, O), ProbeError> {
+    let mut probe = Probe::new(port, operator, ProbeOptions::default())?;
+    let report = probe.run()?;
+    let (_port, operator) = probe.into_parts();
+    Ok((report, operator))
+}
+
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+fn real(path: &std::path::Path) -> Result<ProbeReport, String> {
+    println!(
+        "step 0, port: opening {} (exclusive), reading its modes",
+        path.display()
+    );
+    let modes = ctrlab::hw::Ppdev::modes_of(path).map_err(|e| e.to_string())?;
+    println!("  modes: {modes}");
+    let mut port = ctrlab::hw::Ppdev::open(path).map_err(|e| e.to_string())?;
+    match cycle_time(&mut port) {
+        Ok(us) => println!("  one register read (address + data cycle): {us:.2} µs"),
+        Err(e) => println!("  EPP cycles fail with no answer ({e}): no card, or no EPP"),
+    }
+    probe(port, Console)
+        .map(|(r, _)| r)
+        .map_err(|e| e.to_string())
+}
+
+#[cfg(not(all(feature = "ppdev", target_os = "linux")))]
+fn real(_path: &std::path::Path) -> Result<ProbeReport, String> {
+    Err("--port needs the `ppdev` feature on Linux: \
+         cargo run --example probe --features ppdev -- --port /dev/parport0"
+        .to_owned())
+}
+
+fn simulated() -> Result<ProbeReport, String> {
+    let clock = VirtualClock::new();
+    let rig = SimulatedRig::default();
+    let mut card = rig
+        .card(&Clock::Virtual(clock.clone()))
+        .map_err(|e| e.to_string())?;
+    println!("step 0, port: the simulated card on a virtual clock");
+    let us = cycle_time(&mut card).map_err(|e| e.to_string())?;
+    println!("  one register read (address + data cycle): {us:.3} µs of computer time");
+    // The simulated operator says yes to both confirmations.
+    let hand = SimulatedOperator::new(clock, [true, true]);
+    let result = probe(card, hand);
+    let (report, hand) = result.map_err(|e| e.to_string())?;
+    for line in &hand.transcript {
+        println!("{line}");
+    }
+    if report.map != rig.map {
+        return Err(format!(
+            "the probe found {:?}, not the simulated card's map {:?}",
+            report.map, rig.map
+        ));
+    }
+    println!("the probe rediscovered the simulated card's register map exactly");
+    Ok(report)
+}
+
+fn main() {
+    let args = match parse() {
+        Ok(args) => args,
+        Err(message) => {
+            eprintln!("{message}");
+            std::process::exit(2);
+        }
+    };
+    let report = match &args.port {
+        Some(path) => real(path),
+        None => simulated(),
+    };
+    let report = match report {
+        Ok(report) => report,
+        Err(message) => {
+            eprintln!("probe stopped: {message}");
+            std::process::exit(1);
+        }
+    };
+    for note in &report.notes {
+        println!("note: {note}");
+    }
+    let config = RigConfig {
+        map: report.map,
+        calibration: Calibration::from_probe(&report, &args.base),
+    };
+    println!(
+        "not measured, taken as given: {} m per count, {} V full scale, travel limits ±{:?} m",
+        config.calibration.metres_per_count,
+        config.calibration.volts_full_scale,
+        config.calibration.travel_limits
+    );
+    if let Err(e) = config.write_toml(&args.out) {
+        eprintln!("cannot write the card file: {e}");
+        std::process::exit(1);
+    }
+    println!("card file written to {}", args.out.display());
+    if args.port.is_some() {
+        println!(
+            "next: cargo run --release --example lab5 --features ppdev -- --port {} --card {}",
+            args.port
+                .as_deref()
+                .unwrap_or(std::path::Path::new("/dev/parport0"))
+                .display(),
+            args.out.display()
+        );
+    }
+}
