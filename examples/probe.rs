@@ -221,6 +221,11 @@ fn main() {
         config.calibration.volts_full_scale,
         config.calibration.travel_limits
     );
+    let dir = args.out.parent().filter(|d| !d.as_os_str().is_empty());
+    if let Some(Err(e)) = dir.map(std::fs::create_dir_all) {
+        eprintln!("cannot create {}: {e}", args.out.display());
+        std::process::exit(1);
+    }
     if let Err(e) = config.write_toml(&args.out) {
         eprintln!("cannot write the card file: {e}");
         std::process::exit(1);
