@@ -380,6 +380,27 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// # Errors
     ///
     /// [`ProbeOptions::validate`]'s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// use ctrlab::hw::testing::RegisterFile;
+    /// # use ctrlab::hw::probe::{Hands, Operator};
+    /// # struct Nobody;
+    /// # impl<P> Operator<P> for Nobody {
+    /// #     fn tell(&mut self, _: &str) {}
+    /// #     fn confirm(&mut self, _: &str) -> bool { false }
+    /// #     fn hands(&mut self, _: Hands) {}
+    /// #     fn wait(&mut self, _: &mut P, _: f64) {}
+    /// # }
+    /// let bad = ProbeOptions { samples: 0, ..Default::default() };
+    /// assert!(Probe::new(RegisterFile::new(), Nobody, bad).is_err());
+    /// let probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+    /// let (port, _operator) = probe.into_parts();
+    /// assert_eq!(port.get(0), 0);
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
     pub fn new(port: P, operator: O, options: ProbeOptions) -> Result<Self, HwError> {
         options.validate()?;
         Ok(Self {
@@ -436,6 +457,29 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     ///
     /// [`ProbeError::NoCard`] when EPP cycles time out or no address reads
     /// a constant other than `0x00`/`0xff`; no register is written.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::probe::{Probe, ProbeOptions, RegisterClass};
+    /// use ctrlab::hw::testing::RegisterFile;
+    /// # use ctrlab::hw::probe::{Hands, Operator};
+    /// # struct Nobody;
+    /// # impl<P> Operator<P> for Nobody {
+    /// #     fn tell(&mut self, _: &str) {}
+    /// #     fn confirm(&mut self, _: &str) -> bool { false }
+    /// #     fn hands(&mut self, _: Hands) {}
+    /// #     fn wait(&mut self, _: &mut P, _: f64) {}
+    /// # }
+    /// let mut card = RegisterFile::new();
+    /// card.set(0x07, 0x3c); // the ID
+    /// card.set(0x10, 0xff); // open bus
+    /// let mut probe = Probe::new(card, Nobody, ProbeOptions::default())?;
+    /// let scan = probe.scan()?;
+    /// assert_eq!(scan.id(), Some((0x07, 0x3c)));
+    /// assert_eq!(scan.class(0x10), RegisterClass::Open);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn scan(&mut self) -> Result<&Scan, ProbeError> {
         self.operator.tell(
             "step 1/4, scan: reading all 256 addresses twice (read-only), to tell constant, \
@@ -487,6 +531,24 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// [`ProbeError::OutOfOrder`] for a step not taken;
     /// [`ProbeError::Unsupported`] when the channels inferred by stride
     /// do not fit in a valid [`RegisterMap`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::probe::{Probe, ProbeError, ProbeOptions};
+    /// use ctrlab::hw::testing::RegisterFile;
+    /// # use ctrlab::hw::probe::{Hands, Operator};
+    /// # struct Nobody;
+    /// # impl<P> Operator<P> for Nobody {
+    /// #     fn tell(&mut self, _: &str) {}
+    /// #     fn confirm(&mut self, _: &str) -> bool { false }
+    /// #     fn hands(&mut self, _: Hands) {}
+    /// #     fn wait(&mut self, _: &mut P, _: f64) {}
+    /// # }
+    /// let probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+    /// assert!(matches!(probe.report(), Err(ProbeError::OutOfOrder { .. })));
+    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// ```
     pub fn report(&self) -> Result<ProbeReport, ProbeError> {
         let missing = |needs| ProbeError::OutOfOrder {
             step: "the report",
