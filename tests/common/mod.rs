@@ -58,15 +58,15 @@ pub fn rel_frobenius<const R: usize, const C: usize>(
     (got - want).norm() / want.norm()
 }
 
+/// LQI with a Kalman filter on the rig's positions, as lab5 designs it.
+#[path = "../../examples/common/lqi_design.rs"]
+pub mod lqi_design;
+
 use ctrlab::data::Recording;
-use ctrlab::design::{
-    AntiWindup, EstimatorForm, Observer, ObserverController, SelectOutputs, dlqe, dlqi,
-};
 use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-use ctrlab::lab::{self, SimulatedRig};
-use ctrlab::sim::run_sampled;
-use ctrlab::{Cart, Controller, Discrete, MassSpring, Method, StateSpace};
-use nalgebra::{SVector, vector};
+use ctrlab::lab::SimulatedRig;
+use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
+use nalgebra::vector;
 
 /// The rig's sampling period, s.
 pub const PERIOD: f64 = 0.002;
@@ -79,15 +79,7 @@ pub fn simulate_on<C: Controller<4, 1, 1>>(
     setpoint: f64,
     duration: f64,
 ) -> Recording {
-    run_sampled(
-        sim.plant(),
-        sim.sensor(),
-        controller,
-        |_| vector![setpoint],
-        SVector::zeros(),
-        &sim.sampled_config(duration),
-    )
-    .unwrap()
+    lqi_design::predict(sim, controller, setpoint, duration).unwrap()
 }
 
 /// `controller` toward `setpoint` for `duration` seconds on `sim`'s rig
@@ -118,38 +110,19 @@ pub fn run_on_rig<C: Controller<4, 1, 1>>(
 
 /// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.
 pub fn position_model() -> StateSpace<4, 1, 2, Discrete> {
-    MassSpring::nominal()
-        .state_space(Cart::Two)
-        .unwrap()
-        .with_output(lab::positions(), nalgebra::matrix![0.0; 0.0])
-        .unwrap()
-        .discretize(PERIOD, Method::Zoh)
-        .unwrap()
+    lqi_design::position_model(&MassSpring::nominal(), PERIOD).unwrap()
 }
 
 /// LQI on cart 2 (weights 1e7 on x2, 1e10 on its integral, 1 on u) with a
-/// current-form Kalman filter on both positions (force noise 10 N², each
+/// current-form Kalman filter on both positions (force noise 10 V², each
 /// position read to a count of `metres_per_count`), back-calculation
 /// anti-windup past the drive's 24 mV step; it uses only `[x1, x2]` of the
-/// rig's `[x1, v1, x2, v2]`.
-pub fn positions_lqi(metres_per_count: f64) -> SelectOutputs<ObserverController<4, 1, 2, 1>, 4, 2> {
-    let model = position_model();
-    // Integrate x2, the second measured position.
-    let h = nalgebra::matrix![0.0, 1.0];
-    let tracked = model
-        .with_output(h * model.c(), nalgebra::matrix![0.0])
-        .unwrap();
-    let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e7, 0.0, 1e10]);
-    let lqi = dlqi(&tracked, &q, &nalgebra::matrix![1.0]).unwrap();
-    let rn = SMatrix::<f64, 2, 2>::identity() * (metres_per_count * metres_per_count / 12.0);
-    let kf = dlqe(&model, model.b(), &nalgebra::matrix![10.0], &rn).unwrap();
-    let observer = Observer::new(&model, kf.gain, EstimatorForm::Current).unwrap();
-    let anti_windup = AntiWindup::BackCalculation {
-        tracking: 0.01,
-        deadband: 0.024,
-    };
-    let controller = ObserverController::new(observer, &lqi.gain, h, anti_windup).unwrap();
-    SelectOutputs::new(controller, lab::positions()).unwrap()
+/// rig's `[x1, v1, x2, v2]`. The construction lab5's Design section uses.
+pub fn positions_lqi(metres_per_count: f64) -> lqi_design::PositionsLqi {
+    let q = lqi_design::weights(Cart::Two, 1e7);
+    lqi_design::positions_lqi(&position_model(), Cart::Two, &q, metres_per_count)
+        .unwrap()
+        .controller
 }
 
 /// Last value of channel `name`.
