@@ -70,58 +70,137 @@ pub fn runs_svg(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let cols = 3usize;
     let rows = runs.len().div_ceil(cols).max(1);
-    let height = 60 + 260 * rows as u32;
-    let root = SVGBackend::new(path, (WIDTH, height)).into_drawing_area();
+    let root = SVGBackend::new(path, (WIDTH, 60 + 260 * rows as u32)).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(title, ("sans-serif", 24))?;
     let cells = root.split_evenly((rows, cols));
-    let t_end = runs
-        .iter()
-        .filter_map(|r| r.t.last().copied())
-        .fold(0.0, f64::max)
-        .max(1e-3);
+    let t_end = t_end(runs.iter());
     for (run, cell) in runs.iter().zip(cells.iter()) {
-        let (top, bottom) = cell.split_vertically(160);
-        let (y0, y1) = range(run.x_mm.iter().copied().chain([0.0, setpoint_mm]));
-        let mut chart = ChartBuilder::on(&top)
-            .caption(&run.title, ("sans-serif", 14))
-            .margin(6)
-            .x_label_area_size(0)
-            .y_label_area_size(48)
-            .build_cartesian_2d(0.0..t_end, y0..y1)?;
-        chart
-            .configure_mesh()
-            .y_desc("mm")
-            .label_style(("sans-serif", 11))
-            .draw()?;
-        chart.draw_series(DashedLineSeries::new(
-            [(0.0, setpoint_mm), (t_end, setpoint_mm)],
-            6,
-            4,
-            BLACK.stroke_width(1),
-        ))?;
-        chart.draw_series(LineSeries::new(
-            run.t.iter().copied().zip(run.x_mm.iter().copied()),
-            OKABE_ITO[0].stroke_width(2),
-        ))?;
-        let v = volts_full_scale * 1.1;
-        let mut volts = ChartBuilder::on(&bottom)
-            .margin(6)
-            .x_label_area_size(28)
-            .y_label_area_size(48)
-            .build_cartesian_2d(0.0..t_end, -v..v)?;
-        volts
-            .configure_mesh()
-            .x_desc("t (s)")
-            .y_desc("V")
-            .label_style(("sans-serif", 11))
-            .draw()?;
-        volts.draw_series(LineSeries::new(
-            run.t.iter().copied().zip(run.u.iter().copied()),
-            OKABE_ITO[1].stroke_width(1),
-        ))?;
+        let curve = Styled {
+            run,
+            label: None,
+            position: OKABE_ITO[0],
+            volts: OKABE_ITO[1],
+        };
+        let panel = Panel {
+            caption: &run.title,
+            setpoint_mm,
+            volts_full_scale,
+            t_end,
+            top: 160,
+        };
+        run_panel(cell, &panel, &[curve])?;
     }
     root.present()?;
+    Ok(())
+}
+
+/// The longest run's end, s.
+#[cfg(feature = "plot")]
+fn t_end<'a>(runs: impl Iterator<Item = &'a RunCurve>) -> f64 {
+    runs.filter_map(|r| r.t.last().copied())
+        .fold(0.0, f64::max)
+        .max(1e-3)
+}
+
+/// A run in a panel, with its legend entry and colours.
+#[cfg(feature = "plot")]
+struct Styled<'a> {
+    run: &'a RunCurve,
+    label: Option<&'a str>,
+    position: RGBColor,
+    volts: RGBColor,
+}
+
+/// A panel's frame: caption, setpoint (mm), voltage scale (V), time axis
+/// (s) and the height of its position chart (px).
+#[cfg(feature = "plot")]
+struct Panel<'a> {
+    caption: &'a str,
+    setpoint_mm: f64,
+    volts_full_scale: f64,
+    t_end: f64,
+    top: u32,
+}
+
+/// One panel: the runs' positions over the dashed setpoint on top, their
+/// voltages beneath.
+#[cfg(feature = "plot")]
+fn run_panel(
+    cell: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    panel: &Panel<'_>,
+    curves: &[Styled<'_>],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let Panel {
+        caption,
+        setpoint_mm,
+        volts_full_scale,
+        t_end,
+        top,
+    } = *panel;
+    let (top, bottom) = cell.split_vertically(top);
+    let (y0, y1) = range(
+        curves
+            .iter()
+            .flat_map(|c| c.run.x_mm.iter().copied())
+            .chain([0.0, setpoint_mm]),
+    );
+    let mut chart = ChartBuilder::on(&top)
+        .caption(caption, ("sans-serif", 14))
+        .margin(6)
+        .x_label_area_size(0)
+        .y_label_area_size(48)
+        .build_cartesian_2d(0.0..t_end, y0..y1)?;
+    chart
+        .configure_mesh()
+        .y_desc("mm")
+        .label_style(("sans-serif", 11))
+        .draw()?;
+    chart.draw_series(DashedLineSeries::new(
+        [(0.0, setpoint_mm), (t_end, setpoint_mm)],
+        6,
+        4,
+        BLACK.stroke_width(1),
+    ))?;
+    for c in curves {
+        let series = chart.draw_series(LineSeries::new(
+            c.run.t.iter().copied().zip(c.run.x_mm.iter().copied()),
+            c.position.stroke_width(2),
+        ))?;
+        if let Some(label) = c.label {
+            let color = c.position;
+            series.label(label).legend(move |(x, y)| {
+                PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        }
+    }
+    if curves.iter().any(|c| c.label.is_some()) {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 12))
+            .draw()?;
+    }
+    let v = volts_full_scale * 1.1;
+    let mut volts = ChartBuilder::on(&bottom)
+        .margin(6)
+        .x_label_area_size(28)
+        .y_label_area_size(48)
+        .build_cartesian_2d(0.0..t_end, -v..v)?;
+    volts
+        .configure_mesh()
+        .x_desc("t (s)")
+        .y_desc("V")
+        .label_style(("sans-serif", 11))
+        .draw()?;
+    for c in curves {
+        volts.draw_series(LineSeries::new(
+            c.run.t.iter().copied().zip(c.run.u.iter().copied()),
+            c.volts.stroke_width(1),
+        ))?;
+    }
     Ok(())
 }
 
