@@ -1,6 +1,7 @@
 //! lab5's figures (feature `plot`): the rig runs as small multiples, each
-//! run's position over its setpoint with the applied voltage beneath, and
-//! the identification estimates per run against their mean and the truth.
+//! run's position over its setpoint with the applied voltage beneath,
+//! predicted and measured runs overlaid the same way, and the
+//! identification estimates per run against their mean and the truth.
 //! Without the `plot` feature the report only names the figures.
 #![cfg_attr(not(feature = "plot"), allow(dead_code))]
 
@@ -17,6 +18,14 @@ pub struct RunCurve {
     pub x_mm: Vec<f64>,
     /// Applied voltage, V.
     pub u: Vec<f64>,
+}
+
+/// One panel of overlaid runs (predicted and measured), each run's
+/// `title` its legend entry.
+pub struct ComparePanel {
+    pub title: String,
+    pub setpoint_mm: f64,
+    pub runs: Vec<RunCurve>,
 }
 
 /// One identified parameter: its estimate per run and scheme.
@@ -90,6 +99,46 @@ pub fn runs_svg(
             top: 160,
         };
         run_panel(cell, &panel, &[curve])?;
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// Panels side by side, each with its runs overlaid in the scheme's
+/// colours (position and voltage alike) and a legend: predicted against
+/// measured.
+#[cfg(feature = "plot")]
+pub fn compare_svg(
+    path: &std::path::Path,
+    title: &str,
+    volts_full_scale: f64,
+    panels: &[ComparePanel],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (WIDTH, 60 + 420)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = root.titled(title, ("sans-serif", 24))?;
+    let cells = root.split_evenly((1, panels.len().max(1)));
+    let t_end = t_end(panels.iter().flat_map(|p| p.runs.iter()));
+    for (panel, cell) in panels.iter().zip(cells.iter()) {
+        let curves: Vec<Styled<'_>> = panel
+            .runs
+            .iter()
+            .enumerate()
+            .map(|(k, run)| Styled {
+                run,
+                label: Some(&run.title),
+                position: OKABE_ITO[k % OKABE_ITO.len()],
+                volts: OKABE_ITO[k % OKABE_ITO.len()],
+            })
+            .collect();
+        let frame = Panel {
+            caption: &panel.title,
+            setpoint_mm: panel.setpoint_mm,
+            volts_full_scale,
+            t_end,
+            top: cell.dim_in_pixel().1 * 5 / 8,
+        };
+        run_panel(cell, &frame, &curves)?;
     }
     root.present()?;
     Ok(())

@@ -31,6 +31,7 @@
 
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 mod card;
+mod design;
 mod figures;
 #[path = "../common/lab_tables.rs"]
 mod lab_tables;
@@ -217,6 +218,7 @@ fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::e
     for table in &tables {
         rig_results.push(rig::rig_table(backend, &ident.model, table, report)?);
     }
+    design::section(backend, &ident, report)?;
     answers(report, backend, &ident, &table2, &tables, &rig_results);
     Ok(())
 }

@@ -103,6 +103,30 @@ impl Report {
         Ok(())
     }
 
+    /// Writes panels of overlaid runs (predicted and measured) and links the
+    /// figure.
+    pub fn compare(
+        &mut self,
+        file: &str,
+        title: &str,
+        volts_full_scale: f64,
+        panels: &[crate::figures::ComparePanel],
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        #[cfg(feature = "plot")]
+        {
+            crate::figures::compare_svg(&self.out.join(file), title, volts_full_scale, panels)?;
+            self.add(&format!("![{title}]({file})\n"));
+        }
+        #[cfg(not(feature = "plot"))]
+        {
+            let _ = (volts_full_scale, panels);
+            self.add(&format!(
+                "(figure `{file}`, {title}, needs the `plot` feature)\n"
+            ));
+        }
+        Ok(())
+    }
+
     /// Writes the per-run estimates with their mean and the truth, and
     /// links the figure.
     pub fn estimates(
