@@ -133,10 +133,23 @@ pub(super) fn figures(
     // Progress along the step, 0 at y₀ and 1 at y∞.
     let progress = |v: f64| (v - y0) / delta;
 
+    // Extremes by branch-free folds (all samples are finite by now): the
+    // peak, the undershoot and the largest error all come from them.
+    let extremes = |ys: &[f64]| {
+        ys.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    let (y_min, y_max) = extremes(y);
+
+    // The last sample of y[..end] with |y − y∞| above `threshold`.
+    let last_outside =
+        |threshold: f64, end: usize| y[..end].iter().rposition(|&v| (v - yf).abs() > threshold);
     // When |y − y∞| enters [0, threshold] for good: after the last sample
-    // outside, which must come before the final window.
-    let settles = |threshold: f64| -> Result<f64, Error> {
-        let Some(j) = y.iter().rposition(|&v| (v - yf).abs() > threshold) else {
+    // outside, `j`, which must come before the final window.
+    let settles = |j: Option<usize>, threshold: f64| -> Result<f64, Error> {
+        let Some(j) = j else {
             return Ok(0.0);
         };
         if j + 1 >= n {
@@ -158,13 +171,22 @@ pub(super) fn figures(
         }
         Ok(ts)
     };
-    let settling_time = settles(band)?;
+    let j_settled = last_outside(band, n);
+    let settling_time = settles(j_settled, band)?;
     // Largest error, halved so that it cannot overflow (y∞ was checked
     // against y₀, not against every sample).
-    let half_error = y
-        .iter()
-        .fold(0.0f64, |m, v| m.max((0.5 * v - 0.5 * yf).abs()));
-    let transient_time = settles((options.settling_band * half_error * 2.0).min(f64::MAX))?;
+    let half_error = (0.5 * y_max - 0.5 * yf)
+        .abs()
+        .max((0.5 * y_min - 0.5 * yf).abs());
+    let transient_band = (options.settling_band * half_error * 2.0).min(f64::MAX);
+    // Every sample after the last one outside the settling band is inside
+    // a wider band too: only the samples before it need a look.
+    let end = if transient_band >= band {
+        j_settled.map_or(0, |j| j + 1)
+    } else {
+        n
+    };
+    let transient_time = settles(last_outside(transient_band, end), transient_band)?;
 
     // Rise: first crossings of the two levels.
     let (lo, hi) = options.rise_limits;
@@ -187,15 +209,8 @@ pub(super) fn figures(
         reason: "response never reaches the upper rise level",
     })?;
 
-    // Extremes by branch-free folds (all samples are finite by now); the
-    // peak is the extreme in the step's direction, the undershoot the other.
-    let extremes = |ys: &[f64]| {
-        ys.iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            })
-    };
-    let (y_min, y_max) = extremes(y);
+    // The peak is the extreme in the step's direction, the undershoot the
+    // other.
     let (along, wrong_way) = if delta > 0.0 {
         (y_max, y_min)
     } else {
