@@ -40,8 +40,12 @@
 
 mod drive;
 mod encoders;
+mod error;
+mod options;
 mod scan;
 
+pub use error::ProbeError;
+pub use options::ProbeOptions;
 pub use scan::{OPEN_BUS, RegisterClass, Scan, Snapshot};
 
 use super::{EppPort, HwError, RegisterMap};
@@ -120,164 +124,6 @@ impl<P, O: Operator<P> + ?Sized> Operator<P> for &mut O {
     fn wait(&mut self, port: &mut P, seconds: f64) {
         (**self).wait(port, seconds);
     }
-}
-
-/// How the probe moves and waits.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::hw::probe::ProbeOptions;
-/// let options = ProbeOptions::default();
-/// assert_eq!(options.pulse_duties, [48, 96, 120]); // per mille
-/// assert!(options.validate().is_ok());
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ProbeOptions {
-    /// PWM duties tried in turn (per mille of full scale, > 0 and ≤ 250):
-    /// the first that moves a cart is used. Each has bits 0, 1 and 7 clear,
-    /// so written by mistake to a *high* byte it commands zero duty.
-    pub pulse_duties: [i16; 3],
-    /// How long each pulse lasts, s (0.01–1).
-    pub pulse_time: f64,
-    /// Samples taken while a cart is moved by hand (4–1000).
-    pub samples: usize,
-    /// Time between those samples, s (0.001–1).
-    pub sample_interval: f64,
-    /// The count change that means a cart moved (≥ 2, above the encoder
-    /// noise).
-    pub min_counts: i64,
-    /// The longest watchdog timeout looked for, s (0.05–10); a PWM write
-    /// still obeyed after this long without a kick means no watchdog.
-    pub max_watchdog: f64,
-}
-
-impl Default for ProbeOptions {
-    fn default() -> Self {
-        Self {
-            pulse_duties: [48, 96, 120],
-            pulse_time: 0.15,
-            samples: 30,
-            sample_interval: 0.1,
-            min_counts: 3,
-            max_watchdog: 2.0,
-        }
-    }
-}
-
-impl ProbeOptions {
-    /// Checks every field.
-    ///
-    /// # Errors
-    ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::hw::probe::ProbeOptions;
-    /// let bad = ProbeOptions { pulse_duties: [48, 96, 400], ..Default::default() };
-    /// assert!(bad.validate().is_err());
-    /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        if let Some(&d) = self.pulse_duties.iter().find(|&&d| !(1..=250).contains(&d)) {
-            return Err(HwError::invalid_config(
-                "pulse_duties",
-                f64::from(d),
-                "must be 1–250 per mille",
-            ));
-        }
-        let ranges = [
-            ("pulse_time", self.pulse_time, 0.01, 1.0),
-            ("sample_interval", self.sample_interval, 0.001, 1.0),
-            ("max_watchdog", self.max_watchdog, 0.05, 10.0),
-            ("samples", self.samples as f64, 4.0, 1000.0),
-            ("min_counts", self.min_counts as f64, 2.0, 1e6),
-        ];
-        for (name, value, low, high) in ranges {
-            if !(low..=high).contains(&value) {
-                return Err(HwError::invalid_config(name, value, "out of its range"));
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Why the probe stopped.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::hw::probe::{Operator, Probe, ProbeError, ProbeOptions};
-/// use ctrlab::hw::testing::RegisterFile;
-/// # use ctrlab::hw::probe::Hands;
-/// # struct Nobody;
-/// # impl<P> Operator<P> for Nobody {
-/// #     fn tell(&mut self, _: &str) {}
-/// #     fn confirm(&mut self, _: &str) -> bool { false }
-/// #     fn hands(&mut self, _: Hands) {}
-/// #     fn wait(&mut self, _: &mut P, _: f64) {}
-/// # }
-/// // Every address reads 0: no card.
-/// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
-/// let err = probe.scan().unwrap_err();
-/// assert!(matches!(err, ProbeError::NoCard { .. }));
-/// assert!(err.to_string().contains("every address reads 0x00"));
-/// # Ok::<(), ctrlab::hw::HwError>(())
-/// ```
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ProbeError {
-    /// The port failed (a timeout here means no card answers).
-    #[error(transparent)]
-    Hw(#[from] HwError),
-    /// No card answers: every address reads the same idle value, or EPP
-    /// cycles time out. Nothing was written.
-    #[error(
-        "no card: {reason}. Check the cable, the card's power and the BIOS EPP mode; nothing was written to the card"
-    )]
-    NoCard {
-        /// What the scans saw.
-        reason: String,
-    },
-    /// The operator declined a step; the probe stopped before it.
-    #[error("stopped before {step}: not confirmed")]
-    Declined {
-        /// The step not taken.
-        step: &'static str,
-    },
-    /// A step did not find what it looks for.
-    #[error("{what} not found: {hint}")]
-    NotFound {
-        /// What was looked for.
-        what: &'static str,
-        /// What to check or try.
-        hint: &'static str,
-    },
-    /// The card works in a way the crate's driver does not support.
-    #[error("unsupported card: {what}")]
-    Unsupported {
-        /// What is different.
-        what: &'static str,
-    },
-    /// Positive duty moves the cart towards the wall.
-    #[error(
-        "motor polarity reversed: positive duty moved cart {axis} towards the wall ({counts} counts); swap the motor leads"
-    )]
-    ReversedMotor {
-        /// The cart that moved.
-        axis: usize,
-        /// How far, counts (sign-corrected).
-        counts: i64,
-    },
-    /// A step was called before the one it needs.
-    #[error("{step} needs {needs} first")]
-    OutOfOrder {
-        /// The step called.
-        step: &'static str,
-        /// The step it needs.
-        needs: &'static str,
-    },
 }
 
 /// The control register and its latch and clear bits.

@@ -1,0 +1,80 @@
+//! [`ProbeError`]: why the probe stopped.
+
+use crate::hw::HwError;
+
+/// Why the probe stopped.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::probe::{Operator, Probe, ProbeError, ProbeOptions};
+/// use ctrlab::hw::testing::RegisterFile;
+/// # use ctrlab::hw::probe::Hands;
+/// # struct Nobody;
+/// # impl<P> Operator<P> for Nobody {
+/// #     fn tell(&mut self, _: &str) {}
+/// #     fn confirm(&mut self, _: &str) -> bool { false }
+/// #     fn hands(&mut self, _: Hands) {}
+/// #     fn wait(&mut self, _: &mut P, _: f64) {}
+/// # }
+/// // Every address reads 0: no card.
+/// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+/// let err = probe.scan().unwrap_err();
+/// assert!(matches!(err, ProbeError::NoCard { .. }));
+/// assert!(err.to_string().contains("every address reads 0x00"));
+/// # Ok::<(), ctrlab::hw::HwError>(())
+/// ```
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ProbeError {
+    /// The port failed (a timeout here means no card answers).
+    #[error(transparent)]
+    Hw(#[from] HwError),
+    /// No card answers: every address reads the same idle value, or EPP
+    /// cycles time out. Nothing was written.
+    #[error(
+        "no card: {reason}. Check the cable, the card's power and the BIOS EPP mode; nothing was written to the card"
+    )]
+    NoCard {
+        /// What the scans saw.
+        reason: String,
+    },
+    /// The operator declined a step; the probe stopped before it.
+    #[error("stopped before {step}: not confirmed")]
+    Declined {
+        /// The step not taken.
+        step: &'static str,
+    },
+    /// A step did not find what it looks for.
+    #[error("{what} not found: {hint}")]
+    NotFound {
+        /// What was looked for.
+        what: &'static str,
+        /// What to check or try.
+        hint: &'static str,
+    },
+    /// The card works in a way the crate's driver does not support.
+    #[error("unsupported card: {what}")]
+    Unsupported {
+        /// What is different.
+        what: &'static str,
+    },
+    /// Positive duty moves the cart towards the wall.
+    #[error(
+        "motor polarity reversed: positive duty moved cart {axis} towards the wall ({counts} counts); swap the motor leads"
+    )]
+    ReversedMotor {
+        /// The cart that moved.
+        axis: usize,
+        /// How far, counts (sign-corrected).
+        counts: i64,
+    },
+    /// A step was called before the one it needs.
+    #[error("{step} needs {needs} first")]
+    OutOfOrder {
+        /// The step called.
+        step: &'static str,
+        /// The step it needs.
+        needs: &'static str,
+    },
+}
