@@ -247,13 +247,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         self.operator.wait(&mut self.port, 0.2);
         self.write(control, latch_bit)?;
         let away = self.read_u32_le(low)?;
-        let at_rest = u32::from_le_bytes([
-            rest[usize::from(low)],
-            rest[usize::from(low) + 1],
-            rest[usize::from(low) + 2],
-            rest[usize::from(low) + 3],
-        ]);
-        let moved = i64::from(away.wrapping_sub(at_rest) as i32);
+        let moved = i64::from(away.wrapping_sub(value(rest)) as i32);
         if moved.abs() < self.options.min_counts {
             return Err(ProbeError::NotFound {
                 what: "the direction away from the wall",
