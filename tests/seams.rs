@@ -274,7 +274,7 @@ impl ObserverFeedback {
     }
 
     fn estimate(&self) -> SVector<f64, 4> {
-        *self.observer.estimate()
+        self.observer.estimate()
     }
 
     /// The Kalman gain `L` the observer runs with.

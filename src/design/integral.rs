@@ -272,7 +272,19 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
         integrated: &SVector<f64, I>,
         r: &SVector<f64, I>,
     ) -> SVector<f64, M> {
-        let u = -(self.kx * x) - self.kz * self.z;
+        self.update_feedback(&(self.kx * x), integrated, r)
+    }
+
+    /// [`update`](Self::update) given the state feedback `K_x x` already
+    /// formed (the compensator folds its observer into it).
+    #[inline]
+    pub(crate) fn update_feedback(
+        &mut self,
+        kx_x: &SVector<f64, M>,
+        integrated: &SVector<f64, I>,
+        r: &SVector<f64, I>,
+    ) -> SVector<f64, M> {
+        let u = -kx_x - self.kz * self.z;
         self.z += (r - integrated) * self.period;
         self.asked = u;
         u
@@ -280,15 +292,19 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
 
     #[inline]
     pub(crate) fn applied(&mut self, u: &SVector<f64, M>) {
-        self.z -= self.feedthrough * u;
         let band = self.deadband;
         let excess = (self.asked - u).map(|e| e - e.clamp(-band, band));
-        self.z += self.back * excess;
+        // One write of `z`, after every read of `u`: `u` may live anywhere.
+        self.z += self.back * excess - self.feedthrough * u;
     }
 
     pub(crate) fn reset(&mut self) {
         self.z = SVector::zeros();
         self.asked = SVector::zeros();
+    }
+
+    pub(crate) fn kx(&self) -> &SMatrix<f64, M, N> {
+        &self.kx
     }
 
     pub(crate) fn integrators(&self) -> &SVector<f64, I> {

@@ -41,9 +41,12 @@ pub enum EstimatorForm {
 /// correct(y[k]):   ν = y[k] − C x̂[k|k−1]
 ///                  returns x̂[k|k−1] (Predictor) or x̂[k|k] = x̂[k|k−1] + A⁻¹L ν (Current)
 /// predict(u[k]):   x̂[k+1|k] = A x̂[k|k−1] + B u[k] + L (ν − D u[k])
+///                             = (A − L C) x̂[k|k−1] + (B − L D) u[k] + L y[k]
 /// ```
 ///
-/// (in the current form `A x̂[k|k] + B u[k]` is the same recursion). The
+/// (in the current form `A x̂[k|k] + B u[k]` is the same recursion;
+/// `predict` evaluates the second line, with the `y` of the last `correct`,
+/// zero before the first). The
 /// estimation error obeys `e[k+1] = (A − L C) e[k]` in both forms, so its
 /// poles are the eigenvalues of `A − L C`, checked stable on construction.
 /// The estimate starts at zero (the rig's carts at rest at the origin).
@@ -79,10 +82,16 @@ pub struct Observer<const N: usize, const M: usize, const P: usize> {
     gain: SMatrix<f64, N, P>,
     /// `A⁻¹ L` in the current form, zero in the predictor form.
     correction: SMatrix<f64, N, P>,
+    // A − L C and B − L D: `predict` as x̂⁺ = (A − L C) x̂ + (B − L D) u + L y,
+    // whose chain from one prediction to the next is one product long.
+    error_dynamics: SMatrix<f64, N, N>,
+    input_path: SMatrix<f64, N, M>,
     form: EstimatorForm,
     prior: SVector<f64, N>,
-    estimate: SVector<f64, N>,
-    innovation: SVector<f64, P>,
+    // The prediction the last `correct` started from, with its `measured`:
+    // the estimate is formed from them only when asked for.
+    corrected_from: SVector<f64, N>,
+    measured: SVector<f64, P>,
 }
 
 impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
@@ -146,10 +155,12 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
             model: *model,
             gain,
             correction,
+            error_dynamics,
+            input_path: model.b() - gain * model.d(),
             form,
             prior: SVector::zeros(),
-            estimate: SVector::zeros(),
-            innovation: SVector::zeros(),
+            corrected_from: SVector::zeros(),
+            measured: SVector::zeros(),
         })
     }
 
@@ -169,12 +180,16 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     /// ```
     #[inline]
     pub fn correct(&mut self, y: &SVector<f64, P>) -> SVector<f64, N> {
-        self.innovation = y - self.model.c() * self.prior;
-        self.estimate = match self.form {
-            EstimatorForm::Predictor => self.prior,
-            EstimatorForm::Current => self.prior + self.correction * self.innovation,
-        };
-        self.estimate
+        self.measure(y);
+        self.estimate()
+    }
+
+    /// `correct` without forming the estimate (the compensator's input does
+    /// not go through it).
+    #[inline]
+    pub(crate) fn measure(&mut self, y: &SVector<f64, P>) {
+        self.measured = *y;
+        self.corrected_from = self.prior;
     }
 
     /// The time update after the input `u[k]` was applied: the prediction
@@ -195,12 +210,18 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     /// ```
     #[inline]
     pub fn predict(&mut self, u: &SVector<f64, M>) {
-        let model = &self.model;
         self.prior =
-            model.a() * self.prior + model.b() * u + self.gain * (self.innovation - model.d() * u);
+            self.error_dynamics * self.prior + self.input_path * u + self.gain * self.measured;
     }
 
-    /// The estimate last handed out by [`correct`](Self::correct).
+    /// The prediction `x̂[k|k−1]` the next `correct` starts from, and the
+    /// correction gain `M` (`A⁻¹ L`, or zero in the predictor form).
+    pub(crate) fn prior_and_correction(&self) -> (&SVector<f64, N>, &SMatrix<f64, N, P>) {
+        (&self.prior, &self.correction)
+    }
+
+    /// The estimate at the last [`correct`](Self::correct) (zero before
+    /// the first), formed on demand.
     ///
     /// # Examples
     ///
@@ -209,11 +230,18 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     /// use nalgebra::{matrix, vector};
     /// let model = StateSpace::discrete(matrix![1.0], matrix![0.1], matrix![1.0], matrix![0.0], 0.1)?;
     /// let obs = Observer::new(&model, matrix![0.5], EstimatorForm::Current)?;
-    /// assert_eq!(*obs.estimate(), vector![0.0]);
+    /// assert_eq!(obs.estimate(), vector![0.0]);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
-    pub fn estimate(&self) -> &SVector<f64, N> {
-        &self.estimate
+    #[inline]
+    pub fn estimate(&self) -> SVector<f64, N> {
+        let from = self.corrected_from;
+        match self.form {
+            EstimatorForm::Predictor => from,
+            EstimatorForm::Current => {
+                from + self.correction * (self.measured - self.model.c() * from)
+            }
+        }
     }
 
     /// The model the observer runs on.
@@ -243,12 +271,12 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     /// let mut obs = Observer::new(&model, matrix![0.5], EstimatorForm::Current)?;
     /// obs.correct(&vector![2.0]);
     /// obs.reset();
-    /// assert_eq!(*obs.estimate(), vector![0.0]);
+    /// assert_eq!(obs.estimate(), vector![0.0]);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn reset(&mut self) {
         self.prior = SVector::zeros();
-        self.estimate = SVector::zeros();
-        self.innovation = SVector::zeros();
+        self.corrected_from = SVector::zeros();
+        self.measured = SVector::zeros();
     }
 }
