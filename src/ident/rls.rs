@@ -156,32 +156,18 @@ impl<const P: usize> Rls<P> {
             });
         }
         let e = y - phi.dot(&self.theta);
-        // With φ = s φ̃ (s a power of two, max |φ̃| in [1, 2)) the update is
-        // g e = P φ̃ (e s) / (μ + s² φ̃ᵀPφ̃) and P ← (P − P φ̃ φ̃ᵀ P c) / μ with
-        // c = s² / (μ + s² φ̃ᵀPφ̃): the same algebra, but φᵀPφ cannot
-        // overflow (φ = 1e200 would make the gain 0) or underflow. For
-        // s > 1 numerator and denominator are divided by s².
-        let s = pow2_floor(phi.amax());
-        let phi = phi * (1.0 / s);
         let p_phi = self.p * phi;
         let q = phi.dot(&p_phi);
-        let (step, c) = if s > 1.0 {
-            let denom = self.forgetting / s / s + q;
-            // Both terms underflowed: φ̃ᵀPφ̃ = 0, so Pφ̃ = 0 (P is positive
-            // semidefinite) and there is nothing to learn along φ.
-            if denom == 0.0 {
-                (0.0, 0.0)
-            } else {
-                (e / s / denom, 1.0 / denom)
-            }
+        let (theta, mut p) = if q.is_finite() && q <= f64::MAX / 4.0 {
+            // The textbook update, while φᵀPφ is representable.
+            let gain = p_phi / (self.forgetting + q);
+            // P is symmetric, so φᵀP = (Pφ)ᵀ.
+            let p = (self.p - gain * p_phi.transpose()) / self.forgetting;
+            (self.theta + gain * e, p)
         } else {
-            let s2 = s * s;
-            let denom = self.forgetting + s2 * q;
-            (e * s / denom, s2 / denom)
+            self.scaled_update(phi, e)
         };
-        let theta = self.theta + p_phi * step;
-        // P is symmetric, so φᵀP = (Pφ)ᵀ; symmetrise to stop round-off drift.
-        let mut p = (self.p - p_phi * (p_phi.transpose() * c)) / self.forgetting;
+        // Symmetrise to stop round-off drift.
         p = (p + p.transpose()) * 0.5;
         if !(e.is_finite()
             && theta.iter().all(|v| v.is_finite())
@@ -195,6 +181,33 @@ impl<const P: usize> Rls<P> {
         self.p = p;
         self.updates += 1;
         Ok(e)
+    }
+
+    /// The update for a `φ` so large that `φᵀPφ` overflows (φ = 1e200
+    /// would make the textbook gain 0): with `φ = s φ̃` (`s` a power of two,
+    /// `max |φ̃|` in `[1, 2)`) the gain is `P φ̃ (e / s) / (μ / s² + φ̃ᵀPφ̃)`
+    /// and `P ← (P − P φ̃ φ̃ᵀ P c) / μ` with `c = 1 / (μ / s² + φ̃ᵀPφ̃)`: the
+    /// same algebra, without the overflow. Returns `(θ, P)` before
+    /// symmetrising.
+    #[cold]
+    fn scaled_update(
+        &self,
+        phi: &SVector<f64, P>,
+        e: f64,
+    ) -> (SVector<f64, P>, SMatrix<f64, P, P>) {
+        let s = pow2_floor(phi.amax());
+        let phi = phi * (1.0 / s);
+        let p_phi = self.p * phi;
+        let denom = self.forgetting / s / s + phi.dot(&p_phi);
+        // Both terms underflowed: φ̃ᵀPφ̃ = 0, so Pφ̃ = 0 (P is positive
+        // semidefinite) and there is nothing to learn along φ.
+        let (step, c) = if denom == 0.0 {
+            (0.0, 0.0)
+        } else {
+            (e / s / denom, 1.0 / denom)
+        };
+        let p = (self.p - p_phi * (p_phi.transpose() * c)) / self.forgetting;
+        (self.theta + p_phi * step, p)
     }
 
     /// The current estimate `θ`.
