@@ -40,7 +40,8 @@ pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> S
          port: {port}\n\
          card file: {card}\n\
          {what}\
-         runs: 5 open-loop runs of 5 s with a ±{ident_volts} V square wave, then 26 closed-loop \
+         runs: 5 open-loop runs of 5 s with a ±{ident_volts} V square wave, 20 more of 5 s \
+         comparing inputs of the same peak (square wave, PRBS, multisine, chirp), then 26 closed-loop \
          runs of 3 s (24 for Tables 5 and 6, 2 for the Design section's LQI) saturated at ±{full} V, 3 s pauses between runs; each run \
          halts the motor at the first fault (travel limit, bus fault, stall, timing, Ctrl-C).\n\
          Nothing has been written to the card. Next: open the port and read the ID register \

@@ -32,6 +32,7 @@
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 mod card;
 mod design;
+mod excitation;
 mod figures;
 #[path = "../common/lab_tables.rs"]
 mod lab_tables;
@@ -213,6 +214,7 @@ fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::e
     simulation::table1(report)?;
     let table2 = simulation::table2(report)?;
     let ident = rig::identification(backend, report)?;
+    excitation::section(backend, report)?;
     let tables = rig::rig_tables();
     let mut rig_results = Vec::new();
     for table in &tables {

@@ -32,8 +32,8 @@ pub const M2: f64 = 0.7;
 /// well clear of the friction, well inside the travel), 0.2 s half period,
 /// 5 s.
 pub const IDENT_VOLTS: f64 = 8.0;
-const IDENT_HALF_PERIOD: f64 = 0.2;
-const IDENT_DURATION: f64 = 5.0;
+pub const IDENT_HALF_PERIOD: f64 = 0.2;
+pub const IDENT_DURATION: f64 = 5.0;
 /// Length of each closed-loop rig run, s.
 const STEP_DURATION: f64 = 3.0;
 pub const RUNS: u64 = 5;
@@ -105,6 +105,11 @@ impl Backend {
     /// The truth behind a simulated rig, when there is one.
     pub fn truth(&self) -> Option<MassSpring> {
         self.sim().map(|s| s.truth)
+    }
+
+    /// The simulated card's Coulomb forces (cart 1, cart 2), N.
+    pub fn coulomb_truth(&self) -> Option<[f64; 2]> {
+        self.sim().map(|s| s.coulomb_friction)
     }
 
     fn real_time(&self) -> bool {
