@@ -1,10 +1,11 @@
 //! Identification inner loops: the lab's two-stage identification over
 //! 5000 samples (target < 50 µs; NumPy's `lstsq` alone takes about 56 µs
-//! for one 5000×2 solve) and one `Rls` update for P = 2 (target < 30 ns).
+//! for one 5000×2 solve), one `Rls` update for P = 2 (target < 30 ns), and
+//! the output-error refinement of a 5000-sample run (target < 50 ms).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::data::{Channel, Schema};
-use ctrlab::lab::ident::{Scheme, identify};
+use ctrlab::lab::ident::{Options, Scheme, identify, identify_separate_springs_with, refine};
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{Cart, MassSpring, Recording, Rls};
@@ -63,6 +64,13 @@ fn benches(c: &mut Criterion) {
         "identify, Scheme::Central, 5000 samples (two stages)",
         |b| b.iter(|| identify(black_box(&rec), 1.3, 0.7, Scheme::Central).unwrap()),
     );
+    let start = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default()).unwrap();
+    let mut slow = c.benchmark_group("refine");
+    slow.sample_size(10);
+    slow.bench_function("output-error refinement, 5000 samples", |b| {
+        b.iter(|| refine(black_box(&rec), &start).unwrap())
+    });
+    slow.finish();
     c.bench_function("Rls<2> update", |b| {
         let mut rls = Rls::<2>::new(0.999, 1e3).unwrap();
         let mut k = 0u32;

@@ -43,6 +43,7 @@
 mod average;
 mod estimates;
 mod options;
+mod refine;
 mod regressors;
 mod timing;
 
@@ -51,6 +52,7 @@ pub use estimates::{
     Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, SeparateSpringsEstimate, Warning,
 };
 pub use options::{DEFAULT_MIN_SPEED, Options};
+pub use refine::{RESIDUAL_LAGS, Refined, ResidualTest, Validation, refine, validate};
 pub use timing::{DEFAULT_MAX_JITTER, GAP_RATIO, Timing};
 
 use self::regressors::{

@@ -1,0 +1,414 @@
+//! Validation by simulation ([`validate`]) and the output-error refinement
+//! ([`refine`]) of an identified two-cart model with Coulomb friction.
+//!
+//! The least-squares stages fit the *equation* error of differenced,
+//! quantised positions; the model a controller is designed on must instead
+//! reproduce the *positions*, simulated from the input alone. [`validate`]
+//! measures that on any recording (a fresh run, not the one identified);
+//! [`refine`] starts from the least-squares estimate and minimises the
+//! simulation error over the physical parameters with the
+//! Levenberg–Marquardt method of the `levenberg-marquardt` crate (MINPACK's
+//! algorithm).
+
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra034 as na;
+
+use super::SeparateSpringsEstimate;
+use crate::data::Recording;
+use crate::error::Error;
+use crate::integrate::{Dynamics, Integrator, Rk4};
+use crate::lab::{FrictionPlant, MassSpring};
+use nalgebra::{SVector, vector};
+
+/// Largest lag of the residual tests, samples.
+pub const RESIDUAL_LAGS: usize = 25;
+
+/// A residual test: the largest normalised correlation over lags
+/// `1..=RESIDUAL_LAGS` (autocorrelation) or `0..=RESIDUAL_LAGS`
+/// (cross-correlation with the input), against the 99 % bound `2.58 / √n`
+/// of white residuals independent of the input (MATLAB's `resid`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResidualTest {
+    /// `max |ρ(τ)|` over the lags.
+    pub max_correlation: f64,
+    /// The lag where it is reached, samples.
+    pub lag: usize,
+    /// `2.58 / √n`.
+    pub bound: f64,
+}
+
+impl ResidualTest {
+    /// Whether the correlation stays within the bound.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident::ResidualTest;
+    /// let t = ResidualTest { max_correlation: 0.01, lag: 3, bound: 0.036 };
+    /// assert!(t.passed());
+    /// ```
+    pub fn passed(&self) -> bool {
+        self.max_correlation <= self.bound
+    }
+}
+
+/// How well a model reproduces a recording when simulated from its input.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Validation {
+    /// Fit of each cart's simulated position, %:
+    /// `100 (1 − ‖x − x̂‖ / ‖x − mean(x)‖)` (MATLAB's `compare`, NRMSE).
+    pub fit_percent: [f64; 2],
+    /// RMS of each cart's simulation error, m.
+    pub rms_error: [f64; 2],
+    /// Whiteness of cart 2's simulation error (an output-error model has no
+    /// noise model, so coloured residuals are expected; see the bound).
+    pub whiteness: ResidualTest,
+    /// Cross-correlation of cart 2's simulation error with the input: a
+    /// correlation above the bound means dynamics the model misses.
+    pub independence: ResidualTest,
+}
+
+/// The result of [`refine`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Refined {
+    /// The refined plant (masses as given to the least squares).
+    pub plant: MassSpring,
+    /// The refined Coulomb forces, N (cart 1, cart 2).
+    pub coulomb: [f64; 2],
+    /// The starting (least-squares) model's validation on the same
+    /// recording.
+    pub start: Validation,
+    /// The refined model's validation on the same recording.
+    pub refined: Validation,
+    /// Simulations run (each one pass over the recording).
+    pub evaluations: usize,
+}
+
+/// The recording's input and positions, checked.
+struct Run<'a> {
+    t: &'a [f64],
+    u: &'a [f64],
+    x1: &'a [f64],
+    x2: &'a [f64],
+}
+
+impl<'a> Run<'a> {
+    fn of(rec: &'a Recording) -> Result<Self, Error> {
+        let run = Run {
+            t: rec.time(),
+            u: rec.channel("u")?,
+            x1: rec.channel("x1")?,
+            x2: rec.channel("x2")?,
+        };
+        if run.t.len() < 3 * RESIDUAL_LAGS {
+            return Err(Error::InvalidParameter {
+                name: "recording",
+                value: run.t.len() as f64,
+                reason: "validation needs at least 75 samples",
+            });
+        }
+        Ok(run)
+    }
+
+    /// Simulates `plant` with Coulomb forces `coulomb` from the recorded
+    /// input (held over each interval), starting at the first positions at
+    /// rest; writes the positions into `out`. `false` if the simulation
+    /// left the rig's scale (more than 1 m: a diverging candidate).
+    fn simulate(&self, plant: &MassSpring, coulomb: [f64; 2], out: &mut [[f64; 2]]) -> bool {
+        let mut model = FrictionPlant::new(*plant, coulomb);
+        let mut x: SVector<f64, 4> = vector![self.x1[0], 0.0, self.x2[0], 0.0];
+        for (k, slot) in out.iter_mut().enumerate().take(self.t.len()) {
+            *slot = [x[0], x[2]];
+            if !(x[0].abs() <= 1.0 && x[2].abs() <= 1.0) {
+                return false;
+            }
+            if let Some(&next) = self.t.get(k + 1) {
+                let u = vector![self.u[k]];
+                model.update_mode(self.t[k], &mut x, &u);
+                Rk4.step_mut(&model, self.t[k], next - self.t[k], &mut x, &u);
+            }
+        }
+        true
+    }
+
+    fn validation(&self, sim: &[[f64; 2]]) -> Validation {
+        let n = self.t.len();
+        let mut fit = [0.0; 2];
+        let mut rms = [0.0; 2];
+        for (cart, measured) in [self.x1, self.x2].into_iter().enumerate() {
+            let mean = measured.iter().sum::<f64>() / n as f64;
+            let (mut err, mut spread) = (0.0, 0.0);
+            for k in 0..n {
+                err += (measured[k] - sim[k][cart]).powi(2);
+                spread += (measured[k] - mean).powi(2);
+            }
+            fit[cart] = if spread > 0.0 {
+                100.0 * (1.0 - (err / spread).sqrt())
+            } else {
+                0.0
+            };
+            rms[cart] = (err / n as f64).sqrt();
+        }
+        let e: Vec<f64> = (0..n).map(|k| self.x2[k] - sim[k][1]).collect();
+        Validation {
+            fit_percent: fit,
+            rms_error: rms,
+            whiteness: correlation_test(&e, &e, 1),
+            independence: correlation_test(&e, self.u, 0),
+        }
+    }
+}
+
+/// `max |ρ(τ)|` of `a[k]` against `b[k − τ]`, `τ = first..=RESIDUAL_LAGS`,
+/// normalised by both signals' energies after removing their means.
+fn correlation_test(a: &[f64], b: &[f64], first: usize) -> ResidualTest {
+    let n = a.len();
+    let mean = |s: &[f64]| s.iter().sum::<f64>() / n as f64;
+    let (ma, mb) = (mean(a), mean(b));
+    let energy = |s: &[f64], m: f64| s.iter().map(|v| (v - m).powi(2)).sum::<f64>();
+    let norm = (energy(a, ma) * energy(b, mb)).sqrt();
+    let mut best = (0.0, first);
+    for lag in first..=RESIDUAL_LAGS {
+        let c: f64 = (lag..n).map(|k| (a[k] - ma) * (b[k - lag] - mb)).sum();
+        let rho = if norm > 0.0 { (c / norm).abs() } else { 0.0 };
+        if rho > best.0 {
+            best = (rho, lag);
+        }
+    }
+    ResidualTest {
+        max_correlation: best.0,
+        lag: best.1,
+        bound: 2.58 / (n as f64).sqrt(),
+    }
+}
+
+/// Simulates `plant` with Coulomb forces `coulomb` (N, cart 1 and cart 2)
+/// from the recording's input `u` (held over each interval, in the unit
+/// `plant.gain` converts to newtons), starting at rest at the first
+/// recorded positions, and compares the simulated positions with the
+/// recorded `x1`, `x2` (m).
+///
+/// Validate on a *fresh* run, not the one identified: the fit on the
+/// identification data flatters the model.
+///
+/// # Errors
+///
+/// [`Error::Channel`] when `u`, `x1` or `x2` is missing;
+/// [`Error::InvalidParameter`] for fewer than 75 samples, an invalid plant
+/// (see [`MassSpring::validate`]) or a negative or non-finite force;
+/// [`Error::Overflow`] when the simulation diverges.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// use ctrlab::lab::ident::{Options, identify_separate_springs_with, validate};
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?;
+/// let v = validate(&rec, &est.plant(), [0.0, 0.0])?;
+/// assert!(v.fit_percent[1] > 90.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn validate(
+    rec: &Recording,
+    plant: &MassSpring,
+    coulomb: [f64; 2],
+) -> Result<Validation, Error> {
+    plant.validate()?;
+    check_forces(coulomb)?;
+    let run = Run::of(rec)?;
+    let mut sim = vec![[0.0; 2]; run.t.len()];
+    if !run.simulate(plant, coulomb, &mut sim) {
+        return Err(Error::Overflow {
+            operation: "validation: the model's simulation diverges",
+        });
+    }
+    Ok(run.validation(&sim))
+}
+
+fn check_forces(coulomb: [f64; 2]) -> Result<(), Error> {
+    match coulomb.iter().find(|f| !(f.is_finite() && **f >= 0.0)) {
+        Some(&bad) => Err(Error::InvalidParameter {
+            name: "coulomb",
+            value: bad,
+            reason: "Coulomb forces must be finite and >= 0, N",
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The parameters refined: `ln` of `[k1, k2, b1, b2, K, F1, F2]`, so every
+/// candidate is positive and every step relative.
+const PARAMETERS: usize = 7;
+/// The smallest force or friction coefficient a parameter starts from (a
+/// zero estimate cannot be refined in `ln`), in its SI unit.
+const FLOOR: f64 = 1e-3;
+
+struct Problem<'a> {
+    run: Run<'a>,
+    masses: [f64; 2],
+    q: na::DVector<f64>,
+    sim: Vec<[f64; 2]>,
+    evaluations: std::cell::Cell<usize>,
+}
+
+impl Problem<'_> {
+    fn model(&self, q: &na::DVector<f64>) -> (MassSpring, [f64; 2]) {
+        let p: Vec<f64> = q.iter().map(|v| v.exp()).collect();
+        let plant = MassSpring {
+            m1: self.masses[0],
+            m2: self.masses[1],
+            k1: p[0],
+            k2: p[1],
+            b1: p[2],
+            b2: p[3],
+            gain: p[4],
+        };
+        (plant, [p[5], p[6]])
+    }
+
+    /// Both carts' simulation errors for parameters `q`, each clamped to
+    /// ±1 m so that a diverging candidate is a large, finite cost.
+    fn errors(&self, q: &na::DVector<f64>, sim: &mut [[f64; 2]], out: &mut [f64]) {
+        self.evaluations.set(self.evaluations.get() + 1);
+        let (plant, coulomb) = self.model(q);
+        let finished = self.run.simulate(&plant, coulomb, sim);
+        let n = self.run.t.len();
+        for k in 0..n {
+            let (e1, e2) = if finished {
+                (sim[k][0] - self.run.x1[k], sim[k][1] - self.run.x2[k])
+            } else {
+                (1.0, 1.0)
+            };
+            out[k] = e1.clamp(-1.0, 1.0);
+            out[n + k] = e2.clamp(-1.0, 1.0);
+        }
+    }
+}
+
+impl LeastSquaresProblem<f64, na::Dyn, na::Dyn> for Problem<'_> {
+    type ResidualStorage = na::VecStorage<f64, na::Dyn, na::U1>;
+    type JacobianStorage = na::VecStorage<f64, na::Dyn, na::Dyn>;
+    type ParameterStorage = na::VecStorage<f64, na::Dyn, na::U1>;
+
+    fn set_params(&mut self, q: &na::DVector<f64>) {
+        self.q.copy_from(q);
+    }
+
+    fn params(&self) -> na::DVector<f64> {
+        self.q.clone()
+    }
+
+    fn residuals(&self) -> Option<na::DVector<f64>> {
+        let n = self.run.t.len();
+        let mut r = na::DVector::zeros(2 * n);
+        let mut sim = self.sim.clone();
+        self.errors(&self.q, &mut sim, r.as_mut_slice());
+        Some(r)
+    }
+
+    /// Forward differences in `ln p` with a step of 1e-5 (a relative step
+    /// in `p`): the stick–slip switching makes the simulation only
+    /// piecewise smooth in the forces, so the step is well above √ε.
+    fn jacobian(&self) -> Option<na::DMatrix<f64>> {
+        let n = self.run.t.len();
+        let mut sim = self.sim.clone();
+        let mut base = vec![0.0; 2 * n];
+        self.errors(&self.q, &mut sim, &mut base);
+        let mut j = na::DMatrix::zeros(2 * n, PARAMETERS);
+        let mut shifted = vec![0.0; 2 * n];
+        const STEP: f64 = 1e-5;
+        for col in 0..PARAMETERS {
+            let mut q = self.q.clone();
+            q[col] += STEP;
+            self.errors(&q, &mut sim, &mut shifted);
+            for (row, (s, b)) in shifted.iter().zip(&base).enumerate() {
+                j[(row, col)] = (s - b) / STEP;
+            }
+        }
+        Some(j)
+    }
+}
+
+/// Refines a least-squares estimate by output error: minimises the sum of
+/// both carts' squared simulation errors (m²) over
+/// `[k1, k2, b1, b2, K, F1, F2]` with the masses held, starting from
+/// `start` (its Coulomb forces, or 1 mN where it has none), by
+/// Levenberg–Marquardt in the logarithms of the parameters (so they stay
+/// positive and the steps are relative). The simulation is
+/// [`FrictionPlant`] (Coulomb friction, breakaway at the Coulomb force) by
+/// one RK4 step per sample, input held over each interval, from rest at the
+/// first positions: a card's PWM delay and extra stiction are not in the
+/// model, and bias the refined parameters slightly.
+///
+/// Refine on the identification run and [`validate`] on a fresh one. At
+/// most about 100 simulations run (the work is bounded).
+///
+/// # Errors
+///
+/// Those of [`validate`] for the starting model;
+/// [`Error::NoConvergence`] when the optimiser stops on a usage problem
+/// (non-finite values).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine};
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?;
+/// let r = refine(&rec, &est)?;
+/// assert!(r.refined.fit_percent[1] >= r.start.fit_percent[1]);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refined, Error> {
+    let plant = start.plant();
+    let coulomb = start.coulomb.map_or([0.0; 2], |c| [c[0].value, c[1].value]);
+    let start_validation = validate(rec, &plant, coulomb.map(|f| f.max(0.0)))?;
+    let run = Run::of(rec)?;
+    let n = run.t.len();
+    let p0 = [
+        plant.k1, plant.k2, plant.b1, plant.b2, plant.gain, coulomb[0], coulomb[1],
+    ];
+    let q0 = na::DVector::from_iterator(PARAMETERS, p0.iter().map(|p| p.max(FLOOR).ln()));
+    let problem = Problem {
+        run,
+        masses: [plant.m1, plant.m2],
+        q: q0,
+        sim: vec![[0.0; 2]; n],
+        evaluations: std::cell::Cell::new(0),
+    };
+    // Patience 12: at most 12 · (7 + 1) residual evaluations, each
+    // Jacobian another 8 simulations.
+    let (problem, report) = LevenbergMarquardt::new()
+        .with_patience(12)
+        .minimize(problem);
+    if report.termination.was_usage_issue() {
+        return Err(Error::NoConvergence {
+            operation: "output-error refinement (Levenberg–Marquardt)",
+            iterations: report.number_of_evaluations,
+        });
+    }
+    let (refined_plant, refined_coulomb) = problem.model(&problem.q);
+    let refined = validate(rec, &refined_plant, refined_coulomb)?;
+    // Never worse than the start on its own data: LM only accepts
+    // decreasing steps, but the clamp could in principle mislead it.
+    if refined.rms_error[0].hypot(refined.rms_error[1])
+        > start_validation.rms_error[0].hypot(start_validation.rms_error[1])
+    {
+        return Ok(Refined {
+            plant,
+            coulomb,
+            start: start_validation,
+            refined: start_validation,
+            evaluations: problem.evaluations.get(),
+        });
+    }
+    Ok(Refined {
+        plant: refined_plant,
+        coulomb: refined_coulomb,
+        start: start_validation,
+        refined,
+        evaluations: problem.evaluations.get(),
+    })
+}
