@@ -1,135 +1,12 @@
-//! CSV reading and writing of [`Recording`]s.
+//! Reading a [`Recording`] from CSV.
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::Path;
 
-use super::{Channel, Recording, Schema};
+use super::header::parse_header;
+use super::{csv_error, from_csv_crate, is_input_name};
+use crate::data::{Channel, Recording, Schema};
 use crate::error::Error;
-
-/// The units the CSV reader recognises as a header suffix, with the SI unit
-/// they stand for and how many of them make one SI unit:
-/// `(suffix, SI unit, divisor)`. A header `x1_mm` is channel `x1` in `m`,
-/// read values ÷ 1000 (a division, so `0.001` mm is exactly the double
-/// nearest 1e-6 m); `v1_m_s` is `v1` in `m/s`. The writer uses the SI
-/// suffixes.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::data::KNOWN_UNITS;
-/// assert!(KNOWN_UNITS.contains(&("mm_s", "m/s", 1000.0)));
-/// ```
-pub const KNOWN_UNITS: [(&str, &str, f64); 10] = [
-    ("mm_s", "m/s", 1000.0),
-    ("m_s", "m/s", 1.0),
-    ("rad_s", "rad/s", 1.0),
-    ("mm", "m", 1000.0),
-    ("ms", "s", 1000.0),
-    ("m", "m", 1.0),
-    ("s", "s", 1.0),
-    ("V", "V", 1.0),
-    ("N", "N", 1.0),
-    ("rad", "rad", 1.0),
-];
-
-/// Splits a header into a channel (SI unit) and the divisor to SI: the
-/// bracket form `name [unit]` / `name (unit)` or a known suffix `name_unit`;
-/// otherwise the whole header is the name, without a unit.
-fn parse_header(header: &str) -> (Channel, f64) {
-    let bracketed = header
-        .strip_suffix(']')
-        .and_then(|h| h.rsplit_once('['))
-        .or_else(|| header.strip_suffix(')').and_then(|h| h.rsplit_once('(')));
-    if let Some((name, unit)) = bracketed {
-        let (name, unit) = (name.trim(), unit.trim());
-        let suffix = unit.replace('/', "_");
-        return match KNOWN_UNITS.iter().find(|k| k.0 == suffix) {
-            Some(&(_, si, divisor)) => (Channel::new(name, si), divisor),
-            None => (Channel::new(name, unit), 1.0),
-        };
-    }
-    for &(suffix, si, divisor) in &KNOWN_UNITS {
-        if let Some(name) = header
-            .strip_suffix(suffix)
-            .and_then(|h| h.strip_suffix('_'))
-            .filter(|n| !n.is_empty())
-        {
-            return (Channel::new(name, si), divisor);
-        }
-    }
-    (Channel::new(header, ""), 1.0)
-}
-
-/// The header the writer uses for `channel`: `name_unit` for a unit in
-/// [`KNOWN_UNITS`] (`/` written as `_`), `name [unit]` for any other unit,
-/// `name` alone without one.
-fn header_of(channel: &Channel) -> String {
-    if channel.unit.is_empty() {
-        return channel.name.clone();
-    }
-    let suffix = channel.unit.replace('/', "_");
-    if KNOWN_UNITS.iter().any(|k| k.0 == suffix && k.2 == 1.0) {
-        format!("{}_{suffix}", channel.name)
-    } else {
-        format!("{} [{}]", channel.name, channel.unit)
-    }
-}
-
-impl Recording {
-    /// Checks every channel's header reads back as the same channel in the
-    /// same role, so that a written file always reads back identical.
-    fn check_round_trip(&self) -> Result<(), Error> {
-        let inputs = self.schema.inputs().len();
-        for (k, channel) in self.schema.channels().enumerate() {
-            let (parsed, divisor) = parse_header(&header_of(channel));
-            let reason = if matches!(parsed.name.as_str(), "t" | "time") {
-                Some("a channel cannot be named like the time column (t, time)")
-            } else if parsed != *channel || divisor != 1.0 {
-                Some(
-                    "its CSV header would read back as another channel: \
-                     give it an SI unit, or a name that does not end in a unit",
-                )
-            } else if is_input_name(&channel.name) != (k < inputs) {
-                Some(
-                    "in a CSV file, inputs are the channels named u, u1, u2, …: \
-                     rename it so that its role reads back",
-                )
-            } else {
-                None
-            };
-            if let Some(reason) = reason {
-                return Err(Error::Channel {
-                    name: channel.name.clone(),
-                    reason: reason.to_string(),
-                });
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Input channels in a file are those named `u` or `u` followed by digits
-/// (python-control's and MATLAB's convention for inputs).
-fn is_input_name(name: &str) -> bool {
-    name.strip_prefix('u')
-        .is_some_and(|rest| rest.chars().all(|c| c.is_ascii_digit()))
-}
-
-fn csv_error(line: u64, reason: impl Into<String>) -> Error {
-    Error::Csv {
-        line,
-        reason: reason.into(),
-    }
-}
-
-fn from_csv_crate(err: &csv::Error, fallback_line: u64) -> Error {
-    let line = err
-        .position()
-        .map(|p| p.line())
-        .unwrap_or(fallback_line)
-        .max(1);
-    csv_error(line, err.to_string())
-}
 
 impl Recording {
     /// Reads a recording from a CSV file; see [`from_reader`](Self::from_reader)
@@ -164,7 +41,7 @@ impl Recording {
     /// Every other column is a channel; its header carries its unit, and
     /// values are converted to SI on reading:
     ///
-    /// - `name_unit` with a unit from [`KNOWN_UNITS`] (`x1_mm`, `v1_m_s`,
+    /// - `name_unit` with a unit from [`KNOWN_UNITS`](crate::data::KNOWN_UNITS) (`x1_mm`, `v1_m_s`,
     ///   `u_V`), or `name [unit]` / `name (unit)` with any unit;
     /// - `name` alone: a channel without a unit (the lab's `u`).
     ///
@@ -331,95 +208,5 @@ impl Recording {
             t,
             columns: cols.collect(),
         })
-    }
-
-    /// Writes the recording as CSV to a file; see
-    /// [`to_writer`](Self::to_writer) for the format.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::Io`] (with the path) when the file cannot be created or
-    /// written; the errors of [`to_writer`](Self::to_writer).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// # use ctrlab::Recording;
-    /// # use ctrlab::data::Schema;
-    /// let mut rec = Recording::new(Schema::numbered(1, 2));
-    /// for k in 0..6 {
-    ///     rec.push(k as f64 * 0.002, &[1.0], &[1e-4 * k as f64, 2e-4 * k as f64])?;
-    /// }
-    /// let path = std::env::temp_dir().join("ctrlab_doc_write_csv.csv");
-    /// rec.write_csv(&path)?;
-    /// assert_eq!(Recording::read_csv(&path)?, rec);
-    /// # std::fs::remove_file(&path).ok();
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn write_csv(&self, path: impl AsRef<Path>) -> Result<(), Error> {
-        let path = path.as_ref();
-        let file = std::fs::File::create(path)
-            .map_err(|e| Error::io(format!("creating {}", path.display()), &e))?;
-        let mut w = std::io::BufWriter::new(file);
-        self.to_writer(&mut w).map_err(|e| match e {
-            Error::Io { kind, message, .. } => Error::Io {
-                context: format!("writing {}", path.display()),
-                kind,
-                message,
-            },
-            other => other,
-        })?;
-        w.flush()
-            .map_err(|e| Error::io(format!("writing {}", path.display()), &e))
-    }
-
-    /// Writes the recording as CSV in SI units: header `t_s` and one column
-    /// per channel (inputs, then measurements), each header the channel's
-    /// name and unit (`x1_m`, `v1_m_s`, `u_V`; see [`KNOWN_UNITS`]). Values
-    /// are written in Rust's shortest round-trip form, so reading the output
-    /// back gives the identical recording.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::InvalidRecording`] for a non-finite value (the reader would
-    /// refuse it); [`Error::Channel`] for a channel whose header would not
-    /// read back as itself (a unit outside [`KNOWN_UNITS`] that is not SI
-    /// such as `mm`, a name ending in a unit, a name `t` or `time`, or an
-    /// input not named `u…` / a measurement named `u…`), so that every
-    /// file written reads back identical; [`Error::Io`] when the writer
-    /// fails.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// # use ctrlab::data::{Channel, Recording, Schema};
-    /// let schema = Schema::new(vec![Channel::new("u", "V")], vec![Channel::new("x1", "m"), Channel::new("v1", "m/s")])?;
-    /// let mut rec = Recording::new(schema);
-    /// rec.push(0.0, &[2.0], &[0.001, 0.0025])?;
-    /// let mut out = Vec::new();
-    /// rec.to_writer(&mut out)?;
-    /// assert_eq!(String::from_utf8(out).unwrap(), "t_s,u_V,x1_m,v1_m_s\n0.0,2.0,0.001,0.0025\n");
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn to_writer(&self, writer: impl Write) -> Result<(), Error> {
-        self.check_values()?;
-        self.check_round_trip()?;
-        let io = |e: csv::Error| match e.into_kind() {
-            csv::ErrorKind::Io(e) => Error::io("writing CSV", &e),
-            other => Error::io("writing CSV", &std::io::Error::other(format!("{other:?}"))),
-        };
-        let mut w = csv::Writer::from_writer(writer);
-        let header: Vec<String> = std::iter::once("t_s".to_string())
-            .chain(self.schema.channels().map(header_of))
-            .collect();
-        w.write_record(&header).map_err(io)?;
-        let mut fields: Vec<String> = Vec::with_capacity(header.len());
-        for k in 0..self.len() {
-            fields.clear();
-            fields.push(format!("{:?}", self.t[k]));
-            fields.extend(self.columns.iter().map(|c| format!("{:?}", c[k])));
-            w.write_record(&fields).map_err(io)?;
-        }
-        w.flush().map_err(|e| Error::io("writing CSV", &e))
     }
 }
