@@ -1,10 +1,16 @@
-//! CSV reading and writing of [`Recording`](super::Recording)s: the header
-//! and its units ([`header`]), the reader ([`read`]) and the writer
-//! ([`write`]).
+//! CSV reading and writing of [`Recording`](super::Recording)s: the lines
+//! of a log ([`lines`]: comments, blank lines, the separator), a header
+//! and its units ([`header`]), one field's number ([`value`]), the options
+//! ([`options`]), the reader ([`read`]) and the writer ([`write`]).
 
 mod header;
+mod lines;
+mod options;
 mod read;
+mod value;
 mod write;
+
+pub use self::options::CsvOptions;
 
 use crate::error::Error;
 
@@ -12,8 +18,12 @@ use crate::error::Error;
 /// they stand for and how many of them make one SI unit:
 /// `(suffix, SI unit, divisor)`. A header `x1_mm` is channel `x1` in `m`,
 /// read values ÷ 1000 (a division, so `0.001` mm is exactly the double
-/// nearest 1e-6 m); `v1_m_s` is `v1` in `m/s`. The writer uses the SI
-/// suffixes.
+/// nearest 1e-6 m); `v1_m_s` is `v1` in `m/s`. As a suffix a unit is
+/// matched as written here; in brackets (`name [unit]`, with `/` for `_`)
+/// ignoring case except for the letters `m` and `s`, which SI tells from
+/// `M` (mega) and `S` (siemens): `U [v]` is in `V`, `x [MM]` is not in
+/// `mm` (see [`Recording::from_reader_with`](crate::Recording::from_reader_with)).
+/// The writer uses the SI suffixes.
 ///
 /// # Examples
 ///
@@ -46,13 +56,4 @@ pub(super) fn csv_error(line: u64, reason: impl Into<String>) -> Error {
         line,
         reason: reason.into(),
     }
-}
-
-pub(super) fn from_csv_crate(err: &csv::Error, fallback_line: u64) -> Error {
-    let line = err
-        .position()
-        .map(|p| p.line())
-        .unwrap_or(fallback_line)
-        .max(1);
-    csv_error(line, err.to_string())
 }

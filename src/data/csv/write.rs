@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::header::{header_of, parse_header};
+use super::header::{Scale, header_of, parse_header};
 use super::is_input_name;
 use crate::data::Recording;
 use crate::error::Error;
@@ -14,10 +14,15 @@ impl Recording {
     fn check_round_trip(&self) -> Result<(), Error> {
         let inputs = self.schema.inputs().len();
         for (k, channel) in self.schema.channels().enumerate() {
-            let (parsed, divisor) = parse_header(&header_of(channel));
+            let (parsed, scale) = parse_header(&header_of(channel));
             let reason = if matches!(parsed.name.as_str(), "t" | "time") {
                 Some("a channel cannot be named like the time column (t, time)")
-            } else if parsed != *channel || divisor != 1.0 {
+            } else if parsed.name != channel.name && parsed.name == channel.name.to_lowercase() {
+                Some(
+                    "the CSV reader reads names in lower case: \
+                     name it in lower case so that it reads back",
+                )
+            } else if parsed != *channel || scale != Scale::Divide(1.0) {
                 Some(
                     "its CSV header would read back as another channel: \
                      give it an SI unit, or a name that does not end in a unit",
