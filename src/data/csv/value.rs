@@ -41,14 +41,15 @@ pub(super) fn parse(
     decimal_comma: bool,
     scratch: &mut String,
 ) -> Result<f64, BadValue> {
-    if decimal_comma && let Some(at) = text.find(',') {
-        if text.contains('.') || text[at + 1..].contains(',') {
+    if decimal_comma && let Some(at) = text.bytes().position(|b| b == b',') {
+        let (head, tail) = (&text[..at], &text[at + 1..]);
+        if head.contains('.') || tail.contains([',', '.']) {
             return Err(BadValue::Thousands);
         }
         scratch.clear();
-        scratch.push_str(&text[..at]);
+        scratch.push_str(head);
         scratch.push('.');
-        scratch.push_str(&text[at + 1..]);
+        scratch.push_str(tail);
         return scratch.parse().map_err(|_| BadValue::NotANumber);
     }
     text.parse().map_err(|_| {
@@ -78,6 +79,14 @@ mod tests {
         assert_eq!(parse(",", true, &mut s), Err(BadValue::NotANumber));
         assert_eq!(parse("", true, &mut s), Err(BadValue::Empty));
         assert_eq!(parse("x", false, &mut s), Err(BadValue::NotANumber));
+        // Long, and not ASCII.
+        let long = format!("0,{}1", "0".repeat(80));
+        assert_eq!(parse(&long, true, &mut s), Ok(1e-81));
+        assert_eq!(
+            parse(&format!("{long}x"), true, &mut s),
+            Err(BadValue::NotANumber)
+        );
+        assert_eq!(parse("é,5", true, &mut s), Err(BadValue::NotANumber));
         let why = BadValue::Thousands.describe("x1", "1.234,5", true);
         assert!(
             why.contains("`1.234,5`") && why.contains("thousands"),
