@@ -1,8 +1,11 @@
 //! Reading a lab log: 1e6 rows of `t, u, x1, x2` (a 2 ms log of 33 min)
-//! through `Recording::from_reader` (target < 1 s in release).
+//! through `Recording::from_reader` (target < 1 s in release), and the same
+//! log as Excel writes it in a German locale (`;`, decimal commas, `\r\n`)
+//! with a comment line every 1000 rows.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::Recording;
+use ctrlab::data::CsvOptions;
 use std::hint::black_box;
 
 const ROWS: usize = 1_000_000;
@@ -29,6 +32,24 @@ fn benches(c: &mut Criterion) {
     group.bench_function("from_reader, 1e6 rows t,u,x1,x2 (comma)", |b| {
         b.iter(|| Recording::from_reader(black_box(log.as_bytes())).unwrap())
     });
+    let excel: String = log
+        .replace(',', ";")
+        .replace('.', ",")
+        .lines()
+        .enumerate()
+        .map(|(k, line)| {
+            if k % 1000 == 999 {
+                format!("# {k} rows\r\n{line}\r\n")
+            } else {
+                format!("{line}\r\n")
+            }
+        })
+        .collect();
+    let options = CsvOptions::default();
+    group.bench_function(
+        "from_reader_with, 1e6 rows t;u;x1;x2 (decimal commas, CRLF, comments)",
+        |b| b.iter(|| Recording::from_reader_with(black_box(excel.as_bytes()), &options).unwrap()),
+    );
     group.finish();
 }
 
