@@ -373,6 +373,29 @@ fn the_writer_refuses_names_that_would_read_back_in_lower_case() {
     }
 }
 
+#[test]
+fn a_failing_reader_is_an_io_error() {
+    /// Hands out `text`, then fails.
+    struct Failing(&'static [u8]);
+    impl std::io::Read for Failing {
+        fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+            if self.0.is_empty() {
+                return Err(std::io::Error::other("the USB stick was pulled"));
+            }
+            let n = self.0.len().min(out.len());
+            out[..n].copy_from_slice(&self.0[..n]);
+            self.0 = &self.0[n..];
+            Ok(n)
+        }
+    }
+    for text in [&b""[..], b"# c\n", b"t_s,u\n0,1\n"] {
+        match Recording::from_reader(Failing(text)) {
+            Err(Error::Io { message, .. }) => assert!(message.contains("USB"), "{message}"),
+            other => panic!("expected Error::Io, got {other:?}"),
+        }
+    }
+}
+
 /// How many lines `text` has, counting `\n`, `\r\n` and `\r` as line breaks.
 fn line_count(text: &str) -> u64 {
     let b = text.as_bytes();
