@@ -173,12 +173,15 @@ pub enum Error {
         /// The backend's message.
         reason: String,
     },
-    /// A CSV recording is malformed: a missing or unit-less column, a value
-    /// that is not a finite number, a time column that does not increase or
-    /// is not uniformly sampled, too few rows, or bytes the CSV parser rejects.
+    /// A CSV recording is malformed: a missing or unit-less time column, a
+    /// column in encoder counts without a calibration, a row of the wrong
+    /// width, a value that is not a finite number (or holds a thousands
+    /// separator), a time column that does not increase, too few rows, or
+    /// bytes the CSV parser rejects.
     #[error("CSV line {line}: {reason}")]
     Csv {
-        /// One-based line number in the input (the header is line 1).
+        /// One-based line number in the file, comment and blank lines
+        /// counted (a header after two comment lines is line 3).
         line: u64,
         /// What is wrong on that line, with the offending value.
         reason: String,

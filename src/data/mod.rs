@@ -7,7 +7,9 @@
 //! step metrics consume, reading channels by name. Its [`Schema`] says which
 //! channels it has; the two-cart lab's layout (`u`; `x1, v1, x2, v2`) is one
 //! schema, [`lab::schema`](crate::lab::schema). It reads and writes CSV with
-//! the unit in each header (see [`Recording::from_reader`]).
+//! the unit in each header, and reads the logs students have: `;` or tab
+//! separators, decimal commas, comment lines, any case, raw encoder counts
+//! (see [`Recording::from_reader_with`]).
 //!
 //! # Examples
 //!
@@ -32,7 +34,7 @@ use nalgebra::SVector;
 
 use crate::error::Error;
 
-pub use self::csv::KNOWN_UNITS;
+pub use self::csv::{CsvOptions, KNOWN_UNITS};
 
 /// Largest accepted deviation of one sampling interval from the mean
 /// interval, as a fraction of the mean (1 %), when a recording is checked
