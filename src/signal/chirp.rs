@@ -151,11 +151,7 @@ impl Chirp {
     /// ```
     #[must_use]
     pub fn phase(&self, t: f64) -> f64 {
-        let t = if t.is_nan() {
-            0.0
-        } else {
-            t.clamp(0.0, self.duration)
-        };
+        let t = self.within(t);
         let (f0, f1, big_t) = (self.f0, self.f1, self.duration);
         match self.sweep {
             Sweep::Linear => TAU * t * (f0 + (f1 - f0) * t / (2.0 * big_t)),
@@ -184,15 +180,20 @@ impl Chirp {
     /// ```
     #[must_use]
     pub fn frequency(&self, t: f64) -> f64 {
-        let t = if t.is_nan() {
-            0.0
-        } else {
-            t.clamp(0.0, self.duration)
-        };
+        let t = self.within(t);
         let s = t / self.duration;
         match self.sweep {
             Sweep::Linear => self.f0 + (self.f1 - self.f0) * s,
             Sweep::Logarithmic => self.f0 * (self.f1 / self.f0).powf(s),
+        }
+    }
+
+    /// `t` clamped to the sweep, NaN as 0, s.
+    fn within(&self, t: f64) -> f64 {
+        if t.is_nan() {
+            0.0
+        } else {
+            t.clamp(0.0, self.duration)
         }
     }
 
