@@ -39,6 +39,7 @@ mod lab_tables;
 mod report;
 mod rig;
 mod simulation;
+mod validation;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -215,6 +216,7 @@ fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::e
     let table2 = simulation::table2(report)?;
     let ident = rig::identification(backend, report)?;
     excitation::section(backend, report)?;
+    validation::section(backend, &ident, report)?;
     let tables = rig::rig_tables();
     let mut rig_results = Vec::new();
     for table in &tables {

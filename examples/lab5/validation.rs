@@ -1,0 +1,129 @@
+//! The Validation section: the identified models simulated on a fresh run
+//! (the Excitation section's first PRBS run), and the separate-springs
+//! estimate refined by output error.
+
+use ctrlab::Recording;
+use ctrlab::lab::MassSpring;
+use ctrlab::lab::ident::{
+    Options, Scheme, Validation, identify_separate_springs_with, refine, validate,
+};
+
+use crate::report::Report;
+use crate::rig::{Backend, Identification, M1, M2};
+
+/// The run refined (the first identification run) and the fresh one (the
+/// first PRBS run of the Excitation section), as saved by the runs.
+const IDENT_RUN: &str = "ident_1.csv";
+const FRESH_RUN: &str = "excite_1_1.csv";
+
+fn row(name: &str, plant: &MassSpring, coulomb: [f64; 2], v: &Validation) -> Vec<String> {
+    vec![
+        name.to_string(),
+        format!("{:.1}", plant.k1),
+        format!("{:.1}", plant.k2),
+        format!("{:.3}", plant.b1),
+        format!("{:.3}", plant.b2),
+        format!("{:.4}", plant.gain),
+        format!("{:.3}", coulomb[0]),
+        format!("{:.3}", coulomb[1]),
+        format!("{:.2}", v.fit_percent[0]),
+        format!("{:.2}", v.fit_percent[1]),
+        format!("{:.3}", v.whiteness.max_correlation),
+        format!("{:.3}", v.independence.max_correlation),
+    ]
+}
+
+pub fn section(
+    backend: &Backend,
+    ident: &Identification,
+    report: &mut Report,
+) -> Result<(), Box<dyn std::error::Error>> {
+    report.heading(
+        2,
+        "Validation: the models on a fresh run, and refined by output error",
+    );
+    let runs = backend.out.join("runs");
+    let (rec, fresh) = match (
+        Recording::read_csv(runs.join(IDENT_RUN)),
+        Recording::read_csv(runs.join(FRESH_RUN)),
+    ) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => {
+            report.add(&format!("Not possible: {e}.\n"));
+            return Ok(());
+        }
+    };
+    let options = Options {
+        scheme: Scheme::Central,
+        coulomb: true,
+        ..Options::default()
+    };
+    let separate = identify_separate_springs_with(&rec, M1, M2, &options)?;
+    let refined = refine(&rec, &separate)?;
+    let lab = ident.lab.first().ok_or("no identification run")?.plant();
+    let ls_coulomb = separate
+        .coulomb
+        .map_or([0.0; 2], |c| [c[0].value.max(0.0), c[1].value.max(0.0)]);
+    let mut rows = Vec::new();
+    let mut failures = Vec::new();
+    for (name, plant, coulomb) in [
+        ("lab's formulas (equal springs, no Coulomb)", lab, [0.0; 2]),
+        (
+            "least squares (separate, Coulomb)",
+            separate.plant(),
+            ls_coulomb,
+        ),
+        ("refined by output error", refined.plant, refined.coulomb),
+    ] {
+        match validate(&fresh, &plant, coulomb) {
+            Ok(v) => rows.push(row(name, &plant, coulomb, &v)),
+            Err(e) => failures.push(format!("{name}: {e}")),
+        }
+    }
+    if let (Some(truth), Some(forces)) = (backend.truth(), backend.coulomb_truth())
+        && let Ok(v) = validate(&fresh, &truth, forces)
+    {
+        rows.push(row("**the simulated card's truth**", &truth, forces, &v));
+    }
+    report.add(&format!(
+        "Run 1 of the identification (`runs/{IDENT_RUN}`) identified three ways, each model then simulated from the input of a run it has not seen, the first PRBS run of the Excitation section (`runs/{FRESH_RUN}`), from rest. **Fit** is `100 (1 − ‖x − x̂‖ / ‖x − mean x‖)` of each cart's simulated position (MATLAB's `compare`). The refinement minimises both carts' simulation error on run 1 over k1, k2, b1, b2, K, F1, F2 by Levenberg–Marquardt ({} simulations; fit on run 1 from {:.2} / {:.2} % to {:.2} / {:.2} %). **white** and **indep.** are the largest normalised auto- and cross-correlation (with the input) of cart 2's simulation error over 25 lags, against a 99 % bound of {:.3} for a white error independent of the input: an output-error model has no noise model, so its error is not white; a cross-correlation above the bound is dynamics the model misses (the card's PWM delay and its stiction, 20 % above the Coulomb force, are not in it).\n",
+        refined.evaluations,
+        refined.start.fit_percent[0],
+        refined.start.fit_percent[1],
+        refined.refined.fit_percent[0],
+        refined.refined.fit_percent[1],
+        2.58 / (fresh.len() as f64).sqrt(),
+    ));
+    report.table(
+        &[
+            "model",
+            "k1 (N/m)",
+            "k2 (N/m)",
+            "b1 (N·s/m)",
+            "b2 (N·s/m)",
+            "K (N/V)",
+            "F1 (N)",
+            "F2 (N)",
+            "fit x1 (%)",
+            "fit x2 (%)",
+            "white",
+            "indep.",
+        ],
+        &rows,
+    );
+    for f in failures {
+        report.add(&format!("Not validated: {f}.\n"));
+    }
+    // The lab formulas' bias against the refined model.
+    let p = refined.plant;
+    let bias = |got: f64, want: f64| format!("{:+.1} %", (got / want - 1.0) * 100.0);
+    report.add(&format!(
+        "Against the refined model, the lab's formulas on the same run give k1 {}, k2 {}, b1 {}, b2 {}, K {}: with dry friction left out, its viscous frictions absorb it.\n",
+        bias(lab.k1, p.k1),
+        bias(lab.k2, p.k2),
+        bias(lab.b1, p.b1),
+        bias(lab.b2, p.b2),
+        bias(lab.gain, p.gain),
+    ));
+    Ok(())
+}
