@@ -1,10 +1,12 @@
 //! Identification inner loops: the lab's two-stage identification over
 //! 5000 samples (target < 50 µs; NumPy's `lstsq` alone takes about 56 µs
-//! for one 5000×2 solve) and one `Rls` update for P = 2 (target < 30 ns).
+//! for one 5000×2 solve), with its default Newey–West standard errors and
+//! with the classical ones, and one `Rls` update for P = 2 (target < 30 ns).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::data::{Channel, Schema};
-use ctrlab::lab::ident::{Scheme, identify};
+use ctrlab::ident::Covariance;
+use ctrlab::lab::ident::{Options, Scheme, identify, identify_with};
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{Cart, MassSpring, Recording, Rls};
@@ -63,6 +65,17 @@ fn benches(c: &mut Criterion) {
         "identify, Scheme::Central, 5000 samples (two stages)",
         |b| b.iter(|| identify(black_box(&rec), 1.3, 0.7, Scheme::Central).unwrap()),
     );
+    for scheme in [Scheme::Lab, Scheme::Central] {
+        let options = Options {
+            scheme,
+            covariance: Covariance::Classical,
+            ..Options::default()
+        };
+        c.bench_function(
+            &format!("identify, Scheme::{scheme:?}, classical standard errors, 5000 samples"),
+            |b| b.iter(|| identify_with(black_box(&rec), 1.3, 0.7, &options).unwrap()),
+        );
+    }
     c.bench_function("Rls<2> update", |b| {
         let mut rls = Rls::<2>::new(0.999, 1e3).unwrap();
         let mut k = 0u32;

@@ -3,7 +3,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::kernels::reduce::pow2_floor;
+use crate::kernels::reduce::{dot, max_abs, pow2_floor, sum_by};
 
 /// Largest number of lags the Newey–West sum uses, whatever is asked or
 /// chosen.
@@ -154,6 +154,15 @@ pub enum Covariance {
     },
 }
 
+/// The buffers of [`newey_west`], kept between calls.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Scratch {
+    /// The automatic bandwidth's `h`.
+    series: Vec<f64>,
+    /// A segment's moving sums.
+    sums: Vec<f64>,
+}
+
 /// Newey and West's (1994) rule of thumb for the Bartlett kernel's
 /// bandwidth, `⌊4 (rows / 100)^(2/9)⌋` (statsmodels' default): here the
 /// pre-bandwidth `n` of the automatic selection.
@@ -177,7 +186,7 @@ pub fn newey_west_lags(rows: usize) -> usize {
 /// `starts` (increasing; 0 and entries ≥ `n` ignored). `rows` is the
 /// number of rows fitted (at most `n`, at least `p + 1`); `lags` as asked,
 /// `None` for the automatic bandwidth. Returns the covariance and the
-/// bandwidth used. Overwrites nothing; allocates `O(p²)`.
+/// bandwidth used. `scratch` is reused.
 pub(crate) fn newey_west(
     x: &[f64],
     n: usize,
@@ -185,31 +194,31 @@ pub(crate) fn newey_west(
     starts: &[usize],
     rows: usize,
     lags: Option<usize>,
+    scratch: &mut Scratch,
 ) -> (DMatrix<f64>, usize) {
+    let Scratch { series, sums } = scratch;
     debug_assert!(x.len() == n * p && rows > p);
-    // Every column by a power of two near its largest entry: the sums
-    // below can then neither overflow nor underflow.
-    let scales: Vec<f64> = x
-        .chunks_exact(n)
-        .map(|c| {
-            let m = c.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if m > 0.0 { pow2_floor(m) } else { 1.0 }
-        })
-        .collect();
+    // Every column divided by a power of two near its largest entry
+    // (exact): the sums below can then neither overflow nor underflow.
+    let scales: Vec<f64> = x.chunks_exact(n).map(|c| pow2_floor(max_abs(c))).collect();
+    let inverses: Vec<f64> = scales.iter().map(|s| 1.0 / s).collect();
     let bounds = segment_bounds(starts, n);
     let lags = lags
-        .unwrap_or_else(|| automatic_lags(x, n, p, &scales, &bounds, rows))
+        .unwrap_or_else(|| automatic_lags(x, n, &inverses, &bounds, rows, series))
         .min(MAX_LAGS)
         .min(rows / 4);
-    let mut s = bartlett(x, n, p, &scales, &bounds, lags);
+    let lower = bartlett(x, n, &inverses, &bounds, lags, sums);
     let factor = rows as f64 / ((rows - p) as f64 * (lags + 1) as f64);
+    let mut s = DMatrix::<f64>::zeros(p, p);
+    let mut k = 0;
     for i in 0..p {
         for j in 0..=i {
-            // Σ v vᵀ of the scaled series, unscaled: in two steps, so an
-            // intermediate cannot overflow unless the result does.
-            let v = s[(i, j)] * factor * scales[i] * scales[j];
+            // Σ v vᵀ of the scaled series, unscaled step by step, so that
+            // no intermediate overflows unless the result does.
+            let v = lower[k] * factor * scales[i] * scales[j];
             s[(i, j)] = v;
             s[(j, i)] = v;
+            k += 1;
         }
     }
     (s, lags)
@@ -224,50 +233,67 @@ fn segment_bounds(starts: &[usize], n: usize) -> Vec<usize> {
     bounds
 }
 
-/// `Σ_t v_t v_tᵀ` over every segment, with `v_t` the sum of the scaled
-/// rows `t − L … t` of the segment (zero outside it), `t` running to `L`
-/// rows past its end: `(L + 1) (Γ₀ + Σ_{l=1}^{L} w_l (Γ_l + Γ_lᵀ))` with the
-/// Bartlett weights, exactly. Lower triangle only.
+/// `Σ_t v_t v_tᵀ` over every segment, with `v_t` the sum of the rows
+/// `t − L … t` of the segment (zero outside it), `t` running to `L` rows
+/// past its end: `(L + 1) (Γ₀ + Σ_{l=1}^{L} w_l (Γ_l + Γ_lᵀ))` with the
+/// Bartlett weights, exactly. The lower triangle, row by row.
+///
+/// Column `j` of `x` is taken times `inverses[j]`, a power of two that
+/// brings its largest entry into [1, 2). Each segment's `v` is formed from
+/// prefix sums `P` (`v_t = P_t −
+/// P_{t−L−1}`) in `buf`, and the sums are dot products of its columns. A
+/// segment of `len ≤ L` rows has `v_t = P_{len−1}` for every `t` from
+/// `len − 1` to `L`: that row is kept once, with its weight.
 fn bartlett(
     x: &[f64],
     n: usize,
-    p: usize,
-    scales: &[f64],
+    inverses: &[f64],
     bounds: &[usize],
     lags: usize,
-) -> DMatrix<f64> {
-    let mut s = DMatrix::<f64>::zeros(p, p);
-    let mut v = vec![0.0; p];
-    let at = |j: usize, t: usize| x[j * n + t] / scales[j];
+    buf: &mut Vec<f64>,
+) -> Vec<f64> {
+    let p = inverses.len();
+    let mut s = vec![0.0; p * (p + 1) / 2];
     for w in bounds.windows(2) {
         let (start, len) = (w[0], w[1] - w[0]);
-        v.iter_mut().for_each(|x| *x = 0.0);
-        let mut t = 0;
-        while t < len + lags {
-            if t < len {
-                for (j, x) in v.iter_mut().enumerate() {
-                    *x += at(j, start + t);
-                }
+        // Rows of v kept: t = 0 … len − 1, then t = max(len, L + 1) …
+        // len + L − 1, stored from index len on.
+        let tail = len + lags - len.max(lags + 1);
+        let rows = len + tail;
+        buf.clear();
+        buf.resize(rows * p, 0.0);
+        for (j, v) in buf.chunks_exact_mut(rows).enumerate() {
+            let col = &x[j * n + start..j * n + start + len];
+            let inverse = inverses[j];
+            let mut sum = 0.0;
+            for (v, &x) in v.iter_mut().zip(col) {
+                sum += x * inverse;
+                *v = sum;
             }
-            if t > lags {
-                for (j, x) in v.iter_mut().enumerate() {
-                    *x -= at(j, start + t - lags - 1);
-                }
+            // v_t for t ≥ len: the total less P_{t−L−1}.
+            let first = len.max(lags + 1);
+            for (i, t) in (first..len + lags).enumerate() {
+                v[len + i] = sum - v[t - lags - 1];
             }
-            // A segment no longer than L: from t = len − 1 to t = L the
-            // window holds the whole segment and v is its total; take
-            // those L − len + 2 rows at once.
-            let (weight, next) = if t + 1 == len && len <= lags {
-                ((lags + 2 - len) as f64, lags + 1)
-            } else {
-                (1.0, t + 1)
-            };
-            for i in 0..p {
-                for j in 0..=i {
-                    s[(i, j)] += weight * v[i] * v[j];
-                }
+            // v_t for t < len, downwards so P_{t−L−1} is still there.
+            for t in (lags + 1..len).rev() {
+                v[t] -= v[t - lags - 1];
             }
-            t = next;
+        }
+        // A segment no longer than L: v_{len−1} stands for L − len + 2 rows.
+        let extra = if len <= lags {
+            (lags + 1 - len) as f64
+        } else {
+            0.0
+        };
+        let mut k = 0;
+        for i in 0..p {
+            let vi = &buf[i * rows..(i + 1) * rows];
+            for j in 0..=i {
+                let vj = &buf[j * rows..(j + 1) * rows];
+                s[k] += dot(vi, vj) + extra * vi[len - 1] * vj[len - 1];
+                k += 1;
+            }
         }
     }
     s
@@ -279,45 +305,37 @@ fn bartlett(
 /// 2 Σ_{j=1}^{m} σ_j`, `s⁽¹⁾ = 2 Σ_{j=1}^{m} j σ_j` with the pre-bandwidth
 /// `m` = [`newey_west_lags`]`(rows)`, the bandwidth is
 /// `⌊1.1447 (s⁽¹⁾ / s⁽⁰⁾)^(2/3) rows^(1/3)⌋`; `usize::MAX` (then capped)
-/// when `s⁽⁰⁾ ≤ 0`.
+/// when `s⁽⁰⁾ ≤ 0`. Columns scaled by `inverses` as in [`bartlett`]; `h` is
+/// a buffer.
 fn automatic_lags(
     x: &[f64],
     n: usize,
-    p: usize,
-    scales: &[f64],
+    inverses: &[f64],
     bounds: &[usize],
     rows: usize,
+    h: &mut Vec<f64>,
 ) -> usize {
     let pre = newey_west_lags(rows);
     if pre == 0 {
         return 0;
     }
-    let mut weights = vec![0.0; p];
-    for (j, w) in weights.iter_mut().enumerate() {
-        let ss: f64 = x[j * n..(j + 1) * n]
-            .iter()
-            .map(|v| (v / scales[j]) * (v / scales[j]))
-            .sum();
+    h.clear();
+    h.resize(n, 0.0);
+    for (c, &inverse) in x.chunks_exact(n).zip(inverses) {
+        let ss = sum_by(c, |v| (v * inverse) * (v * inverse));
         if ss > 0.0 {
-            *w = 1.0 / ss.sqrt();
+            // Each column scaled to a root sum of squares of one: |h_t| ≤ p.
+            let w = 1.0 / ss.sqrt();
+            h.iter_mut()
+                .zip(c)
+                .for_each(|(h, v)| *h += (v * inverse) * w);
         }
     }
-    // Each column scaled to a root sum of squares of one: |h_t| ≤ p.
-    let h = |t: usize| {
-        (0..p)
-            .map(|j| x[j * n + t] / scales[j] * weights[j])
-            .sum::<f64>()
-    };
     let mut sigma = vec![0.0; pre + 1];
     for w in bounds.windows(2) {
-        for t in w[0]..w[1] {
-            let ht = h(t);
-            if ht == 0.0 {
-                continue;
-            }
-            for (j, sj) in sigma.iter_mut().enumerate().take((t - w[0]).min(pre) + 1) {
-                *sj += ht * h(t - j);
-            }
+        let seg = &h[w[0]..w[1]];
+        for (j, sj) in sigma.iter_mut().enumerate().take(seg.len()) {
+            *sj += dot(&seg[j..], &seg[..seg.len() - j]);
         }
     }
     let s0 = sigma[0] + 2.0 * sigma[1..].iter().sum::<f64>();

@@ -3,7 +3,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::Covariance;
-use super::solve::{SolveOptions, solve_augmented};
+use super::solve::{SolveOptions, Workspace, solve_augmented};
 use crate::error::Error;
 
 /// Default limit on the column-equilibrated condition number (10¹⁰, i.e.
@@ -70,8 +70,9 @@ pub struct LeastSquares {
     segment_starts: Vec<usize>,
     /// Column-major `[Φ D⁻¹ | λ]`, overwritten by the QR factors.
     work: Vec<f64>,
-    /// A copy of `work` before QR, for the Newey–West covariance.
-    hac: Vec<f64>,
+    /// A copy of `work` before QR and the sums' buffer, for the
+    /// Newey–West covariance.
+    hac: Workspace,
 }
 
 /// The result of a least-squares solve. All vectors are indexed like the
@@ -151,7 +152,7 @@ impl LeastSquares {
             covariance: Covariance::Classical,
             segment_starts: Vec::new(),
             work: Vec::new(),
-            hac: Vec::new(),
+            hac: Workspace::default(),
         }
     }
 

@@ -36,4 +36,4 @@ pub(crate) use covariance::newey_west;
 pub use covariance::{Covariance, MAX_LAGS, newey_west_lags};
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};
 pub use rls::Rls;
-pub(crate) use solve::{SolveOptions, solve_augmented};
+pub(crate) use solve::{SolveOptions, Workspace, solve_augmented};

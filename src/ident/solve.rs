@@ -6,7 +6,7 @@ use faer::linalg::qr::no_pivoting::factor::{qr_in_place, qr_in_place_scratch};
 use faer::{MatMut, Par};
 use nalgebra::{DMatrix, DVector};
 
-use super::covariance::newey_west;
+use super::covariance::{Scratch, newey_west};
 use super::{Covariance, LeastSquaresFit};
 use crate::error::Error;
 use crate::kernels::reduce::{first_non_finite, max_abs, pow2_floor, sum_by};
@@ -28,6 +28,15 @@ pub(crate) struct SolveOptions<'a> {
     pub also: Option<&'a [f64]>,
 }
 
+/// The buffers of the covariance, kept between solves.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Workspace {
+    /// The equilibrated `[Φ | λ]`, then the influence series and `e`.
+    pub copy: Vec<f64>,
+    /// The Newey–West sums' buffers.
+    pub scratch: Scratch,
+}
+
 /// What [`solve_augmented`] found.
 #[derive(Debug, Clone)]
 pub(crate) struct Solved {
@@ -38,8 +47,8 @@ pub(crate) struct Solved {
 
 /// Solves `Φ θ ≈ λ` by QR, given column-major `a = [Φ | λ]` (`m` rows, `p + 1`
 /// columns), destroying `a`. With a Newey–West covariance or `influence`,
-/// `hac` receives a copy of the equilibrated `a` (its allocation is
-/// reused); with `influence` it is left holding the influence series,
+/// `workspace.copy` receives a copy of the equilibrated `a` (its allocation
+/// is reused); with `influence` it is left holding the influence series,
 /// column-major `m × p`: row `t` is `(ΦᵀΦ)⁻¹ φ_t e_t`, in the parameters'
 /// units (their sum over the rows is `θ̂ − θ` to first order).
 pub(crate) fn solve_augmented(
@@ -47,8 +56,9 @@ pub(crate) fn solve_augmented(
     m: usize,
     p: usize,
     options: &SolveOptions<'_>,
-    hac: &mut Vec<f64>,
+    workspace: &mut Workspace,
 ) -> Result<Solved, Error> {
+    let hac = &mut workspace.copy;
     let max_condition = options.max_condition;
     debug_assert_eq!(a.len(), m * (p + 1));
     if p == 0 || m <= p {
@@ -177,7 +187,15 @@ pub(crate) fn solve_augmented(
     let mut covariance = match newey_west_lags {
         None => &rinv * rinv.transpose() * (ssr / (m - p) as f64),
         Some(lags) => {
-            let (cov, used) = newey_west(&hac[..m * p], m, p, options.segment_starts, m, lags);
+            let (cov, used) = newey_west(
+                &hac[..m * p],
+                m,
+                p,
+                options.segment_starts,
+                m,
+                lags,
+                &mut workspace.scratch,
+            );
             covariance_kind = Covariance::NeweyWest { lags: Some(used) };
             cov
         }

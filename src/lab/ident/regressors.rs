@@ -4,7 +4,8 @@
 use super::timing::Segment;
 use crate::error::Error;
 use crate::ident::{
-    Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, SolveOptions, newey_west, solve_augmented,
+    Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, SolveOptions, Workspace, newey_west,
+    solve_augmented,
 };
 
 /// The finite differences of a [`Scheme`](super::Scheme), as monomorphised
@@ -184,8 +185,9 @@ pub(super) struct Solver {
     buf: Vec<f64>,
     /// Stage 2's `z`, the column multiplying `k2` in its `λ`.
     z: Vec<f64>,
-    /// The solve's copy of `buf`, then its influence series.
-    hac: Vec<f64>,
+    /// The solve's copy of `buf`, then its influence series; the sums'
+    /// buffer.
+    hac: Workspace,
     /// Stage 1's influence series on all rows of the segments (zero where
     /// it used none), column-major.
     first: Vec<f64>,
@@ -201,7 +203,7 @@ impl Solver {
             covariance,
             buf: Vec::new(),
             z: Vec::new(),
-            hac: Vec::new(),
+            hac: Workspace::default(),
             first: Vec::new(),
             second: Vec::new(),
             starts: Vec::new(),
@@ -253,7 +255,7 @@ impl Solver {
         };
         series.clear();
         series.resize(n * p, 0.0);
-        for (from, to) in self.hac[..m * p]
+        for (from, to) in self.hac.copy[..m * p]
             .chunks_exact(m)
             .zip(series.chunks_exact_mut(n))
         {
@@ -280,7 +282,8 @@ impl Solver {
         let series = if second { &self.second } else { &self.first };
         self.starts.clear();
         self.starts.extend(data.segments.iter().map(|s| s.row0));
-        let (covariance, used) = newey_west(series, n, p, &self.starts, m, lags);
+        let (covariance, used) =
+            newey_west(series, n, p, &self.starts, m, lags, &mut self.hac.scratch);
         fit.std_errors = covariance.diagonal().map(|v| v.max(0.0).sqrt());
         fit.covariance = covariance;
         fit.covariance_kind = Covariance::NeweyWest { lags: Some(used) };
