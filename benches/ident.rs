@@ -1,11 +1,15 @@
 //! Identification inner loops: the lab's two-stage identification over
 //! 5000 samples (target < 50 µs; NumPy's `lstsq` alone takes about 56 µs
-//! for one 5000×2 solve), one `Rls` update for P = 2 (target < 30 ns), and
+//! for one 5000×2 solve), with its default Newey–West standard errors and
+//! with the classical ones, one `Rls` update for P = 2 (target < 30 ns), and
 //! the output-error refinement of a 5000-sample run (target < 50 ms).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::data::{Channel, Schema};
-use ctrlab::lab::ident::{Options, Scheme, identify, identify_separate_springs_with, refine};
+use ctrlab::ident::Covariance;
+use ctrlab::lab::ident::{
+    Options, Scheme, identify, identify_separate_springs_with, identify_with, refine,
+};
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{Cart, MassSpring, Recording, Rls};
@@ -64,6 +68,17 @@ fn benches(c: &mut Criterion) {
         "identify, Scheme::Central, 5000 samples (two stages)",
         |b| b.iter(|| identify(black_box(&rec), 1.3, 0.7, Scheme::Central).unwrap()),
     );
+    for scheme in [Scheme::Lab, Scheme::Central] {
+        let options = Options {
+            scheme,
+            covariance: Covariance::Classical,
+            ..Options::default()
+        };
+        c.bench_function(
+            &format!("identify, Scheme::{scheme:?}, classical standard errors, 5000 samples"),
+            |b| b.iter(|| identify_with(black_box(&rec), 1.3, 0.7, &options).unwrap()),
+        );
+    }
     let start = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default()).unwrap();
     let mut slow = c.benchmark_group("refine");
     slow.sample_size(10);

@@ -16,6 +16,7 @@ use std::io::Write as _;
 use std::process::ExitCode;
 
 use ctrlab::Recording;
+use ctrlab::ident::Covariance;
 use ctrlab::lab::ident::{MassSpringEstimate, Scheme, identify};
 
 const USAGE: &str = "usage: identify [LOG.csv] [--m1 KG] [--m2 KG]
@@ -86,9 +87,14 @@ fn print_estimate(out: &mut String, name: &str, e: &MassSpringEstimate) {
         ("stage 1 [k12, b1]", &e.first),
         ("stage 2 [K, b2]", &e.second),
     ] {
+        let errors = match fit.covariance_kind {
+            Covariance::NeweyWest { lags: Some(lags) } => format!("Newey–West, {lags} lags"),
+            Covariance::NeweyWest { lags: None } => "Newey–West".to_string(),
+            Covariance::Classical => "classical".to_string(),
+        };
         writeln!(
             out,
-            "  {stage:<18} fit {:6.2} %, R² {:.5}, condition {:.3e}, {} rows",
+            "  {stage:<18} fit {:6.2} %, R² {:.5}, condition {:.3e}, {} rows, errors {errors}",
             fit.fit_percent, fit.r_squared, fit.condition, fit.rows
         )
         .unwrap_or_default();

@@ -8,6 +8,7 @@ use std::time::Duration;
 
 use ctrlab::data::{Channel, Schema};
 use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
+use ctrlab::ident::Covariance;
 use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
     Estimate, GAP_RATIO, Options, Scheme, SeparateSpringsEstimate, Spread, identify,
@@ -374,6 +375,11 @@ proptest! {
         min_speed in prop_oneof![Just(0.0), Just(0.005), Just(f64::INFINITY), 0.0f64..1.0],
         max_jitter in prop_oneof![Just(0.0), Just(0.05), Just(0.5), 0.0f64..0.5],
         scheme in prop_oneof![Just(Scheme::Lab), Just(Scheme::Central)],
+        covariance in prop_oneof![
+            Just(Covariance::Classical),
+            Just(Covariance::NeweyWest { lags: None }),
+            (0usize..100).prop_map(|l| Covariance::NeweyWest { lags: Some(l) }),
+        ],
     ) {
         // Time: running sums of the steps (in ms, so gaps and jitter occur).
         let mut rec = Recording::new(log_schema());
@@ -382,9 +388,14 @@ proptest! {
             t += step * 1e-3;
             rec.push(t, &[(k % 7) as f64 - 3.0], &[x1, x2]).unwrap();
         }
-        let options = Options { scheme, coulomb, min_speed, max_jitter };
-        let _ = identify_with(&rec, 1.3, 0.7, &options);
-        let _ = identify_separate_springs_with(&rec, 1.3, 0.7, &options);
+        let options = Options { scheme, coulomb, min_speed, max_jitter, covariance };
+        let finite = |e: &[Estimate]| e.iter().all(|e| e.value.is_finite() && e.std_error.is_finite());
+        if let Ok(e) = identify_with(&rec, 1.3, 0.7, &options) {
+            prop_assert!(finite(&[e.k12, e.b1, e.gain, e.b2]), "{e:?}");
+        }
+        if let Ok(e) = identify_separate_springs_with(&rec, 1.3, 0.7, &options) {
+            prop_assert!(finite(&[e.k1, e.k2, e.b1, e.gain, e.b2]), "{e:?}");
+        }
     }
 }
 

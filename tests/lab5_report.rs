@@ -202,7 +202,11 @@ fn the_validation_section_simulates_each_model_on_a_fresh_run() {
         .filter(|l| l.starts_with("| ") && !l.starts_with("| model"))
         .map(|l| l.trim_matches('|').split(" | ").map(str::trim).collect())
         .collect();
-    assert_eq!(rows.len(), 4, "lab, least squares, refined, truth: {rows:?}");
+    assert_eq!(
+        rows.len(),
+        4,
+        "lab, least squares, refined, truth: {rows:?}"
+    );
     for row in &rows {
         assert_eq!(row.len(), 12, "{row:?}");
         assert!(row[1..].iter().all(|c| number(c).is_some()), "{row:?}");
@@ -210,5 +214,8 @@ fn the_validation_section_simulates_each_model_on_a_fresh_run() {
     // Measured: the lab's formulas fit 83.6 / 84.6 %, the refined model
     // 98.8 / 98.9 % (the truth itself 98.7 / 98.8 %: stiction and delay).
     let fit = |r: &Vec<&str>| number(r[9]).unwrap();
-    assert!(fit(&rows[2]) > 97.0 && fit(&rows[2]) > fit(&rows[0]), "{rows:?}");
+    assert!(
+        fit(&rows[2]) > 97.0 && fit(&rows[2]) > fit(&rows[0]),
+        "{rows:?}"
+    );
 }

@@ -1,12 +1,10 @@
 //! Batch linear least squares by Householder QR (faer inside).
 
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::qr::no_pivoting::factor::{qr_in_place, qr_in_place_scratch};
-use faer::{MatMut, Par};
 use nalgebra::{DMatrix, DVector};
 
+use super::Covariance;
+use super::solve::{SolveOptions, Workspace, solve_augmented};
 use crate::error::Error;
-use crate::kernels::reduce::{first_non_finite, max_abs, pow2_floor, sum_by};
 
 /// Default limit on the column-equilibrated condition number (10¹⁰, i.e.
 /// more than ten of the sixteen significant digits lost): above it a
@@ -39,6 +37,12 @@ pub const DEFAULT_MAX_CONDITION: f64 = 1e10;
 /// to unit norm, so it does not depend on the parameters' units. The
 /// workspace is kept between solves.
 ///
+/// The covariance is [`Covariance::Classical`] unless
+/// [`with_covariance`](Self::with_covariance) asks for Newey–West; rows
+/// from separate runs or segments are marked by
+/// [`start_segment`](Self::start_segment), so that its sums never pair
+/// rows across them.
+///
 /// # Examples
 ///
 /// ```
@@ -61,8 +65,14 @@ pub struct LeastSquares {
     /// Right-hand side.
     rhs: Vec<f64>,
     max_condition: f64,
+    covariance: Covariance,
+    /// Rows where a segment starts (increasing, each > 0).
+    segment_starts: Vec<usize>,
     /// Column-major `[Φ D⁻¹ | λ]`, overwritten by the QR factors.
     work: Vec<f64>,
+    /// A copy of `work` before QR and the sums' buffer, for the
+    /// Newey–West covariance.
+    hac: Workspace,
 }
 
 /// The result of a least-squares solve. All vectors are indexed like the
@@ -83,8 +93,11 @@ pub struct LeastSquares {
 pub struct LeastSquaresFit {
     /// The estimate `θ̂`.
     pub theta: DVector<f64>,
-    /// Estimated covariance of `θ̂`: `σ̂² (ΦᵀΦ)⁻¹` with
-    /// `σ̂² = ‖r‖² / (rows − parameters)` (computed from R, not from `ΦᵀΦ`).
+    /// Estimated covariance of `θ̂`, as [`covariance_kind`](Self::covariance_kind)
+    /// says: classically `σ̂² (ΦᵀΦ)⁻¹` with
+    /// `σ̂² = ‖r‖² / (rows − parameters)`, or the Newey–West sandwich
+    /// (computed from R, never from `ΦᵀΦ`). In the products of the
+    /// parameters' units.
     pub covariance: DMatrix<f64>,
     /// Standard errors, the square roots of the covariance's diagonal.
     pub std_errors: DVector<f64>,
@@ -102,6 +115,9 @@ pub struct LeastSquaresFit {
     pub condition: f64,
     /// Number of rows used.
     pub rows: usize,
+    /// How `covariance` was estimated; for Newey–West with the bandwidth
+    /// actually used (`lags: Some(L)`, after the automatic rule and the cap).
+    pub covariance_kind: Covariance,
 }
 
 impl LeastSquares {
@@ -133,8 +149,101 @@ impl LeastSquares {
             columns: (0..parameters).map(|_| Vec::with_capacity(rows)).collect(),
             rhs: Vec::with_capacity(rows),
             max_condition: DEFAULT_MAX_CONDITION,
+            covariance: Covariance::Classical,
+            segment_starts: Vec::new(),
             work: Vec::new(),
+            hac: Workspace::default(),
         }
+    }
+
+    /// Sets how the covariance of `θ̂` is estimated (default
+    /// [`Covariance::Classical`]); the estimate itself does not change.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::ident::{Covariance, LeastSquares};
+    ///
+    /// let nw = Covariance::NeweyWest { lags: None };
+    /// let mut ls = LeastSquares::new(1).with_covariance(nw);
+    /// assert_eq!(ls.covariance(), nw);
+    /// ls.push_columns(&[&[1.0; 8]], &[1.0, 2.0, 1.5, 0.5, 1.0, 2.0, 1.5, 0.5])?;
+    /// let fit = ls.solve()?;
+    /// assert_eq!(fit.covariance_kind, Covariance::NeweyWest { lags: Some(2) });
+    /// assert!(fit.std_errors[0].is_finite());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[must_use]
+    pub fn with_covariance(mut self, covariance: Covariance) -> Self {
+        self.covariance = covariance;
+        self
+    }
+
+    /// How the covariance is estimated.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::ident::{Covariance, LeastSquares};
+    /// assert_eq!(LeastSquares::new(2).covariance(), Covariance::Classical);
+    /// ```
+    pub fn covariance(&self) -> Covariance {
+        self.covariance
+    }
+
+    /// Marks the next row pushed as the first of a new segment (another
+    /// run, or the part of a recording after a gap): the Newey–West sums
+    /// pair no row with one across the mark. Nothing happens before the
+    /// first row, or twice at the same row. The estimate and the classical
+    /// covariance do not depend on segments.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::ident::{Covariance, LeastSquares};
+    ///
+    /// let nw = Covariance::NeweyWest { lags: Some(1) };
+    /// let (mut one, mut two) = (LeastSquares::new(1).with_covariance(nw), LeastSquares::new(1).with_covariance(nw));
+    /// let y = [1.0, 2.0, 0.5, 1.5, 3.0, 2.5, 1.0, 2.0];
+    /// one.push_columns(&[&[1.0; 8]], &y)?;
+    /// two.push_columns(&[&[1.0; 4]], &y[..4])?;
+    /// two.start_segment();
+    /// two.push_columns(&[&[1.0; 4]], &y[4..])?;
+    /// assert_eq!(two.segments(), 2);
+    /// let (a, b) = (one.solve()?, two.solve()?);
+    /// assert_eq!(a.theta, b.theta);
+    /// assert_ne!(a.std_errors, b.std_errors); // rows 3 and 4 are not paired
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn start_segment(&mut self) {
+        let row = self.rows();
+        if row > 0 && self.segment_starts.last() != Some(&row) {
+            self.segment_starts.push(row);
+        }
+    }
+
+    /// Number of segments ([`start_segment`](Self::start_segment)): 1 with
+    /// rows and no mark, 0 without rows.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::ident::LeastSquares;
+    /// let mut ls = LeastSquares::new(1);
+    /// assert_eq!(ls.segments(), 0);
+    /// ls.push_row(&[1.0], 1.0)?;
+    /// ls.start_segment();
+    /// assert_eq!(ls.segments(), 1); // nothing after the mark yet
+    /// ls.push_row(&[1.0], 2.0)?;
+    /// assert_eq!(ls.segments(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn segments(&self) -> usize {
+        let rows = self.rows();
+        if rows == 0 {
+            return 0;
+        }
+        1 + self.segment_starts.iter().filter(|&&s| s < rows).count()
     }
 
     /// Sets the largest accepted condition number of the column-equilibrated
@@ -187,7 +296,7 @@ impl LeastSquares {
         self.rhs.len()
     }
 
-    /// Removes every row, keeping the allocations.
+    /// Removes every row and segment mark, keeping the allocations.
     ///
     /// # Examples
     ///
@@ -202,6 +311,7 @@ impl LeastSquares {
     pub fn clear(&mut self) {
         self.columns.iter_mut().for_each(Vec::clear);
         self.rhs.clear();
+        self.segment_starts.clear();
     }
 
     /// Appends one row `φᵀ θ = λ`. Allocation-free while capacity lasts.
@@ -307,183 +417,13 @@ impl LeastSquares {
             self.work.extend_from_slice(col);
         }
         self.work.extend_from_slice(&self.rhs);
-        solve_augmented(&mut self.work, m, p, self.max_condition)
+        let options = SolveOptions {
+            max_condition: self.max_condition,
+            covariance: self.covariance,
+            segment_starts: &self.segment_starts,
+            influence: false,
+            also: None,
+        };
+        Ok(solve_augmented(&mut self.work, m, p, &options, &mut self.hac)?.fit)
     }
-}
-
-/// Solves `Φ θ ≈ λ` by QR, given column-major `a = [Φ | λ]` (`m` rows, `p + 1`
-/// columns), destroying `a`.
-pub(crate) fn solve_augmented(
-    a: &mut [f64],
-    m: usize,
-    p: usize,
-    max_condition: f64,
-) -> Result<LeastSquaresFit, Error> {
-    debug_assert_eq!(a.len(), m * (p + 1));
-    if p == 0 || m <= p {
-        return Err(Error::TooFewSamples {
-            what: "least squares (more rows than parameters)",
-            needed: p.max(1) + 1,
-            got: m,
-        });
-    }
-    // Equilibrate every column (λ too) by a power of two, so that its
-    // largest entry is in [1, 2): exact, and then no norm, product or
-    // square in the QR or the statistics below can overflow or underflow,
-    // whatever the units (a column of 1e308, another of 1e-200). The
-    // results are unscaled at the end.
-    let mut exponents = vec![0i32; p + 1];
-    for (j, (col, e)) in a.chunks_exact_mut(m).zip(exponents.iter_mut()).enumerate() {
-        if let Some(i) = first_non_finite(col) {
-            return Err(Error::NonFinite {
-                matrix: "regressor",
-                row: i,
-                col: j,
-                value: col[i],
-            });
-        }
-        *e = binary_exponent(max_abs(col));
-        if *e != 0 {
-            let f = pow2(-*e);
-            col.iter_mut().for_each(|v| *v *= f);
-        }
-    }
-    let e_lambda = exponents[p];
-    // Spread of λ about its mean, before QR overwrites it.
-    let lam = &a[p * m..];
-    let mean = sum_by(lam, |v| v) / m as f64;
-    let sst = sum_by(lam, |v| (v - mean) * (v - mean));
-
-    let n = p + 1;
-    // Tall and narrow (a handful of columns): blocking buys nothing and
-    // costs about half the time at 5000 × 3.
-    let bs = 1;
-    let mut h = vec![0.0; bs * n];
-    let mut mem = MemBuffer::new(qr_in_place_scratch::<f64>(
-        m,
-        n,
-        bs,
-        Par::Seq,
-        Default::default(),
-    ));
-    qr_in_place(
-        MatMut::from_column_major_slice_mut(a, m, n),
-        MatMut::from_column_major_slice_mut(&mut h, bs, n),
-        Par::Seq,
-        MemStack::new(&mut mem),
-        Default::default(),
-    );
-    // The upper triangle of `a` now holds R_aug = [R z; 0 ρ], |ρ| = ‖r‖.
-    let r = |i: usize, j: usize| a[j * m + i];
-
-    // Householder QR commutes with column scaling, so the equilibrated
-    // regressor Φ D⁻¹ (unit columns) has the triangular factor R D⁻¹, with
-    // ‖Φ_j‖ = ‖R_j‖: its singular values give a unit-free condition number.
-    let mut rmat = DMatrix::from_fn(p, p, |i, j| if i <= j { r(i, j) } else { 0.0 });
-    for j in 0..p {
-        let norm = rmat.column(j).norm();
-        if norm > 0.0 {
-            rmat.column_mut(j).unscale_mut(norm);
-        }
-    }
-    let iterations = 200 * p;
-    let sv = rmat
-        .try_svd_unordered(false, false, f64::EPSILON, iterations)
-        .ok_or(Error::NoConvergence {
-            operation: "least squares (singular values of R)",
-            iterations,
-        })?
-        .singular_values;
-    let smax = sv.max();
-    let smin = sv.min();
-    let condition = if smin > 0.0 {
-        smax / smin
-    } else {
-        f64::INFINITY
-    };
-    if condition.is_nan() || condition > max_condition {
-        let rank = sv.iter().filter(|&&s| s * max_condition > smax).count();
-        return Err(Error::RankDeficient { rank, condition });
-    }
-
-    // Back substitution R θ' = z, then undo the scaling.
-    let mut theta = DVector::zeros(p);
-    for i in (0..p).rev() {
-        let mut s = r(i, p);
-        for j in i + 1..p {
-            s -= r(i, j) * theta[j];
-        }
-        theta[i] = s / r(i, i);
-    }
-    // R⁻¹ by back substitution, column by column.
-    let mut rinv = DMatrix::zeros(p, p);
-    for c in 0..p {
-        for i in (0..=c).rev() {
-            let mut s = if i == c { 1.0 } else { 0.0 };
-            for j in i + 1..=c {
-                s -= r(i, j) * rinv[(j, c)];
-            }
-            rinv[(i, c)] = s / r(i, i);
-        }
-    }
-    let ssr = r(p, p) * r(p, p);
-    let sigma2 = ssr / (m - p) as f64;
-    let mut covariance = &rinv * rinv.transpose() * sigma2;
-    let mut std_errors = covariance.diagonal().map(f64::sqrt);
-    let (r_squared, fit_percent) = if sst > 0.0 {
-        (1.0 - ssr / sst, (1.0 - (ssr / sst).sqrt()) * 100.0)
-    } else if ssr == 0.0 {
-        (1.0, 100.0)
-    } else {
-        (f64::NEG_INFINITY, f64::NEG_INFINITY)
-    };
-    // Undo the equilibration: θ_j and its standard error in λ's units per
-    // column j's, the covariance in their products.
-    for j in 0..p {
-        let d = e_lambda - exponents[j];
-        theta[j] = scale_pow2(theta[j], d);
-        std_errors[j] = scale_pow2(std_errors[j], d);
-        for i in 0..p {
-            covariance[(i, j)] =
-                scale_pow2(scale_pow2(covariance[(i, j)], d), e_lambda - exponents[i]);
-        }
-    }
-    let residual_rms = scale_pow2((ssr / m as f64).sqrt(), e_lambda);
-    let finite = |v: &[f64]| v.iter().all(|v| v.is_finite());
-    if !(finite(theta.as_slice())
-        && finite(std_errors.as_slice())
-        && finite(covariance.as_slice())
-        && residual_rms.is_finite())
-    {
-        return Err(Error::Overflow {
-            operation: "least squares (the estimate or its covariance exceeds f64::MAX)",
-        });
-    }
-    Ok(LeastSquaresFit {
-        theta,
-        covariance,
-        std_errors,
-        residual_rms,
-        r_squared,
-        fit_percent,
-        condition,
-        rows: m,
-    })
-}
-
-/// `e` with `2^e ≤ x < 2^(e+1)` for a finite `x > 0` (0 for `x = 0`).
-fn binary_exponent(x: f64) -> i32 {
-    pow2_floor(x).log2() as i32
-}
-
-/// `2^e` for `|e| ≤ 1022`, exactly.
-fn pow2(e: i32) -> f64 {
-    2f64.powi(e)
-}
-
-/// `v · 2^d` for `|d| ≤ 2046`, in two exact halves: no intermediate
-/// overflows unless the result does.
-fn scale_pow2(v: f64, d: i32) -> f64 {
-    let half = d / 2;
-    v * pow2(half) * pow2(d - half)
 }

@@ -3,7 +3,9 @@
 //!
 //! - [`LeastSquares`]: batch linear least squares by QR (faer inside, never
 //!   the normal equations), with covariance, standard errors, residual RMS,
-//!   R², fit % and condition number.
+//!   R², fit % and condition number; the covariance classical or
+//!   Newey–West ([`Covariance`]) for equation errors that are correlated
+//!   from row to row, as differenced samples' are.
 //! - [`Rls`]: recursive least squares, fixed size and allocation-free, with
 //!   a forgetting factor, for identification inside the control loop.
 //!
@@ -25,9 +27,13 @@
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
+mod covariance;
 mod least_squares;
 mod rls;
+mod solve;
 
-pub(crate) use least_squares::solve_augmented;
+pub(crate) use covariance::newey_west;
+pub use covariance::{Covariance, MAX_LAGS, newey_west_lags};
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};
 pub use rls::Rls;
+pub(crate) use solve::{SolveOptions, Workspace, solve_augmented};

@@ -26,6 +26,28 @@ pub(crate) fn sum_by(x: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + tail
 }
 
+/// `Σ a[k] b[k]` over the shorter length, with eight independent
+/// accumulators.
+#[inline]
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; LANES];
+    let (ca, cb) = (a.chunks_exact(LANES), b.chunks_exact(LANES));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(a, b)| a * b)
+        .sum();
+    for (a, b) in ca.zip(cb) {
+        for i in 0..LANES {
+            acc[i] += a[i] * b[i];
+        }
+    }
+    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + tail
+}
+
 /// `max_k |(x[k+1] − x[k]) − step|` over consecutive pairs, with eight
 /// independent lanes (the `if` form compiles to SIMD max). NaN differences
 /// are ignored, so check finiteness separately.

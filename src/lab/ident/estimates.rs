@@ -20,7 +20,9 @@ use crate::model::{Continuous, StateSpace};
 pub struct Estimate {
     /// The estimate.
     pub value: f64,
-    /// Its standard error from the least-squares covariance.
+    /// Its standard error (same unit), from the covariance
+    /// [`Options::covariance`](super::Options::covariance) chose
+    /// (Newey–West by default).
     pub std_error: f64,
 }
 
@@ -79,7 +81,8 @@ pub struct MassSpringEstimate {
     /// Stage 1 fit (`θ = [k12, b1]`, then `F1` with Coulomb friction): fit
     /// %, R², condition number, rows, ….
     pub first: LeastSquaresFit,
-    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction).
+    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction); with
+    /// Newey–West its covariance includes stage 1's error in `k12`.
     pub second: LeastSquaresFit,
 }
 
@@ -188,7 +191,8 @@ pub struct SeparateSpringsEstimate {
     pub timing: Timing,
     /// Stage 1 fit (`θ = [k1, k2, b1]`, then `F1` with Coulomb friction).
     pub first: LeastSquaresFit,
-    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction).
+    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction); with
+    /// Newey–West its covariance includes stage 1's error in `k2`.
     pub second: LeastSquaresFit,
 }
 

@@ -3,7 +3,10 @@
 
 use super::timing::Segment;
 use crate::error::Error;
-use crate::ident::{DEFAULT_MAX_CONDITION, LeastSquaresFit, solve_augmented};
+use crate::ident::{
+    Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, SolveOptions, Workspace, newey_west,
+    solve_augmented,
+};
 
 /// The finite differences of a [`Scheme`](super::Scheme), as monomorphised
 /// kernels: a runtime `match` on the scheme inside the per-sample column
@@ -164,6 +167,137 @@ fn column<I: Iterator<Item = f64>>(
     }
 }
 
+/// Which stage [`Solver::solve`] solves.
+#[derive(Debug, Clone, Copy)]
+enum Stage {
+    /// Stage 1: its influence series is kept for stage 2.
+    First,
+    /// Stage 2, whose `λ` holds `k2 z` with `k2` from stage 1's parameter
+    /// `k2_index`.
+    Second { k2_index: usize },
+}
+
+/// The columns of a stage, `[Φ | λ]` column-major, and how they are solved.
+pub(super) struct Solver {
+    /// How the covariance is estimated.
+    covariance: Covariance,
+    /// The stage's columns.
+    buf: Vec<f64>,
+    /// Stage 2's `z`, the column multiplying `k2` in its `λ`.
+    z: Vec<f64>,
+    /// The solve's copy of `buf`, then its influence series; the sums'
+    /// buffer.
+    hac: Workspace,
+    /// Stage 1's influence series on all rows of the segments (zero where
+    /// it used none), column-major.
+    first: Vec<f64>,
+    /// The same for stage 2, with stage 1's carried through `k2`.
+    second: Vec<f64>,
+    /// Rows where a segment starts.
+    starts: Vec<usize>,
+}
+
+impl Solver {
+    pub fn new(covariance: Covariance) -> Self {
+        Self {
+            covariance,
+            buf: Vec::new(),
+            z: Vec::new(),
+            hac: Workspace::default(),
+            first: Vec::new(),
+            second: Vec::new(),
+            starts: Vec::new(),
+        }
+    }
+
+    /// Solves the `m × p` stage in `buf`, whose rows are those of `data`'s
+    /// segments, or with `keep` those where a cart moves.
+    ///
+    /// With Newey–West, each row's influence `(ΦᵀΦ)⁻¹ φ_t e_t` is placed
+    /// at its sample in the segments (zero at the rows left out, so that
+    /// lags count samples), and stage 2's carries stage 1's error in `k2`:
+    /// `θ̂₂` is affine in `k2`, `∂θ̂₂/∂k2 = g` solves `Φ₂ g ≈ z`, so a row's
+    /// influence on `θ̂₂` is its own plus `g` times its influence on `k̂2`.
+    /// The covariance is the Newey–West sum of those series, within the
+    /// segments.
+    fn solve(
+        &mut self,
+        data: &Data<'_>,
+        keep: Option<&Motion>,
+        m: usize,
+        p: usize,
+        stage: Stage,
+    ) -> Result<LeastSquaresFit, Error> {
+        let Covariance::NeweyWest { lags } = self.covariance else {
+            let options = SolveOptions {
+                max_condition: DEFAULT_MAX_CONDITION,
+                covariance: Covariance::Classical,
+                segment_starts: &[],
+                influence: false,
+                also: None,
+            };
+            return Ok(solve_augmented(&mut self.buf, m, p, &options, &mut self.hac)?.fit);
+        };
+        let second = matches!(stage, Stage::Second { .. });
+        let options = SolveOptions {
+            max_condition: DEFAULT_MAX_CONDITION,
+            covariance: Covariance::Classical,
+            segment_starts: &[],
+            influence: true,
+            also: second.then_some(self.z.as_slice()),
+        };
+        let solved = solve_augmented(&mut self.buf, m, p, &options, &mut self.hac)?;
+        let mut fit = solved.fit;
+        let n = data.rows;
+        let series = match stage {
+            Stage::First => &mut self.first,
+            Stage::Second { .. } => &mut self.second,
+        };
+        series.clear();
+        series.resize(n * p, 0.0);
+        for (from, to) in self.hac.copy[..m * p]
+            .chunks_exact(m)
+            .zip(series.chunks_exact_mut(n))
+        {
+            match keep {
+                None => to.copy_from_slice(from),
+                Some(motion) => {
+                    let rows = motion
+                        .direction
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, d)| **d != 0.0);
+                    for (&v, (r, _)) in from.iter().zip(rows) {
+                        to[r] = v;
+                    }
+                }
+            }
+        }
+        if let (Stage::Second { k2_index }, Some(g)) = (stage, &solved.also) {
+            let k2 = &self.first[k2_index * n..(k2_index + 1) * n];
+            for (j, col) in self.second.chunks_exact_mut(n).enumerate() {
+                col.iter_mut().zip(k2).for_each(|(v, &k)| *v += g[j] * k);
+            }
+        }
+        let series = if second { &self.second } else { &self.first };
+        self.starts.clear();
+        self.starts.extend(data.segments.iter().map(|s| s.row0));
+        let (covariance, used) =
+            newey_west(series, n, p, &self.starts, m, lags, &mut self.hac.scratch);
+        fit.std_errors = covariance.diagonal().map(|v| v.max(0.0).sqrt());
+        fit.covariance = covariance;
+        fit.covariance_kind = Covariance::NeweyWest { lags: Some(used) };
+        if !(fit.covariance.iter().all(|v| v.is_finite())
+            && fit.std_errors.iter().all(|v| v.is_finite()))
+        {
+            return Err(Error::Overflow {
+                operation: "identification (a standard error exceeds f64::MAX)",
+            });
+        }
+        Ok(fit)
+    }
+}
+
 /// The rows a stage uses: all, or those where its cart moves.
 fn row_count(data: &Data<'_>, coulomb: Option<&Motion>) -> usize {
     coulomb.map_or(data.rows, |m| m.moving)
@@ -208,8 +342,9 @@ pub(super) fn stage1_equal<D: Differences>(
     data: &Data<'_>,
     m1: f64,
     coulomb: Option<&Motion>,
-    buf: &mut Vec<f64>,
+    solver: &mut Solver,
 ) -> Result<LeastSquaresFit, Error> {
+    let buf = &mut solver.buf;
     let (x1, x2) = (data.x1, data.x2);
     let m = row_count(data, coulomb);
     let p = 2 + usize::from(coulomb.is_some());
@@ -223,7 +358,7 @@ pub(super) fn stage1_equal<D: Differences>(
             .map(move |(x1, x2)| t2 * (2.0 * D::pos(x1) - D::pos(x2)))
     });
     push_cart1_friction_and_lambda::<D>(data, m1, coulomb, buf);
-    solve_augmented(buf, m, p, DEFAULT_MAX_CONDITION)
+    solver.solve(data, coulomb, m, p, Stage::First)
 }
 
 /// Stage 1 with separate springs: `[k1, k2, b1]`, then `F1` with the
@@ -232,8 +367,9 @@ pub(super) fn stage1_separate<D: Differences>(
     data: &Data<'_>,
     m1: f64,
     coulomb: Option<&Motion>,
-    buf: &mut Vec<f64>,
+    solver: &mut Solver,
 ) -> Result<LeastSquaresFit, Error> {
+    let buf = &mut solver.buf;
     let (x1, x2) = (data.x1, data.x2);
     let m = row_count(data, coulomb);
     let p = 3 + usize::from(coulomb.is_some());
@@ -251,19 +387,32 @@ pub(super) fn stage1_separate<D: Differences>(
             .map(move |(x1, x2)| t2 * (D::pos(x1) - D::pos(x2)))
     });
     push_cart1_friction_and_lambda::<D>(data, m1, coulomb, buf);
-    solve_augmented(buf, m, p, DEFAULT_MAX_CONDITION)
+    solver.solve(data, coulomb, m, p, Stage::First)
 }
 
-/// Stage 2 (equations (9)–(11)): `[K, b2]` given the coupling spring `k2`,
-/// then `F2` with the Coulomb column.
+/// Stage 2 (equations (9)–(11)): `[K, b2]` given the coupling spring `k2`
+/// (stage 1's parameter `k2_index`), then `F2` with the Coulomb column.
 pub(super) fn stage2<D: Differences>(
     data: &Data<'_>,
     m2: f64,
-    k2: f64,
+    (k2, k2_index): (f64, usize),
     coulomb: Option<&Motion>,
-    buf: &mut Vec<f64>,
+    solver: &mut Solver,
 ) -> Result<LeastSquaresFit, Error> {
-    let (x1, x2, u) = (data.x1, data.x2, data.u);
+    let (x1, x2) = (data.x1, data.x2);
+    if matches!(solver.covariance, Covariance::NeweyWest { .. }) {
+        // ∂λ/∂k2, the spring column of λ below.
+        solver.z.clear();
+        column(&mut solver.z, data, coulomb, |seg| {
+            let t2 = seg.dt * seg.dt;
+            let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
+            triples(x2)
+                .zip(triples(x1))
+                .map(move |(x2, x1)| t2 * (D::pos(x2) - D::pos(x1)))
+        });
+    }
+    let buf = &mut solver.buf;
+    let u = data.u;
     let m = row_count(data, coulomb);
     let p = 2 + usize::from(coulomb.is_some());
     buf.clear();
@@ -286,5 +435,5 @@ pub(super) fn stage2<D: Differences>(
             .zip(triples(x1))
             .map(move |(x2, x1)| m2 * second_difference(x2) + k2 * t2 * (D::pos(x2) - D::pos(x1)))
     });
-    solve_augmented(buf, m, p, DEFAULT_MAX_CONDITION)
+    solver.solve(data, coulomb, m, p, Stage::Second { k2_index })
 }

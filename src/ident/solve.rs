@@ -1,0 +1,347 @@
+//! The QR solve behind [`LeastSquares`](super::LeastSquares) and the lab's
+//! two-stage identification, with the covariance of the estimate.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::qr::no_pivoting::factor::{qr_in_place, qr_in_place_scratch};
+use faer::{MatMut, Par};
+use nalgebra::{DMatrix, DVector};
+
+use super::covariance::{Scratch, newey_west};
+use super::{Covariance, LeastSquaresFit};
+use crate::error::Error;
+use crate::kernels::reduce::{first_non_finite, max_abs, pow2_floor, sum_by};
+
+/// How [`solve_augmented`] solves and what it reports.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SolveOptions<'a> {
+    /// Largest accepted column-equilibrated condition number.
+    pub max_condition: f64,
+    /// How the covariance is estimated.
+    pub covariance: Covariance,
+    /// Rows where a new segment starts (increasing): the Newey–West sums
+    /// do not pair rows across them. 0 and rows ≥ `m` are ignored.
+    pub segment_starts: &'a [usize],
+    /// Leave the influence series in `hac` (see [`solve_augmented`]).
+    pub influence: bool,
+    /// Also solve `Φ g ≈ z` for this column `z` (`m` values, finite), by
+    /// the same factorisation; only with `influence`.
+    pub also: Option<&'a [f64]>,
+}
+
+/// The buffers of the covariance, kept between solves.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Workspace {
+    /// The equilibrated `[Φ | λ]`, then the influence series and `e`.
+    pub copy: Vec<f64>,
+    /// The Newey–West sums' buffers.
+    pub scratch: Scratch,
+}
+
+/// What [`solve_augmented`] found.
+#[derive(Debug, Clone)]
+pub(crate) struct Solved {
+    pub fit: LeastSquaresFit,
+    /// `g` of [`SolveOptions::also`].
+    pub also: Option<DVector<f64>>,
+}
+
+/// Solves `Φ θ ≈ λ` by QR, given column-major `a = [Φ | λ]` (`m` rows, `p + 1`
+/// columns), destroying `a`. With a Newey–West covariance or `influence`,
+/// `workspace.copy` receives a copy of the equilibrated `a` (its allocation
+/// is reused); with `influence` it is left holding the influence series,
+/// column-major `m × p`: row `t` is `(ΦᵀΦ)⁻¹ φ_t e_t`, in the parameters'
+/// units (their sum over the rows is `θ̂ − θ` to first order).
+pub(crate) fn solve_augmented(
+    a: &mut [f64],
+    m: usize,
+    p: usize,
+    options: &SolveOptions<'_>,
+    workspace: &mut Workspace,
+) -> Result<Solved, Error> {
+    let hac = &mut workspace.copy;
+    let max_condition = options.max_condition;
+    debug_assert_eq!(a.len(), m * (p + 1));
+    if p == 0 || m <= p {
+        return Err(Error::TooFewSamples {
+            what: "least squares (more rows than parameters)",
+            needed: p.max(1) + 1,
+            got: m,
+        });
+    }
+    // Equilibrate every column (λ too) by a power of two, so that its
+    // largest entry is in [1, 2): exact, and then no norm, product or
+    // square in the QR or the statistics below can overflow or underflow,
+    // whatever the units (a column of 1e308, another of 1e-200). The
+    // results are unscaled at the end.
+    let mut exponents = vec![0i32; p + 1];
+    for (j, (col, e)) in a.chunks_exact_mut(m).zip(exponents.iter_mut()).enumerate() {
+        if let Some(i) = first_non_finite(col) {
+            return Err(Error::NonFinite {
+                matrix: "regressor",
+                row: i,
+                col: j,
+                value: col[i],
+            });
+        }
+        *e = binary_exponent(max_abs(col));
+        if *e != 0 {
+            let f = pow2(-*e);
+            col.iter_mut().for_each(|v| *v *= f);
+        }
+    }
+    let e_lambda = exponents[p];
+    let newey_west_lags = match options.covariance {
+        Covariance::Classical => None,
+        Covariance::NeweyWest { lags } => Some(lags),
+    };
+    if newey_west_lags.is_some() || options.influence {
+        // The equilibrated problem, which QR is about to overwrite.
+        hac.clear();
+        hac.extend_from_slice(a);
+    }
+    // Spread of λ about its mean, before QR overwrites it.
+    let lam = &a[p * m..];
+    let mean = sum_by(lam, |v| v) / m as f64;
+    let sst = sum_by(lam, |v| (v - mean) * (v - mean));
+
+    let n = p + 1;
+    // Tall and narrow (a handful of columns): blocking buys nothing and
+    // costs about half the time at 5000 × 3.
+    let bs = 1;
+    let mut h = vec![0.0; bs * n];
+    let mut mem = MemBuffer::new(qr_in_place_scratch::<f64>(
+        m,
+        n,
+        bs,
+        Par::Seq,
+        Default::default(),
+    ));
+    qr_in_place(
+        MatMut::from_column_major_slice_mut(a, m, n),
+        MatMut::from_column_major_slice_mut(&mut h, bs, n),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        Default::default(),
+    );
+    // The upper triangle of `a` now holds R_aug = [R z; 0 ρ], |ρ| = ‖r‖.
+    let r = |i: usize, j: usize| a[j * m + i];
+
+    // Householder QR commutes with column scaling, so the equilibrated
+    // regressor Φ D⁻¹ (unit columns) has the triangular factor R D⁻¹, with
+    // ‖Φ_j‖ = ‖R_j‖: its singular values give a unit-free condition number.
+    let mut rmat = DMatrix::from_fn(p, p, |i, j| if i <= j { r(i, j) } else { 0.0 });
+    for j in 0..p {
+        let norm = rmat.column(j).norm();
+        if norm > 0.0 {
+            rmat.column_mut(j).unscale_mut(norm);
+        }
+    }
+    let iterations = 200 * p;
+    let sv = rmat
+        .try_svd_unordered(false, false, f64::EPSILON, iterations)
+        .ok_or(Error::NoConvergence {
+            operation: "least squares (singular values of R)",
+            iterations,
+        })?
+        .singular_values;
+    let smax = sv.max();
+    let smin = sv.min();
+    let condition = if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
+    if condition.is_nan() || condition > max_condition {
+        let rank = sv.iter().filter(|&&s| s * max_condition > smax).count();
+        return Err(Error::RankDeficient { rank, condition });
+    }
+
+    // Back substitution R θ' = z, then undo the scaling.
+    let mut theta = DVector::zeros(p);
+    for i in (0..p).rev() {
+        let mut s = r(i, p);
+        for j in i + 1..p {
+            s -= r(i, j) * theta[j];
+        }
+        theta[i] = s / r(i, i);
+    }
+    // R⁻¹ by back substitution, column by column.
+    let mut rinv = DMatrix::zeros(p, p);
+    for c in 0..p {
+        for i in (0..=c).rev() {
+            let mut s = if i == c { 1.0 } else { 0.0 };
+            for j in i + 1..=c {
+                s -= r(i, j) * rinv[(j, c)];
+            }
+            rinv[(i, c)] = s / r(i, i);
+        }
+    }
+    let ssr = r(p, p) * r(p, p);
+    let mut also = None;
+    if newey_west_lags.is_some() || options.influence {
+        let z = options.also.filter(|_| options.influence);
+        let g = influence(hac, m, p, &theta, &rinv, z);
+        also = g.map(|(g, e_z)| DVector::from_fn(p, |j, _| scale_pow2(g[j], e_z - exponents[j])));
+    }
+    let mut covariance_kind = options.covariance;
+    let mut covariance = match newey_west_lags {
+        None => &rinv * rinv.transpose() * (ssr / (m - p) as f64),
+        Some(lags) => {
+            let (cov, used) = newey_west(
+                &hac[..m * p],
+                m,
+                p,
+                options.segment_starts,
+                m,
+                lags,
+                &mut workspace.scratch,
+            );
+            covariance_kind = Covariance::NeweyWest { lags: Some(used) };
+            cov
+        }
+    };
+    // A positive semi-definite covariance's diagonal is ≥ 0; rounding
+    // could leave a vanishing variance a hair below.
+    let mut std_errors = covariance.diagonal().map(|v| v.max(0.0).sqrt());
+    let (r_squared, fit_percent) = if sst > 0.0 {
+        (1.0 - ssr / sst, (1.0 - (ssr / sst).sqrt()) * 100.0)
+    } else if ssr == 0.0 {
+        (1.0, 100.0)
+    } else {
+        (f64::NEG_INFINITY, f64::NEG_INFINITY)
+    };
+    // Undo the equilibration: θ_j and its standard error in λ's units per
+    // column j's, the covariance in their products.
+    for j in 0..p {
+        let d = e_lambda - exponents[j];
+        theta[j] = scale_pow2(theta[j], d);
+        std_errors[j] = scale_pow2(std_errors[j], d);
+        for i in 0..p {
+            covariance[(i, j)] =
+                scale_pow2(scale_pow2(covariance[(i, j)], d), e_lambda - exponents[i]);
+        }
+    }
+    let residual_rms = scale_pow2((ssr / m as f64).sqrt(), e_lambda);
+    let finite = |v: &[f64]| v.iter().all(|v| v.is_finite());
+    if !(finite(theta.as_slice())
+        && finite(std_errors.as_slice())
+        && finite(covariance.as_slice())
+        && residual_rms.is_finite())
+    {
+        return Err(Error::Overflow {
+            operation: "least squares (the estimate or its covariance exceeds f64::MAX)",
+        });
+    }
+    let fit = LeastSquaresFit {
+        theta,
+        covariance,
+        std_errors,
+        residual_rms,
+        r_squared,
+        fit_percent,
+        condition,
+        rows: m,
+        covariance_kind,
+    };
+    if options.influence {
+        // In the parameters' units, as θ̂.
+        for (j, col) in hac[..m * p].chunks_exact_mut(m).enumerate() {
+            let d = e_lambda - exponents[j];
+            col.iter_mut().for_each(|v| *v = scale_pow2(*v, d));
+            if first_non_finite(col).is_some() {
+                return Err(Error::Overflow {
+                    operation: "least squares (the influence of a row exceeds f64::MAX)",
+                });
+            }
+        }
+    }
+    if let Some(g) = &also
+        && !g.iter().all(|v| v.is_finite())
+    {
+        return Err(Error::Overflow {
+            operation: "least squares (a sensitivity exceeds f64::MAX)",
+        });
+    }
+    Ok(Solved { fit, also })
+}
+
+/// `e` with `2^e ≤ x < 2^(e+1)` for a finite `x > 0` (0 for `x = 0`).
+fn binary_exponent(x: f64) -> i32 {
+    pow2_floor(x).log2() as i32
+}
+
+/// `2^e` for `|e| ≤ 1022`, exactly.
+fn pow2(e: i32) -> f64 {
+    2f64.powi(e)
+}
+
+/// `v · 2^d` for `|d| ≤ 2046`, in two exact halves: no intermediate
+/// overflows unless the result does.
+fn scale_pow2(v: f64, d: i32) -> f64 {
+    let half = d / 2;
+    v * pow2(half) * pow2(d - half)
+}
+
+/// The influence series of the equilibrated problem in `work` (column-major
+/// `[Φ | λ]`, `m × (p + 1)`, equilibrated `θ`, `R⁻¹`): on return
+/// `work[..m p]` holds row by row `R⁻¹ R⁻ᵀ φ_t e_t` with `e = λ − Φ θ`, and
+/// `work[m p..]` holds `e`. With `z`, also `g = R⁻¹ R⁻ᵀ Φᵀ z` of `z`
+/// divided by `2^e_z` (returned with `e_z`).
+fn influence(
+    work: &mut [f64],
+    m: usize,
+    p: usize,
+    theta: &DVector<f64>,
+    rinv: &DMatrix<f64>,
+    z: Option<&[f64]>,
+) -> Option<(DVector<f64>, i32)> {
+    let (phi, lambda) = work.split_at_mut(m * p);
+    // e = λ − Φ θ, in place of λ.
+    for (j, col) in phi.chunks_exact(m).enumerate() {
+        let t = theta[j];
+        lambda.iter_mut().zip(col).for_each(|(e, &x)| *e -= t * x);
+    }
+    let e = &*lambda;
+    // U = Φ R⁻¹ (the thin Q), in place: column j needs columns 0 … j of Φ
+    // (R⁻¹ is upper triangular), so go down.
+    for j in (0..p).rev() {
+        let (before, rest) = phi.split_at_mut(j * m);
+        let col = &mut rest[..m];
+        let d = rinv[(j, j)];
+        col.iter_mut().for_each(|v| *v *= d);
+        for (k, other) in before.chunks_exact(m).enumerate() {
+            let c = rinv[(k, j)];
+            if c != 0.0 {
+                col.iter_mut().zip(other).for_each(|(v, &x)| *v += c * x);
+            }
+        }
+    }
+    // g = R⁻¹ Uᵀ z, z equilibrated like the other columns.
+    let g = z.map(|z| {
+        let e_z = binary_exponent(max_abs(z));
+        let f = pow2(-e_z);
+        let qz = DVector::from_fn(p, |j, _| {
+            phi[j * m..(j + 1) * m]
+                .iter()
+                .zip(z)
+                .map(|(q, z)| q * (z * f))
+                .sum::<f64>()
+        });
+        (rinv * qz, e_z)
+    });
+    // diag(e) U R⁻ᵀ: column j of U R⁻ᵀ is Σ_{k ≥ j} U_k R⁻¹[j, k], so go up.
+    for j in 0..p {
+        let (head, tail) = phi.split_at_mut((j + 1) * m);
+        let col = &mut head[j * m..];
+        let d = rinv[(j, j)];
+        col.iter_mut().for_each(|v| *v *= d);
+        for (k, other) in tail.chunks_exact(m).enumerate() {
+            let c = rinv[(j, j + 1 + k)];
+            if c != 0.0 {
+                col.iter_mut().zip(other).for_each(|(v, &x)| *v += c * x);
+            }
+        }
+        col.iter_mut().zip(e).for_each(|(v, &e)| *v *= e);
+    }
+    g
+}
