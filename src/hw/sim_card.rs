@@ -268,33 +268,50 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
             Time::Virtual(clock) => clock.now_nanos(),
             Time::Real(start) => u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX),
         };
-        let behind = now.saturating_sub(self.t_nanos) as f64 * 1e-9;
+        if now <= self.t_nanos {
+            // Another register access in the same instant (the loop reads
+            // several per tick): nothing to integrate, only writes or a
+            // watchdog trip due now.
+            self.advance_to(now);
+            return Ok(());
+        }
+        let behind = (now - self.t_nanos) as f64 * 1e-9;
         if behind / self.config.max_substep > MAX_CATCH_UP_STEPS as f64 {
-            return Err(HwError::Simulation {
-                reason: format!(
-                    "its clock is {behind:.6e} s ahead, more than the {:.6e} s it catches up in \
-                     at most {MAX_CATCH_UP_STEPS} RK4 sub-steps of {} s",
-                    MAX_CATCH_UP_STEPS as f64 * self.config.max_substep,
-                    self.config.max_substep
-                ),
-                at: self.time(),
-            });
+            return Err(self.too_far_behind(behind));
         }
         let before = (self.t_nanos, self.state, self.duty, self.pending);
         self.advance_to(now);
         if let Some(i) = self.state.iter().position(|v| !v.is_finite()) {
             let (value, at) = (self.state[i], self.time());
             (self.t_nanos, self.state, self.duty, self.pending) = before;
-            return Err(HwError::Simulation {
-                reason: format!(
-                    "plant state {i} became {value} on the way to this time (the model \
-                     diverged); the card stays at t = {:.4} s",
-                    self.time()
-                ),
-                at,
-            });
+            return Err(self.diverged(i, value, at));
         }
         Ok(())
+    }
+
+    #[cold]
+    fn too_far_behind(&self, behind: f64) -> HwError {
+        HwError::Simulation {
+            reason: format!(
+                "its clock is {behind:.6e} s ahead, more than the {:.6e} s it catches up in \
+                 at most {MAX_CATCH_UP_STEPS} RK4 sub-steps of {} s",
+                MAX_CATCH_UP_STEPS as f64 * self.config.max_substep,
+                self.config.max_substep
+            ),
+            at: self.time(),
+        }
+    }
+
+    #[cold]
+    fn diverged(&self, state: usize, value: f64, at: f64) -> HwError {
+        HwError::Simulation {
+            reason: format!(
+                "plant state {state} became {value} on the way to this time (the model \
+                 diverged); the card stays at t = {:.4} s",
+                self.time()
+            ),
+            at,
+        }
     }
 
     /// Puts the plant in state `x` now, as a hand moving the carts would:
