@@ -9,15 +9,15 @@
 //! friction's stick–slip) is a bias common to every run, which no standard
 //! error covers.
 
-use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
+mod common;
+
 use ctrlab::ident::Covariance;
 use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
     Estimate, Options, Scheme, identify_separate_springs_with, identify_with,
 };
-use ctrlab::signal::{Signal, SquareWave};
-use ctrlab::{MassSpring, OpenLoop, Recording};
-use nalgebra::vector;
+use ctrlab::signal::SquareWave;
+use ctrlab::{MassSpring, Recording};
 
 /// The default simulated rig with the seed, and with equal springs
 /// (950 N/m) so that the equal-spring model's `k12` has one true value;
@@ -34,22 +34,7 @@ fn equal_springs(seed: u64) -> SimulatedRig {
 /// lab5's identification run on `sim`: ±8 V square wave, 0.2 s half
 /// period, 5 s at 2 ms.
 fn record(sim: &SimulatedRig) -> Recording {
-    let wave = SquareWave::new(8.0, 0.2).unwrap();
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration: 5.0,
-        ..LoopConfig::default()
-    };
-    hw::run(
-        rig,
-        OpenLoop,
-        |t| vector![wave.value(t)],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .unwrap()
-    .recording
+    common::open_loop(sim, &SquareWave::new(8.0, 0.2).unwrap(), 5.0)
 }
 
 fn options(coulomb: bool, covariance: Covariance) -> Options {

@@ -4,44 +4,27 @@
 //! reproduces a fresh run at least as well as the least-squares one, and
 //! its parameters are within the bounds of the truth.
 
-use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
+mod common;
+
+use common::open_loop;
 use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine, validate};
 use ctrlab::lab::{MassSpring, SimulatedRig};
-use ctrlab::signal::{Prbs, Signal, SquareWave};
-use ctrlab::{Error, OpenLoop, Recording};
-use nalgebra::vector;
+use ctrlab::signal::{Prbs, SquareWave};
+use ctrlab::{Error, Recording};
 
 /// A 5 s run of the lab's square wave on `sim`, of force `8 + 2 F_max` N
 /// (9 to 14 N; ±8 V is 8.9 N on the default motor): enough above the
 /// friction for both carts to slide, within the ±50 mm travel.
 fn square_run(sim: &SimulatedRig) -> Recording {
     let volts = (8.0 + 2.0 * sim.coulomb_friction[0].max(sim.coulomb_friction[1])) / sim.truth.gain;
-    open_loop(sim, &SquareWave::new(volts, 0.2).unwrap())
+    open_loop(sim, &SquareWave::new(volts, 0.2).unwrap(), 5.0)
 }
 
 /// The fresh run a model is validated on: another input, a PRBS (40 ms
 /// clock) of the same force as [`square_run`].
 fn prbs_run(sim: &SimulatedRig) -> Recording {
     let volts = (8.0 + 2.0 * sim.coulomb_friction[0].max(sim.coulomb_friction[1])) / sim.truth.gain;
-    open_loop(sim, &Prbs::new(volts, 0.04, 7, 0x35).unwrap())
-}
-
-fn open_loop(sim: &SimulatedRig, input: &dyn Signal) -> Recording {
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration: 5.0,
-        ..LoopConfig::default()
-    };
-    run(
-        rig,
-        OpenLoop,
-        |t| vector![input.value(t)],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .unwrap()
-    .recording
+    open_loop(sim, &Prbs::new(volts, 0.04, 7, 0x35).unwrap(), 5.0)
 }
 
 fn rig(gain: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {

@@ -7,12 +7,9 @@ mod common;
 
 use common::lqi_design::{self, Design, Metrics, Spec};
 use common::run_on_rig;
-use ctrlab::OpenLoop;
-use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
 use ctrlab::lab::ident::{Options, Scheme, identify_separate_springs_with};
 use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
-use ctrlab::signal::{Signal, SquareWave};
-use nalgebra::vector;
+use ctrlab::signal::SquareWave;
 use std::sync::OnceLock;
 
 const SETPOINT: f64 = 0.030;
@@ -21,22 +18,7 @@ const SETPOINT: f64 = 0.030;
 /// identification runs (±8 V square wave, 0.2 s half period, 5 s) on
 /// `sim`, with the masses known.
 fn identified(sim: &SimulatedRig) -> (MassSpring, [f64; 2]) {
-    let wave = SquareWave::new(8.0, 0.2).unwrap();
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration: 5.0,
-        ..LoopConfig::default()
-    };
-    let rec = hw::run(
-        rig,
-        OpenLoop,
-        |t| vector![wave.value(t)],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .unwrap()
-    .recording;
+    let rec = common::open_loop(sim, &SquareWave::new(8.0, 0.2).unwrap(), 5.0);
     let options = Options {
         scheme: Scheme::Central,
         coulomb: true,

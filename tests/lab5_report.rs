@@ -36,11 +36,27 @@ fn number(cell: &str) -> Option<f64> {
     cell.trim_matches('*').parse().ok()
 }
 
+/// The report `LAB5_REPORT` names.
+fn report() -> String {
+    let path = std::env::var("LAB5_REPORT").expect("LAB5_REPORT names the report to check");
+    std::fs::read_to_string(&path).expect("the report is readable")
+}
+
+/// The text under `heading`, up to the next second-level heading.
+fn section<'a>(report: &'a str, heading: &str) -> &'a str {
+    report
+        .split(heading)
+        .nth(1)
+        .unwrap_or_else(|| panic!("the report has no `{heading}`"))
+        .split("\n## ")
+        .next()
+        .unwrap_or_default()
+}
+
 #[test]
 #[ignore = "run by .ci/run after the lab5 example, with LAB5_REPORT set"]
 fn the_lab5_report_has_every_table_with_numbers() {
-    let path = std::env::var("LAB5_REPORT").expect("LAB5_REPORT names the report to check");
-    let report = std::fs::read_to_string(&path).expect("the report is readable");
+    let report = report();
     let tables = tables(&report);
     for n in 1..=6 {
         let rows = tables
@@ -151,16 +167,8 @@ fn the_lab5_report_has_every_table_with_numbers() {
 #[test]
 #[ignore = "run by .ci/run after the lab5 example, with LAB5_REPORT set"]
 fn the_excitation_section_compares_four_inputs_on_the_simulated_truth() {
-    let path = std::env::var("LAB5_REPORT").expect("LAB5_REPORT names the report to check");
-    let report = std::fs::read_to_string(&path).expect("the report is readable");
-    let section = report
-        .split("## Excitation")
-        .nth(1)
-        .expect("the Excitation section")
-        .split("\n## ")
-        .next()
-        .unwrap_or_default();
-    let rows: Vec<Vec<&str>> = section
+    let report = report();
+    let rows: Vec<Vec<&str>> = section(&report, "## Excitation")
         .lines()
         .filter(|l| l.starts_with("| **"))
         .map(|l| l.trim_matches('|').split(" | ").map(str::trim).collect())
@@ -188,16 +196,8 @@ fn the_excitation_section_compares_four_inputs_on_the_simulated_truth() {
 #[test]
 #[ignore = "run by .ci/run after the lab5 example, with LAB5_REPORT set"]
 fn the_validation_section_simulates_each_model_on_a_fresh_run() {
-    let path = std::env::var("LAB5_REPORT").expect("LAB5_REPORT names the report to check");
-    let report = std::fs::read_to_string(&path).expect("the report is readable");
-    let section = report
-        .split("## Validation")
-        .nth(1)
-        .expect("the Validation section")
-        .split("\n## ")
-        .next()
-        .unwrap_or_default();
-    let rows: Vec<Vec<&str>> = section
+    let report = report();
+    let rows: Vec<Vec<&str>> = section(&report, "## Validation")
         .lines()
         .filter(|l| l.starts_with("| ") && !l.starts_with("| model"))
         .map(|l| l.trim_matches('|').split(" | ").map(str::trim).collect())

@@ -3,12 +3,12 @@
 //! voltage and length, each identified as the separate-springs model with
 //! Coulomb friction.
 
-use ctrlab::OpenLoop;
 use ctrlab::lab::ident::{
     Options, Scheme, SeparateSpringsEstimate, identify_separate_springs_with,
 };
 use ctrlab::nalgebra::vector;
 use ctrlab::signal::{Chirp, Multisine, Phases, Prbs, Signal, SquareWave, Sweep};
+use ctrlab::{OpenLoop, Recording};
 
 use crate::report::Report;
 use crate::rig::{Backend, IDENT_DURATION, IDENT_HALF_PERIOD, IDENT_VOLTS, M1, M2, RUNS};
@@ -61,8 +61,13 @@ fn inputs() -> Result<Vec<Input>, ctrlab::Error> {
 }
 
 /// Every input `RUNS` times; a table of the estimates' errors against the
-/// truth (simulated rig) or their spread (real card).
-pub fn section(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::error::Error>> {
+/// truth (simulated rig) or their spread (real card). Returns the first
+/// PRBS run's recording, a run the Validation section's models have not
+/// seen.
+pub fn section(
+    backend: &Backend,
+    report: &mut Report,
+) -> Result<Option<Recording>, Box<dyn std::error::Error>> {
     report.heading(2, "Excitation: which input identifies best");
     report.add(&format!(
         "The same identification (separate springs, Coulomb friction, Central scheme) from four inputs of the same peak ({IDENT_VOLTS} V) and length ({IDENT_DURATION} s), {RUNS} runs each (recordings in `runs/excite_*.csv`). The square wave puts its power on a few odd harmonics of 2.5 Hz; the PRBS spreads it flat to 11 Hz; the multisine puts it exactly on 50 lines from 0.2 to 10 Hz; the chirp sweeps 0.2–10 Hz once, the same time per octave.\n"
@@ -77,6 +82,7 @@ pub fn section(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std
     let mut rows = Vec::new();
     // (input, worst |error| %) on the simulated rig.
     let mut worst: Vec<(&str, f64)> = Vec::new();
+    let mut fresh = None;
     for (i, (name, what, signal)) in inputs()?.into_iter().enumerate() {
         let mut estimates: Vec<SeparateSpringsEstimate> = Vec::new();
         let mut failure = None;
@@ -98,10 +104,15 @@ pub fn section(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std
                 IDENT_DURATION,
             )?;
             match outcome {
-                Ok(out) => match identify_separate_springs_with(&out.recording, M1, M2, &options) {
-                    Ok(e) => estimates.push(e),
-                    Err(e) => failure = Some(format!("not identified: {e}")),
-                },
+                Ok(out) => {
+                    match identify_separate_springs_with(&out.recording, M1, M2, &options) {
+                        Ok(e) => estimates.push(e),
+                        Err(e) => failure = Some(format!("not identified: {e}")),
+                    }
+                    if name == "PRBS" && seed == 1 {
+                        fresh = Some(out.recording);
+                    }
+                }
                 Err(e) => failure = Some(format!("run halted: {}", e.error)),
             }
             if failure.is_some() {
@@ -164,5 +175,5 @@ pub fn section(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std
     } else {
         report.add("Means over the runs (the real rig's truth is unknown: compare the inputs with each other and with the square wave's Tables 3 and 4).\n");
     }
-    Ok(())
+    Ok(fresh)
 }

@@ -215,8 +215,8 @@ fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::e
     simulation::table1(report)?;
     let table2 = simulation::table2(report)?;
     let ident = rig::identification(backend, report)?;
-    excitation::section(backend, report)?;
-    validation::section(backend, &ident, report)?;
+    let fresh = excitation::section(backend, report)?;
+    validation::section(backend, &ident, fresh.as_ref(), report)?;
     let tables = rig::rig_tables();
     let mut rig_results = Vec::new();
     for table in &tables {

@@ -214,6 +214,10 @@ fn square() -> SquareWave {
 pub struct Identification {
     pub lab: Vec<MassSpringEstimate>,
     pub central: Vec<MassSpringEstimate>,
+    /// Separate springs with Coulomb friction (Central), one per run.
+    pub separate: Vec<SeparateSpringsEstimate>,
+    /// Run 1's recording.
+    pub first_run: Recording,
     /// Lab and Central on one run of an equal-springs, frictionless truth
     /// (simulated rig only): the schemes' own bias, free of model error.
     pub equal_springs: Option<(MassSpring, MassSpringEstimate, MassSpringEstimate)>,
@@ -448,19 +452,18 @@ pub fn identification(
             },
         ],
     )?;
-    if let Some(rec) = first {
-        let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<_>>();
-        report.figure(
-            "identification.svg",
-            &format!("Identification run 1: positions under a ±{IDENT_VOLTS} V square wave"),
-            "t (s)",
-            "position (mm)",
-            &[
-                ("x1".into(), rec.time().to_vec(), mm(rec.channel("x1")?)),
-                ("x2".into(), rec.time().to_vec(), mm(rec.channel("x2")?)),
-            ],
-        )?;
-    }
+    let first = first.ok_or("no identification run")?;
+    let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<_>>();
+    report.figure(
+        "identification.svg",
+        &format!("Identification run 1: positions under a ±{IDENT_VOLTS} V square wave"),
+        "t (s)",
+        "position (mm)",
+        &[
+            ("x1".into(), first.time().to_vec(), mm(first.channel("x1")?)),
+            ("x2".into(), first.time().to_vec(), mm(first.channel("x2")?)),
+        ],
+    )?;
 
     let model = MassSpring {
         m1: M1,
@@ -532,6 +535,8 @@ pub fn identification(
     Ok(Identification {
         lab,
         central,
+        separate,
+        first_run: first,
         equal_springs,
         model,
         coulomb: [sf1, sf2],

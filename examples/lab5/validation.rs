@@ -4,15 +4,13 @@
 
 use ctrlab::Recording;
 use ctrlab::lab::MassSpring;
-use ctrlab::lab::ident::{
-    Options, Scheme, Validation, identify_separate_springs_with, refine, validate,
-};
+use ctrlab::lab::ident::{Validation, refine, validate};
 
 use crate::report::Report;
-use crate::rig::{Backend, Identification, M1, M2};
+use crate::rig::{Backend, Identification};
 
-/// The run refined (the first identification run) and the fresh one (the
-/// first PRBS run of the Excitation section), as saved by the runs.
+/// Where the run refined (the first identification run) and the fresh one
+/// (the first PRBS run of the Excitation section) are saved, for the text.
 const IDENT_RUN: &str = "ident_1.csv";
 const FRESH_RUN: &str = "excite_1_1.csv";
 
@@ -36,30 +34,20 @@ fn row(name: &str, plant: &MassSpring, coulomb: [f64; 2], v: &Validation) -> Vec
 pub fn section(
     backend: &Backend,
     ident: &Identification,
+    fresh: Option<&Recording>,
     report: &mut Report,
 ) -> Result<(), Box<dyn std::error::Error>> {
     report.heading(
         2,
         "Validation: the models on a fresh run, and refined by output error",
     );
-    let runs = backend.out.join("runs");
-    let (rec, fresh) = match (
-        Recording::read_csv(runs.join(IDENT_RUN)),
-        Recording::read_csv(runs.join(FRESH_RUN)),
-    ) {
-        (Ok(a), Ok(b)) => (a, b),
-        (Err(e), _) | (_, Err(e)) => {
-            report.add(&format!("Not possible: {e}.\n"));
-            return Ok(());
-        }
+    let Some(fresh) = fresh else {
+        report.add("Not possible: the Excitation section's first PRBS run did not complete.\n");
+        return Ok(());
     };
-    let options = Options {
-        scheme: Scheme::Central,
-        coulomb: true,
-        ..Options::default()
-    };
-    let separate = identify_separate_springs_with(&rec, M1, M2, &options)?;
-    let refined = refine(&rec, &separate)?;
+    let rec = &ident.first_run;
+    let separate = ident.separate.first().ok_or("no identification run")?;
+    let refined = refine(rec, separate)?;
     let lab = ident.lab.first().ok_or("no identification run")?.plant();
     let ls_coulomb = separate
         .coulomb
@@ -75,13 +63,13 @@ pub fn section(
         ),
         ("refined by output error", refined.plant, refined.coulomb),
     ] {
-        match validate(&fresh, &plant, coulomb) {
+        match validate(fresh, &plant, coulomb) {
             Ok(v) => rows.push(row(name, &plant, coulomb, &v)),
             Err(e) => failures.push(format!("{name}: {e}")),
         }
     }
     if let (Some(truth), Some(forces)) = (backend.truth(), backend.coulomb_truth())
-        && let Ok(v) = validate(&fresh, &truth, forces)
+        && let Ok(v) = validate(fresh, &truth, forces)
     {
         rows.push(row("**the simulated card's truth**", &truth, forces, &v));
     }

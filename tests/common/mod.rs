@@ -65,6 +65,7 @@ pub mod lqi_design;
 use ctrlab::data::Recording;
 use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
 use ctrlab::lab::SimulatedRig;
+use ctrlab::signal::Signal;
 use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
 use nalgebra::vector;
 
@@ -106,6 +107,26 @@ pub fn run_on_rig<C: Controller<4, 1, 1>>(
     .unwrap();
     assert_eq!(out.stats.overruns, 0);
     out.recording
+}
+
+/// `input` (V) open loop for `duration` seconds on `sim`'s rig (card,
+/// driver, 2 ms loop) over a fresh virtual clock.
+pub fn open_loop(sim: &SimulatedRig, input: &dyn Signal, duration: f64) -> Recording {
+    let clock = VirtualClock::new();
+    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
+    let config = LoopConfig {
+        duration,
+        ..LoopConfig::default()
+    };
+    hw::run(
+        rig,
+        ctrlab::OpenLoop,
+        |t| vector![input.value(t)],
+        &Clock::Virtual(clock),
+        &config,
+    )
+    .unwrap()
+    .recording
 }
 
 /// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.
