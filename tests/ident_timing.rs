@@ -372,6 +372,7 @@ proptest! {
             0..60,
         ),
         coulomb in any::<bool>(),
+        free_m2 in any::<bool>(),
         min_speed in prop_oneof![Just(0.0), Just(0.005), Just(f64::INFINITY), 0.0f64..1.0],
         max_jitter in prop_oneof![Just(0.0), Just(0.05), Just(0.5), 0.0f64..0.5],
         scheme in prop_oneof![Just(Scheme::Lab), Just(Scheme::Central)],
@@ -388,13 +389,15 @@ proptest! {
             t += step * 1e-3;
             rec.push(t, &[(k % 7) as f64 - 3.0], &[x1, x2]).unwrap();
         }
-        let options = Options { scheme, coulomb, min_speed, max_jitter, covariance };
+        let options = Options { scheme, coulomb, min_speed, free_m2, max_jitter, covariance };
         let finite = |e: &[Estimate]| e.iter().all(|e| e.value.is_finite() && e.std_error.is_finite());
         if let Ok(e) = identify_with(&rec, 1.3, 0.7, &options) {
             prop_assert!(finite(&[e.k12, e.b1, e.gain, e.b2]), "{e:?}");
+            prop_assert!(e.m2_estimate.is_none_or(|m| finite(&[m]) && m.value > 0.0), "{e:?}");
         }
         if let Ok(e) = identify_separate_springs_with(&rec, 1.3, 0.7, &options) {
             prop_assert!(finite(&[e.k1, e.k2, e.b1, e.gain, e.b2]), "{e:?}");
+            prop_assert!(e.m2_estimate.is_none_or(|m| finite(&[m]) && m.value > 0.0), "{e:?}");
         }
     }
 }

@@ -4,7 +4,7 @@
 use super::{Scheme, Timing};
 use crate::error::Error;
 use crate::ident::LeastSquaresFit;
-use crate::lab::{Cart, MassSpring};
+use crate::lab::{Cart, FrictionPlant, MassSpring};
 use crate::model::{Continuous, StateSpace};
 
 /// One identified parameter and its standard error (same unit).
@@ -67,9 +67,13 @@ pub struct MassSpringEstimate {
     /// Coulomb friction force of cart 1 and cart 2, N, when identified
     /// ([`Options::coulomb`](super::Options::coulomb)); `None` otherwise.
     pub coulomb: Option<[Estimate; 2]>,
+    /// Cart 2's effective mass, kg, when fitted
+    /// ([`Options::free_m2`](super::Options::free_m2)); `None` when given.
+    pub m2_estimate: Option<Estimate>,
     /// Mass of cart 1 used, kg.
     pub m1: f64,
-    /// Mass of cart 2 used, kg.
+    /// Mass of cart 2, kg: the one given, or the fitted one
+    /// ([`m2_estimate`](Self::m2_estimate)).
     pub m2: f64,
     /// Mean sampling period over the segments used, s: the recording's
     /// period when it has no gap.
@@ -81,7 +85,8 @@ pub struct MassSpringEstimate {
     /// Stage 1 fit (`θ = [k12, b1]`, then `F1` with Coulomb friction): fit
     /// %, R², condition number, rows, ….
     pub first: LeastSquaresFit,
-    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction); with
+    /// Stage 2 fit (`θ = [K, b2]`, then `m2` when
+    /// [free](super::Options::free_m2), then `F2` with Coulomb friction); with
     /// Newey–West its covariance includes stage 1's error in `k12`.
     pub second: LeastSquaresFit,
 }
@@ -125,6 +130,27 @@ impl MassSpringEstimate {
             b2: self.b2.value,
             gain: self.gain.value,
         }
+    }
+
+    /// The identified plant with its Coulomb friction, a nonlinear
+    /// [`Dynamics`](crate::integrate::Dynamics) to simulate (breakaway at
+    /// the Coulomb force; a negative force estimate taken as 0, none
+    /// without [`Options::coulomb`](super::Options::coulomb)).
+    /// [`plant`](Self::plant) is its linear part, for design.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{Options, identify_with}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::default() })?;
+    /// let model = est.friction_plant();
+    /// assert_eq!(model.truth, est.plant());
+    /// assert_eq!(model.friction[1], est.coulomb.unwrap()[1].value.max(0.0));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn friction_plant(&self) -> FrictionPlant {
+        FrictionPlant::new(self.plant(), coulomb_forces(self.coulomb))
     }
 
     /// The identified continuous model (equation (3)), output the position
@@ -178,9 +204,13 @@ pub struct SeparateSpringsEstimate {
     /// Coulomb friction force of cart 1 and cart 2, N, when identified
     /// ([`Options::coulomb`](super::Options::coulomb)); `None` otherwise.
     pub coulomb: Option<[Estimate; 2]>,
+    /// Cart 2's effective mass, kg, when fitted
+    /// ([`Options::free_m2`](super::Options::free_m2)); `None` when given.
+    pub m2_estimate: Option<Estimate>,
     /// Mass of cart 1 used, kg.
     pub m1: f64,
-    /// Mass of cart 2 used, kg.
+    /// Mass of cart 2, kg: the one given, or the fitted one
+    /// ([`m2_estimate`](Self::m2_estimate)).
     pub m2: f64,
     /// Mean sampling period over the segments used, s: the recording's
     /// period when it has no gap.
@@ -191,7 +221,8 @@ pub struct SeparateSpringsEstimate {
     pub timing: Timing,
     /// Stage 1 fit (`θ = [k1, k2, b1]`, then `F1` with Coulomb friction).
     pub first: LeastSquaresFit,
-    /// Stage 2 fit (`θ = [K, b2]`, then `F2` with Coulomb friction); with
+    /// Stage 2 fit (`θ = [K, b2]`, then `m2` when
+    /// [free](super::Options::free_m2), then `F2` with Coulomb friction); with
     /// Newey–West its covariance includes stage 1's error in `k2`.
     pub second: LeastSquaresFit,
 }
@@ -237,6 +268,27 @@ impl SeparateSpringsEstimate {
         }
     }
 
+    /// The identified plant with its Coulomb friction, a nonlinear
+    /// [`Dynamics`](crate::integrate::Dynamics) to simulate (breakaway at
+    /// the Coulomb force; a negative force estimate taken as 0, none
+    /// without [`Options::coulomb`](super::Options::coulomb)).
+    /// [`plant`](Self::plant) is its linear part, for design.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{Options, identify_separate_springs_with}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::default() })?;
+    /// let model = est.friction_plant();
+    /// assert_eq!(model.truth, est.plant());
+    /// assert_eq!(model.friction[1], est.coulomb.unwrap()[1].value.max(0.0));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn friction_plant(&self) -> FrictionPlant {
+        FrictionPlant::new(self.plant(), coulomb_forces(self.coulomb))
+    }
+
     /// The identified continuous model, output the position of cart 2.
     ///
     /// # Errors
@@ -255,6 +307,11 @@ impl SeparateSpringsEstimate {
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.plant().state_space(Cart::Two)
     }
+}
+
+/// The fitted Coulomb forces, N, each at least 0; zero when not fitted.
+fn coulomb_forces(coulomb: Option<[Estimate; 2]>) -> [f64; 2] {
+    coulomb.map_or([0.0; 2], |c| c.map(|f| f.value.max(0.0)))
 }
 
 /// The range of cart masses (kg) the lab's identification takes as

@@ -12,6 +12,10 @@
 //! Optionally ([`Options::coulomb`]) each equation gets a Coulomb friction
 //! term `F sign(v)`, fitted only over the rows where that cart clearly
 //! moves (see [`Options::min_speed`] for why).
+//! With [`Options::free_m2`] cart 2's effective mass is fitted in stage 2
+//! too (the motor's inertia adds to the weighed cart), the equation then
+//! divided by it so that the noisy second difference stays out of the
+//! regressors.
 //!
 //! The recording must hold the channels `u` (the input), `x1` and `x2`
 //! (positions, m): the lab's [`schema`](super::schema), or the lab's own
@@ -199,7 +203,7 @@ fn motions(
         ),
         (
             motion(data.x2, data, options.min_speed),
-            3,
+            3 + usize::from(options.free_m2),
             "Coulomb friction: rows where cart 2 moves faster than min_speed",
         ),
     ];
@@ -237,6 +241,14 @@ fn coulomb_forces(
         }
     };
     coulomb.then(|| [last(first), last(second)])
+}
+
+/// Cart 2's effective mass, stage 2's third parameter, when fitted.
+fn fitted_m2(free: bool, second: &LeastSquaresFit) -> Option<Estimate> {
+    free.then(|| Estimate {
+        value: second.theta[2],
+        std_error: second.std_errors[2],
+    })
 }
 
 /// Identifies `k12 = k1 = k2`, `b1`, `K` and `b2` from a recording with
@@ -324,6 +336,7 @@ fn equal_springs<D: Differences>(
     options: &Options,
 ) -> Result<MassSpringEstimate, Error> {
     let (data, timing, dt) = prepare(recording, m1, m2, options)?;
+    let fixed_m2 = (!options.free_m2).then_some(m2);
     let motion = motions(&data, options, 3)?;
     let [cart1, cart2] = match &motion {
         Some([a, b]) => [Some(a), Some(b)],
@@ -333,16 +346,18 @@ fn equal_springs<D: Differences>(
     let mut solver = Solver::new(options.covariance);
     let first = stage1_equal::<D>(&data, m1, cart1, &mut solver)?;
     let [k12, b1] = estimates::<2>(&first);
-    let second = stage2::<D>(&data, m2, (k12.value, 0), cart2, &mut solver)?;
+    let second = stage2::<D>(&data, fixed_m2, (k12.value, 0), cart2, &mut solver)?;
     let [gain, b2] = estimates::<2>(&second);
+    let m2_estimate = fitted_m2(options.free_m2, &second);
     Ok(MassSpringEstimate {
         k12,
         b1,
         gain,
         b2,
         coulomb: coulomb_forces(options.coulomb, &first, &second),
+        m2_estimate,
         m1,
-        m2,
+        m2: m2_estimate.map_or(m2, |e| e.value),
         dt,
         scheme: options.scheme,
         timing,
@@ -422,6 +437,7 @@ fn separate_springs<D: Differences>(
     options: &Options,
 ) -> Result<SeparateSpringsEstimate, Error> {
     let (data, timing, dt) = prepare(recording, m1, m2, options)?;
+    let fixed_m2 = (!options.free_m2).then_some(m2);
     let motion = motions(&data, options, 4)?;
     let [cart1, cart2] = match &motion {
         Some([a, b]) => [Some(a), Some(b)],
@@ -430,8 +446,9 @@ fn separate_springs<D: Differences>(
     let mut solver = Solver::new(options.covariance);
     let first = stage1_separate::<D>(&data, m1, cart1, &mut solver)?;
     let [k1, k2, b1] = estimates::<3>(&first);
-    let second = stage2::<D>(&data, m2, (k2.value, 1), cart2, &mut solver)?;
+    let second = stage2::<D>(&data, fixed_m2, (k2.value, 1), cart2, &mut solver)?;
     let [gain, b2] = estimates::<2>(&second);
+    let m2_estimate = fitted_m2(options.free_m2, &second);
     Ok(SeparateSpringsEstimate {
         k1,
         k2,
@@ -439,8 +456,9 @@ fn separate_springs<D: Differences>(
         gain,
         b2,
         coulomb: coulomb_forces(options.coulomb, &first, &second),
+        m2_estimate,
         m1,
-        m2,
+        m2: m2_estimate.map_or(m2, |e| e.value),
         dt,
         scheme: options.scheme,
         timing,
