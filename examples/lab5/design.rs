@@ -15,8 +15,9 @@ use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::vector;
 
 use crate::figures::{ComparePanel, RunCurve};
+use crate::identification::Identification;
 use crate::report::Report;
-use crate::rig::{Backend, Identification, PERIOD, pct};
+use crate::rig::{Backend, PERIOD, pct};
 use lqi_design::{Choice, DRIVE_DELAY, DURATION, Design, INTEGRAL_RATIO, Metrics, Spec, Step};
 
 /// Cart 2 to Table 5's 30 mm; cart 1 to Table 6's 15 mm (the report
@@ -48,7 +49,7 @@ pub fn section(
     report: &mut Report,
 ) -> Result<(), Box<dyn std::error::Error>> {
     report.heading(2, "Design: predict, then run");
-    let coulomb = [ident.coulomb[0].mean, ident.coulomb[1].mean];
+    let coulomb = ident.coulomb();
     // What is known of the rig without identifying anything: its encoders,
     // drive and period (the card's calibration).
     let calibration = SimulatedRig {
@@ -427,7 +428,7 @@ fn differences(
     count: f64,
 ) {
     report.heading(3, "Where prediction and rig differ");
-    let coulomb = [ident.coulomb[0].mean, ident.coulomb[1].mean];
+    let coulomb = ident.coulomb();
     let mut lines = Vec::new();
     for c in cases {
         let spec = &c.design.spec;
@@ -511,7 +512,7 @@ fn walk(c: &Case, ident: &Identification, backend: &Backend, err: f64, count: f6
     let kz = c.design.lqi.gain[4].abs();
     let rate = kz * err.abs() * count;
     let breakaway = |i: usize| {
-        backend.sim().map_or(ident.coulomb[i].mean, |sim| {
+        backend.sim().map_or(ident.coulomb()[i], |sim| {
             sim.stiction[i].max(sim.coulomb_friction[i])
         })
     };

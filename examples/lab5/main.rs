@@ -9,6 +9,11 @@
 //! - Tables 5 and 6 run on the rig with the lab's gains;
 //! - the answers the lab report asks for, stated from the numbers.
 //!
+//! With `--logs DIR` lab5 works offline on a student's own recordings
+//! instead: Tables 1 and 2 in simulation, then Tables 3 and 4, the
+//! identified model with its uncertainty, and the validation from every
+//! `*.csv` in `DIR` (the rig sections need a rig and are skipped).
+//!
 //! Writes `report.md`, one SVG per table and every run's recording as CSV
 //! (`runs/`) into `--out DIR` (default `target/lab5`). Ctrl-C halts the rig,
 //! keeps the run's recording and the report so far.
@@ -17,6 +22,7 @@
 //! cargo run --release --example lab5
 //! cargo run --release --example lab5 -- --out my_report      # elsewhere
 //! cargo run --release --example lab5 -- --truth truth.toml   # another simulated rig
+//! cargo run --release --example lab5 -- --logs my_runs        # Tables 3 and 4 from my CSV logs
 //! cargo run --release --example lab5 -- --real-time          # wall-clock loop (about two minutes)
 //! cargo run --release --example lab5 -- --real-time --rt-priority 80   # with SCHED_FIFO
 //! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml
@@ -34,6 +40,7 @@ mod card;
 mod design;
 mod excitation;
 mod figures;
+mod identification;
 #[path = "../common/lab_tables.rs"]
 mod lab_tables;
 mod report;
@@ -47,11 +54,13 @@ use std::time::Instant;
 
 use ctrlab::hw::{RealTime, StopSignal};
 use ctrlab::lab::SimulatedRig;
+use identification::Identification;
 use report::Report;
 use rig::{Backend, BackendKind, RigResult, RigRow, RigTable, pct};
 
 const USAGE: &str = "usage: lab5 [--out DIR] [--truth FILE] [--real-time] [--rt-priority N]
             [--port /dev/parportN --card card.toml]
+       lab5 [--out DIR] --logs DIR [--metres-per-count M]
 
   --out DIR         where report.md, the SVGs and runs/*.csv go (default target/lab5)
   --truth FILE      the simulated rig from a TOML file (see ctrlab::lab::SimulatedRig)
@@ -59,7 +68,11 @@ const USAGE: &str = "usage: lab5 [--out DIR] [--truth FILE] [--real-time] [--rt-
   --rt-priority N   run the loop with SCHED_FIFO priority N (1-99), memory locked (Linux)
   --port PATH       run the rig sections on the real PC104 card (feature `ppdev`)
   --card FILE       the real card's register map and calibration (ctrlab::lab::RigConfig),
-                    written by the probe; required with --port";
+                    written by the probe; required with --port
+  --logs DIR        offline: identify from every *.csv in DIR (two or more identification
+                    runs: columns t, u, x1, x2 with units, e.g. t_s;u_V;x1_mm;x2_mm)
+  --metres-per-count M
+                    with --logs: the encoders' calibration, for positions logged in counts";
 
 struct Args {
     out: PathBuf,
@@ -68,6 +81,8 @@ struct Args {
     rt_priority: Option<i32>,
     port: Option<PathBuf>,
     card: Option<PathBuf>,
+    logs: Option<PathBuf>,
+    metres_per_count: Option<f64>,
 }
 
 fn parse_args() -> Result<Option<Args>, String> {
@@ -78,6 +93,8 @@ fn parse_args() -> Result<Option<Args>, String> {
         rt_priority: None,
         port: None,
         card: None,
+        logs: None,
+        metres_per_count: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -94,9 +111,29 @@ fn parse_args() -> Result<Option<Args>, String> {
             }
             "--port" => args.port = Some(it.next().ok_or("--port needs a device path")?.into()),
             "--card" => args.card = Some(it.next().ok_or("--card needs a card file")?.into()),
+            "--logs" => args.logs = Some(it.next().ok_or("--logs needs a directory")?.into()),
+            "--metres-per-count" => {
+                let m = it.next().ok_or("--metres-per-count needs a number (m)")?;
+                args.metres_per_count = Some(
+                    m.parse()
+                        .map_err(|_| format!("--metres-per-count: `{m}` is not a number"))?,
+                );
+            }
             "-h" | "--help" => return Ok(None),
             other => return Err(format!("unknown argument `{other}`")),
         }
+    }
+    if args.logs.is_some()
+        && (args.truth.is_some() || args.port.is_some() || args.real_time || args.card.is_some())
+    {
+        return Err(
+            "--logs works offline on recorded runs: --truth, --real-time, --port and \
+                    --card are for the rig sections, which it skips"
+                .into(),
+        );
+    }
+    if args.metres_per_count.is_some() && args.logs.is_none() {
+        return Err("--metres-per-count calibrates logged counts: use it with --logs".into());
     }
     Ok(Some(args))
 }
@@ -189,10 +226,17 @@ fn main() -> ExitCode {
 
 fn lab(args: &Args) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let started = Instant::now();
-    let backend = backend(args)?;
+    let backend = match &args.logs {
+        Some(_) => None,
+        None => Some(backend(args)?),
+    };
     std::fs::create_dir_all(&args.out)?;
     let mut report = Report::new(&args.out);
-    let result = sections(&backend, &mut report);
+    let result = match (&backend, &args.logs) {
+        (Some(backend), _) => sections(backend, &mut report),
+        (None, Some(dir)) => offline_sections(dir, args.metres_per_count, &mut report),
+        (None, None) => unreachable!("a backend is built unless --logs is given"),
+    };
     if let Err(e) = &result {
         // Keep what was measured: the report so far, with the reason.
         report.add(&format!("\n**The lab stopped early:** {e}\n"));
@@ -205,25 +249,65 @@ fn lab(args: &Args) -> Result<PathBuf, Box<dyn std::error::Error>> {
     result.map(|()| path)
 }
 
-fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::error::Error>> {
+fn title(report: &mut Report, command: &str) {
     report.heading(1, "Lab 5: state feedback control of the two-cart rig");
     report.add(&format!(
-        "Generated by `ctrlab` {} (`cargo run --release --example lab5`). Units: mm, s, N, V; poles in 1/s.\n",
+        "Generated by `ctrlab` {} (`{command}`). Units: mm, s, N, V; poles in 1/s.\n",
         env!("CARGO_PKG_VERSION")
     ));
+}
 
+fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::error::Error>> {
+    title(report, "cargo run --release --example lab5");
     simulation::table1(report)?;
     let table2 = simulation::table2(report)?;
-    let ident = rig::identification(backend, report)?;
+    let truth = backend.truth().zip(backend.coulomb_truth());
+    let (runs, intro) = identification::rig_runs(backend)?;
+    let mut ident = identification::identification(runs, &intro, truth, report)?;
+    ident.equal_springs = identification::equal_springs(backend, report)?;
     let fresh = excitation::section(backend, report)?;
-    validation::section(backend, &ident, fresh.as_ref(), report)?;
+    validation::section(
+        &ident,
+        fresh.as_ref().map(|r| ("runs/excite_1_1.csv", r)),
+        truth,
+        report,
+    )?;
     let tables = rig::rig_tables();
     let mut rig_results = Vec::new();
     for table in &tables {
         rig_results.push(rig::rig_table(backend, &ident.model, table, report)?);
     }
     design::section(backend, &ident, report)?;
-    answers(report, backend, &ident, &table2, &tables, &rig_results);
+    report.heading(2, "Answers to the report's questions");
+    answer_model(report, Some(backend), &ident);
+    answers(report, &ident, &table2, &tables, &rig_results);
+    Ok(())
+}
+
+/// `--logs DIR`: Tables 1 and 2 in simulation, then identification and
+/// validation from the logs; no rig.
+fn offline_sections(
+    dir: &std::path::Path,
+    metres_per_count: Option<f64>,
+    report: &mut Report,
+) -> Result<(), Box<dyn std::error::Error>> {
+    title(
+        report,
+        &format!(
+            "cargo run --release --example lab5 -- --logs {}",
+            dir.display()
+        ),
+    );
+    simulation::table1(report)?;
+    simulation::table2(report)?;
+    let options = ctrlab::data::CsvOptions { metres_per_count };
+    let (runs, intro) = identification::log_runs(dir, &options)?;
+    let ident = identification::identification(runs, &intro, None, report)?;
+    let fresh = ident.runs.get(1).map(|r| (r.name.as_str(), &r.recording));
+    validation::section(&ident, fresh, None, report)?;
+    report.heading(2, "Answers to the report's questions");
+    answer_model(report, None, &ident);
+    report.add("Tables 5 and 6 and the design on the rig need the rig: run lab5 without `--logs` (on the simulated rig, or the card with `--port`).\n");
     Ok(())
 }
 
@@ -295,32 +379,25 @@ fn effect(name: &str, context: &str, k: usize, rows: &[(&[f64; 4], &RigResult)])
     s
 }
 
-fn answers(
-    report: &mut Report,
-    backend: &Backend,
-    ident: &rig::Identification,
-    table2: &[simulation::Measured],
-    tables: &[RigTable],
-    results: &[Vec<RigResult>],
-) {
-    report.heading(2, "Answers to the report's questions");
+/// Question 1: the state equations with the identified parameters.
+fn answer_model(report: &mut Report, backend: Option<&Backend>, ident: &Identification) {
     report.heading(3, "1. The state equations with the identified parameters");
     let m = &ident.model;
-    let [f1, f2] = &ident.coulomb;
+    let [f1, f2] = ident.coulomb();
     let mut s = format!(
-        "With m1 = {} kg and m2 = {} kg known: k1 = {:.1} N/m, k2 = {:.1} N/m, b1 = {:.3} N·s/m, b2 = {:.3} N·s/m, K = {:.4} N/V, and Coulomb friction {:.2} N on cart 1 and {:.2} N on cart 2 (averages of five runs); the matrices are in the section above.",
-        m.m1, m.m2, m.k1, m.k2, m.b1, m.b2, m.gain, f1.mean, f2.mean
+        "With m1 = {} kg and m2 = {} kg known: k1 = {:.1} N/m, k2 = {:.1} N/m, b1 = {:.3} N·s/m, b2 = {:.3} N·s/m, K = {:.4} N/V, and Coulomb friction {:.2} N on cart 1 and {:.2} N on cart 2 (averages of {} runs); the matrices are in the section above.",
+        m.m1, m.m2, m.k1, m.k2, m.b1, m.b2, m.gain, f1, f2, ident.average.runs
     );
-    if let Some(sim) = backend.sim() {
+    if let Some(sim) = backend.and_then(Backend::sim) {
         s += &format!(
             " The card's Coulomb friction is {} N and {} N: identified {} and {}.",
             sim.coulomb_friction[0],
             sim.coulomb_friction[1],
-            pct(f1.mean, sim.coulomb_friction[0]),
-            pct(f2.mean, sim.coulomb_friction[1]),
+            pct(f1, sim.coulomb_friction[0]),
+            pct(f2, sim.coulomb_friction[1]),
         );
     }
-    if let Some(t) = backend.truth() {
+    if let Some(t) = backend.and_then(Backend::truth) {
         let avg = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
         let lab_k = avg(ident.lab.iter().map(|e| e.gain.value).collect());
         let cen_k = avg(ident.central.iter().map(|e| e.gain.value).collect());
@@ -348,7 +425,15 @@ fn answers(
         );
     }
     report.add(&format!("{s}\n"));
+}
 
+fn answers(
+    report: &mut Report,
+    ident: &Identification,
+    table2: &[simulation::Measured],
+    tables: &[RigTable],
+    results: &[Vec<RigResult>],
+) {
     report.heading(3, "2. The effect of each entry of Kf");
     let mut lines = Vec::new();
     let row2 = |kf: [f64; 4]| table2.iter().find(|r| r.kf == kf);
@@ -408,8 +493,8 @@ fn answers(
         .count();
     lines.push(format!(
         "- The gains are volts per millimetre, so on a rig with K = {:.2} N/V they act {:.1} times harder than on the nominal force-input model of Table 2: they saturate the 24 V drive, and the loop that matters is the sampled one (a velocity gain makes the 2 ms loop unstable once K·Kf4·1000·T/m2 passes about 2). The identified model sampled at 2 ms predicts stable/unstable correctly for {agree} of the {} rig runs (stable ↔ metrics measured).",
-        m.gain,
-        m.gain,
+        ident.model.gain,
+        ident.model.gain,
         all.len()
     ));
     lines.push("- Background: the steady-state error cannot reach zero with u = Kf (G r − x), which is proportional with no integral action, so the springs' static force is held by a standing error, e_ss = r (1 − closed-loop DC gain); a prefilter (`StateFeedback::with_prefilter`) or an integrator removes it. Cart 1 is moved only through the spring k2 (non-collocated control), which is why its position loop destabilises far sooner than cart 2's.".into());

@@ -8,20 +8,13 @@ use ctrlab::hw::{
     Clock, HwError, LoopConfig, LoopStats, RealTime, RunError, RunOutcome, StopSignal,
     VirtualClock, run,
 };
-use ctrlab::lab::ident::{
-    MassSpringEstimate, Options, Scheme, SeparateSpringsEstimate, Spread, average, identify,
-    identify_separate_springs_with,
-};
 use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::{SVector, vector};
-use ctrlab::signal::{Signal, SquareWave};
-use ctrlab::{
-    Controller, Error, OpenLoop, Recording, StateFeedback, StepInfo, StepInfoOptions, step_info,
-};
+use ctrlab::{Controller, Error, Recording, StateFeedback, StepInfo, StepInfoOptions, step_info};
 
-use crate::figures::{ParamPanel, RunCurve};
+use crate::figures::RunCurve;
 use crate::lab_tables::{self, fmt_kf, fmt_poles};
-use crate::report::{Report, fmt_state_equations};
+use crate::report::Report;
 
 /// The loop period, s.
 pub const PERIOD: f64 = 0.002;
@@ -112,7 +105,7 @@ impl Backend {
         self.sim().map(|s| s.coulomb_friction)
     }
 
-    fn real_time(&self) -> bool {
+    pub fn real_time(&self) -> bool {
         match &self.kind {
             BackendKind::Simulated { real_time, .. } => *real_time,
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
@@ -184,7 +177,7 @@ impl Backend {
     }
 
     /// A sentence on the loop's timing, for real-time runs.
-    fn timing(&self, stats: &[LoopStats]) -> Option<String> {
+    pub fn timing(&self, stats: &[LoopStats]) -> Option<String> {
         if !self.real_time() || stats.is_empty() {
             return None;
         }
@@ -205,342 +198,9 @@ impl Backend {
     }
 }
 
-/// The identification input: the lab's square wave, V.
-fn square() -> SquareWave {
-    SquareWave::new(IDENT_VOLTS, IDENT_HALF_PERIOD).expect("valid constants")
-}
-
-/// All estimates of the identification runs.
-pub struct Identification {
-    pub lab: Vec<MassSpringEstimate>,
-    pub central: Vec<MassSpringEstimate>,
-    /// Separate springs with Coulomb friction (Central), one per run.
-    pub separate: Vec<SeparateSpringsEstimate>,
-    /// Run 1's recording.
-    pub first_run: Recording,
-    /// Lab and Central on one run of an equal-springs, frictionless truth
-    /// (simulated rig only): the schemes' own bias, free of model error.
-    pub equal_springs: Option<(MassSpring, MassSpringEstimate, MassSpringEstimate)>,
-    /// The identified model: averages of the separate-springs estimates.
-    pub model: MassSpring,
-    /// The identified Coulomb forces, N (cart 1, cart 2).
-    pub coulomb: [Spread; 2],
-}
-
 /// Relative error in percent, signed.
 pub fn pct(got: f64, want: f64) -> String {
     format!("{:+.2} %", (got / want - 1.0) * 100.0)
-}
-
-fn pm(s: &Spread, digits: usize) -> String {
-    format!("{:.*} ± {:.*}", digits, s.mean, digits, s.std_dev)
-}
-
-fn spread_of(values: impl Iterator<Item = f64>) -> Result<Spread, Error> {
-    Spread::of(&values.collect::<Vec<_>>())
-}
-
-/// Five open-loop runs, identified by both schemes; Tables 3 and 4.
-pub fn identification(
-    backend: &Backend,
-    report: &mut Report,
-) -> Result<Identification, Box<dyn std::error::Error>> {
-    report.heading(2, "Identification runs (rig)");
-    report.add(&format!(
-        "{RUNS} open-loop runs on {}: a ±{IDENT_VOLTS} V square wave, {IDENT_HALF_PERIOD} s half period, {IDENT_DURATION} s at T = {} ms, through `MassSpringRig` → `Pc104` → the card (recordings in `runs/ident_*.csv`). Masses known: m1 = {M1} kg, m2 = {M2} kg. **Lab** is equations (6)–(11) as the lab's MATLAB code; **Central** uses central-difference velocities, the input averaged over the hold and Numerov-weighted positions; **separate** identifies k1 ≠ k2 and each cart's Coulomb friction (Central, rows where the cart moves).\n",
-        backend.describe(),
-        PERIOD * 1e3
-    ));
-    let (mut lab, mut central, mut separate) = (Vec::new(), Vec::new(), Vec::new());
-    let mut stats = Vec::new();
-    let mut first = None;
-    let wave = square();
-    let options = Options {
-        scheme: Scheme::Central,
-        coulomb: true,
-        ..Options::default()
-    };
-    for seed in 1..=RUNS {
-        let out = backend
-            .experiment(
-                &format!("ident_{seed}"),
-                seed,
-                None,
-                OpenLoop,
-                |t| vector![wave.value(t)],
-                IDENT_DURATION,
-            )?
-            .map_err(|e| format!("identification run {seed}: {e}"))?;
-        let rec = out.recording;
-        stats.push(out.stats);
-        lab.push(identify(&rec, M1, M2, Scheme::Lab)?);
-        central.push(identify(&rec, M1, M2, Scheme::Central)?);
-        separate.push(identify_separate_springs_with(&rec, M1, M2, &options)?);
-        if seed == 1 {
-            first = Some(rec);
-        }
-    }
-    if let Some(s) = backend.timing(&stats) {
-        report.add(&s);
-    }
-
-    let truth = backend.truth();
-    let coulomb =
-        |e: &SeparateSpringsEstimate, cart: usize| e.coulomb.map_or(f64::NAN, |c| c[cart].value);
-    let mut rows3 = Vec::new();
-    let mut rows4 = Vec::new();
-    for i in 0..lab.len() {
-        let (l, c, s) = (&lab[i], &central[i], &separate[i]);
-        rows3.push(vec![
-            format!("{}", i + 1),
-            format!("{:.2}", l.k12.value),
-            format!("{:.3}", l.b1.value),
-            format!("{:.2}", c.k12.value),
-            format!("{:.3}", c.b1.value),
-            format!("{:.2}", s.k1.value),
-            format!("{:.2}", s.k2.value),
-            format!("{:.3}", s.b1.value),
-            format!("{:.3}", coulomb(s, 0)),
-        ]);
-        rows4.push(vec![
-            format!("{}", i + 1),
-            format!("{:.4}", l.gain.value),
-            format!("{:.3}", l.b2.value),
-            format!("{:.4}", c.gain.value),
-            format!("{:.3}", c.b2.value),
-            format!("{:.4}", s.gain.value),
-            format!("{:.3}", s.b2.value),
-            format!("{:.3}", coulomb(s, 1)),
-        ]);
-    }
-    let (al, ac) = (average(&lab)?, average(&central)?);
-    let sk1 = spread_of(separate.iter().map(|s| s.k1.value))?;
-    let sk2 = spread_of(separate.iter().map(|s| s.k2.value))?;
-    let sb1 = spread_of(separate.iter().map(|s| s.b1.value))?;
-    let sg = spread_of(separate.iter().map(|s| s.gain.value))?;
-    let sb2 = spread_of(separate.iter().map(|s| s.b2.value))?;
-    let sf1 = spread_of(separate.iter().map(|s| coulomb(s, 0)))?;
-    let sf2 = spread_of(separate.iter().map(|s| coulomb(s, 1)))?;
-    rows3.push(vec![
-        "**mean ± sd**".into(),
-        pm(&al.k12, 2),
-        pm(&al.b1, 3),
-        pm(&ac.k12, 2),
-        pm(&ac.b1, 3),
-        pm(&sk1, 2),
-        pm(&sk2, 2),
-        pm(&sb1, 3),
-        pm(&sf1, 3),
-    ]);
-    rows4.push(vec![
-        "**mean ± sd**".into(),
-        pm(&al.gain, 4),
-        pm(&al.b2, 3),
-        pm(&ac.gain, 4),
-        pm(&ac.b2, 3),
-        pm(&sg, 4),
-        pm(&sb2, 3),
-        pm(&sf2, 3),
-    ]);
-    if let (Some(t), Some(sim)) = (truth, backend.sim()) {
-        rows3.push(vec![
-            "truth (simulated card)".into(),
-            format!("k1 {:.0}, k2 {:.0}", t.k1, t.k2),
-            format!("{:.3}", t.b1),
-            String::new(),
-            String::new(),
-            format!("{:.2}", t.k1),
-            format!("{:.2}", t.k2),
-            format!("{:.3}", t.b1),
-            format!("{:.3}", sim.coulomb_friction[0]),
-        ]);
-        rows4.push(vec![
-            "truth (simulated card)".into(),
-            format!("{:.4}", t.gain),
-            format!("{:.3}", t.b2),
-            String::new(),
-            String::new(),
-            format!("{:.4}", t.gain),
-            format!("{:.3}", t.b2),
-            format!("{:.3}", sim.coulomb_friction[1]),
-        ]);
-    }
-    report.heading(3, "Table 3: springs and friction of cart 1");
-    report.table(
-        &[
-            "run",
-            "k12 Lab (N/m)",
-            "b1 Lab (N·s/m)",
-            "k12 Central (N/m)",
-            "b1 Central (N·s/m)",
-            "k1 separate (N/m)",
-            "k2 separate (N/m)",
-            "b1 separate (N·s/m)",
-            "Coulomb 1 separate (N)",
-        ],
-        &rows3,
-    );
-    let values = |f: &dyn Fn(usize) -> f64| (0..lab.len()).map(f).collect::<Vec<f64>>();
-    report.estimates(
-        "table3.svg",
-        "Table 3: estimates per run",
-        &[
-            ParamPanel {
-                name: "k1, k12 (N/m)".into(),
-                schemes: vec![
-                    ("Lab k12".into(), values(&|i| lab[i].k12.value)),
-                    ("Central k12".into(), values(&|i| central[i].k12.value)),
-                    ("separate k1".into(), values(&|i| separate[i].k1.value)),
-                ],
-                truth: truth.map(|t| t.k1),
-            },
-            ParamPanel {
-                name: "k2 (N/m)".into(),
-                schemes: vec![
-                    ("Lab k12".into(), values(&|i| lab[i].k12.value)),
-                    ("Central k12".into(), values(&|i| central[i].k12.value)),
-                    ("separate k2".into(), values(&|i| separate[i].k2.value)),
-                ],
-                truth: truth.map(|t| t.k2),
-            },
-            ParamPanel {
-                name: "b1 (N·s/m)".into(),
-                schemes: vec![
-                    ("Lab".into(), values(&|i| lab[i].b1.value)),
-                    ("Central".into(), values(&|i| central[i].b1.value)),
-                    ("separate".into(), values(&|i| separate[i].b1.value)),
-                ],
-                truth: truth.map(|t| t.b1),
-            },
-        ],
-    )?;
-    report.heading(3, "Table 4: motor gain and friction of cart 2");
-    report.table(
-        &[
-            "run",
-            "K Lab (N/V)",
-            "b2 Lab (N·s/m)",
-            "K Central (N/V)",
-            "b2 Central (N·s/m)",
-            "K separate (N/V)",
-            "b2 separate (N·s/m)",
-            "Coulomb 2 separate (N)",
-        ],
-        &rows4,
-    );
-    report.estimates(
-        "table4.svg",
-        "Table 4: estimates per run",
-        &[
-            ParamPanel {
-                name: "K (N/V)".into(),
-                schemes: vec![
-                    ("Lab".into(), values(&|i| lab[i].gain.value)),
-                    ("Central".into(), values(&|i| central[i].gain.value)),
-                    ("separate".into(), values(&|i| separate[i].gain.value)),
-                ],
-                truth: truth.map(|t| t.gain),
-            },
-            ParamPanel {
-                name: "b2 (N·s/m)".into(),
-                schemes: vec![
-                    ("Lab".into(), values(&|i| lab[i].b2.value)),
-                    ("Central".into(), values(&|i| central[i].b2.value)),
-                    ("separate".into(), values(&|i| separate[i].b2.value)),
-                ],
-                truth: truth.map(|t| t.b2),
-            },
-        ],
-    )?;
-    let first = first.ok_or("no identification run")?;
-    let mm = |v: &[f64]| v.iter().map(|x| x * 1e3).collect::<Vec<_>>();
-    report.figure(
-        "identification.svg",
-        &format!("Identification run 1: positions under a ±{IDENT_VOLTS} V square wave"),
-        "t (s)",
-        "position (mm)",
-        &[
-            ("x1".into(), first.time().to_vec(), mm(first.channel("x1")?)),
-            ("x2".into(), first.time().to_vec(), mm(first.channel("x2")?)),
-        ],
-    )?;
-
-    let model = MassSpring {
-        m1: M1,
-        m2: M2,
-        k1: sk1.mean,
-        k2: sk2.mean,
-        b1: sb1.mean,
-        b2: sb2.mean,
-        gain: sg.mean,
-    };
-    report.heading(3, "Identified state equations");
-    report.add(&format!(
-        "From the averages of the separate-springs estimates, equations (3)/(14), output cart 2; the Coulomb friction ({:.2} N and {:.2} N) is outside the linear model:\n",
-        sf1.mean, sf2.mean
-    ));
-    let sys = model.state_space(Cart::Two)?;
-    report.add(&fmt_state_equations(&sys));
-    report.add(&format!("Open-loop poles: {}.\n", fmt_poles(&sys.poles()?)));
-    // The lab's formulas assume k1 = k2 and no Coulomb friction. On a truth
-    // where that holds, the only difference between the schemes is the
-    // finite differences themselves.
-    let equal_springs = match (backend.truth(), backend.sim()) {
-        (Some(t), Some(sim)) => {
-            let truth = MassSpring { k2: t.k1, ..t };
-            let run_backend = Backend {
-                kind: BackendKind::Simulated {
-                    sim: Box::new(SimulatedRig {
-                        coulomb_friction: [0.0; 2],
-                        stiction: [0.0; 2],
-                        ..sim.clone()
-                    }),
-                    real_time: backend.real_time(),
-                },
-                realtime: backend.realtime,
-                stop: backend.stop.clone(),
-                out: backend.out.clone(),
-            };
-            let out = run_backend
-                .experiment(
-                    "ident_equal_springs",
-                    99,
-                    Some(truth),
-                    OpenLoop,
-                    |t| vector![square().value(t)],
-                    IDENT_DURATION,
-                )?
-                .map_err(|e| format!("equal-springs run: {e}"))?;
-            let rec = out.recording;
-            let (l, c) = (
-                identify(&rec, M1, M2, Scheme::Lab)?,
-                identify(&rec, M1, M2, Scheme::Central)?,
-            );
-            report.add(&format!(
-                "One more run on a card whose springs are equal (k1 = k2 = {:.0} N/m) and without Coulomb friction, where the lab's model is exact, isolates the schemes' own bias: Lab k12 {}, b1 {}, K {}, b2 {}; Central k12 {}, b1 {}, K {}, b2 {}.\n",
-                truth.k1,
-                pct(l.k12.value, truth.k1),
-                pct(l.b1.value, truth.b1),
-                pct(l.gain.value, truth.gain),
-                pct(l.b2.value, truth.b2),
-                pct(c.k12.value, truth.k1),
-                pct(c.b1.value, truth.b1),
-                pct(c.gain.value, truth.gain),
-                pct(c.b2.value, truth.b2),
-            ));
-            Some((truth, l, c))
-        }
-        _ => None,
-    };
-    Ok(Identification {
-        lab,
-        central,
-        separate,
-        first_run: first,
-        equal_springs,
-        model,
-        coulomb: [sf1, sf2],
-    })
 }
 
 /// How a closed-loop rig run ended.

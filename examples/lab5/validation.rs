@@ -1,18 +1,13 @@
 //! The Validation section: the identified models simulated on a fresh run
-//! (the Excitation section's first PRBS run), and the separate-springs
-//! estimate refined by output error.
+//! (the Excitation section's first PRBS run on the rig, the second log with
+//! `--logs`), and the separate-springs estimate refined by output error.
 
 use ctrlab::Recording;
 use ctrlab::lab::MassSpring;
 use ctrlab::lab::ident::{Validation, refine, validate};
 
+use crate::identification::Identification;
 use crate::report::Report;
-use crate::rig::{Backend, Identification};
-
-/// Where the run refined (the first identification run) and the fresh one
-/// (the first PRBS run of the Excitation section) are saved, for the text.
-const IDENT_RUN: &str = "ident_1.csv";
-const FRESH_RUN: &str = "excite_1_1.csv";
 
 fn row(name: &str, plant: &MassSpring, coulomb: [f64; 2], v: &Validation) -> Vec<String> {
     vec![
@@ -31,21 +26,24 @@ fn row(name: &str, plant: &MassSpring, coulomb: [f64; 2], v: &Validation) -> Vec
     ]
 }
 
+/// `fresh`: the run the models have not seen, and its name for the text;
+/// `truth`: the simulated card's plant and Coulomb forces.
 pub fn section(
-    backend: &Backend,
     ident: &Identification,
-    fresh: Option<&Recording>,
+    fresh: Option<(&str, &Recording)>,
+    truth: Option<(MassSpring, [f64; 2])>,
     report: &mut Report,
 ) -> Result<(), Box<dyn std::error::Error>> {
     report.heading(
         2,
         "Validation: the models on a fresh run, and refined by output error",
     );
-    let Some(fresh) = fresh else {
+    let Some((fresh_name, fresh)) = fresh else {
         report.add("Not possible: the Excitation section's first PRBS run did not complete.\n");
         return Ok(());
     };
-    let rec = &ident.first_run;
+    let first = ident.runs.first().ok_or("no identification run")?;
+    let rec = &first.recording;
     let separate = ident.separate.first().ok_or("no identification run")?;
     let refined = refine(rec, separate)?;
     let lab = ident.lab.first().ok_or("no identification run")?.plant();
@@ -68,14 +66,16 @@ pub fn section(
             Err(e) => failures.push(format!("{name}: {e}")),
         }
     }
-    if let (Some(truth), Some(forces)) = (backend.truth(), backend.coulomb_truth())
+    if let Some((truth, forces)) = truth
         && let Ok(v) = validate(fresh, &truth, forces)
     {
         rows.push(row("**the simulated card's truth**", &truth, forces, &v));
     }
     report.add(&format!(
-        "Run 1 of the identification (`runs/{IDENT_RUN}`) identified three ways, each model then simulated from the input of a run it has not seen, the first PRBS run of the Excitation section (`runs/{FRESH_RUN}`), from rest. **Fit** is `100 (1 − ‖x − x̂‖ / ‖x − mean x‖)` of each cart's simulated position (MATLAB's `compare`). The refinement minimises both carts' simulation error on run 1 over k1, k2, b1, b2, K, F1, F2 by Levenberg–Marquardt ({} simulations; fit on run 1 from {:.2} / {:.2} % to {:.2} / {:.2} %). **white** and **indep.** are the largest normalised auto- and cross-correlation (with the input) of cart 2's simulation error over 25 lags, against a 99 % bound of {:.3} for a white error independent of the input: an output-error model has no noise model, so its error is not white; a cross-correlation above the bound is dynamics the model misses (the card's PWM delay and its stiction, 20 % above the Coulomb force, are not in it).\n",
+        "The first identification run (`{}`) identified three ways, each model then simulated from the input of a run it has not seen (`{fresh_name}`), from rest. **Fit** is `100 (1 − ‖x − x̂‖ / ‖x − mean x‖)` of each cart's simulated position (MATLAB's `compare`). The refinement minimises both carts' simulation error on that run over k1, k2, b1, b2, K, F1, F2 by Levenberg–Marquardt ({} simulations; fit on `{}` from {:.2} / {:.2} % to {:.2} / {:.2} %). **white** and **indep.** are the largest normalised auto- and cross-correlation (with the input) of cart 2's simulation error over 25 lags, against a 99 % bound of {:.3} for a white error independent of the input: an output-error model has no noise model, so its error is not white; a cross-correlation above the bound is dynamics the model misses (a drive's delay, and stiction above the Coulomb force, are not in it).\n",
+        first.name,
         refined.evaluations,
+        first.name,
         refined.start.fit_percent[0],
         refined.start.fit_percent[1],
         refined.refined.fit_percent[0],

@@ -1,6 +1,6 @@
 //! The averages over repeated runs (Tables 3 and 4).
 
-use super::MassSpringEstimate;
+use super::{MassSpringEstimate, SeparateSpringsEstimate};
 use crate::error::Error;
 use crate::kernels::reduce::pow2_floor;
 
@@ -135,6 +135,160 @@ pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Error> 
         b1: spread(runs.iter().map(|r| r.b1.value), n)?,
         gain: spread(runs.iter().map(|r| r.gain.value), n)?,
         b2: spread(runs.iter().map(|r| r.b2.value), n)?,
+        runs: n,
+    })
+}
+
+/// The averaged model of repeated separate-springs identifications
+/// ([`average_separate_springs`]): each parameter's mean and spread over
+/// the runs, and the model of the means.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{Recording, lab::ident::{average_separate_springs, identify_separate_springs, Scheme}};
+/// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+/// let avg = average_separate_springs(&[est.clone(), est.clone()])?;
+/// assert_eq!(avg.plant(), est.plant());
+/// assert_eq!((avg.runs, avg.k2.std_dev, avg.coulomb), (2, 0.0, None));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeparateSpringsAverage {
+    /// Spring between the wall and cart 1, N/m.
+    pub k1: Spread,
+    /// Spring between the carts, N/m.
+    pub k2: Spread,
+    /// Viscous friction of cart 1, N·s/m.
+    pub b1: Spread,
+    /// Motor gain `K`, N per input unit.
+    pub gain: Spread,
+    /// Viscous friction of cart 2, N·s/m.
+    pub b2: Spread,
+    /// Coulomb friction force of cart 1 and cart 2, N, when every run
+    /// fitted it.
+    pub coulomb: Option<[Spread; 2]>,
+    /// Mass of cart 1, kg (the same in every run).
+    pub m1: f64,
+    /// Mass of cart 2, kg: the one given (spread 0), or the fitted ones
+    /// ([`Options::free_m2`](super::Options::free_m2)).
+    pub m2: Spread,
+    /// Number of runs averaged.
+    pub runs: usize,
+}
+
+impl SeparateSpringsAverage {
+    /// The model of the means, as [`MassSpring`](crate::lab::MassSpring)
+    /// parameters (the linear part, for design).
+    pub fn plant(&self) -> crate::lab::MassSpring {
+        crate::lab::MassSpring {
+            m1: self.m1,
+            m2: self.m2.mean,
+            k1: self.k1.mean,
+            k2: self.k2.mean,
+            b1: self.b1.mean,
+            b2: self.b2.mean,
+            gain: self.gain.mean,
+        }
+    }
+
+    /// The model of the means with its mean Coulomb forces (each at least
+    /// 0; none when not fitted), to simulate.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{Options, average_separate_springs, identify_separate_springs_with}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::DEFAULT })?;
+    /// let avg = average_separate_springs(&[est.clone(), est.clone()])?;
+    /// assert_eq!(avg.friction_plant(), est.friction_plant());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn friction_plant(&self) -> crate::lab::FrictionPlant {
+        let forces = self
+            .coulomb
+            .map_or([0.0; 2], |c| c.map(|f| f.mean.max(0.0)));
+        crate::lab::FrictionPlant::new(self.plant(), forces)
+    }
+}
+
+/// Averages repeated separate-springs identifications (one per run) into
+/// one model: each parameter's mean and sample standard deviation.
+///
+/// # Errors
+///
+/// [`Error::TooFewSamples`] for fewer than two runs;
+/// [`Error::InvalidParameter`] when the runs were identified with different
+/// `m1`, or some with Coulomb friction and some without (their parameters
+/// mean different things); [`Error::Overflow`] for a spread beyond
+/// `f64::MAX`.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{Error, Recording, lab::ident::{Options, average_separate_springs, identify_separate_springs, identify_separate_springs_with, Scheme}};
+/// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let a = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
+/// let b = identify_separate_springs(&rec, 1.2, 0.7, Scheme::Central)?;
+/// assert!(matches!(average_separate_springs(&[a.clone(), b]), Err(Error::InvalidParameter { name: "m1", .. })));
+/// let friction = Options { coulomb: true, ..Options::DEFAULT };
+/// let c = identify_separate_springs_with(&rec, 1.3, 0.7, &friction)?;
+/// assert!(matches!(average_separate_springs(&[a, c]), Err(Error::InvalidParameter { name: "coulomb", .. })));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn average_separate_springs(
+    runs: &[SeparateSpringsEstimate],
+) -> Result<SeparateSpringsAverage, Error> {
+    let n = runs.len();
+    let Some(first) = runs.first().filter(|_| n >= 2) else {
+        return Err(Error::TooFewSamples {
+            what: "averaging identification runs",
+            needed: 2,
+            got: n,
+        });
+    };
+    if let Some(other) = runs.iter().find(|r| r.m1 != first.m1) {
+        return Err(Error::InvalidParameter {
+            name: "m1",
+            value: other.m1,
+            reason: "the runs were identified with different masses of cart 1",
+        });
+    }
+    if runs
+        .iter()
+        .any(|r| r.coulomb.is_some() != first.coulomb.is_some())
+    {
+        return Err(Error::InvalidParameter {
+            name: "coulomb",
+            value: runs.iter().filter(|r| r.coulomb.is_some()).count() as f64,
+            reason: "runs with and without Coulomb friction cannot be averaged",
+        });
+    }
+    let of = |f: fn(&SeparateSpringsEstimate) -> f64| spread(runs.iter().map(f), n);
+    let coulomb = match first.coulomb {
+        Some(_) => {
+            let force = |cart: usize| {
+                spread(
+                    runs.iter()
+                        .filter_map(move |r| Some(r.coulomb?[cart].value)),
+                    n,
+                )
+            };
+            Some([force(0)?, force(1)?])
+        }
+        None => None,
+    };
+    Ok(SeparateSpringsAverage {
+        k1: of(|r| r.k1.value)?,
+        k2: of(|r| r.k2.value)?,
+        b1: of(|r| r.b1.value)?,
+        gain: of(|r| r.gain.value)?,
+        b2: of(|r| r.b2.value)?,
+        coulomb,
+        m1: first.m1,
+        m2: of(|r| r.m2)?,
         runs: n,
     })
 }

@@ -51,7 +51,9 @@ mod refine;
 mod regressors;
 mod timing;
 
-pub use average::{MassSpringAverage, Spread, average};
+pub use average::{
+    MassSpringAverage, SeparateSpringsAverage, Spread, average, average_separate_springs,
+};
 pub use estimates::{
     Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, SeparateSpringsEstimate, Warning,
 };
