@@ -239,6 +239,40 @@ fn simulation_of_a_diverging_plant_is_an_error() {
         let err = simulate(&sys, &t, vector![1.0], |_| vector![0.0], solver).unwrap_err();
         assert!(matches!(err, Error::Overflow { .. }), "{err}");
     }
+    // Only the output overflows (the states stay within 1); only one of two
+    // states diverges, and the output is the other one.
+    let output_only = StateSpace::continuous(
+        matrix![-1.0],
+        matrix![1.0],
+        matrix![f64::MAX],
+        matrix![f64::MAX],
+    )
+    .unwrap();
+    let err = simulate(
+        &output_only,
+        &t,
+        vector![0.0],
+        |_| vector![1.0],
+        Solver::Zoh,
+    )
+    .unwrap_err();
+    assert!(matches!(err, Error::Overflow { .. }), "{err}");
+    let one_of_two = StateSpace::continuous(
+        matrix![50.0, 0.0; 0.0, -1.0],
+        matrix![1.0; 1.0],
+        matrix![0.0, 1.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    let err = simulate(
+        &one_of_two,
+        &t,
+        vector![0.0, 0.0],
+        |_| vector![1.0],
+        Solver::Zoh,
+    )
+    .unwrap_err();
+    assert!(matches!(err, Error::Overflow { .. }), "{err}");
 }
 
 #[test]
