@@ -7,7 +7,9 @@
 mod common;
 
 use common::open_loop;
-use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine, validate};
+use ctrlab::lab::ident::{
+    Options, Refined, SeparateSpringsEstimate, identify_separate_springs_with, refine, validate,
+};
 use ctrlab::lab::{MassSpring, SimulatedRig};
 use ctrlab::signal::{Prbs, SquareWave};
 use ctrlab::{Error, Recording};
@@ -16,23 +18,41 @@ use ctrlab::{Error, Recording};
 /// (9 to 14 N; ±8 V is 8.9 N on the default motor): enough above the
 /// friction for both carts to slide, within the ±50 mm travel.
 fn square_run(sim: &SimulatedRig) -> Recording {
-    let volts = (8.0 + 2.0 * sim.coulomb_friction[0].max(sim.coulomb_friction[1])) / sim.truth.gain;
-    open_loop(sim, &SquareWave::new(volts, 0.2).unwrap(), 5.0)
+    open_loop(sim, &SquareWave::new(volts(sim), 0.2).unwrap(), 5.0)
+}
+
+/// The runs' drive, V: `8 + 2 F_max` N on the default truth's springs,
+/// scaled by their compliance over `sim`'s (cart 2's static deflection
+/// stays that of the default springs: 20 % softer springs at the full
+/// force overshoot the ±50 mm travel).
+fn volts(sim: &SimulatedRig) -> f64 {
+    let compliance = |p: &MassSpring| 1.0 / p.k1 + 1.0 / p.k2;
+    let force = 8.0 + 2.0 * sim.coulomb_friction[0].max(sim.coulomb_friction[1]);
+    force * compliance(&SimulatedRig::default_truth()) / compliance(&sim.truth) / sim.truth.gain
 }
 
 /// The fresh run a model is validated on: another input, a PRBS (40 ms
 /// clock) of the same force as [`square_run`].
 fn prbs_run(sim: &SimulatedRig) -> Recording {
-    let volts = (8.0 + 2.0 * sim.coulomb_friction[0].max(sim.coulomb_friction[1])) / sim.truth.gain;
-    open_loop(sim, &Prbs::new(volts, 0.04, 7, 0x35).unwrap(), 5.0)
+    open_loop(sim, &Prbs::new(volts(sim), 0.04, 7, 0x35).unwrap(), 5.0)
 }
 
 fn rig(gain: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {
-    SimulatedRig {
-        truth: MassSpring {
+    rig_of(
+        MassSpring {
             gain,
             ..SimulatedRig::default_truth()
         },
+        friction,
+        seed,
+    )
+}
+
+/// The default rig with `truth` inside, Coulomb forces `friction` (N) and
+/// stiction 20 % above them.
+fn rig_of(truth: MassSpring, friction: [f64; 2], seed: u64) -> SimulatedRig {
+    SimulatedRig {
+        truth,
         coulomb_friction: friction,
         stiction: friction.map(|f| 1.2 * f),
         seed,
@@ -40,12 +60,44 @@ fn rig(gain: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {
     }
 }
 
-#[test]
-fn refinement_recovers_the_truth_and_validates_on_a_fresh_run() {
+/// Identifies `sim`'s square-wave run with Coulomb friction and refines
+/// it: the estimate, the refined result and its errors against the truth,
+/// % (k1, k2, b1, b2, K; then F1, F2).
+fn refine_square_run(
+    sim: &SimulatedRig,
+) -> (SeparateSpringsEstimate, Refined, [(&'static str, f64); 7]) {
     let options = Options {
         coulomb: true,
         ..Options::default()
     };
+    let rec = square_run(sim);
+    let ls = identify_separate_springs_with(&rec, 1.3, 0.7, &options).unwrap();
+    let r = refine(&rec, &ls).unwrap();
+    let (t, f) = (sim.truth, sim.coulomb_friction);
+    let err = |got: f64, want: f64| (got / want - 1.0) * 100.0;
+    let errors = [
+        ("k1", err(r.plant.k1, t.k1)),
+        ("k2", err(r.plant.k2, t.k2)),
+        ("b1", err(r.plant.b1, t.b1)),
+        ("b2", err(r.plant.b2, t.b2)),
+        ("K", err(r.plant.gain, t.gain)),
+        ("F1", err(r.coulomb[0], f[0])),
+        ("F2", err(r.coulomb[1], f[1])),
+    ];
+    (ls, r, errors)
+}
+
+/// The issue's bounds: k1, k2, b1, b2 and K within 1 %, the Coulomb forces
+/// within 10 % of the truth.
+fn within_bounds(errors: &[(&str, f64); 7]) -> bool {
+    errors
+        .iter()
+        .enumerate()
+        .all(|(i, (_, e))| e.abs() < if i < 5 { 1.0 } else { 10.0 })
+}
+
+#[test]
+fn refinement_recovers_the_truth_and_validates_on_a_fresh_run() {
     for (gain, friction) in [
         (1.11, [1.0, 2.0]),
         (0.8, [0.5, 0.5]),
@@ -53,22 +105,7 @@ fn refinement_recovers_the_truth_and_validates_on_a_fresh_run() {
         (1.5, [2.0, 1.0]),
     ] {
         let sim = rig(gain, friction, 7);
-        let rec = square_run(&sim);
-        let ls = identify_separate_springs_with(&rec, 1.3, 0.7, &options).unwrap();
-        let r = refine(&rec, &ls).unwrap();
-        let t = sim.truth;
-        let err = |got: f64, want: f64| (got / want - 1.0) * 100.0;
-        let errors = [
-            ("k1", err(r.plant.k1, t.k1)),
-            ("k2", err(r.plant.k2, t.k2)),
-            ("b1", err(r.plant.b1, t.b1)),
-            ("b2", err(r.plant.b2, t.b2)),
-            ("K", err(r.plant.gain, t.gain)),
-        ];
-        let forces = [
-            err(r.coulomb[0], friction[0]),
-            err(r.coulomb[1], friction[1]),
-        ];
+        let (ls, r, errors) = refine_square_run(&sim);
         let ls_fit = validate(&prbs_run(&rig(gain, friction, 8)), &ls.plant(), {
             let c = ls.coulomb.unwrap();
             [c[0].value.max(0.0), c[1].value.max(0.0)]
@@ -76,7 +113,7 @@ fn refinement_recovers_the_truth_and_validates_on_a_fresh_run() {
         .unwrap();
         let fresh = validate(&prbs_run(&rig(gain, friction, 8)), &r.plant, r.coulomb).unwrap();
         println!(
-            "K = {gain}, F = {friction:?}: {errors:.2?}, F {forces:.1?} %; fit on its run {:.2?} → {:.2?} %, \
+            "K = {gain}, F = {friction:?}: {errors:.2?} %; fit on its run {:.2?} → {:.2?} %, \
              on a fresh PRBS run LS {:.2?} / refined {:.2?} %, {} simulations; \
              whiteness {:.3} (bound {:.3}), independence {:.3}",
             r.start.fit_percent,
@@ -88,18 +125,10 @@ fn refinement_recovers_the_truth_and_validates_on_a_fresh_run() {
             fresh.whiteness.bound,
             fresh.independence.max_correlation,
         );
-        for (name, e) in errors {
-            assert!(
-                e.abs() < 1.0,
-                "K = {gain}, F = {friction:?}: {name} {e:+.2} %"
-            );
-        }
-        for e in forces {
-            assert!(
-                e.abs() < 10.0,
-                "K = {gain}, F = {friction:?}: Coulomb {e:+.1} %"
-            );
-        }
+        assert!(
+            within_bounds(&errors),
+            "K = {gain}, F = {friction:?}: {errors:.2?} %"
+        );
         assert!(r.refined.fit_percent[1] >= r.start.fit_percent[1] - 1e-9);
         assert!(fresh.fit_percent[1] > 90.0 && fresh.fit_percent[0] > 80.0);
     }
@@ -158,5 +187,56 @@ proptest::proptest! {
                            v.whiteness.max_correlation, v.independence.max_correlation];
             proptest::prop_assert!(figures.iter().all(|f| f.is_finite()), "{v:?}");
         }
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig {
+        cases: 8,
+        max_shrink_iters: 16,
+        ..proptest::prelude::ProptestConfig::default()
+    })]
+    /// Any plausible truth: motor gain 0.8–2 N/V, Coulomb forces 0.5–3 N
+    /// (stiction 20 % above), springs and viscous frictions within ±20 % of
+    /// the default truth, any noise seed: the refinement of the square-wave
+    /// run meets the issue's bounds. Prints each case's errors and the
+    /// worst so far.
+    ///
+    /// Ignored: it fails, on the model, not the optimiser (the crate's own
+    /// tolerances give the same result). (1) K = 0.8 N/V, F = [0.5, 1.81] N,
+    /// springs and viscous frictions within 5 % of the default: K 1.26 % and
+    /// F2 7.8 % high for every seed (least squares had K 0.2 % off); without
+    /// stiction, PWM delay and noise K is 0.25 % off, yet the refined model
+    /// fits that run twice as well as the truth: one RK4 step per 2 ms
+    /// sample with stick decisions only at samples is not the card's plant
+    /// (0.25 ms sub-steps), so the optimum is biased. (2) K = 0.8 N/V,
+    /// F = [0.5, 1.5] N, k2 = 816 N/m, b1 = 9.6 N·s/m: b1 1.3–1.6 % low and
+    /// F1 7–10.7 % high over seeds. (3) Some 20 %-softer-spring truths still
+    /// leave the ±50 mm travel. Run with `--ignored`.
+    #[test]
+    #[ignore = "fails: the refinement model's bias at low K with F2 > F1, see the doc"]
+    fn refinement_recovers_any_plausible_truth(
+        gain in 0.8f64..2.0, f1 in 0.5f64..3.0, f2 in 0.5f64..3.0,
+        k1 in 0.8f64..1.2, k2 in 0.8f64..1.2, b1 in 0.8f64..1.2, b2 in 0.8f64..1.2,
+        seed in 0u64..1_000_000,
+    ) {
+        static WORST: std::sync::Mutex<[f64; 7]> = std::sync::Mutex::new([0.0; 7]);
+        let d = SimulatedRig::default_truth();
+        let truth = MassSpring {
+            k1: k1 * d.k1, k2: k2 * d.k2, b1: b1 * d.b1, b2: b2 * d.b2, gain, ..d
+        };
+        let sim = rig_of(truth, [f1, f2], seed);
+        let (_, r, errors) = refine_square_run(&sim);
+        if let Ok(mut worst) = WORST.lock() {
+            for (w, (_, e)) in worst.iter_mut().zip(&errors) {
+                *w = w.max(e.abs());
+            }
+            eprintln!(
+                "{truth:?}, F [{f1:.2}, {f2:.2}] N, seed {seed}: {errors:.2?} %, {} simulations; \
+                 worst so far (k1, k2, b1, b2, K, F1, F2) {:.2?} %",
+                r.evaluations, *worst
+            );
+        }
+        proptest::prop_assert!(within_bounds(&errors), "{truth:?}, F [{f1}, {f2}]: {errors:.2?} %");
     }
 }

@@ -198,7 +198,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// let rig = SimulatedRig::default();
     /// let card = rig.card(&Clock::RealTime)?;
-    /// assert_eq!(card.plant().truth, rig.truth);
+    /// assert_eq!(card.plant().truth(), rig.truth);
     /// # Ok::<(), ctrlab::hw::HwError>(())
     /// ```
     pub fn plant(&self) -> &D {

@@ -24,6 +24,10 @@ use crate::sim::SampledConfig;
 /// decisions are taken in [`update_mode`](Dynamics::update_mode) between
 /// integration steps, so a stuck cart's speed is exactly zero.
 ///
+/// The equations' coefficients (`k/m`, `b/m`, `K/m`, `F/m`) are computed
+/// once, when the plant is built, not on each of an RK4 step's four
+/// derivatives: the parameters are read through accessors for that reason.
+///
 /// # Examples
 ///
 /// ```
@@ -42,16 +46,47 @@ use crate::sim::SampledConfig;
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrictionPlant {
-    /// The linear plant (masses, springs, viscous friction, motor gain).
-    pub truth: MassSpring,
-    /// Coulomb (sliding) friction force on cart 1 and cart 2, N (≥ 0).
-    pub friction: [f64; 2],
-    /// Breakaway (static) friction force on cart 1 and cart 2, N; taken as
-    /// at least `friction`.
-    pub stiction: [f64; 2],
+    truth: MassSpring,
+    friction: [f64; 2],
+    stiction: [f64; 2],
     /// Each cart's sliding direction (±1) for the current step, or 0 while
     /// it sticks; only used for a cart with friction.
     direction: [f64; 2],
+    /// The linear plant's accelerations per unit state and input, 1/s²,
+    /// 1/s, N/(kg·unit): the entries of A's rows 1 and 3 and of B as
+    /// [`MassSpring`]'s equations give them.
+    accel: Accelerations,
+    /// Coulomb force over mass per cart, m/s².
+    friction_accel: [f64; 2],
+}
+
+/// The nonzero entries of the rows of `[A B]` that give the accelerations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Accelerations {
+    /// `[−(k1 + k2)/m1, −b1/m1, k2/m1]` on `[x1, v1, x2]`.
+    cart1: [f64; 3],
+    /// `[k2/m2, −k2/m2, −b2/m2, K/m2]` on `[x1, x2, v2, u]`.
+    cart2: [f64; 4],
+}
+
+impl Accelerations {
+    fn of(p: &MassSpring) -> Self {
+        Self {
+            cart1: [-(p.k1 + p.k2) / p.m1, -p.b1 / p.m1, p.k2 / p.m1],
+            cart2: [p.k2 / p.m2, -p.k2 / p.m2, -p.b2 / p.m2, p.gain / p.m2],
+        }
+    }
+
+    /// Each cart's acceleration from everything but Coulomb friction, m/s².
+    #[inline]
+    fn at(&self, x: &SVector<f64, 4>, u: f64) -> [f64; 2] {
+        let [a10, a11, a12] = self.cart1;
+        let [a30, a32, a33, b3] = self.cart2;
+        [
+            a10 * x[0] + a11 * x[1] + a12 * x[2],
+            a30 * x[0] + a32 * x[2] + a33 * x[3] + b3 * u,
+        ]
+    }
 }
 
 impl FrictionPlant {
@@ -63,7 +98,8 @@ impl FrictionPlant {
     /// ```
     /// # use ctrlab::lab::{FrictionPlant, MassSpring};
     /// let p = FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]);
-    /// assert_eq!(p.friction, [1.0, 2.0]);
+    /// assert_eq!(p.friction(), [1.0, 2.0]);
+    /// assert_eq!(p.stiction(), [1.0, 2.0]);
     /// ```
     pub fn new(truth: MassSpring, friction: [f64; 2]) -> Self {
         Self {
@@ -71,6 +107,8 @@ impl FrictionPlant {
             friction,
             stiction: friction,
             direction: [0.0; 2],
+            accel: Accelerations::of(&truth),
+            friction_accel: [friction[0] / truth.m1, friction[1] / truth.m2],
         }
     }
 
@@ -82,12 +120,51 @@ impl FrictionPlant {
     /// ```
     /// # use ctrlab::lab::{FrictionPlant, MassSpring};
     /// let p = FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]).with_stiction([1.3, 2.5]);
-    /// assert_eq!(p.stiction, [1.3, 2.5]);
+    /// assert_eq!(p.stiction(), [1.3, 2.5]);
     /// ```
     #[must_use]
     pub fn with_stiction(mut self, stiction: [f64; 2]) -> Self {
         self.stiction = stiction;
         self
+    }
+
+    /// The linear plant (masses, springs, viscous friction, motor gain).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// let p = FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]);
+    /// assert_eq!(p.truth(), MassSpring::nominal());
+    /// ```
+    pub fn truth(&self) -> MassSpring {
+        self.truth
+    }
+
+    /// Coulomb (sliding) friction force on cart 1 and cart 2, N.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// assert_eq!(FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]).friction(), [1.0, 2.0]);
+    /// ```
+    pub fn friction(&self) -> [f64; 2] {
+        self.friction
+    }
+
+    /// Breakaway (static) friction force on cart 1 and cart 2, N, as given
+    /// (the plant holds a cart with at least its Coulomb force).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// let p = FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]).with_stiction([1.2, 2.4]);
+    /// assert_eq!(p.stiction(), [1.2, 2.4]);
+    /// ```
+    pub fn stiction(&self) -> [f64; 2] {
+        self.stiction
     }
 
     /// The force that holds a cart at rest, N.
@@ -105,28 +182,28 @@ impl FrictionPlant {
 
     /// Net force on `cart` from everything but Coulomb friction, N.
     fn other_force(&self, x: &SVector<f64, 4>, u: &SVector<f64, 1>, cart: usize) -> f64 {
-        self.truth.derivative(0.0, x, u)[2 * cart + 1] * self.mass(cart)
+        self.accel.at(x, u[0])[cart] * self.mass(cart)
     }
 }
 
 impl Dynamics<4, 1> for FrictionPlant {
     #[inline]
-    fn derivative(&self, t: f64, x: &SVector<f64, 4>, u: &SVector<f64, 1>) -> SVector<f64, 4> {
-        let mut dx = self.truth.derivative(t, x, u);
+    fn derivative(&self, _t: f64, x: &SVector<f64, 4>, u: &SVector<f64, 1>) -> SVector<f64, 4> {
+        let mut dx = SVector::from([x[1], 0.0, x[3], 0.0]);
+        let accel = self.accel.at(x, u[0]);
         for cart in 0..2 {
+            dx[2 * cart + 1] = accel[cart];
             if self.friction[cart] > 0.0 {
                 if self.direction[cart] == 0.0 {
                     dx[2 * cart] = 0.0;
                     dx[2 * cart + 1] = 0.0;
                 } else {
-                    dx[2 * cart + 1] -=
-                        self.friction[cart] * self.direction[cart] / self.mass(cart);
+                    dx[2 * cart + 1] -= self.friction_accel[cart] * self.direction[cart];
                 }
             }
         }
         dx
     }
-
     /// First, a sliding cart whose speed reached or crossed zero sticks if
     /// the other forces are within its breakaway force, otherwise reverses;
     /// then a sticking cart breaks away when the other forces (under the
@@ -443,7 +520,7 @@ impl SimulatedRig {
     /// ```
     /// use ctrlab::lab::SimulatedRig;
     /// let sim = SimulatedRig { coulomb_friction: [1.0, 2.0], ..Default::default() };
-    /// assert_eq!(sim.plant().friction, [1.0, 2.0]);
+    /// assert_eq!(sim.plant().friction(), [1.0, 2.0]);
     /// ```
     pub fn plant(&self) -> FrictionPlant {
         FrictionPlant::new(self.truth, self.coulomb_friction).with_stiction(self.stiction)
