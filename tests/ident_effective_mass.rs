@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::open_loop;
+use common::{friction_rig, open_loop};
 use ctrlab::Recording;
 use ctrlab::ident::Covariance;
 use ctrlab::lab::ident::{Options, identify_separate_springs_with, identify_with};
@@ -14,16 +14,11 @@ use ctrlab::signal::SquareWave;
 /// The rig with cart 2's effective mass `m2` (kg) and Coulomb friction
 /// `friction` (N), stiction 20 % above it.
 fn rig(m2: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {
-    SimulatedRig {
-        truth: MassSpring {
-            m2,
-            ..SimulatedRig::default_truth()
-        },
-        coulomb_friction: friction,
-        stiction: friction.map(|f| 1.2 * f),
-        seed,
-        ..SimulatedRig::default()
-    }
+    let truth = MassSpring {
+        m2,
+        ..SimulatedRig::default_truth()
+    };
+    friction_rig(truth, friction, seed)
 }
 
 /// The lab's square wave, 5 s, of force `8 + 2 F_max` N.

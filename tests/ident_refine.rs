@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::open_loop;
+use common::{friction_rig, open_loop};
 use ctrlab::lab::ident::{
     Options, Refined, SeparateSpringsEstimate, identify_separate_springs_with, refine, validate,
 };
@@ -38,7 +38,7 @@ fn prbs_run(sim: &SimulatedRig) -> Recording {
 }
 
 fn rig(gain: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {
-    rig_of(
+    friction_rig(
         MassSpring {
             gain,
             ..SimulatedRig::default_truth()
@@ -46,18 +46,6 @@ fn rig(gain: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {
         friction,
         seed,
     )
-}
-
-/// The default rig with `truth` inside, Coulomb forces `friction` (N) and
-/// stiction 20 % above them.
-fn rig_of(truth: MassSpring, friction: [f64; 2], seed: u64) -> SimulatedRig {
-    SimulatedRig {
-        truth,
-        coulomb_friction: friction,
-        stiction: friction.map(|f| 1.2 * f),
-        seed,
-        ..SimulatedRig::default()
-    }
 }
 
 /// Identifies `sim`'s square-wave run with Coulomb friction and refines
@@ -225,7 +213,7 @@ proptest::proptest! {
         let truth = MassSpring {
             k1: k1 * d.k1, k2: k2 * d.k2, b1: b1 * d.b1, b2: b2 * d.b2, gain, ..d
         };
-        let sim = rig_of(truth, [f1, f2], seed);
+        let sim = friction_rig(truth, [f1, f2], seed);
         let (_, r, errors) = refine_square_run(&sim);
         if let Ok(mut worst) = WORST.lock() {
             for (w, (_, e)) in worst.iter_mut().zip(&errors) {

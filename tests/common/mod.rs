@@ -109,6 +109,18 @@ pub fn run_on_rig<C: Controller<4, 1, 1>>(
     out.recording
 }
 
+/// The default simulated rig with plant `truth`, Coulomb friction
+/// `friction` (N, cart 1 and 2) and stiction 20 % above it, noise `seed`.
+pub fn friction_rig(truth: MassSpring, friction: [f64; 2], seed: u64) -> SimulatedRig {
+    SimulatedRig {
+        truth,
+        coulomb_friction: friction,
+        stiction: friction.map(|f| 1.2 * f),
+        seed,
+        ..SimulatedRig::default()
+    }
+}
+
 /// `input` (V) open loop for `duration` seconds on `sim`'s rig (card,
 /// driver, 2 ms loop) over a fresh virtual clock.
 pub fn open_loop(sim: &SimulatedRig, input: &dyn Signal, duration: f64) -> Recording {

@@ -145,8 +145,8 @@ impl MassSpringEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let est = identify_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::default() })?;
     /// let model = est.friction_plant();
-    /// assert_eq!(model.truth, est.plant());
-    /// assert_eq!(model.friction[1], est.coulomb.unwrap()[1].value.max(0.0));
+    /// assert_eq!(model.truth(), est.plant());
+    /// assert_eq!(model.friction()[1], est.coulomb.unwrap()[1].value.max(0.0));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn friction_plant(&self) -> FrictionPlant {
@@ -281,8 +281,8 @@ impl SeparateSpringsEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::default() })?;
     /// let model = est.friction_plant();
-    /// assert_eq!(model.truth, est.plant());
-    /// assert_eq!(model.friction[1], est.coulomb.unwrap()[1].value.max(0.0));
+    /// assert_eq!(model.truth(), est.plant());
+    /// assert_eq!(model.friction()[1], est.coulomb.unwrap()[1].value.max(0.0));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn friction_plant(&self) -> FrictionPlant {
