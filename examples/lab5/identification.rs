@@ -383,21 +383,57 @@ fn uncertainty(
 ) {
     report.heading(3, "The identified model and its uncertainty");
     type Pick = fn(&SeparateSpringsEstimate) -> Option<Estimate>;
-    let rows: [(&str, Pick, Option<f64>, usize); 7] = [
-        ("k1 (N/m)", |e| Some(e.k1), truth.map(|(t, _)| t.k1), 1),
-        ("k2 (N/m)", |e| Some(e.k2), truth.map(|(t, _)| t.k2), 1),
-        ("b1 (N·s/m)", |e| Some(e.b1), truth.map(|(t, _)| t.b1), 3),
-        ("b2 (N·s/m)", |e| Some(e.b2), truth.map(|(t, _)| t.b2), 3),
-        ("K (N/V)", |e| Some(e.gain), truth.map(|(t, _)| t.gain), 4),
+    /// Name, estimate, spread over the runs, truth, decimals.
+    type Row = (&'static str, Pick, Option<Spread>, Option<f64>, usize);
+    let forces = average.coulomb.map(|[f1, f2]| (f1, f2));
+    // Each parameter's spread over the runs is the average's own.
+    let rows: [Row; 7] = [
+        (
+            "k1 (N/m)",
+            |e| Some(e.k1),
+            Some(average.k1),
+            truth.map(|(t, _)| t.k1),
+            1,
+        ),
+        (
+            "k2 (N/m)",
+            |e| Some(e.k2),
+            Some(average.k2),
+            truth.map(|(t, _)| t.k2),
+            1,
+        ),
+        (
+            "b1 (N·s/m)",
+            |e| Some(e.b1),
+            Some(average.b1),
+            truth.map(|(t, _)| t.b1),
+            3,
+        ),
+        (
+            "b2 (N·s/m)",
+            |e| Some(e.b2),
+            Some(average.b2),
+            truth.map(|(t, _)| t.b2),
+            3,
+        ),
+        (
+            "K (N/V)",
+            |e| Some(e.gain),
+            Some(average.gain),
+            truth.map(|(t, _)| t.gain),
+            4,
+        ),
         (
             "F1 (N)",
             |e| Some(e.coulomb?[0]),
+            forces.map(|f| f.0),
             truth.map(|(_, f)| f[0]),
             3,
         ),
         (
             "F2 (N)",
             |e| Some(e.coulomb?[1]),
+            forces.map(|f| f.1),
             truth.map(|(_, f)| f[1]),
             3,
         ),
@@ -405,14 +441,11 @@ fn uncertainty(
     let n = separate.len() as f64;
     let mut table = Vec::new();
     let mut ratios = Vec::new();
-    for (name, pick, want, digits) in rows {
-        let estimates: Vec<Estimate> = separate.iter().filter_map(pick).collect();
-        if estimates.len() != separate.len() {
+    for (name, pick, spread, want, digits) in rows {
+        let Some(Spread { mean, std_dev: sd }) = spread else {
             continue;
-        }
-        let values: Vec<f64> = estimates.iter().map(|e| e.value).collect();
-        let mean = values.iter().sum::<f64>() / n;
-        let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        };
+        let estimates: Vec<Estimate> = separate.iter().filter_map(pick).collect();
         let se = (estimates.iter().map(|e| e.std_error.powi(2)).sum::<f64>() / n).sqrt();
         ratios.push(se / sd);
         let mut row = vec![

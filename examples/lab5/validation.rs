@@ -47,9 +47,7 @@ pub fn section(
     let separate = ident.separate.first().ok_or("no identification run")?;
     let refined = refine(rec, separate)?;
     let lab = ident.lab.first().ok_or("no identification run")?.plant();
-    let ls_coulomb = separate
-        .coulomb
-        .map_or([0.0; 2], |c| [c[0].value.max(0.0), c[1].value.max(0.0)]);
+    let ls_coulomb = separate.friction_plant().friction();
     let mut rows = Vec::new();
     let mut failures = Vec::new();
     for (name, plant, coulomb) in [
