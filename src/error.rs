@@ -157,6 +157,22 @@ pub enum Error {
         /// What it must satisfy.
         reason: &'static str,
     },
+    /// A matrix of a run-time-sized model or problem has the wrong shape.
+    #[error(
+        "matrix {matrix} is {found_rows}×{found_cols}, expected {expected_rows}×{expected_cols}"
+    )]
+    DimensionMismatch {
+        /// Which matrix (`"A"`, `"B"`, `"Q"`, …).
+        matrix: &'static str,
+        /// The rows it must have.
+        expected_rows: usize,
+        /// The columns it must have.
+        expected_cols: usize,
+        /// The rows it has.
+        found_rows: usize,
+        /// The columns it has.
+        found_cols: usize,
+    },
     /// An iterative algorithm did not converge.
     #[error("{operation} did not converge after {iterations} iterations")]
     NoConvergence {
@@ -391,6 +407,42 @@ impl Error {
             kind: err.kind(),
             message: err.to_string(),
         }
+    }
+}
+
+/// Checks a run-time-sized matrix's entries as [`check_finite`] does.
+pub(crate) fn check_finite_dyn(
+    matrix: &'static str,
+    m: &nalgebra::DMatrix<f64>,
+) -> Result<(), Error> {
+    match m.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::NonFinite {
+            matrix,
+            row: i % m.nrows(),
+            col: i / m.nrows(),
+            value: m[i],
+        }),
+    }
+}
+
+/// Checks a run-time-sized matrix's shape.
+pub(crate) fn check_shape(
+    matrix: &'static str,
+    m: &nalgebra::DMatrix<f64>,
+    rows: usize,
+    cols: usize,
+) -> Result<(), Error> {
+    if m.shape() == (rows, cols) {
+        Ok(())
+    } else {
+        Err(Error::DimensionMismatch {
+            matrix,
+            expected_rows: rows,
+            expected_cols: cols,
+            found_rows: m.nrows(),
+            found_cols: m.ncols(),
+        })
     }
 }
 

@@ -119,7 +119,7 @@ pub use ident::{LeastSquares, LeastSquaresFit, Rls};
 pub use integrate::{Euler, Integrator, Rk4};
 pub use lab::{Cart, MassSpring};
 pub use metrics::{StepInfo, StepInfoOptions, step_info, step_info_mimo, step_info_of};
-pub use model::{Continuous, Discrete, Domain, Dynamics, StateSpace};
+pub use model::{Continuous, Discrete, Domain, DynStateSpace, Dynamics, StateSpace};
 pub use sim::{Response, impulse_response, initial_response, run_sampled, step_response};
 
 // The README's code blocks are compiled and run as doctests.

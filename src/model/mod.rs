@@ -1,14 +1,17 @@
 //! Typed models: linear [`StateSpace`] models with their sizes and time
-//! domain ([`Continuous`] or [`Discrete`]) in the type, and the
+//! domain ([`Continuous`] or [`Discrete`]) in the type, [`DynStateSpace`]
+//! models sized at run time with the domain still in the type, and the
 //! [`Dynamics`] trait any plant (linear or not) implements for simulation.
 //!
 //! This is the bottom layer: it names no particular plant (the lab's
 //! two-cart plant is [`lab::MassSpring`](crate::lab::MassSpring)).
 
 mod display;
+mod dyn_state_space;
 mod dynamics;
 mod state_space;
 
+pub use dyn_state_space::DynStateSpace;
 pub use dynamics::Dynamics;
 pub(crate) use state_space::period_of;
 pub use state_space::{Continuous, Discrete, Domain, StateSpace};

@@ -55,6 +55,11 @@ impl Discrete {
     pub fn dt(&self) -> f64 {
         self.dt
     }
+
+    /// A discrete domain with a period the caller has checked (`check_dt`).
+    pub(crate) fn new_unchecked(dt: f64) -> Self {
+        Self { dt }
+    }
 }
 
 impl Domain for Continuous {}

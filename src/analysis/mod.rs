@@ -19,6 +19,8 @@
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
+mod dynamic;
+
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::Error;
@@ -167,33 +169,40 @@ fn singular_values(m: &DMatrix<f64>, name: &'static str) -> Result<Vec<f64>, Err
 pub(crate) fn eigenvalues<const N: usize>(
     a: &SMatrix<f64, N, N>,
 ) -> Result<[Complex<f64>; N], Error> {
+    let values = eigenvalues_dyn(&DMatrix::from_column_slice(N, N, a.as_slice()))?;
     let mut out = [Complex::new(0.0, 0.0); N];
-    if N == 0 {
-        return Ok(out);
+    out.copy_from_slice(&values);
+    Ok(out)
+}
+
+/// Eigenvalues of a square run-time-sized matrix, sorted as [`eigenvalues`]
+/// sorts them. The one implementation behind every model's `poles()`.
+pub(crate) fn eigenvalues_dyn(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, Error> {
+    let n = a.nrows();
+    debug_assert_eq!(n, a.ncols());
+    if n == 0 {
+        return Ok(Vec::new());
     }
-    let iterations = ITERATIONS_PER_DIM * N;
-    match DMatrix::from_fn(N, N, |r, c| a[(r, c)]).try_schur(f64::EPSILON, iterations) {
-        Some(schur) => {
-            for (o, e) in out.iter_mut().zip(schur.complex_eigenvalues().iter()) {
-                *o = *e;
-            }
-        }
-        None => {
-            // nalgebra's Francis iteration has no exceptional shifts and can
-            // stall on a matrix with a repeated, non-defective eigenvalue
-            // (a closed loop with a pole placed twice or three times);
-            // faer's eigenvalue solver has them.
-            let values = faer::Mat::<f64>::from_fn(N, N, |r, c| a[(r, c)])
-                .eigenvalues()
-                .map_err(|_| Error::NoConvergence {
-                    operation: "Schur decomposition (eigenvalues)",
-                    iterations,
-                })?;
-            for (o, e) in out.iter_mut().zip(values.iter()) {
-                *o = Complex::new(e.re, e.im);
-            }
-        }
-    }
+    let iterations = ITERATIONS_PER_DIM * n;
+    // faer's multishift QR (exceptional shifts, aggressive early deflation)
+    // first: it converges where nalgebra's Francis iteration stalls (a
+    // repeated, non-defective eigenvalue; CAREX 6's 30 states) and is the
+    // faster at large n. nalgebra's Schur is the fallback.
+    let view = faer::MatRef::from_column_major_slice(a.as_slice(), n, n);
+    let mut out: Vec<Complex<f64>> = match view.eigenvalues() {
+        Ok(values) => values.iter().map(|e| Complex::new(e.re, e.im)).collect(),
+        Err(_) => a
+            .clone()
+            .try_schur(f64::EPSILON, iterations)
+            .ok_or(Error::NoConvergence {
+                operation: "Schur decomposition (eigenvalues)",
+                iterations,
+            })?
+            .complex_eigenvalues()
+            .iter()
+            .copied()
+            .collect(),
+    };
     if out.iter().any(|p| !(p.re.is_finite() && p.im.is_finite())) {
         return Err(Error::Overflow {
             operation: "eigenvalues",
