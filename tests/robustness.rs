@@ -662,3 +662,17 @@ fn discrete_simulation_is_finite_or_an_error() {
         "{err}"
     );
 }
+
+/// Found by `proptest_api::simulation`: `round(t_end / dt)` rounds up, so a
+/// `t_end` near f64::MAX put the grid's last time at +∞ inside `Ok`.
+#[test]
+fn a_time_grid_whose_last_time_overflows_is_refused() {
+    let err = time_grid(1.79e308, 0.7e308).unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidParameter { name: "t_end", .. }),
+        "{err}"
+    );
+    // Just below, the grid is finite.
+    let t = time_grid(1.4e308, 0.7e308).unwrap();
+    assert!(t.iter().all(|v| v.is_finite()) && t.len() == 3);
+}

@@ -9,9 +9,11 @@
 mod display;
 mod dyn_state_space;
 mod dynamics;
+mod interconnect;
 mod state_space;
 
 pub use dyn_state_space::DynStateSpace;
 pub use dynamics::Dynamics;
+pub use interconnect::Sign;
 pub(crate) use state_space::period_of;
 pub use state_space::{Continuous, Discrete, Domain, StateSpace};

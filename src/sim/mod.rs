@@ -190,6 +190,14 @@ pub fn time_grid(t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
             reason: "t_end / dt exceeds MAX_SAMPLES",
         });
     }
+    // Rounding `t_end / dt` up can put the last sample past f64::MAX.
+    if !(n * dt).is_finite() {
+        return Err(Error::InvalidParameter {
+            name: "t_end",
+            value: t_end,
+            reason: "the grid's last time, round(t_end / dt)·dt, overflows",
+        });
+    }
     Ok((0..=n as usize).map(|k| k as f64 * dt).collect())
 }
 
