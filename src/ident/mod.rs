@@ -8,6 +8,8 @@
 //!   from row to row, as differenced samples' are.
 //! - [`Rls`]: recursive least squares, fixed size and allocation-free, with
 //!   a forgetting factor, for identification inside the control loop.
+//! - [`etfe`] and [`spa`]: a frequency response from input/output data, raw
+//!   (the ratio of the DFTs) or smoothed (Blackman–Tukey), MATLAB's names.
 //!
 //! The lab's two-cart regressors (equations (6)–(11)) build on these in
 //! [`lab::ident`](crate::lab::ident).
@@ -31,9 +33,13 @@ mod covariance;
 mod least_squares;
 mod rls;
 mod solve;
+mod spectral;
 
 pub(crate) use covariance::newey_west;
 pub use covariance::{Covariance, MAX_LAGS, newey_west_lags};
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};
 pub use rls::Rls;
 pub(crate) use solve::{SolveOptions, Workspace, solve_augmented};
+pub use spectral::{
+    ETFE_MIN_INPUT, FrequencyEstimate, MAX_SPECTRAL_SAMPLES, SPA_DEFAULT_LAG, etfe, spa,
+};
