@@ -336,7 +336,6 @@ impl<D: Domain> DynStateSpace<D> {
 
     /// A model from matrices the caller has already checked (shapes
     /// conforming, entries finite).
-    #[allow(dead_code)] // for the interconnection and design code being built on it
     pub(crate) fn from_parts_unchecked(
         a: DMatrix<f64>,
         b: DMatrix<f64>,
@@ -350,7 +349,6 @@ impl<D: Domain> DynStateSpace<D> {
 
     /// A model from computed matrices: shapes are the caller's, but an entry
     /// that overflowed is reported as [`Error::Overflow`] of `operation`.
-    #[allow(dead_code)] // for the discretisation being built on it
     pub(crate) fn from_computed(
         a: DMatrix<f64>,
         b: DMatrix<f64>,
