@@ -222,6 +222,9 @@ const PADE_Q: usize = 6;
 /// ```
 pub const EXPM_MAX_ERROR: f64 = 1e-8;
 
+/// `(Ad, Bd)` of a model under a held input.
+pub(crate) type Held<N, M> = (OMatrix<f64, N, N>, OMatrix<f64, N, M>);
+
 /// Exact ZOH: `Ad = exp(A h)`, `Bd = ∫₀ʰ exp(A s) ds · B`.
 ///
 /// Both come out of `exp(W)` with `W = [[A, B], [0, 0]] h`, computed by
@@ -244,7 +247,7 @@ pub(crate) fn zoh<N: Dim, M: Dim>(
     a: &OMatrix<f64, N, N>,
     b: &OMatrix<f64, N, M>,
     h: f64,
-) -> Result<(OMatrix<f64, N, N>, OMatrix<f64, N, M>), Error>
+) -> Result<Held<N, M>, Error>
 where
     DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N>,
 {

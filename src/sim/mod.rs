@@ -21,7 +21,7 @@ pub use dynamic::DynResponse;
 pub use responses::{impulse_response, initial_response, step_response};
 pub use sampled::{SampledConfig, Sensor, run_sampled};
 
-use crate::discretize::zoh;
+use crate::discretize::{Held, zoh};
 use crate::error::{Error, check_dt};
 use crate::integrate::{Integrator, Rk4};
 use crate::kernels::reduce::max_step_deviation;
@@ -335,7 +335,7 @@ where
         return Ok((xs, ys));
     }
     // ZOH matrices, recomputed only when the interval length changes.
-    let mut cached: Option<(f64, OMatrix<f64, N, N>, OMatrix<f64, N, M>)> = None;
+    let mut cached: Option<(f64, Held<N, M>)> = None;
     for (k, &tk) in t.iter().enumerate() {
         let u = input(tk);
         check_input(&u, b.ncols())?;
@@ -346,10 +346,9 @@ where
                 let h = next - tk;
                 let same = matches!(&cached, Some((hc, ..)) if (hc - h).abs() <= tol);
                 if !same {
-                    let (ad, bd) = zoh(a, b, h)?;
-                    cached = Some((h, ad, bd));
+                    cached = Some((h, zoh(a, b, h)?));
                 }
-                cached.as_ref().map(|(_, ad, bd)| ad * &x + bd * &u)
+                cached.as_ref().map(|(_, (ad, bd))| ad * &x + bd * &u)
             }
         };
         xs.push(x);
