@@ -7,9 +7,15 @@
 //! delay, saturation and measurement quantisation and noise, producing the
 //! same [`Recording`](crate::Recording) as the rig's loop.
 //!
-//! The inner loops are [`StateSpace::advance_mut`] and
-//! [`Integrator::step_mut`], which allocate nothing; the functions here
-//! allocate only their output, once, up front.
+//! A model sized at run time ([`DynStateSpace`](crate::DynStateSpace)) has
+//! the same simulations as methods (`sys.step_response(t_end, dt)`, …),
+//! returning a [`DynResponse`]; they run the same loops, generic over the
+//! matrices' dimensions.
+//!
+//! For a fixed-size model the inner loops (the recursion
+//! `x ← A x + B u` of [`StateSpace::advance_mut`], and
+//! [`Integrator::step_mut`]) allocate nothing; the functions here allocate
+//! only their output, once, up front.
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, SVector, allocator::Allocator};
 
