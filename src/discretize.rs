@@ -5,13 +5,16 @@
 //! The definitions match SciPy's `cont2discrete` (methods `zoh`, `bilinear`,
 //! `euler`, `backward_diff`); the reference fixtures in `tests/data/` check it.
 //!
-//! Everything here is fixed-size and allocation-free.
+//! Each algorithm is written once, generic over nalgebra's [`Dim`]: a
+//! fixed-size [`StateSpace`] runs it on stack matrices without allocating,
+//! a run-time-sized [`DynStateSpace`] on heap matrices, with the same
+//! arithmetic in the same order (the results agree bit for bit).
 
-use nalgebra::SMatrix;
+use nalgebra::{Const, DMatrix, DefaultAllocator, Dim, OMatrix, SMatrix, U0, allocator::Allocator};
 
 use crate::error::{Error, check_dt};
 use crate::kernels::linalg::Lu;
-use crate::model::{Continuous, Discrete, StateSpace};
+use crate::model::{Continuous, Discrete, DynStateSpace, StateSpace};
 
 /// How to turn a continuous model into a discrete one with period `h`.
 ///
@@ -74,39 +77,122 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
         method: Method,
     ) -> Result<StateSpace<N, M, P, Discrete>, Error> {
         check_dt(dt)?;
-        match method {
-            Method::Zoh => {
-                let (ad, bd) = zoh(self.a(), self.b(), dt)?;
-                StateSpace::from_computed(ad, bd, *self.c(), *self.d(), dt, "ZOH discretisation")
-            }
-            Method::Tustin => self.gbt(dt, 0.5, "Tustin discretisation"),
-            Method::ForwardEuler => self.gbt(dt, 0.0, "forward Euler discretisation"),
-            Method::BackwardEuler => self.gbt(dt, 1.0, "backward Euler discretisation"),
-        }
-    }
-
-    /// Generalised bilinear transform with weight `alpha` (SciPy's `gbt`).
-    fn gbt(
-        &self,
-        dt: f64,
-        alpha: f64,
-        operation: &'static str,
-    ) -> Result<StateSpace<N, M, P, Discrete>, Error> {
-        let id = SMatrix::<f64, N, N>::identity();
-        let a = self.a();
-        let ima = id - a * (alpha * dt);
-        let (ad, bd, cd, dd) = if alpha == 0.0 {
-            (id + a * dt, self.b() * dt, *self.c(), *self.d())
-        } else {
-            let lu = Lu::new(&ima, operation)?;
-            let ad = lu.solve(&(id + a * ((1.0 - alpha) * dt)));
-            let bd = lu.solve(&(self.b() * dt));
-            let cd = Lu::solve_right(&ima, self.c(), operation)?;
-            let dd = self.d() + self.c() * bd * alpha;
-            (ad, bd, cd, dd)
-        };
+        let ((ad, bd, cd, dd), operation) =
+            discretize_parts(self.a(), self.b(), self.c(), self.d(), dt, method)?;
         StateSpace::from_computed(ad, bd, cd, dd, dt, operation)
     }
+}
+
+impl DynStateSpace<Continuous> {
+    /// The discrete model with sampling period `dt` seconds by `method`:
+    /// the algorithm of [`StateSpace::discretize`] (ZOH by scaling and
+    /// squaring with its error estimate, the generalised bilinear transform
+    /// for the others), run on the heap; the result agrees with the
+    /// fixed-size one bit for bit.
+    ///
+    /// # Errors
+    ///
+    /// As [`StateSpace::discretize`]: [`Error::InvalidParameter`] named
+    /// `"dt"`, [`Error::Singular`], [`Error::Overflow`],
+    /// [`Error::IllConditioned`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{DynStateSpace, Method};
+    /// use nalgebra::dmatrix;
+    ///
+    /// // x' = -x + u held for 0.1 s: Ad = e^-0.1, Bd = 1 - e^-0.1.
+    /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
+    /// let d = sys.discretize(0.1, Method::Zoh)?;
+    /// assert!((d.a()[(0, 0)] - (-0.1f64).exp()).abs() < 1e-15);
+    /// assert!((d.b()[(0, 0)] - (1.0 - (-0.1f64).exp())).abs() < 1e-15);
+    /// assert_eq!(d.dt(), 0.1);
+    /// // Tustin changes C and D too: Dd = α C Bd with α = ½.
+    /// let t = sys.discretize(0.1, Method::Tustin)?;
+    /// assert!((t.d()[(0, 0)] - 0.5 * t.b()[(0, 0)]).abs() < 1e-15);
+    /// assert!(sys.discretize(0.0, Method::Zoh).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "c2d")]
+    pub fn discretize(&self, dt: f64, method: Method) -> Result<DynStateSpace<Discrete>, Error> {
+        check_dt(dt)?;
+        let ((ad, bd, cd, dd), operation) =
+            discretize_parts(self.a(), self.b(), self.c(), self.d(), dt, method)?;
+        DynStateSpace::from_computed(ad, bd, cd, dd, Discrete::new_unchecked(dt), operation)
+    }
+}
+
+/// The four matrices of a model with `N` states, `M` inputs, `P` outputs.
+type Parts<N, M, P> = (
+    OMatrix<f64, N, N>,
+    OMatrix<f64, N, M>,
+    OMatrix<f64, P, N>,
+    OMatrix<f64, P, M>,
+);
+
+/// `(Ad, Bd, Cd, Dd)` of `(A, B, C, D)` by `method` at period `dt` (already
+/// checked), with the name of the operation for an overflow of the result.
+fn discretize_parts<N: Dim, M: Dim, P: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
+    c: &OMatrix<f64, P, N>,
+    d: &OMatrix<f64, P, M>,
+    dt: f64,
+    method: Method,
+) -> Result<(Parts<N, M, P>, &'static str), Error>
+where
+    DefaultAllocator: Allocator<N, N>
+        + Allocator<N, M>
+        + Allocator<P, N>
+        + Allocator<N, P>
+        + Allocator<P, M>
+        + Allocator<N>,
+{
+    match method {
+        Method::Zoh => {
+            const OP: &str = "ZOH discretisation";
+            let (ad, bd) = zoh(a, b, dt)?;
+            Ok(((ad, bd, c.clone(), d.clone()), OP))
+        }
+        Method::Tustin => gbt(a, b, c, d, dt, 0.5, "Tustin discretisation"),
+        Method::ForwardEuler => gbt(a, b, c, d, dt, 0.0, "forward Euler discretisation"),
+        Method::BackwardEuler => gbt(a, b, c, d, dt, 1.0, "backward Euler discretisation"),
+    }
+}
+
+/// Generalised bilinear transform with weight `alpha` (SciPy's `gbt`).
+fn gbt<N: Dim, M: Dim, P: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
+    c: &OMatrix<f64, P, N>,
+    d: &OMatrix<f64, P, M>,
+    dt: f64,
+    alpha: f64,
+    operation: &'static str,
+) -> Result<(Parts<N, M, P>, &'static str), Error>
+where
+    DefaultAllocator: Allocator<N, N>
+        + Allocator<N, M>
+        + Allocator<P, N>
+        + Allocator<N, P>
+        + Allocator<P, M>
+        + Allocator<N>,
+{
+    let (n, _) = a.shape_generic();
+    let id = OMatrix::<f64, N, N>::identity_generic(n, n);
+    let parts = if alpha == 0.0 {
+        (id + a * dt, b * dt, c.clone(), d.clone())
+    } else {
+        let ima = &id - a * (alpha * dt);
+        let lu = Lu::new(&ima, operation)?;
+        let ad = lu.solve(&(id + a * ((1.0 - alpha) * dt)));
+        let bd = lu.solve(&(b * dt));
+        let cd = Lu::solve_right(&ima, c, operation)?;
+        let dd = d + c * &bd * alpha;
+        (ad, bd, cd, dd)
+    };
+    Ok((parts, operation))
 }
 
 /// Degree of the diagonal Padé approximant; with the scaling below
@@ -136,6 +222,9 @@ const PADE_Q: usize = 6;
 /// ```
 pub const EXPM_MAX_ERROR: f64 = 1e-8;
 
+/// `(Ad, Bd)` of a model under a held input.
+pub(crate) type Held<N, M> = (OMatrix<f64, N, N>, OMatrix<f64, N, M>);
+
 /// Exact ZOH: `Ad = exp(A h)`, `Bd = ∫₀ʰ exp(A s) ds · B`.
 ///
 /// Both come out of `exp(W)` with `W = [[A, B], [0, 0]] h`, computed by
@@ -154,21 +243,27 @@ pub const EXPM_MAX_ERROR: f64 = 1e-8;
 /// (`2^s (N + 2) ε > `[`EXPM_MAX_ERROR`]) a componentwise bound on the
 /// rounding error is carried along, and a result whose bound exceeds the
 /// limit is refused rather than returned wrong.
-pub(crate) fn zoh<const N: usize, const M: usize>(
-    a: &SMatrix<f64, N, N>,
-    b: &SMatrix<f64, N, M>,
+pub(crate) fn zoh<N: Dim, M: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
     h: f64,
-) -> Result<(SMatrix<f64, N, N>, SMatrix<f64, N, M>), Error> {
+) -> Result<Held<N, M>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N>,
+{
     const OP: &str = "ZOH discretisation";
+    let (n, m) = b.shape_generic();
     let mut x = a * h;
     let mut y = b * h;
     if x.iter().chain(y.iter()).any(|v| !v.is_finite()) {
         return Err(Error::Overflow { operation: OP });
     }
     // ∞-norm of W: the largest row sum over [X Y].
-    let norm = (0..N)
-        .map(|i| x.row(i).abs().sum() + y.row(i).abs().sum())
-        .fold(0.0f64, f64::max);
+    let row_sum = |i: usize| -> f64 {
+        x.row(i).iter().map(|v| v.abs()).sum::<f64>()
+            + y.row(i).iter().map(|v| v.abs()).sum::<f64>()
+    };
+    let norm = (0..n.value()).map(row_sum).fold(0.0f64, f64::max);
     if !norm.is_finite() {
         // Row sums beyond f64::MAX: 2^1024 and more halvings would be
         // needed, and the squarings could not be accurate anyway.
@@ -184,33 +279,33 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
     x *= scale;
     y *= scale;
 
-    let id = SMatrix::<f64, N, N>::identity();
-    let mut nx = id;
-    let mut dx = id;
-    let mut ny = SMatrix::<f64, N, M>::zeros();
-    let mut dy = SMatrix::<f64, N, M>::zeros();
-    let mut xk = id; // X^k
+    let id = OMatrix::<f64, N, N>::identity_generic(n, n);
+    let mut nx = id.clone();
+    let mut dx = id.clone();
+    let mut ny = OMatrix::<f64, N, M>::zeros_generic(n, m);
+    let mut dy = OMatrix::<f64, N, M>::zeros_generic(n, m);
+    let mut xk = id.clone(); // X^k
     let mut pk = y; // X^(k-1) Y
     let mut c = 1.0;
     let mut sign = 1.0;
     for k in 1..=PADE_Q {
         c *= (PADE_Q - k + 1) as f64 / (k * (2 * PADE_Q - k + 1)) as f64;
         sign = -sign;
-        xk = x * xk;
-        nx += xk * c;
-        dx += xk * (sign * c);
-        ny += pk * c;
-        dy += pk * (sign * c);
-        pk = x * pk;
+        xk = &x * &xk;
+        nx += &xk * c;
+        dx += &xk * (sign * c);
+        ny += &pk * c;
+        dy += &pk * (sign * c);
+        pk = &x * &pk;
     }
     let lu = Lu::new(&dx, OP)?;
     let mut e = lu.solve(&nx);
-    let mut g = lu.solve(&(ny - dy));
-    let unit = (N + 2) as f64 * f64::EPSILON;
+    let mut g = lu.solve(&(&ny - &dy));
+    let unit = (n.value() + 2) as f64 * f64::EPSILON;
     if 2f64.powi(squarings) * unit <= EXPM_MAX_ERROR {
         for _ in 0..squarings {
-            g = e * g + g;
-            e = e * e;
+            g = &e * &g + &g;
+            e = &e * &e;
         }
     } else {
         // Componentwise error bounds: the solve's to start (ε-relative to
@@ -221,8 +316,8 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
         // rotation whose rounding has made it decay must not pass), G at
         // the end.
         let inv = lu.solve(&id).abs();
-        let mut de = inv * (nx.abs() + dx.abs() * e.abs()) * unit;
-        let mut dg = inv * ((ny - dy).abs() + dx.abs() * g.abs()) * unit;
+        let mut de = &inv * (nx.abs() + dx.abs() * e.abs()) * unit;
+        let mut dg = &inv * ((&ny - &dy).abs() + dx.abs() * g.abs()) * unit;
         // A bound that overflowed (NaN from inf · 0 included) is no bound.
         let largest = |m: &[f64]| {
             m.iter().fold(
@@ -240,10 +335,10 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
                 break;
             }
             let ga = g.abs();
-            dg = (ea + id) * dg + de * ga + (ea * ga + ga) * unit;
-            de = de * ea + ea * de + ea * ea * unit;
-            g = e * g + g;
-            e = e * e;
+            dg = (&ea + &id) * &dg + &de * &ga + (&ea * &ga + &ga) * unit;
+            de = &de * &ea + &ea * &de + &ea * &ea * unit;
+            g = &e * &g + &g;
+            e = &e * &e;
         }
         error = error.max(largest(de.as_slice()) / e.abs().amax().max(1.0));
         if g.amax() > 0.0 {
@@ -290,4 +385,37 @@ pub(crate) fn zoh<const N: usize, const M: usize>(
 pub fn expm<const N: usize>(a: &SMatrix<f64, N, N>) -> Result<SMatrix<f64, N, N>, Error> {
     crate::error::check_finite("A", a)?;
     zoh(a, &SMatrix::<f64, N, 0>::zeros(), 1.0).map(|(e, _)| e)
+}
+
+/// [`expm`] of a square run-time-sized matrix: the same scaling and
+/// squaring, error estimate and refusals; the result agrees with the
+/// fixed-size one bit for bit.
+///
+/// # Errors
+///
+/// [`Error::DimensionMismatch`] named `"A"` unless `a` is square; as
+/// [`expm`] otherwise.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::discretize::expm_dyn;
+/// use nalgebra::{DMatrix, dmatrix};
+///
+/// let theta = 0.3f64;
+/// let r = expm_dyn(&dmatrix![0.0, -theta; theta, 0.0])?;
+/// assert!((r[(0, 0)] - theta.cos()).abs() < 1e-15);
+/// assert!((r[(1, 0)] - theta.sin()).abs() < 1e-15);
+/// // A nilpotent shift of any size: exp is the truncated series.
+/// let n = 6;
+/// let shift = DMatrix::from_fn(n, n, |i, j| if j == i + 1 { 1.0 } else { 0.0 });
+/// assert!((expm_dyn(&shift)?[(0, n - 1)] - 1.0 / 120.0).abs() < 1e-15);
+/// assert!(expm_dyn(&DMatrix::zeros(2, 3)).is_err());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn expm_dyn(a: &DMatrix<f64>) -> Result<DMatrix<f64>, Error> {
+    crate::error::check_shape("A", a, a.nrows(), a.nrows())?;
+    crate::error::check_finite_dyn("A", a)?;
+    let none = OMatrix::<f64, _, U0>::zeros_generic(a.shape_generic().0, Const::<0>);
+    zoh(a, &none, 1.0).map(|(e, _)| e)
 }

@@ -11,7 +11,10 @@
 //! Modelling and simulation:
 //!
 //! - [`model`]: [`StateSpace`] with its sizes and time domain in the type,
-//!   and the [`Dynamics`] trait any plant implements.
+//!   [`DynStateSpace`] with its sizes chosen at run time (the same
+//!   analysis, discretisation, responses, step metrics and pole placement,
+//!   as methods, by the same code), and the [`Dynamics`] trait any plant
+//!   implements.
 //! - [`discretize`]: ZOH (exact), Tustin, forward and backward Euler, and
 //!   [`expm`](discretize::expm).
 //! - [`integrate`]: the [`Rk4`] and [`Euler`] steppers.

@@ -1,13 +1,13 @@
 //! Pole placement for single-input systems, Ackermann's formula, and the
 //! validation of target poles that [`place`](super::place) shares.
 
-use nalgebra::{Complex, SMatrix};
+use nalgebra::{Complex, DMatrix, SMatrix};
 
-use crate::analysis::{eigenvalues, scaled_krylov_rank};
+use crate::analysis::{eigenvalues_dyn, scaled_krylov_rank};
 use crate::error::Error;
 use crate::kernels::linalg::Lu;
 use crate::kernels::reduce::pow2_floor;
-use crate::model::{Domain, StateSpace};
+use crate::model::{Domain, DynStateSpace, StateSpace};
 
 /// Relative distance within which two targets count as a conjugate pair.
 const CONJUGATE_RTOL: f64 = 1e-10;
@@ -55,17 +55,85 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
     sys: &StateSpace<N, 1, P, D>,
     poles: &[Complex<f64>; N],
 ) -> Result<SMatrix<f64, 1, N>, Error> {
+    let a = DMatrix::from_column_slice(N, N, sys.a().as_slice());
+    let b = DMatrix::from_column_slice(N, 1, sys.b().as_slice());
+    let k = acker_pair(&a, &b, poles)?;
+    Ok(SMatrix::from_row_slice(k.as_slice()))
+}
+
+impl<D: Domain> DynStateSpace<D> {
+    /// The state gain `K` (`1 × n`) that puts the poles of `A − B K` at
+    /// `poles` (`n` of them; `s` in rad/s or `z`) by Ackermann's formula:
+    /// [`acker`], the same code, for a single-input model sized at run
+    /// time.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::DimensionMismatch`] named `"B"` unless the model has one
+    /// input; [`Error::LengthMismatch`] named `"poles"` unless there are
+    /// `n` targets; as [`acker`] otherwise.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::DynStateSpace;
+    /// use nalgebra::{Complex, dmatrix};
+    ///
+    /// // A double integrator: poles at −1 ± i need K = [2, 2].
+    /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; 0.0, 0.0], dmatrix![0.0; 1.0],
+    ///                                     dmatrix![1.0, 0.0], dmatrix![0.0])?;
+    /// let k = sys.acker(&[Complex::new(-1.0, 1.0), Complex::new(-1.0, -1.0)])?;
+    /// assert!((k[(0, 0)] - 2.0).abs() < 1e-12 && (k[(0, 1)] - 2.0).abs() < 1e-12);
+    /// assert!(sys.acker(&[Complex::new(-1.0, 0.0)]).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn acker(&self, poles: &[Complex<f64>]) -> Result<DMatrix<f64>, Error> {
+        let (n, m) = (self.states(), self.inputs());
+        if m != 1 {
+            return Err(Error::DimensionMismatch {
+                matrix: "B",
+                expected_rows: n,
+                expected_cols: 1,
+                found_rows: n,
+                found_cols: m,
+            });
+        }
+        check_targets(poles, n)?;
+        acker_pair(self.a(), self.b(), poles)
+    }
+}
+
+/// One target per state, or [`Error::LengthMismatch`] named `"poles"`.
+pub(crate) fn check_targets(poles: &[Complex<f64>], states: usize) -> Result<(), Error> {
+    if poles.len() == states {
+        Ok(())
+    } else {
+        Err(Error::LengthMismatch {
+            what: "poles",
+            expected: states,
+            found: poles.len(),
+        })
+    }
+}
+
+/// [`acker`] on a bare pair `(A, b)`, `b` one column, one target per state
+/// (the callers' checks): the gain as a `1 × n` matrix.
+fn acker_pair(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    poles: &[Complex<f64>],
+) -> Result<DMatrix<f64>, Error> {
+    let n = a.nrows();
     let coeffs = real_polynomial(poles)?;
-    let (a, b) = (sys.a(), sys.b());
     // Controllability matrix [B, A B, …, A^(N−1) B], each new column
     // divided by a power of two s_j as it is formed (so that it cannot
     // overflow, and the LU's pivot test sees no units): 𝒞 = 𝒞̃ S with
     // S = diag(s₀, s₀s₁, …), so the last row of 𝒞⁻¹ = S⁻¹ 𝒞̃⁻¹ is that of
     // 𝒞̃⁻¹ divided by s₀ s₁ … s_(N−1).
-    let mut ctrb = SMatrix::<f64, N, N>::zeros();
-    let mut col = *b;
+    let mut ctrb = DMatrix::zeros(n, n);
+    let mut col = b.column(0).into_owned();
     let mut last_scale = 1.0;
-    for j in 0..N {
+    for j in 0..n {
         let s = pow2_floor(col.amax());
         col /= s;
         ctrb.set_column(j, &col);
@@ -78,13 +146,13 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
         });
     }
     // φ(A) by Horner: coeffs are monic, highest power first.
-    let mut phi = SMatrix::<f64, N, N>::identity();
+    let mut phi = DMatrix::identity(n, n);
     for &c in &coeffs[1..] {
-        phi = a * phi + SMatrix::<f64, N, N>::identity() * c;
+        phi = a * phi + DMatrix::identity(n, n) * c;
     }
-    let mut last = SMatrix::<f64, 1, N>::zeros();
-    if N > 0 {
-        last[N - 1] = 1.0;
+    let mut last = DMatrix::zeros(1, n);
+    if n > 0 {
+        last[n - 1] = 1.0;
     }
     // The scale-free rank test costs an SVD, so it runs only when the LU's
     // pivot test (the stricter of the two) refuses: a rank below N is an
@@ -94,8 +162,8 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
         Ok(row) => row,
         Err(lu) => {
             let rank = scaled_krylov_rank(a, b)?;
-            return Err(if rank < N {
-                Error::Uncontrollable { rank, states: N }
+            return Err(if rank < n {
+                Error::Uncontrollable { rank, states: n }
             } else {
                 lu
             });
@@ -107,7 +175,7 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
             operation: "Ackermann gain",
         });
     }
-    check_placement(&(a - b * k), poles)?;
+    check_placement(&(a - b * &k), poles)?;
     Ok(k)
 }
 
@@ -121,17 +189,14 @@ const PLACEMENT_RTOL: f64 = 1e-3;
 /// but for many states or targets far from the open-loop poles the closed
 /// loop is so sensitive that the gain's rounding moves its poles by tens
 /// of percent. Such a gain is refused, not returned.
-fn check_placement<const N: usize>(
-    a_cl: &SMatrix<f64, N, N>,
-    targets: &[Complex<f64>; N],
-) -> Result<(), Error> {
-    let got = eigenvalues(a_cl)?;
+fn check_placement(a_cl: &DMatrix<f64>, targets: &[Complex<f64>]) -> Result<(), Error> {
+    let got = eigenvalues_dyn(a_cl)?;
     let scale = targets.iter().map(|t| t.norm()).fold(0.0, f64::max);
     // Each target against its nearest computed pole not used yet.
-    let mut used = [false; N];
+    let mut used = vec![false; got.len()];
     let mut worst = 0.0f64;
     for t in targets {
-        let nearest = (0..N)
+        let nearest = (0..got.len())
             .filter(|&j| !used[j])
             .min_by(|&x, &y| (got[x] - t).norm().total_cmp(&(got[y] - t).norm()));
         if let Some(j) = nearest {
@@ -155,7 +220,7 @@ fn check_placement<const N: usize>(
 
 /// Monic real polynomial with the given roots, highest power first
 /// (`N + 1` coefficients, returned in a `Vec`: design time, not a hot loop).
-fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>, Error> {
+fn real_polynomial(poles: &[Complex<f64>]) -> Result<Vec<f64>, Error> {
     let paired = conjugate_pairs(poles)?;
     let mut coeffs = vec![1.0];
     let mul = |coeffs: &mut Vec<f64>, factor: &[f64]| {
@@ -168,7 +233,7 @@ fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>
         *coeffs = out;
     };
     let mut i = 0;
-    while i < N {
+    while i < paired.len() {
         let p = paired[i];
         if p.im == 0.0 {
             mul(&mut coeffs, &[1.0, -p.re]);
@@ -187,9 +252,8 @@ fn real_polynomial<const N: usize>(poles: &[Complex<f64>; N]) -> Result<Vec<f64>
 /// come out with an imaginary part of exactly 0; each complex pair comes out
 /// adjacent, the one with positive imaginary part first and its exact
 /// conjugate second.
-pub(crate) fn conjugate_pairs<const N: usize>(
-    poles: &[Complex<f64>; N],
-) -> Result<[Complex<f64>; N], Error> {
+pub(crate) fn conjugate_pairs(poles: &[Complex<f64>]) -> Result<Vec<Complex<f64>>, Error> {
+    let n = poles.len();
     let bad = |index: usize, reason| Error::InvalidPole {
         index,
         re: poles[index].re,
@@ -202,10 +266,10 @@ pub(crate) fn conjugate_pairs<const N: usize>(
     {
         return Err(bad(i, "target poles must be finite"));
     }
-    let mut used = [false; N];
-    let mut out = [Complex::new(0.0, 0.0); N];
+    let mut used = vec![false; n];
+    let mut out = vec![Complex::new(0.0, 0.0); n];
     let mut next = 0;
-    for i in 0..N {
+    for i in 0..n {
         if used[i] {
             continue;
         }
@@ -218,7 +282,7 @@ pub(crate) fn conjugate_pairs<const N: usize>(
             continue;
         }
         // Closest unused partner to the conjugate.
-        let partner = (i + 1..N)
+        let partner = (i + 1..n)
             .filter(|&j| !used[j])
             .min_by(|&x, &y| {
                 (poles[x] - p.conj())

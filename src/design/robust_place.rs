@@ -1,13 +1,13 @@
 //! Pole placement for multi-input systems by the robust method of Kautsky,
 //! Nichols and Van Dooren (method 0), and its dual for observers.
 
-use nalgebra::{Complex, SMatrix, SVector};
+use nalgebra::{Complex, DMatrix, DVector, SMatrix};
 
-use super::place::conjugate_pairs;
-use crate::analysis::eigenvalues;
+use super::place::{check_targets, conjugate_pairs};
+use crate::analysis::{eigenvalues_dyn, krylov, rank};
 use crate::error::Error;
 use crate::kernels::linalg::{Lu, householder_q};
-use crate::model::{Continuous, Domain, StateSpace};
+use crate::model::{Domain, DynStateSpace, StateSpace};
 
 /// Sweeps over all eigenvectors at most (SciPy's `place_poles` default).
 const MAX_SWEEPS: usize = 30;
@@ -21,7 +21,13 @@ const NEGLIGIBLE: f64 = 1e-8;
 /// target: python-control's own test of `place` checks six decimals.
 pub(crate) const PLACE_TOL: f64 = 1e-6;
 
-type CMatrix<const R: usize, const C: usize> = SMatrix<Complex<f64>, R, C>;
+type CMatrix = DMatrix<Complex<f64>>;
+type CVector = DVector<Complex<f64>>;
+
+/// A run-time-sized copy of a fixed-size matrix.
+fn heap<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> DMatrix<f64> {
+    DMatrix::from_column_slice(R, C, m.as_slice())
+}
 
 /// The state gain `K` that puts the poles of `A − B K` at `poles`, for any
 /// number of inputs, by the robust eigenvector method of Kautsky, Nichols
@@ -92,7 +98,8 @@ pub fn place<const N: usize, const M: usize, const P: usize, D: Domain>(
     sys: &StateSpace<N, M, P, D>,
     poles: &[Complex<f64>; N],
 ) -> Result<SMatrix<f64, M, N>, Error> {
-    place_pair(sys.a(), sys.b(), poles)
+    let k = place_pair(&heap(sys.a()), &heap(sys.b()), poles)?;
+    Ok(SMatrix::from_column_slice(k.as_slice()))
 }
 
 /// The observer gain `L` that puts the poles of `A − L C` at `poles`: a
@@ -130,7 +137,83 @@ pub fn place_observer<const N: usize, const M: usize, const P: usize, D: Domain>
     sys: &StateSpace<N, M, P, D>,
     poles: &[Complex<f64>; N],
 ) -> Result<SMatrix<f64, N, P>, Error> {
-    place_pair(&sys.a().transpose(), &sys.c().transpose(), poles)
+    let l = observer_pair(&heap(sys.a()), &heap(sys.c()), poles)?;
+    Ok(SMatrix::from_column_slice(l.as_slice()))
+}
+
+impl<D: Domain> DynStateSpace<D> {
+    /// The state gain `K` (`m × n`) that puts the poles of `A − B K` at
+    /// `poles` (`n` of them; `s` in rad/s or `z`), by the robust method of
+    /// [`place`], the same code: of all gains that place the poles, one with
+    /// well-conditioned closed-loop eigenvectors.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::LengthMismatch`] named `"poles"` unless there are `n`
+    /// targets; as [`place`] otherwise.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{DynStateSpace, MassSpring, Cart};
+    /// use nalgebra::Complex;
+    ///
+    /// let plant = DynStateSpace::from(MassSpring::nominal().state_space(Cart::Two)?);
+    /// let targets = [Complex::new(-30.0, 30.0), Complex::new(-30.0, -30.0),
+    ///                Complex::new(-40.0, 0.0), Complex::new(-50.0, 0.0)];
+    /// let k = plant.place(&targets)?;
+    /// assert_eq!(k.shape(), (1, 4));
+    /// let closed = DynStateSpace::continuous(plant.a() - plant.b() * &k, plant.b().clone(),
+    ///                                        plant.c().clone(), plant.d().clone())?;
+    /// let p = closed.poles()?;
+    /// assert!((p[0] - Complex::new(-50.0, 0.0)).norm() < 1e-6 * 50.0);
+    /// assert!((p[3] - Complex::new(-30.0, 30.0)).norm() < 1e-6 * 50.0);
+    /// assert!(plant.place(&targets[..3]).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "place_poles")]
+    pub fn place(&self, poles: &[Complex<f64>]) -> Result<DMatrix<f64>, Error> {
+        check_targets(poles, self.states())?;
+        place_pair(self.a(), self.b(), poles)
+    }
+
+    /// The observer gain `L` (`n × p`) that puts the poles of `A − L C` at
+    /// `poles`: [`place_observer`], the same code (placement on the dual
+    /// `(Aᵀ, Cᵀ)`).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::LengthMismatch`] named `"poles"` unless there are `n`
+    /// targets; as [`place_observer`] otherwise.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::DynStateSpace;
+    /// use nalgebra::{Complex, dmatrix};
+    ///
+    /// // A double integrator, position measured; error poles at −10, −20.
+    /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; 0.0, 0.0], dmatrix![0.0; 1.0],
+    ///                                     dmatrix![1.0, 0.0], dmatrix![0.0])?;
+    /// let l = sys.place_observer(&[Complex::new(-10.0, 0.0), Complex::new(-20.0, 0.0)])?;
+    /// // (s + 10)(s + 20) = s² + 30 s + 200: L = [30; 200].
+    /// assert!((l[(0, 0)] - 30.0).abs() < 1e-9 && (l[(1, 0)] - 200.0).abs() < 1e-9);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "luenberger")]
+    pub fn place_observer(&self, poles: &[Complex<f64>]) -> Result<DMatrix<f64>, Error> {
+        check_targets(poles, self.states())?;
+        observer_pair(self.a(), self.c(), poles)
+    }
+}
+
+/// [`place_observer`] on a bare pair `(A, C)`.
+fn observer_pair(
+    a: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    poles: &[Complex<f64>],
+) -> Result<DMatrix<f64>, Error> {
+    place_pair(&a.transpose(), &c.transpose(), poles)
         .map(|k| k.transpose())
         .map_err(|e| match e {
             Error::Uncontrollable { rank, states } => Error::Unobservable { rank, states },
@@ -142,16 +225,18 @@ pub fn place_observer<const N: usize, const M: usize, const P: usize, D: Domain>
         })
 }
 
-/// [`place`] on a bare pair `(A, B)`.
-fn place_pair<const N: usize, const M: usize>(
-    a: &SMatrix<f64, N, N>,
-    b: &SMatrix<f64, N, M>,
-    poles: &[Complex<f64>; N],
-) -> Result<SMatrix<f64, M, N>, Error> {
+/// [`place`] on a bare pair `(A, B)` with one target per state (the
+/// callers' check).
+fn place_pair(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    poles: &[Complex<f64>],
+) -> Result<DMatrix<f64>, Error> {
+    let (n, m) = b.shape();
     let targets = conjugate_pairs(poles)?;
     if let Some(p) = targets
         .iter()
-        .find(|p| targets.iter().filter(|q| q == p).count() > M)
+        .find(|p| targets.iter().filter(|q| q == p).count() > m)
     {
         return Err(Error::InvalidParameter {
             name: "poles",
@@ -163,30 +248,30 @@ fn place_pair<const N: usize, const M: usize>(
         matrix: "B",
         reason: "must have full column rank, with no more inputs than states",
     };
-    if M == 0 || M > N {
+    if m == 0 || m > n {
         return Err(rank_error);
     }
     // B = U [Z; 0]: U from Householder reflections of B's columns.
-    let mut padded = CMatrix::<N, N>::zeros();
+    let mut padded = CMatrix::zeros(n, n);
     padded
-        .fixed_columns_mut::<M>(0)
+        .columns_mut(0, m)
         .copy_from(&b.map(|v| Complex::new(v, 0.0)));
-    let u = householder_q(&padded, M).map(|c| c.re);
-    let z: SMatrix<f64, M, M> = (u.transpose() * b).fixed_rows::<M>(0).into_owned();
+    let u = householder_q(&padded, m).map(|c| c.re);
+    let z = (u.transpose() * b).rows(0, m).into_owned();
     let z_max = z.amax();
-    if (0..M).any(|i| z[(i, i)].abs() <= N as f64 * f64::EPSILON * z_max) || z_max == 0.0 {
+    if (0..m).any(|i| z[(i, i)].abs() <= n as f64 * f64::EPSILON * z_max) || z_max == 0.0 {
         return Err(rank_error);
     }
     let z_lu = Lu::new(&z, "pole placement (B)")?;
 
-    let (x, lambda) = if M == N {
-        (SMatrix::<f64, N, N>::identity(), real_block_form(&targets))
+    let x = if m == n {
+        DMatrix::identity(n, n)
     } else {
-        let x = eigenvectors::<N, M>(a, &u, &targets);
-        (real_columns(&x, &targets), real_block_form(&targets))
+        real_columns(&eigenvectors(a, &u, &targets, m), &targets)
     };
+    let lambda = real_block_form(&targets);
     // A − B K = X Λ X⁻¹.
-    let closed = Lu::solve_right(&x, &(x * lambda), "pole placement (eigenvector matrix)")
+    let closed = Lu::solve_right(&x, &(&x * lambda), "pole placement (eigenvector matrix)")
         .map_err(|_| {
             uncontrollable_or(
                 a,
@@ -196,76 +281,70 @@ fn place_pair<const N: usize, const M: usize>(
                 },
             )
         })?;
-    let rows: SMatrix<f64, M, N> = (u.transpose() * (a - closed))
-        .fixed_rows::<M>(0)
-        .into_owned();
+    let rows = (u.transpose() * (a - closed)).rows(0, m).into_owned();
     let k = z_lu.solve(&rows);
     if k.iter().any(|v| !v.is_finite()) {
         return Err(Error::Overflow {
             operation: "pole placement gain",
         });
     }
-    check_placed(&(a - b * k), &targets).map_err(|e| uncontrollable_or(a, b, e))?;
+    check_placed(&(a - b * &k), &targets).map_err(|e| uncontrollable_or(a, b, e))?;
     Ok(k)
 }
 
 /// The closed-loop eigenvectors, one per target (complex; a conjugate
 /// pair's second the conjugate of the first), by KNV method 0 when there is
-/// a choice (`M > 1`).
-fn eigenvectors<const N: usize, const M: usize>(
-    a: &SMatrix<f64, N, N>,
-    u: &SMatrix<f64, N, N>,
-    targets: &[Complex<f64>; N],
-) -> CMatrix<N, N> {
+/// a choice (`m > 1`).
+fn eigenvectors(a: &DMatrix<f64>, u: &DMatrix<f64>, targets: &[Complex<f64>], m: usize) -> CMatrix {
+    let n = a.nrows();
     let ut_a = u.transpose() * a;
-    let mut bases = [CMatrix::<N, M>::zeros(); N];
-    let mut x = CMatrix::<N, N>::zeros();
+    let mut bases = vec![CMatrix::zeros(n, m); n];
+    let mut x = CMatrix::zeros(n, n);
     let mut j = 0;
-    while j < N {
+    while j < n {
         let lambda = targets[j];
-        // S_j = ker W, W = U₁ᵀ (A − λ I): the last M columns of the Q of
+        // S_j = ker W, W = U₁ᵀ (A − λ I): the last m columns of the Q of
         // a QR of Wᴴ span it.
-        let mut wh = CMatrix::<N, N>::zeros();
-        for col in 0..N - M {
-            for row in 0..N {
-                let w = Complex::new(ut_a[(M + col, row)], 0.0) - lambda * u[(row, M + col)];
+        let mut wh = CMatrix::zeros(n, n);
+        for col in 0..n - m {
+            for row in 0..n {
+                let w = Complex::new(ut_a[(m + col, row)], 0.0) - lambda * u[(row, m + col)];
                 wh[(row, col)] = w.conj();
             }
         }
-        let basis: CMatrix<N, M> = householder_q(&wh, N - M)
-            .fixed_columns::<M>(N - M)
-            .into_owned();
+        let basis = householder_q(&wh, n - m).columns(n - m, m).into_owned();
         // SciPy's start: the normalised sum of the basis vectors.
         let start = basis.column_sum();
-        let start = start / Complex::new(start.norm().max(f64::MIN_POSITIVE), 0.0);
-        bases[j] = basis;
+        let start = &start / Complex::new(start.norm().max(f64::MIN_POSITIVE), 0.0);
         x.set_column(j, &start);
         if lambda.im != 0.0 {
             bases[j + 1] = basis.map(|c| c.conj());
             x.set_column(j + 1, &start.map(|c| c.conj()));
+            bases[j] = basis;
             j += 2;
         } else {
+            bases[j] = basis;
             j += 1;
         }
     }
-    if M == 1 {
+    if m == 1 {
         return x;
     }
     let floor = f64::EPSILON.sqrt();
     let mut det_before = det_abs(&real_columns(&x, targets));
     for _ in 0..MAX_SWEEPS {
         let mut j = 0;
-        while j < N {
+        while j < n {
             let y = if targets[j].im == 0.0 {
                 knv_update(&x, &bases[j], j)
             } else {
                 pair_update(&x, &bases[j], targets, j)
             };
             if let Some(y) = y {
-                x.set_column(j, &y);
                 if targets[j].im != 0.0 {
                     x.set_column(j + 1, &y.map(|c| c.conj()));
                 }
+                x.set_column(j, &y);
             }
             j += if targets[j].im != 0.0 { 2 } else { 1 };
         }
@@ -283,14 +362,11 @@ fn eigenvectors<const N: usize, const M: usize>(
 /// its space `S_j` closest to the normal of the other eigenvectors' span;
 /// `None` to keep the old one when the normal is (nearly) orthogonal to
 /// `S_j`.
-fn knv_update<const N: usize, const M: usize>(
-    x: &CMatrix<N, N>,
-    basis: &CMatrix<N, M>,
-    j: usize,
-) -> Option<SVector<Complex<f64>, N>> {
-    let mut others = *x;
-    others.swap_columns(j, N - 1);
-    let normal = householder_q(&others, N - 1).column(N - 1).into_owned();
+fn knv_update(x: &CMatrix, basis: &CMatrix, j: usize) -> Option<CVector> {
+    let n = x.ncols();
+    let mut others = x.clone();
+    others.swap_columns(j, n - 1);
+    let normal = householder_q(&others, n - 1).column(n - 1).into_owned();
     unit(basis * (basis.adjoint() * normal))
 }
 
@@ -301,28 +377,27 @@ fn knv_update<const N: usize, const M: usize>(
 /// `xᴴ (u uᴴ − ū uᵀ) x`; over `x = S μ`, `‖μ‖ = 1`, it is largest at the
 /// dominant eigenvector of the Hermitian `Sᴴ (u uᴴ − ū uᵀ) S`. The old `x`
 /// is projected on that direction (keeping its phase).
-fn pair_update<const N: usize, const M: usize>(
-    x: &CMatrix<N, N>,
-    basis: &CMatrix<N, M>,
-    targets: &[Complex<f64>; N],
+fn pair_update(
+    x: &CMatrix,
+    basis: &CMatrix,
+    targets: &[Complex<f64>],
     j: usize,
-) -> Option<SVector<Complex<f64>, N>> {
-    if N < 3 {
+) -> Option<CVector> {
+    let n = x.ncols();
+    if n < 3 {
         // No other columns: any x of S works as well as another.
         return None;
     }
     let mut others = real_columns(x, targets).map(|v| Complex::new(v, 0.0));
-    others.swap_columns(j + 1, N - 1);
-    others.swap_columns(j, N - 2);
-    let q = householder_q(&others, N - 2);
-    let u: SVector<Complex<f64>, N> =
-        SVector::from_fn(|i, _| Complex::new(q[(i, N - 2)].re, q[(i, N - 1)].re));
-    let a = basis.adjoint() * u;
+    others.swap_columns(j + 1, n - 1);
+    others.swap_columns(j, n - 2);
+    let q = householder_q(&others, n - 2);
+    let u = CVector::from_fn(n, |i, _| Complex::new(q[(i, n - 2)].re, q[(i, n - 1)].re));
+    let a = basis.adjoint() * &u;
     let b = basis.adjoint() * u.map(|c| c.conj());
     let mu = dominant_rank_two(&a, &b)?;
     let direction = basis * mu;
-    let old = x.column(j);
-    let along = direction.dotc(&old);
+    let along = direction.dotc(&x.column(j));
     if along.norm() > NEGLIGIBLE {
         unit(direction * along)
     } else {
@@ -333,12 +408,9 @@ fn pair_update<const N: usize, const M: usize>(
 /// The unit eigenvector, for the eigenvalue of largest magnitude, of the
 /// rank-two Hermitian `a aᴴ − b bᴴ`: it lies in `span(a, b)`, so a 2 × 2
 /// Hermitian eigenproblem on an orthonormal basis of that span gives it.
-fn dominant_rank_two<const M: usize>(
-    a: &SVector<Complex<f64>, M>,
-    b: &SVector<Complex<f64>, M>,
-) -> Option<SVector<Complex<f64>, M>> {
-    let e1 = unit(*a).or_else(|| unit(*b))?;
-    let rest = b - e1 * e1.dotc(b);
+fn dominant_rank_two(a: &CVector, b: &CVector) -> Option<CVector> {
+    let e1 = unit(a.clone()).or_else(|| unit(b.clone()))?;
+    let rest = b - &e1 * e1.dotc(b);
     let e2 = if rest.norm() > NEGLIGIBLE * b.norm() {
         unit(rest)
     } else {
@@ -375,20 +447,17 @@ fn dominant_rank_two<const M: usize>(
 }
 
 /// `v / ‖v‖`, or `None` for a negligible `v`.
-fn unit<const R: usize>(v: SVector<Complex<f64>, R>) -> Option<SVector<Complex<f64>, R>> {
+fn unit(v: CVector) -> Option<CVector> {
     let norm = v.norm();
     (norm > NEGLIGIBLE).then(|| v / Complex::new(norm, 0.0))
 }
 
 /// The real form of the eigenvector matrix: a real target's eigenvector as
 /// is, a pair's as its real and imaginary parts.
-fn real_columns<const N: usize>(
-    x: &CMatrix<N, N>,
-    targets: &[Complex<f64>; N],
-) -> SMatrix<f64, N, N> {
+fn real_columns(x: &CMatrix, targets: &[Complex<f64>]) -> DMatrix<f64> {
     let mut out = x.map(|c| c.re);
     let mut j = 0;
-    while j < N {
+    while j < targets.len() {
         if targets[j].im != 0.0 {
             out.set_column(j + 1, &x.column(j).map(|c| c.im));
             j += 2;
@@ -402,10 +471,11 @@ fn real_columns<const N: usize>(
 /// `Λ` in real block form to match [`real_columns`]: `a` on the diagonal
 /// for a real target, `[[a, b], [−b, a]]` for a pair `a ± b i`
 /// (`A (xr + i xi) = (a + b i)(xr + i xi)` is `A [xr xi] = [xr xi] [[a, b], [−b, a]]`).
-fn real_block_form<const N: usize>(targets: &[Complex<f64>; N]) -> SMatrix<f64, N, N> {
-    let mut lambda = SMatrix::<f64, N, N>::zeros();
+fn real_block_form(targets: &[Complex<f64>]) -> DMatrix<f64> {
+    let n = targets.len();
+    let mut lambda = DMatrix::zeros(n, n);
     let mut j = 0;
-    while j < N {
+    while j < n {
         let p = targets[j];
         lambda[(j, j)] = p.re;
         if p.im != 0.0 {
@@ -421,20 +491,17 @@ fn real_block_form<const N: usize>(targets: &[Complex<f64>; N]) -> SMatrix<f64, 
 }
 
 /// `|det X|`, 0 for a numerically singular `X`.
-fn det_abs<const N: usize>(x: &SMatrix<f64, N, N>) -> f64 {
+fn det_abs(x: &DMatrix<f64>) -> f64 {
     Lu::new(x, "determinant").map_or(0.0, |lu| lu.det().abs())
 }
 
 /// Every target has its own achieved pole (eigenvalue of `closed`) within
 /// `PLACE_TOL · max(1, |target|)`, matched greedily nearest first.
-pub(crate) fn check_placed<const N: usize>(
-    closed: &SMatrix<f64, N, N>,
-    targets: &[Complex<f64>; N],
-) -> Result<(), Error> {
-    let achieved = eigenvalues(closed)?;
-    let mut used = [false; N];
+fn check_placed(closed: &DMatrix<f64>, targets: &[Complex<f64>]) -> Result<(), Error> {
+    let achieved = eigenvalues_dyn(closed)?;
+    let mut used = vec![false; achieved.len()];
     for target in targets {
-        let nearest = (0..N).filter(|&i| !used[i]).min_by(|&x, &y| {
+        let nearest = (0..achieved.len()).filter(|&i| !used[i]).min_by(|&x, &y| {
             (achieved[x] - target)
                 .norm()
                 .total_cmp(&(achieved[y] - target).norm())
@@ -455,23 +522,10 @@ pub(crate) fn check_placed<const N: usize>(
 
 /// [`Error::Uncontrollable`] when `(A, B)` is not controllable (the reason
 /// a placement failed), otherwise `error`.
-fn uncontrollable_or<const N: usize, const M: usize>(
-    a: &SMatrix<f64, N, N>,
-    b: &SMatrix<f64, N, M>,
-    error: Error,
-) -> Error {
-    let pair = StateSpace::<N, M, 0, Continuous>::from_parts_unchecked(
-        *a,
-        *b,
-        SMatrix::zeros(),
-        SMatrix::zeros(),
-        Continuous,
-    );
-    match pair
-        .controllability()
-        .and_then(|c| crate::analysis::rank(&c, None))
-    {
-        Ok(rank) if rank < N => Error::Uncontrollable { rank, states: N },
+fn uncontrollable_or(a: &DMatrix<f64>, b: &DMatrix<f64>, error: Error) -> Error {
+    let n = a.nrows();
+    match krylov(a, b, "controllability matrix").and_then(|c| rank(&c, None)) {
+        Ok(rank) if rank < n => Error::Uncontrollable { rank, states: n },
         _ => error,
     }
 }

@@ -1,39 +1,49 @@
-//! Small dense kernels on fixed-size matrices that nalgebra offers only behind
-//! typenum bounds for a generic `N` (its `lu()` needs `Const<N>: DimMin`).
-//! Keeping them here lets the public API take plain `const N: usize`.
+//! Small dense kernels written once for fixed-size and run-time-sized
+//! matrices: generic over nalgebra's [`Dim`] (`Const<N>` for a `SMatrix`,
+//! `Dyn` for a `DMatrix`), so a fixed-size caller gets stack matrices and
+//! no allocation, and a run-time-sized caller the same arithmetic on the
+//! heap. nalgebra's own `lu()` needs `DimMin` bounds that a plain
+//! `const N: usize` cannot state, hence these.
 
-use nalgebra::{Complex, SMatrix};
+use nalgebra::{
+    Complex, DefaultAllocator, Dim, Matrix, OMatrix, OVector, Storage, U1, allocator::Allocator,
+};
 
 use crate::error::Error;
 
 /// LU factors with partial pivoting, `P A = L U`, packed in one matrix.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Lu<const N: usize> {
-    lu: SMatrix<f64, N, N>,
-    perm: [usize; N],
+#[derive(Debug, Clone)]
+pub(crate) struct Lu<N: Dim>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
+    lu: OMatrix<f64, N, N>,
+    perm: OVector<usize, N>,
 }
 
-impl<const N: usize> Lu<N> {
+impl<N: Dim> Lu<N>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
     /// Factors `a`; refuses a matrix whose smallest pivot is negligible
     /// against its largest (`≤ N·ε·max`), i.e. singular to working precision.
-    pub(crate) fn new(a: &SMatrix<f64, N, N>, operation: &'static str) -> Result<Self, Error> {
-        let mut lu = *a;
-        let mut perm = [0usize; N];
-        for (i, p) in perm.iter_mut().enumerate() {
-            *p = i;
-        }
+    pub(crate) fn new(a: &OMatrix<f64, N, N>, operation: &'static str) -> Result<Self, Error> {
+        let mut lu = a.clone();
+        let (dim, _) = lu.shape_generic();
+        let n = dim.value();
+        let mut perm = OVector::<usize, N>::from_fn_generic(dim, U1, |i, _| i);
         let mut max_pivot = 0.0f64;
         let mut min_pivot = f64::INFINITY;
-        for k in 0..N {
+        for k in 0..n {
             let mut p = k;
-            for i in k + 1..N {
+            for i in k + 1..n {
                 if lu[(i, k)].abs() > lu[(p, k)].abs() {
                     p = i;
                 }
             }
             if p != k {
                 lu.swap_rows(p, k);
-                perm.swap(p, k);
+                perm.swap_rows(p, k);
             }
             let pivot = lu[(k, k)];
             max_pivot = max_pivot.max(pivot.abs());
@@ -41,29 +51,34 @@ impl<const N: usize> Lu<N> {
             if pivot == 0.0 || !pivot.is_finite() {
                 return Err(Error::Singular { operation });
             }
-            for i in k + 1..N {
+            for i in k + 1..n {
                 let l = lu[(i, k)] / pivot;
                 lu[(i, k)] = l;
-                for j in k + 1..N {
+                for j in k + 1..n {
                     lu[(i, j)] -= l * lu[(k, j)];
                 }
             }
         }
-        if N > 0 && min_pivot <= (N as f64) * f64::EPSILON * max_pivot {
+        if n > 0 && min_pivot <= (n as f64) * f64::EPSILON * max_pivot {
             return Err(Error::Singular { operation });
         }
         Ok(Self { lu, perm })
     }
 
     /// Solves `A X = B` for `X`.
-    pub(crate) fn solve<const K: usize>(&self, b: &SMatrix<f64, N, K>) -> SMatrix<f64, N, K> {
-        let mut x = SMatrix::<f64, N, K>::zeros();
+    pub(crate) fn solve<K: Dim>(&self, b: &OMatrix<f64, N, K>) -> OMatrix<f64, N, K>
+    where
+        DefaultAllocator: Allocator<N, K>,
+    {
+        let n = self.perm.len();
+        let (rows, cols) = b.shape_generic();
+        let mut x = OMatrix::<f64, N, K>::zeros_generic(rows, cols);
         for (i, &p) in self.perm.iter().enumerate() {
             x.set_row(i, &b.row(p));
         }
-        for c in 0..K {
+        for c in 0..cols.value() {
             // Forward substitution with unit-diagonal L.
-            for i in 0..N {
+            for i in 0..n {
                 let mut s = x[(i, c)];
                 for j in 0..i {
                     s -= self.lu[(i, j)] * x[(j, c)];
@@ -71,9 +86,9 @@ impl<const N: usize> Lu<N> {
                 x[(i, c)] = s;
             }
             // Back substitution with U.
-            for i in (0..N).rev() {
+            for i in (0..n).rev() {
                 let mut s = x[(i, c)];
-                for j in i + 1..N {
+                for j in i + 1..n {
                     s -= self.lu[(i, j)] * x[(j, c)];
                 }
                 x[(i, c)] = s / self.lu[(i, i)];
@@ -85,10 +100,12 @@ impl<const N: usize> Lu<N> {
     /// The determinant of the factored matrix: the product of the pivots,
     /// signed by the row permutation.
     pub(crate) fn det(&self) -> f64 {
-        let mut det: f64 = (0..N).map(|i| self.lu[(i, i)]).product();
+        let n = self.perm.len();
+        let mut det: f64 = (0..n).map(|i| self.lu[(i, i)]).product();
         // The permutation's sign from its cycle decomposition.
-        let mut seen = [false; N];
-        for start in 0..N {
+        let mut seen =
+            OVector::<bool, N>::from_element_generic(self.perm.shape_generic().0, U1, false);
+        for start in 0..n {
             let mut i = start;
             let mut length = 0;
             while !seen[i] {
@@ -104,11 +121,14 @@ impl<const N: usize> Lu<N> {
     }
 
     /// Solves `X A = B` for `X` (a row-vector system), via `Aᵀ Xᵀ = Bᵀ`.
-    pub(crate) fn solve_right<const K: usize>(
-        a: &SMatrix<f64, N, N>,
-        b: &SMatrix<f64, K, N>,
+    pub(crate) fn solve_right<K: Dim>(
+        a: &OMatrix<f64, N, N>,
+        b: &OMatrix<f64, K, N>,
         operation: &'static str,
-    ) -> Result<SMatrix<f64, K, N>, Error> {
+    ) -> Result<OMatrix<f64, K, N>, Error>
+    where
+        DefaultAllocator: Allocator<K, N> + Allocator<N, K>,
+    {
         Ok(Lu::new(&a.transpose(), operation)?
             .solve(&b.transpose())
             .transpose())
@@ -120,15 +140,20 @@ impl<const N: usize> Lu<N> {
 /// orthonormal basis of the orthogonal complement of those columns' span
 /// (or of a subspace of it when they are dependent: a zero column is
 /// skipped). Complex, so it serves complex eigenvector bases too.
-pub(crate) fn householder_q<const N: usize>(
-    a: &SMatrix<Complex<f64>, N, N>,
+pub(crate) fn householder_q<N: Dim>(
+    a: &OMatrix<Complex<f64>, N, N>,
     k: usize,
-) -> SMatrix<Complex<f64>, N, N> {
-    let mut r = *a;
-    let mut q = SMatrix::<Complex<f64>, N, N>::identity();
-    let mut v = [Complex::new(0.0, 0.0); N];
-    for j in 0..k.min(N) {
-        let norm = (j..N).map(|i| r[(i, j)].norm_sqr()).sum::<f64>().sqrt();
+) -> OMatrix<Complex<f64>, N, N>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
+    let (dim, _) = a.shape_generic();
+    let n = dim.value();
+    let mut r = a.clone();
+    let mut q = OMatrix::<Complex<f64>, N, N>::identity_generic(dim, dim);
+    let mut v = OVector::<Complex<f64>, N>::zeros_generic(dim, U1);
+    for j in 0..k.min(n) {
+        let norm = (j..n).map(|i| r[(i, j)].norm_sqr()).sum::<f64>().sqrt();
         if norm == 0.0 {
             continue;
         }
@@ -139,24 +164,24 @@ pub(crate) fn householder_q<const N: usize>(
         } else {
             Complex::new(1.0, 0.0)
         };
-        for i in j..N {
+        for i in j..n {
             v[i] = r[(i, j)];
         }
         v[j] += phase * norm;
-        let v_norm = (j..N).map(|i| v[i].norm_sqr()).sum::<f64>().sqrt();
-        for vi in &mut v[j..] {
-            *vi /= v_norm;
+        let v_norm = (j..n).map(|i| v[i].norm_sqr()).sum::<f64>().sqrt();
+        for i in j..n {
+            v[i] /= v_norm;
         }
         // R ← H R and Q ← Q H with H = I − 2 v vᴴ.
-        for c in 0..N {
-            let dot: Complex<f64> = (j..N).map(|i| v[i].conj() * r[(i, c)]).sum();
-            for i in j..N {
+        for c in 0..n {
+            let dot: Complex<f64> = (j..n).map(|i| v[i].conj() * r[(i, c)]).sum();
+            for i in j..n {
                 r[(i, c)] -= v[i] * dot * 2.0;
             }
         }
-        for row in 0..N {
-            let dot: Complex<f64> = (j..N).map(|i| q[(row, i)] * v[i]).sum();
-            for i in j..N {
+        for row in 0..n {
+            let dot: Complex<f64> = (j..n).map(|i| q[(row, i)] * v[i]).sum();
+            for i in j..n {
                 q[(row, i)] -= dot * v[i].conj() * 2.0;
             }
         }
@@ -165,7 +190,7 @@ pub(crate) fn householder_q<const N: usize>(
 }
 
 /// The 1-norm (largest column sum of magnitudes).
-pub(crate) fn norm1<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> f64 {
+pub(crate) fn norm1<R: Dim, C: Dim, S: Storage<f64, R, C>>(m: &Matrix<f64, R, C, S>) -> f64 {
     m.column_iter()
         .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
         .fold(0.0, f64::max)
@@ -175,14 +200,30 @@ pub(crate) fn norm1<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> f
 /// count as *on* it: eigenvalues are computed to about `ε ‖A‖`, so a pole
 /// within `100 N ε max(1, ‖A‖₁)` of the boundary (a rigid-body mode whose
 /// exact value is 0, say) is marginal, not stable.
-pub(crate) fn boundary_tolerance<const N: usize>(a: &SMatrix<f64, N, N>) -> f64 {
-    100.0 * N as f64 * f64::EPSILON * norm1(a).max(1.0)
+pub(crate) fn boundary_tolerance<N: Dim, S: Storage<f64, N, N>>(a: &Matrix<f64, N, N, S>) -> f64 {
+    100.0 * a.nrows() as f64 * f64::EPSILON * norm1(a).max(1.0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::matrix;
+    use nalgebra::{DMatrix, SMatrix, dmatrix, matrix};
+
+    #[test]
+    fn run_time_sized_factors_match_fixed_size_ones_bit_for_bit() {
+        let a = matrix![0.0, 2.0, 1.0; 1.0, 1.0, 0.0; 3.0, 0.0, 1.0];
+        let b = matrix![1.0, -2.0; 2.0, 0.5; -1.0, 3.0];
+        let ad = DMatrix::from_column_slice(3, 3, a.as_slice());
+        let bd = DMatrix::from_column_slice(3, 2, b.as_slice());
+        let (fixed, dynamic) = (Lu::new(&a, "t").unwrap(), Lu::new(&ad, "t").unwrap());
+        assert_eq!(fixed.solve(&b).as_slice(), dynamic.solve(&bd).as_slice());
+        assert_eq!(fixed.det(), dynamic.det());
+        assert!(Lu::new(&dmatrix![1.0, 2.0; 2.0, 4.0], "t").is_err());
+        // An empty matrix factors (nothing to pivot) and solves to nothing.
+        let empty = Lu::new(&DMatrix::<f64>::zeros(0, 0), "t").unwrap();
+        assert_eq!(empty.solve(&DMatrix::zeros(0, 2)).shape(), (0, 2));
+        assert_eq!(empty.det(), 1.0);
+    }
 
     #[test]
     fn solves_with_pivoting() {

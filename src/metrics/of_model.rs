@@ -5,7 +5,8 @@ use super::step_info::{Crossings, figures};
 use super::{StepInfo, StepInfoOptions, step_info};
 use crate::data::Recording;
 use crate::error::Error;
-use crate::model::{Domain, StateSpace, period_of};
+use crate::model::{Domain, DynStateSpace, StateSpace, period_of};
+#[cfg(doc)]
 use crate::sim::step_response;
 
 /// Step-response figures of a stable single-input single-output model,
@@ -52,6 +53,25 @@ pub fn step_info_of<const N: usize, D: Domain>(
     info
 }
 
+/// Refuses the options that name one number for every channel.
+fn check_mimo_options(options: &StepInfoOptions) -> Result<(), Error> {
+    for (name, value) in [
+        ("initial_value", options.initial_value),
+        ("final_value", options.final_value),
+        ("reference", options.reference),
+    ] {
+        if let Some(value) = value {
+            return Err(Error::InvalidParameter {
+                name,
+                value,
+                reason: "is one number for every channel: leave it None for \
+                         step_info_mimo (each channel's final value is its DC gain)",
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Step-response figures of every channel of a stable model with `M`
 /// inputs and `P` outputs, continuous or discrete (MATLAB's `stepinfo` and
 /// python-control's `step_info` of a MIMO model): `[output][input]`, the
@@ -95,31 +115,42 @@ pub fn step_info_mimo<const N: usize, const M: usize, const P: usize, D: Domain>
     dt: f64,
     options: &StepInfoOptions,
 ) -> Result<[[Result<StepInfo, Error>; M]; P], Error> {
-    for (name, value) in [
-        ("initial_value", options.initial_value),
-        ("final_value", options.final_value),
-        ("reference", options.reference),
-    ] {
-        if let Some(value) = value {
-            return Err(Error::InvalidParameter {
-                name,
-                value,
-                reason: "is one number for every channel: leave it None for \
-                         step_info_mimo (each channel's final value is its DC gain)",
-            });
-        }
-    }
+    check_mimo_options(options)?;
     channels(sys, t_end, dt, options)
 }
 
-/// The figures of every channel; `options.final_value`, when given, serves
-/// them all (the callers allow it for one channel only).
+/// The figures of every channel of a fixed-size model, by
+/// [`channels_dyn`] (the one implementation).
 fn channels<const N: usize, const M: usize, const P: usize, D: Domain>(
     sys: &StateSpace<N, M, P, D>,
     t_end: f64,
     dt: f64,
     options: &StepInfoOptions,
 ) -> Result<[[Result<StepInfo, Error>; M]; P], Error> {
+    let mut rows = channels_dyn(&DynStateSpace::from(sys), t_end, dt, options)?.into_iter();
+    // `channels_dyn` returns P rows of M figures; the fallbacks are never
+    // taken, and are errors rather than panics.
+    let missing = |index| {
+        Err(Error::OutOfRange {
+            what: "channel",
+            index,
+            len: M * P,
+        })
+    };
+    Ok(core::array::from_fn(|i| {
+        let mut row = rows.next().unwrap_or_default().into_iter();
+        core::array::from_fn(|j| row.next().unwrap_or_else(|| missing(i * M + j)))
+    }))
+}
+
+/// The figures of every channel, `[output][input]`; `options.final_value`,
+/// when given, serves them all (the callers allow it for one channel only).
+fn channels_dyn<D: Domain>(
+    sys: &DynStateSpace<D>,
+    t_end: f64,
+    dt: f64,
+    options: &StepInfoOptions,
+) -> Result<Vec<Vec<Result<StepInfo, Error>>>, Error> {
     options.validate()?;
     if let Some(p) = sys.unstable_pole()? {
         return Err(Error::Unstable {
@@ -136,26 +167,120 @@ fn channels<const N: usize, const M: usize, const P: usize, D: Domain>(
         None => Crossings::Interpolated,
         Some(_) => Crossings::AtSamples,
     };
-    let mut responses = Vec::with_capacity(M);
-    for j in 0..M {
-        responses.push(step_response(&sys.select_input(j)?, t_end, dt)?);
+    let mut responses = Vec::with_capacity(sys.inputs());
+    for j in 0..sys.inputs() {
+        responses.push(sys.select_input(j)?.step_response(t_end, dt)?);
     }
-    Ok(core::array::from_fn(|i| {
-        core::array::from_fn(|j| {
-            let r = &responses[j];
-            let y: Vec<f64> = r.y.iter().map(|y| y[i]).collect();
-            let final_value = options.final_value.or(gain.map(|g| g[(i, j)]));
-            figures(
-                &r.t,
-                &y,
-                &StepInfoOptions {
-                    final_value,
-                    ..*options
-                },
-                crossings,
-            )
+    Ok((0..sys.outputs())
+        .map(|i| {
+            responses
+                .iter()
+                .enumerate()
+                .map(|(j, r)| {
+                    let y: Vec<f64> = r.y.iter().map(|y| y[i]).collect();
+                    let final_value = options.final_value.or(gain.as_ref().map(|g| g[(i, j)]));
+                    figures(
+                        &r.t,
+                        &y,
+                        &StepInfoOptions {
+                            final_value,
+                            ..*options
+                        },
+                        crossings,
+                    )
+                })
+                .collect()
         })
-    }))
+        .collect())
+}
+
+impl<D: Domain> DynStateSpace<D> {
+    /// Step-response figures of a stable single-input single-output model,
+    /// continuous or discrete: [`step_info_of`] for a model sized at run
+    /// time, the same code (its unit step response on
+    /// [`time_grid`](crate::sim::time_grid)`(t_end, dt)`, s, against its DC
+    /// gain unless `options.final_value` says otherwise).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::DimensionMismatch`] unless the model has one input (named
+    /// `"B"`) and one output (named `"C"`); as [`step_info_of`] otherwise.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{DynStateSpace, StepInfoOptions};
+    /// use nalgebra::dmatrix;
+    ///
+    /// // A first-order lag, τ = 0.1 s: rise time τ ln 9, 2 % settling τ ln 50.
+    /// let lag = DynStateSpace::continuous(dmatrix![-10.0], dmatrix![10.0], dmatrix![1.0], dmatrix![0.0])?;
+    /// let info = lag.step_info(2.0, 0.01, &StepInfoOptions::default())?;
+    /// assert!((info.rise_time - 0.1 * 9f64.ln()).abs() < 1e-3);
+    /// assert!((info.settling_time - 0.1 * 50f64.ln()).abs() < 1e-3);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "stepinfo")]
+    pub fn step_info(
+        &self,
+        t_end: f64,
+        dt: f64,
+        options: &StepInfoOptions,
+    ) -> Result<StepInfo, Error> {
+        let (n, m, p) = (self.states(), self.inputs(), self.outputs());
+        if m != 1 || p != 1 {
+            let (matrix, rows, cols, found_rows, found_cols) = if m != 1 {
+                ("B", n, 1, n, m)
+            } else {
+                ("C", 1, n, p, n)
+            };
+            return Err(Error::DimensionMismatch {
+                matrix,
+                expected_rows: rows,
+                expected_cols: cols,
+                found_rows,
+                found_cols,
+            });
+        }
+        channels_dyn(self, t_end, dt, options)?
+            .pop()
+            .and_then(|mut row| row.pop())
+            .unwrap_or(Err(Error::OutOfRange {
+                what: "channel",
+                index: 0,
+                len: 0,
+            }))
+    }
+
+    /// Step-response figures of every channel, `[output][input]`:
+    /// [`step_info_mimo`] for a model sized at run time, the same code.
+    ///
+    /// # Errors
+    ///
+    /// As [`step_info_mimo`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{DynStateSpace, Error, StepInfoOptions};
+    /// use nalgebra::dmatrix;
+    ///
+    /// // Two lags, τ = 0.1 s and 1 s, one per input and output.
+    /// let sys = DynStateSpace::continuous(dmatrix![-10.0, 0.0; 0.0, -1.0], dmatrix![10.0, 0.0; 0.0, 1.0],
+    ///                                     dmatrix![1.0, 0.0; 0.0, 1.0], dmatrix![0.0, 0.0; 0.0, 0.0])?;
+    /// let info = sys.step_info_mimo(10.0, 0.001, &StepInfoOptions::default())?;
+    /// assert!((info[1][1].as_ref().unwrap().rise_time - 9f64.ln()).abs() < 1e-6);
+    /// assert!(matches!(info[0][1], Err(Error::InvalidData { .. })));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn step_info_mimo(
+        &self,
+        t_end: f64,
+        dt: f64,
+        options: &StepInfoOptions,
+    ) -> Result<Vec<Vec<Result<StepInfo, Error>>>, Error> {
+        check_mimo_options(options)?;
+        channels_dyn(self, t_end, dt, options)
+    }
 }
 
 /// [`step_info`] of channel `channel` of a recording (from the rig's loop or

@@ -14,7 +14,12 @@ use crate::model::{Continuous, Discrete, Domain, StateSpace};
 /// `y = C x + D u` in continuous time, `x[k+1] = A x[k] + B u[k]` with period
 /// `dt` s in discrete time. The matrices are nalgebra [`DMatrix`]es on the
 /// heap; the design-time algorithms (poles, Riccati equations, frequency
-/// responses) run on them through faer. Convert from a fixed-size model with
+/// responses) run on them through faer. Analysis (`poles`, `is_stable`,
+/// `dc_gain`, `controllability`, `damping`, …), `discretize`, the standard
+/// responses (`step_response`, …, returning a
+/// [`DynResponse`](crate::sim::DynResponse)), `step_info` and pole placement
+/// (`place`, `place_observer`, `acker`) are methods, running the same code
+/// as the fixed-size functions. Convert from a fixed-size model with
 /// `From`, and back with `TryFrom`, which checks the sizes:
 ///
 /// # Examples

@@ -7,19 +7,27 @@
 //! delay, saturation and measurement quantisation and noise, producing the
 //! same [`Recording`](crate::Recording) as the rig's loop.
 //!
-//! The inner loops are [`StateSpace::advance_mut`] and
-//! [`Integrator::step_mut`], which allocate nothing; the functions here
-//! allocate only their output, once, up front.
+//! A model sized at run time ([`DynStateSpace`](crate::DynStateSpace)) has
+//! the same simulations as methods (`sys.step_response(t_end, dt)`, …),
+//! returning a [`DynResponse`]; they run the same loops, generic over the
+//! matrices' dimensions.
+//!
+//! For a fixed-size model the inner loops (the recursion
+//! `x ← A x + B u` of [`StateSpace::advance_mut`], and
+//! [`Integrator::step_mut`]) allocate nothing; the functions here allocate
+//! only their output, once, up front.
 
-use nalgebra::SVector;
+use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, SVector, allocator::Allocator};
 
+mod dynamic;
 mod responses;
 mod sampled;
 
+pub use dynamic::DynResponse;
 pub use responses::{impulse_response, initial_response, step_response};
 pub use sampled::{SampledConfig, Sensor, run_sampled};
 
-use crate::discretize::zoh;
+use crate::discretize::{Held, zoh};
 use crate::error::{Error, check_dt};
 use crate::integrate::{Integrator, Rk4};
 use crate::kernels::reduce::max_step_deviation;
@@ -256,20 +264,67 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
             _ => return Err(bad("more than sim::MAX_RK4_STEPS RK4 steps in all")),
         }
     }
+    let Solver::Rk4 { substeps } = solver else {
+        let (x, y) = lsim_zoh(sys.a(), sys.b(), sys.c(), sys.d(), t, x0, input)?;
+        return Ok(Response {
+            t: t.to_vec(),
+            x,
+            y,
+        });
+    };
     let mut out = Response::with_capacity(t.len());
+    let mut x = x0;
+    let uniform = uniform_step(t, grid_rounding(t));
+    for (k, &tk) in t.iter().enumerate() {
+        let u = input(tk);
+        check_input(&u, M)?;
+        out.t.push(tk);
+        out.x.push(x);
+        out.y.push(sys.output(&x, &u));
+        let Some(&next) = t.get(k + 1) else { break };
+        let h = uniform.unwrap_or(next - tk);
+        let hs = h / substeps as f64;
+        for s in 0..substeps {
+            Rk4.step_mut(sys, tk + s as f64 * hs, hs, &mut x, &u);
+        }
+    }
+    out.check_finite("simulation (the response diverged past f64::MAX)")?;
+    Ok(out)
+}
+
+/// What a continuous simulation that overflows reports.
+const DIVERGED_CONTINUOUS: &str = "simulation (the response diverged past f64::MAX)";
+
+/// The states and outputs of `(A, B, C, D)` over the grid `t` (checked)
+/// from `x0` (checked) under the input `input(t)` held between grid times,
+/// by exact ZOH steps: the one implementation behind [`simulate`] and
+/// [`DynStateSpace::simulate`](crate::DynStateSpace::simulate). For
+/// fixed-size matrices nothing in the loop allocates.
+pub(crate) fn lsim_zoh<N: Dim, M: Dim, P: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
+    c: &OMatrix<f64, P, N>,
+    d: &OMatrix<f64, P, M>,
+    t: &[f64],
+    x0: OVector<f64, N>,
+    mut input: impl FnMut(f64) -> OVector<f64, M>,
+) -> Result<States<N, P>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
+    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
+{
+    let mut xs = Vec::with_capacity(t.len());
+    let mut ys = Vec::with_capacity(t.len());
     let mut x = x0;
     // Intervals that differ by no more than the rounding of the grid's
     // times are one interval: a uniform grid is one discretisation with its
     // mean step (no drift), however its times were rounded.
     let tol = grid_rounding(t);
     let uniform = uniform_step(t, tol);
-    if let (Solver::Zoh, Some(h)) = (solver, uniform) {
+    if let Some(h) = uniform {
         // One discretisation for the whole grid, and a loop that holds
-        // only the recursion and the stores (the general loop below checks
-        // the interval and the solver at every sample).
-        let (ad, bd) = zoh(sys.a(), sys.b(), h)?;
-        let d = StateSpace::from_computed(ad, bd, *sys.c(), *sys.d(), h, "ZOH")?;
-        out.t.extend_from_slice(t);
+        // only the recursion and the stores.
+        let (ad, bd) = zoh(a, b, h)?;
         // The finite check folded into the loop: once a state component is
         // not finite, every component of every later state is not (`A x`
         // sums every column, and 0·∞ and 0·NaN are NaN), so the last state
@@ -277,54 +332,62 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
         let mut probe = 0.0;
         for &tk in t {
             let u = input(tk);
-            check_input(&u)?;
-            let y = d.output(&x, &u);
+            check_input(&u, b.ncols())?;
+            let y = c * &x + d * &u;
             probe += y.iter().map(|v| v * 0.0).sum::<f64>();
-            out.x.push(x);
-            out.y.push(y);
-            d.advance_mut(&mut x, &u);
+            let next = &ad * &x + &bd * &u;
+            xs.push(x);
+            ys.push(y);
+            x = next;
         }
-        let last = out.x.last().is_none_or(|x| x.iter().all(|v| v.is_finite()));
+        let last = xs.last().is_none_or(|x| x.iter().all(|v| v.is_finite()));
         if !(last && probe == 0.0) {
             return Err(Error::Overflow {
-                operation: "simulation (the response diverged past f64::MAX)",
+                operation: DIVERGED_CONTINUOUS,
             });
         }
-        return Ok(out);
+        return Ok((xs, ys));
     }
     // ZOH matrices, recomputed only when the interval length changes.
-    let mut cached: Option<(f64, StateSpace<N, M, P, Discrete>)> = None;
+    let mut cached: Option<(f64, Held<N, M>)> = None;
     for (k, &tk) in t.iter().enumerate() {
         let u = input(tk);
-        check_input(&u)?;
-        out.t.push(tk);
-        out.x.push(x);
-        out.y.push(sys.output(&x, &u));
-        let Some(&next) = t.get(k + 1) else { break };
-        let h = uniform.unwrap_or(next - tk);
-        match solver {
-            Solver::Zoh => {
-                let same = matches!(&cached, Some((hc, _)) if (hc - h).abs() <= tol);
+        check_input(&u, b.ncols())?;
+        let y = c * &x + d * &u;
+        let next = match t.get(k + 1) {
+            None => None,
+            Some(&next) => {
+                let h = next - tk;
+                let same = matches!(&cached, Some((hc, ..)) if (hc - h).abs() <= tol);
                 if !same {
-                    let (ad, bd) = zoh(sys.a(), sys.b(), h)?;
-                    let d = StateSpace::from_computed(ad, bd, *sys.c(), *sys.d(), h, "ZOH")?;
-                    cached = Some((h, d));
+                    cached = Some((h, zoh(a, b, h)?));
                 }
-                if let Some((_, d)) = &cached {
-                    d.advance_mut(&mut x, &u);
-                }
+                cached.as_ref().map(|(_, (ad, bd))| ad * &x + bd * &u)
             }
-            Solver::Rk4 { substeps } => {
-                let hs = h / substeps as f64;
-                for s in 0..substeps {
-                    Rk4.step_mut(sys, tk + s as f64 * hs, hs, &mut x, &u);
-                }
-            }
+        };
+        xs.push(x);
+        ys.push(y);
+        match next {
+            Some(next) => x = next,
+            None => break,
         }
     }
-    out.check_finite("simulation (the response diverged past f64::MAX)")?;
-    Ok(out)
+    let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
+    if xs
+        .iter()
+        .zip(&ys)
+        .all(|(x, y)| finite(x.as_slice()) & finite(y.as_slice()))
+    {
+        Ok((xs, ys))
+    } else {
+        Err(Error::Overflow {
+            operation: DIVERGED_CONTINUOUS,
+        })
+    }
 }
+
+/// The states and outputs of a simulation, one per sample.
+pub(crate) type States<N, P> = (Vec<OVector<f64, N>>, Vec<OVector<f64, P>>);
 
 /// How far apart two of the grid's intervals may be and still be the same
 /// interval: `2 ε max|t|`, two units in the last place of its largest time
@@ -342,7 +405,7 @@ fn uniform_step(t: &[f64], tol: f64) -> Option<f64> {
     (mean.is_finite() && max_step_deviation(t, mean) <= tol).then_some(mean)
 }
 
-fn check_grid(t: &[f64]) -> Result<(), Error> {
+pub(super) fn check_grid(t: &[f64]) -> Result<(), Error> {
     let bad = |value: f64, reason| Error::InvalidParameter {
         name: "t",
         value,
@@ -370,8 +433,19 @@ fn check_grid(t: &[f64]) -> Result<(), Error> {
 /// What a discrete simulation that overflows reports.
 const DIVERGED: &str = "discrete simulation (the response diverged past f64::MAX)";
 
-/// Refuses a non-finite input sample.
-fn check_input<const M: usize>(u: &SVector<f64, M>) -> Result<(), Error> {
+/// Refuses an input sample that is not finite or does not have `inputs`
+/// entries (a closure's vector, sized at run time).
+fn check_input<M: Dim>(u: &OVector<f64, M>, inputs: usize) -> Result<(), Error>
+where
+    DefaultAllocator: Allocator<M>,
+{
+    if u.len() != inputs {
+        return Err(Error::LengthMismatch {
+            what: "input",
+            expected: inputs,
+            found: u.len(),
+        });
+    }
     match u.iter().find(|v| !v.is_finite()) {
         Some(&value) => Err(Error::InvalidParameter {
             name: "input",
@@ -439,7 +513,7 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
     sys: &StateSpace<N, M, P, Discrete>,
     x0: SVector<f64, N>,
     steps: usize,
-    mut control: impl FnMut(usize, &SVector<f64, N>) -> SVector<f64, M>,
+    control: impl FnMut(usize, &SVector<f64, N>) -> SVector<f64, M>,
 ) -> Result<Response<N, P>, Error> {
     if steps > MAX_SAMPLES {
         return Err(Error::InvalidParameter {
@@ -455,16 +529,45 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
             reason: "the initial state must be finite",
         });
     }
+    let (x, y) = discrete_feedback(sys.a(), sys.b(), sys.c(), sys.d(), x0, steps, control)?;
     let dt = sys.dt();
-    let mut out = Response::with_capacity(steps);
+    Ok(Response {
+        t: (0..steps).map(|k| k as f64 * dt).collect(),
+        x,
+        y,
+    })
+}
+
+/// The states and outputs of the discrete `(A, B, C, D)` for `steps`
+/// samples from `x0` under `u[k] = control(k, &x[k])`: the one
+/// implementation behind [`simulate_discrete_feedback`] and the discrete
+/// simulations of [`DynStateSpace`](crate::DynStateSpace). `steps` and
+/// `x0` are the caller's to check. For fixed-size matrices nothing in the
+/// loop allocates.
+pub(crate) fn discrete_feedback<N: Dim, M: Dim, P: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
+    c: &OMatrix<f64, P, N>,
+    d: &OMatrix<f64, P, M>,
+    x0: OVector<f64, N>,
+    steps: usize,
+    mut control: impl FnMut(usize, &OVector<f64, N>) -> OVector<f64, M>,
+) -> Result<States<N, P>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
+    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
+{
+    let mut xs = Vec::with_capacity(steps);
+    let mut ys = Vec::with_capacity(steps);
     let mut x = x0;
     for k in 0..steps {
         let u = control(k, &x);
-        check_input(&u)?;
-        out.t.push(k as f64 * dt);
-        out.x.push(x);
-        out.y.push(sys.output(&x, &u));
-        sys.advance_mut(&mut x, &u);
+        check_input(&u, b.ncols())?;
+        let y = c * &x + d * &u;
+        let next = a * &x + b * &u;
+        xs.push(x);
+        ys.push(y);
+        x = next;
         // Stop at the first overflow: a controller would otherwise see
         // infinities and the error would blame its input.
         if x.iter().any(|v| !v.is_finite()) {
@@ -473,6 +576,11 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
             });
         }
     }
-    out.check_finite(DIVERGED)?;
-    Ok(out)
+    if ys.iter().all(|y| y.iter().all(|v| v.is_finite())) {
+        Ok((xs, ys))
+    } else {
+        Err(Error::Overflow {
+            operation: DIVERGED,
+        })
+    }
 }

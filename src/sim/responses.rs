@@ -16,7 +16,7 @@ use crate::error::{Error, check_finite};
 use crate::model::{Domain, StateSpace, period_of};
 
 /// The grid of a response of a model in `domain`.
-fn grid<D: Domain>(domain: &D, t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
+pub(super) fn grid<D: Domain>(domain: &D, t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
     match period_of(domain) {
         None => time_grid(t_end, dt),
         // NaN fails the comparison too.

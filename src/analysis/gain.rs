@@ -1,0 +1,67 @@
+//! The DC gain, on run-time-sized matrices (the one implementation behind
+//! both model types' `dc_gain`).
+
+use nalgebra::DMatrix;
+
+use crate::error::Error;
+use crate::kernels::linalg::Lu;
+use crate::kernels::reduce::pow2_floor;
+
+/// The steady-state gain of `(A, B, C, D)`: `−C A⁻¹ B + D` in continuous
+/// time (`period = None`), `C (I − A)⁻¹ B + D` in discrete time.
+pub(crate) fn dc_gain(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    d: &DMatrix<f64>,
+    period: Option<f64>,
+) -> Result<DMatrix<f64>, Error> {
+    let g = match period {
+        None => {
+            let x = gain_solve(a.clone(), b.clone(), "DC gain (pole at s = 0)")?;
+            d - c * x
+        }
+        Some(_) => {
+            let n = a.nrows();
+            let i_minus_a = DMatrix::identity(n, n) - a;
+            let x = gain_solve(i_minus_a, b.clone(), "DC gain (pole at z = 1)")?;
+            c * x + d
+        }
+    };
+    if g.iter().all(|v| v.is_finite()) {
+        Ok(g)
+    } else {
+        Err(Error::Overflow {
+            operation: "DC gain",
+        })
+    }
+}
+
+/// Solves `m x = b` for a DC gain, refusing an `m` so ill-conditioned that
+/// the gain would have fewer than about four correct digits: a pole at
+/// s = 0 / z = 1 that rounding moved slightly off it must be reported, not
+/// turned into a huge, meaningless number. The equations are first scaled
+/// by powers of two (each row's largest entry in [1, 2)), and the test is
+/// the Skeel condition number `‖ |m⁻¹| |m| ‖∞`, which no such scaling
+/// changes: `diag(−1, −1e12)` is perfectly conditioned.
+fn gain_solve(
+    mut m: DMatrix<f64>,
+    mut b: DMatrix<f64>,
+    operation: &'static str,
+) -> Result<DMatrix<f64>, Error> {
+    let n = m.nrows();
+    for i in 0..n {
+        let f = 1.0 / pow2_floor(m.row(i).amax());
+        m.row_mut(i).scale_mut(f);
+        b.row_mut(i).scale_mut(f);
+    }
+    let lu = Lu::new(&m, operation)?;
+    let skeel = (lu.solve(&DMatrix::identity(n, n)).abs() * m.abs())
+        .row_iter()
+        .map(|r| r.sum())
+        .fold(0.0, f64::max);
+    if !skeel.is_finite() || skeel * f64::EPSILON > 1e-4 {
+        return Err(Error::Singular { operation });
+    }
+    Ok(lu.solve(&b))
+}
