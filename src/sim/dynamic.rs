@@ -267,7 +267,7 @@ impl<D: Domain> DynStateSpace<D> {
                 Ok(DynResponse { t, x, y })
             }
             Some(period) => {
-                let (t, x, y) = discrete_feedback(a, b, c, d, period, x0, t.len(), |k, _x| {
+                let (t, x, y) = discrete_feedback((a, b, c, d), period, x0, t.len(), |k, _x| {
                     DVector::from_element(m, input(k))
                 })?;
                 Ok(DynResponse { t, x, y })
@@ -396,10 +396,7 @@ impl DynStateSpace<Discrete> {
         }
         self.check_state(x0)?;
         let (t, x, y) = discrete_feedback::<Dyn, Dyn, Dyn>(
-            self.a(),
-            self.b(),
-            self.c(),
-            self.d(),
+            (self.a(), self.b(), self.c(), self.d()),
             self.dt(),
             x0.clone(),
             steps,

@@ -381,6 +381,14 @@ where
 /// The states and outputs of a simulation, one per sample.
 pub(crate) type States<N, P> = (Vec<OVector<f64, N>>, Vec<OVector<f64, P>>);
 
+/// The matrices `(A, B, C, D)` of a model, borrowed.
+pub(crate) type Abcd<'a, N, M, P> = (
+    &'a OMatrix<f64, N, N>,
+    &'a OMatrix<f64, N, M>,
+    &'a OMatrix<f64, P, N>,
+    &'a OMatrix<f64, P, M>,
+);
+
 /// Sample times (s), states and outputs of a discrete simulation.
 pub(crate) type Sampled<N, P> = (Vec<f64>, Vec<OVector<f64, N>>, Vec<OVector<f64, P>>);
 
@@ -525,10 +533,7 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
         });
     }
     let (t, x, y) = discrete_feedback(
-        sys.a(),
-        sys.b(),
-        sys.c(),
-        sys.d(),
+        (sys.a(), sys.b(), sys.c(), sys.d()),
         sys.dt(),
         x0,
         steps,
@@ -545,10 +550,7 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
 /// `x0` are the caller's to check. For fixed-size matrices nothing in the
 /// loop allocates.
 pub(crate) fn discrete_feedback<N: Dim, M: Dim, P: Dim>(
-    a: &OMatrix<f64, N, N>,
-    b: &OMatrix<f64, N, M>,
-    c: &OMatrix<f64, P, N>,
-    d: &OMatrix<f64, P, M>,
+    (a, b, c, d): Abcd<'_, N, M, P>,
     dt: f64,
     x0: OVector<f64, N>,
     steps: usize,
