@@ -256,20 +256,23 @@ impl<D: Domain> DynStateSpace<D> {
         let t = grid(&self.domain(), t_end, dt)?;
         let m = self.inputs();
         let (a, b, c, d) = (self.a(), self.b(), self.c(), self.d());
-        let (x, y) = match period_of(&self.domain()) {
+        match period_of(&self.domain()) {
             None => {
                 // The input is asked for once per grid time, in order.
                 let mut k = 0;
-                lsim_zoh(a, b, c, d, &t, x0, |_t| {
+                let (x, y) = lsim_zoh(a, b, c, d, &t, x0, |_t| {
                     k += 1;
                     DVector::from_element(m, input(k - 1))
-                })?
+                })?;
+                Ok(DynResponse { t, x, y })
             }
-            Some(_) => discrete_feedback(a, b, c, d, x0, t.len(), |k, _x| {
-                DVector::from_element(m, input(k))
-            })?,
-        };
-        Ok(DynResponse { t, x, y })
+            Some(period) => {
+                let (t, x, y) = discrete_feedback((a, b, c, d), period, x0, t.len(), |k, _x| {
+                    DVector::from_element(m, input(k))
+                })?;
+                Ok(DynResponse { t, x, y })
+            }
+        }
     }
 
     fn single_input(&self) -> Result<(), Error> {
@@ -392,20 +395,13 @@ impl DynStateSpace<Discrete> {
             });
         }
         self.check_state(x0)?;
-        let (x, y) = discrete_feedback::<Dyn, Dyn, Dyn>(
-            self.a(),
-            self.b(),
-            self.c(),
-            self.d(),
+        let (t, x, y) = discrete_feedback::<Dyn, Dyn, Dyn>(
+            (self.a(), self.b(), self.c(), self.d()),
+            self.dt(),
             x0.clone(),
             steps,
             control,
         )?;
-        let dt = self.dt();
-        Ok(DynResponse {
-            t: (0..steps).map(|k| k as f64 * dt).collect(),
-            x,
-            y,
-        })
+        Ok(DynResponse { t, x, y })
     }
 }

@@ -389,6 +389,17 @@ where
 /// The states and outputs of a simulation, one per sample.
 pub(crate) type States<N, P> = (Vec<OVector<f64, N>>, Vec<OVector<f64, P>>);
 
+/// The matrices `(A, B, C, D)` of a model, borrowed.
+pub(crate) type Abcd<'a, N, M, P> = (
+    &'a OMatrix<f64, N, N>,
+    &'a OMatrix<f64, N, M>,
+    &'a OMatrix<f64, P, N>,
+    &'a OMatrix<f64, P, M>,
+);
+
+/// Sample times (s), states and outputs of a discrete simulation.
+pub(crate) type Sampled<N, P> = (Vec<f64>, Vec<OVector<f64, N>>, Vec<OVector<f64, P>>);
+
 /// How far apart two of the grid's intervals may be and still be the same
 /// interval: `2 ε max|t|`, two units in the last place of its largest time
 /// (each time is rounded once, `k·dt` or `t + dt`, so each interval is off
@@ -529,40 +540,42 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
             reason: "the initial state must be finite",
         });
     }
-    let (x, y) = discrete_feedback(sys.a(), sys.b(), sys.c(), sys.d(), x0, steps, control)?;
-    let dt = sys.dt();
-    Ok(Response {
-        t: (0..steps).map(|k| k as f64 * dt).collect(),
-        x,
-        y,
-    })
+    let (t, x, y) = discrete_feedback(
+        (sys.a(), sys.b(), sys.c(), sys.d()),
+        sys.dt(),
+        x0,
+        steps,
+        control,
+    )?;
+    Ok(Response { t, x, y })
 }
 
-/// The states and outputs of the discrete `(A, B, C, D)` for `steps`
-/// samples from `x0` under `u[k] = control(k, &x[k])`: the one
+/// The times (`k dt`), states and outputs of the discrete `(A, B, C, D)`
+/// with period `dt` for `steps` samples from `x0` under
+/// `u[k] = control(k, &x[k])`: the one
 /// implementation behind [`simulate_discrete_feedback`] and the discrete
 /// simulations of [`DynStateSpace`](crate::DynStateSpace). `steps` and
 /// `x0` are the caller's to check. For fixed-size matrices nothing in the
 /// loop allocates.
 pub(crate) fn discrete_feedback<N: Dim, M: Dim, P: Dim>(
-    a: &OMatrix<f64, N, N>,
-    b: &OMatrix<f64, N, M>,
-    c: &OMatrix<f64, P, N>,
-    d: &OMatrix<f64, P, M>,
+    (a, b, c, d): Abcd<'_, N, M, P>,
+    dt: f64,
     x0: OVector<f64, N>,
     steps: usize,
     mut control: impl FnMut(usize, &OVector<f64, N>) -> OVector<f64, M>,
-) -> Result<States<N, P>, Error>
+) -> Result<Sampled<N, P>, Error>
 where
     DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
     DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
 {
+    let mut ts = Vec::with_capacity(steps);
     let mut xs = Vec::with_capacity(steps);
     let mut ys = Vec::with_capacity(steps);
     let mut x = x0;
     for k in 0..steps {
         let u = control(k, &x);
         check_input(&u, b.ncols())?;
+        ts.push(k as f64 * dt);
         let y = c * &x + d * &u;
         let next = a * &x + b * &u;
         xs.push(x);
@@ -576,8 +589,10 @@ where
             });
         }
     }
-    if ys.iter().all(|y| y.iter().all(|v| v.is_finite())) {
-        Ok((xs, ys))
+    // Folds without early exit, which vectorise.
+    let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
+    if ys.iter().fold(true, |ok, y| ok & finite(y.as_slice())) {
+        Ok((ts, xs, ys))
     } else {
         Err(Error::Overflow {
             operation: DIVERGED,
