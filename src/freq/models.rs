@@ -1,0 +1,81 @@
+//! Zeros of the state-space model types.
+
+use nalgebra::{Complex, DMatrix};
+
+use super::zeros::invariant_zeros;
+use crate::error::Error;
+use crate::model::{Domain, DynStateSpace, StateSpace};
+
+impl<D: Domain> DynStateSpace<D> {
+    /// The invariant zeros: the finite `s` (rad/s; `z` for a discrete
+    /// model) at which the Rosenbrock system matrix `[A − sI, B; C, D]`
+    /// loses rank, sorted by real then imaginary part. For a minimal SISO
+    /// model they are the transmission zeros, the roots of the transfer
+    /// function's numerator; for a non-minimal one they include the
+    /// uncontrollable and unobservable modes that cancel.
+    ///
+    /// Square models (inputs = outputs) only: full-rank `D` through
+    /// `eig(A − B D⁻¹ C)`, `D = 0` with a full-rank first Markov parameter
+    /// through the zero dynamics (exactly `n − r m` zeros for relative
+    /// degree `r`), otherwise the finite generalized eigenvalues of the
+    /// pencil by faer's QZ, where an eigenvalue counts as infinite beyond
+    /// `‖[A B; C D]‖_F / √ε`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidMatrix`] (`"D"`) for a non-square model (not
+    /// implemented: select a square subsystem); the errors of the
+    /// eigenvalue computations.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Cart, DynStateSpace, MassSpring};
+    ///
+    /// let plant = DynStateSpace::from(MassSpring::nominal().state_space(Cart::Two)?);
+    /// let z = plant.zeros()?;
+    /// // Cart 1's own resonance, √(k1/m1) ≈ 26 rad/s, lightly damped.
+    /// assert_eq!(z.len(), 2);
+    /// assert!(z.iter().all(|z| z.re < 0.0 && z.im.abs() > 20.0));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "tzero")]
+    #[doc(alias = "zero")]
+    pub fn zeros(&self) -> Result<Vec<Complex<f64>>, Error> {
+        invariant_zeros(self.a(), self.b(), self.c(), self.d())
+    }
+}
+
+impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M, P, D> {
+    /// The invariant zeros, as [`DynStateSpace::zeros`].
+    ///
+    /// # Errors
+    ///
+    /// As [`DynStateSpace::zeros`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StateSpace;
+    /// use nalgebra::matrix;
+    ///
+    /// // (s + 3) / ((s + 1)(s + 2)) with a feedthrough of 1: zeros of
+    /// // s² + 4 s + 5 = (s + 2)² + 1.
+    /// let sys = StateSpace::continuous(matrix![-3.0, -2.0; 1.0, 0.0], matrix![1.0; 0.0],
+    ///                                  matrix![1.0, 3.0], matrix![1.0])?;
+    /// let z = sys.zeros()?;
+    /// assert!((z[0].re + 2.0).abs() < 1e-12 && (z[0].im.abs() - 1.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "tzero")]
+    #[doc(alias = "zero")]
+    pub fn zeros(&self) -> Result<Vec<Complex<f64>>, Error> {
+        let heap = |m: &[f64], r: usize, c: usize| DMatrix::from_column_slice(r, c, m);
+        invariant_zeros(
+            &heap(self.a().as_slice(), N, N),
+            &heap(self.b().as_slice(), N, M),
+            &heap(self.c().as_slice(), P, N),
+            &heap(self.d().as_slice(), P, M),
+        )
+    }
+}

@@ -1,0 +1,720 @@
+//! Transfer functions: [`TransferFunction`] (SISO, numerator and
+//! denominator polynomials) and [`TransferMatrix`] (MIMO, one SISO entry
+//! per output and input), with `ss2tf` and `tf2ss`.
+
+use nalgebra::{Complex, DMatrix};
+
+use super::poly;
+use super::zeros::siso_numerator;
+use crate::analysis::eigenvalues_dyn;
+use crate::error::{Error, check_dt};
+use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, period_of};
+
+/// A polynomial argument checked: non-empty, finite, leading exact zeros
+/// removed.
+pub(crate) fn check_poly(what: &'static str, p: &[f64]) -> Result<Vec<f64>, Error> {
+    if p.is_empty() {
+        return Err(Error::InvalidData {
+            what,
+            index: 0,
+            reason: "empty polynomial: give at least one coefficient",
+        });
+    }
+    if let Some(index) = p.iter().position(|c| !c.is_finite()) {
+        return Err(Error::InvalidData {
+            what,
+            index,
+            reason: "polynomial coefficient is not finite",
+        });
+    }
+    Ok(poly::trim(p).to_vec())
+}
+
+/// A SISO transfer function `G = num / den` in time domain `D`, the
+/// polynomials in descending powers of `s` (continuous) or `z` (discrete,
+/// period `dt` s), as python-control's `tf` and MATLAB's `tf` take them:
+/// `[1.0, 3.0]` is `s + 3`.
+///
+/// Leading exact zeros are dropped. The transfer function may be improper
+/// (it can still be evaluated); only [`to_state_space`](Self::to_state_space)
+/// needs it proper. Nothing is cancelled: `(s + 1) / (s + 1)` keeps both
+/// factors.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::TransferFunction;
+/// use nalgebra::Complex;
+///
+/// // 10 / (s² + 2 s + 10): ωn = √10 rad/s, ζ ≈ 0.32, DC gain 1.
+/// let g = TransferFunction::continuous(&[10.0], &[1.0, 2.0, 10.0])?;
+/// assert_eq!(g.dc_gain()?, 1.0);
+/// let at = g.evaluate(Complex::new(0.0, 10f64.sqrt()))?; // s = jωn
+/// assert!((at - Complex::new(0.0, -10f64.sqrt() / 2.0)).norm() < 1e-12);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[doc(alias = "tf")]
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferFunction<D: Domain = Continuous> {
+    num: Vec<f64>,
+    den: Vec<f64>,
+    domain: D,
+}
+
+impl TransferFunction<Continuous> {
+    /// `num(s) / den(s)`, coefficients in descending powers of `s`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidData`] (`what` = `"num"` or `"den"`) for an empty
+    /// polynomial, a non-finite coefficient (with its index), or a zero
+    /// denominator.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, freq::TransferFunction};
+    ///
+    /// let g = TransferFunction::continuous(&[0.0, 2.0], &[1.0, 1.0])?;
+    /// assert_eq!(g.num(), &[2.0]); // leading zero dropped
+    /// assert!(matches!(TransferFunction::continuous(&[1.0], &[0.0, 0.0]),
+    ///                  Err(Error::InvalidData { what: "den", .. })));
+    /// assert!(TransferFunction::continuous(&[], &[1.0]).is_err());
+    /// assert!(TransferFunction::continuous(&[f64::NAN], &[1.0]).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn continuous(num: &[f64], den: &[f64]) -> Result<Self, Error> {
+        Self::with_domain(num, den, Continuous)
+    }
+}
+
+impl TransferFunction<Discrete> {
+    /// `num(z) / den(z)` with sampling period `dt` (s), coefficients in
+    /// descending powers of `z`.
+    ///
+    /// # Errors
+    ///
+    /// As [`TransferFunction::continuous`], and [`Error::InvalidParameter`]
+    /// for a `dt` that is not finite and positive.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::freq::TransferFunction;
+    ///
+    /// // A discrete integrator-like lag, 0.5 / (z − 0.5), period 0.1 s.
+    /// let g = TransferFunction::discrete(&[0.5], &[1.0, -0.5], 0.1)?;
+    /// assert_eq!(g.dt(), 0.1);
+    /// assert_eq!(g.dc_gain()?, 1.0);
+    /// assert!(TransferFunction::discrete(&[1.0], &[1.0], -1.0).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn discrete(num: &[f64], den: &[f64], dt: f64) -> Result<Self, Error> {
+        check_dt(dt)?;
+        Self::with_domain(num, den, Discrete::new_unchecked(dt))
+    }
+
+    /// The sampling period in seconds.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::discrete(&[1.0], &[1.0, 0.0], 0.002)?.dt(), 0.002);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn dt(&self) -> f64 {
+        self.domain.dt()
+    }
+}
+
+impl<D: Domain> TransferFunction<D> {
+    pub(crate) fn with_domain(num: &[f64], den: &[f64], domain: D) -> Result<Self, Error> {
+        let num = check_poly("num", num)?;
+        let den = check_poly("den", den)?;
+        if den == [0.0] {
+            return Err(Error::InvalidData {
+                what: "den",
+                index: 0,
+                reason: "the denominator is the zero polynomial",
+            });
+        }
+        Ok(Self { num, den, domain })
+    }
+
+    /// The numerator's coefficients, descending powers.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::continuous(&[1.0, 3.0], &[1.0, 2.0, 1.0])?.num(), &[1.0, 3.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn num(&self) -> &[f64] {
+        &self.num
+    }
+
+    /// The denominator's coefficients, descending powers.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::continuous(&[1.0], &[2.0, 1.0])?.den(), &[2.0, 1.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn den(&self) -> &[f64] {
+        &self.den
+    }
+
+    /// The time domain: [`Continuous`], or [`Discrete`] with its period.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Continuous, freq::TransferFunction};
+    /// assert_eq!(TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.domain(), Continuous);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn domain(&self) -> D {
+        self.domain
+    }
+
+    /// Whether `deg num ≤ deg den` (a state-space realisation exists).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert!(TransferFunction::continuous(&[1.0, 0.0], &[1.0, 1.0])?.is_proper());
+    /// assert!(!TransferFunction::continuous(&[1.0, 0.0, 0.0], &[1.0, 1.0])?.is_proper());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn is_proper(&self) -> bool {
+        self.num.len() <= self.den.len()
+    }
+
+    /// `G` at a complex point `s` (rad/s) or `z` (dimensionless).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] for a non-finite point;
+    /// [`Error::Singular`] if the denominator vanishes there (a pole);
+    /// [`Error::Overflow`] if the value is not finite.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, freq::TransferFunction};
+    /// use nalgebra::Complex;
+    ///
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 0.0])?; // 1/s
+    /// assert_eq!(g.evaluate(Complex::new(0.0, 2.0))?, Complex::new(0.0, -0.5));
+    /// assert!(matches!(g.evaluate(Complex::new(0.0, 0.0)), Err(Error::Singular { .. })));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "evalfr")]
+    pub fn evaluate(&self, s: Complex<f64>) -> Result<Complex<f64>, Error> {
+        if !(s.re.is_finite() && s.im.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "s",
+                value: if s.re.is_finite() { s.im } else { s.re },
+                reason: "the point must be finite",
+            });
+        }
+        let g = poly::eval_ratio(&self.num, &self.den, s).ok_or(Error::Singular {
+            operation: "transfer function evaluation (a pole)",
+        })?;
+        if g.re.is_finite() && g.im.is_finite() {
+            Ok(g)
+        } else {
+            Err(Error::Overflow {
+                operation: "transfer function evaluation",
+            })
+        }
+    }
+
+    /// The poles: roots of the denominator, sorted by real then imaginary
+    /// part (rad/s for continuous models, `z` for discrete ones).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::NoConvergence`] or [`Error::Overflow`] from the eigenvalues
+    /// of the companion matrix.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// let p = TransferFunction::continuous(&[1.0], &[1.0, 3.0, 2.0])?.poles()?;
+    /// assert!((p[0].re + 2.0).abs() < 1e-12 && (p[1].re + 1.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "pole")]
+    pub fn poles(&self) -> Result<Vec<Complex<f64>>, Error> {
+        poly::roots(&self.den)
+    }
+
+    /// The zeros: roots of the numerator (the transmission zeros of a SISO
+    /// model), sorted as [`poles`](Self::poles). None for `G ≡ 0`.
+    ///
+    /// # Errors
+    ///
+    /// As [`poles`](Self::poles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// let z = TransferFunction::continuous(&[2.0, 6.0], &[1.0, 3.0, 2.0])?.zeros()?;
+    /// assert_eq!(z.len(), 1);
+    /// assert!((z[0].re + 3.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "zero")]
+    pub fn zeros(&self) -> Result<Vec<Complex<f64>>, Error> {
+        poly::roots(&self.num)
+    }
+
+    /// The DC gain: `G(0)` for continuous models, `G(1)` for discrete ones.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Singular`] if there is a pole at `s = 0` (`z = 1`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::continuous(&[4.0], &[1.0, 2.0])?.dc_gain()?, 2.0);
+    /// assert!(TransferFunction::continuous(&[1.0], &[1.0, 0.0])?.dc_gain().is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "dcgain")]
+    pub fn dc_gain(&self) -> Result<f64, Error> {
+        let point = match period_of(&self.domain) {
+            None => Complex::new(0.0, 0.0),
+            Some(_) => Complex::new(1.0, 0.0),
+        };
+        self.evaluate(point)
+            .map(|g| g.re)
+            .map_err(|e| match e {
+                Error::Singular { .. } => Error::Singular {
+                    operation: "DC gain (pole at s = 0 or z = 1)",
+                },
+                e => e,
+            })
+    }
+
+    /// A state-space realisation in SciPy's `tf2ss` form (controllable
+    /// canonical form): with `den` made monic, `sⁿ + a₁ sⁿ⁻¹ + … + aₙ`,
+    /// `A` has first row `[−a₁ … −aₙ]` and ones on its subdiagonal,
+    /// `B = e₁`, `D = b₀` (the numerator's `sⁿ` coefficient) and
+    /// `C = [b₁ − b₀ a₁, …, bₙ − b₀ aₙ]`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidData`] (`"num"`) for an improper transfer function;
+    /// [`Error::Overflow`] if normalising overflows.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::freq::TransferFunction;
+    /// use nalgebra::dmatrix;
+    ///
+    /// let g = TransferFunction::continuous(&[1.0, 3.0], &[1.0, 3.0, 2.0])?;
+    /// let sys = g.to_state_space()?;
+    /// assert_eq!(sys.a(), &dmatrix![-3.0, -2.0; 1.0, 0.0]);
+    /// assert_eq!(sys.c(), &dmatrix![1.0, 3.0]);
+    /// assert!(TransferFunction::continuous(&[1.0, 0.0], &[1.0])?.to_state_space().is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "tf2ss")]
+    pub fn to_state_space(&self) -> Result<DynStateSpace<D>, Error> {
+        if !self.is_proper() {
+            return Err(Error::InvalidData {
+                what: "num",
+                index: 0,
+                reason: "improper transfer function (numerator degree above the \
+                         denominator's): it has no state-space realisation",
+            });
+        }
+        let n = self.den.len() - 1;
+        let lead = self.den[0];
+        let den: Vec<f64> = self.den.iter().map(|c| c / lead).collect();
+        let mut num = vec![0.0; n + 1];
+        let off = n + 1 - self.num.len();
+        for (i, c) in self.num.iter().enumerate() {
+            num[off + i] = c / lead;
+        }
+        let mut a = DMatrix::zeros(n, n);
+        let mut b = DMatrix::zeros(n, 1);
+        let mut c = DMatrix::zeros(1, n);
+        for k in 0..n {
+            a[(0, k)] = -den[k + 1];
+            if k + 1 < n {
+                a[(k + 1, k)] = 1.0;
+            }
+            c[(0, k)] = num[k + 1] - num[0] * den[k + 1];
+        }
+        if n > 0 {
+            b[(0, 0)] = 1.0;
+        }
+        let d = DMatrix::from_element(1, 1, num[0]);
+        DynStateSpace::from_computed(a, b, c, d, self.domain, "tf2ss")
+    }
+
+    /// The transfer function of a SISO state-space model, `ss2tf`: the
+    /// denominator is the characteristic polynomial `det(sI − A)` (monic,
+    /// degree `n`, nothing cancelled, as SciPy's `ss2tf`), the numerator
+    /// `gain · ∏(s − zᵢ)` with the model's invariant zeros and its leading
+    /// coefficient (`D`, or the first non-zero Markov parameter
+    /// `C A^k B`).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::DimensionMismatch`] (`"D"`) unless the model has one input
+    /// and one output; the errors of the eigenvalue computations.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{DynStateSpace, freq::TransferFunction};
+    /// use nalgebra::dmatrix;
+    ///
+    /// let sys = DynStateSpace::continuous(dmatrix![-3.0, -2.0; 1.0, 0.0], dmatrix![1.0; 0.0],
+    ///                                     dmatrix![1.0, 3.0], dmatrix![0.0])?;
+    /// let g = TransferFunction::from_state_space(&sys)?;
+    /// assert_eq!(g.den(), &[1.0, 3.0, 2.0]);
+    /// assert!((g.num()[0] - 1.0).abs() < 1e-12 && (g.num()[1] - 3.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "ss2tf")]
+    pub fn from_state_space(sys: &DynStateSpace<D>) -> Result<Self, Error> {
+        if sys.inputs() != 1 || sys.outputs() != 1 {
+            return Err(Error::DimensionMismatch {
+                matrix: "D",
+                expected_rows: 1,
+                expected_cols: 1,
+                found_rows: sys.outputs(),
+                found_cols: sys.inputs(),
+            });
+        }
+        let den = poly::from_roots(&eigenvalues_dyn(sys.a())?);
+        entry(sys, &den, 0, 0)
+    }
+}
+
+/// The `(output, input)` entry of a model's transfer matrix over `den`.
+fn entry<D: Domain>(
+    sys: &DynStateSpace<D>,
+    den: &[f64],
+    output: usize,
+    input: usize,
+) -> Result<TransferFunction<D>, Error> {
+    let (zeros, gain) = siso_numerator(sys.a(), sys.b(), sys.c(), sys.d(), output, input)?;
+    let num: Vec<f64> = poly::from_roots(&zeros).iter().map(|c| c * gain).collect();
+    if num.iter().chain(den).any(|c| !c.is_finite()) {
+        return Err(Error::Overflow { operation: "ss2tf" });
+    }
+    TransferFunction::with_domain(&num, den, sys.domain())
+}
+
+impl<D: Domain> TryFrom<&DynStateSpace<D>> for TransferFunction<D> {
+    type Error = Error;
+
+    /// [`TransferFunction::from_state_space`].
+    fn try_from(sys: &DynStateSpace<D>) -> Result<Self, Error> {
+        Self::from_state_space(sys)
+    }
+}
+
+impl<const N: usize, D: Domain> TryFrom<&StateSpace<N, 1, 1, D>> for TransferFunction<D> {
+    type Error = Error;
+
+    /// [`TransferFunction::from_state_space`] of the fixed-size model.
+    fn try_from(sys: &StateSpace<N, 1, 1, D>) -> Result<Self, Error> {
+        Self::from_state_space(&DynStateSpace::from(sys))
+    }
+}
+
+/// A MIMO transfer function: one SISO [`TransferFunction`] per output `i`
+/// and input `j`, `Y_i = Σ_j G_ij U_j`, all in time domain `D`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{DynStateSpace, freq::TransferMatrix};
+/// use nalgebra::dmatrix;
+///
+/// // Two decoupled lags: 1/(s + 1) and 2/(s + 2).
+/// let sys = DynStateSpace::continuous(dmatrix![-1.0, 0.0; 0.0, -2.0], dmatrix![1.0, 0.0; 0.0, 2.0],
+///                                     dmatrix![1.0, 0.0; 0.0, 1.0], dmatrix![0.0, 0.0; 0.0, 0.0])?;
+/// let g = TransferMatrix::from_state_space(&sys)?;
+/// assert_eq!((g.outputs(), g.inputs()), (2, 2));
+/// assert!((g.get(1, 1)?.dc_gain()? - 1.0).abs() < 1e-12);
+/// assert_eq!(g.get(0, 1)?.num(), &[0.0]);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferMatrix<D: Domain = Continuous> {
+    outputs: usize,
+    inputs: usize,
+    /// Row-major: entry `(i, j)` at `i · inputs + j`.
+    entries: Vec<TransferFunction<D>>,
+}
+
+impl<D: Domain> TransferMatrix<D> {
+    /// A transfer matrix from its entries, row by row (`rows[i][j]` from
+    /// input `j` to output `i`), all in the same domain.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::LengthMismatch`] if the rows differ in length;
+    /// [`Error::InvalidData`] if there is no entry or the entries' periods
+    /// differ.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::freq::{TransferFunction, TransferMatrix};
+    ///
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
+    /// let m = TransferMatrix::new(vec![vec![g.clone(), g.clone()]])?;
+    /// assert_eq!((m.outputs(), m.inputs()), (1, 2));
+    /// assert!(TransferMatrix::new(vec![vec![g.clone()], vec![]]).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn new(rows: Vec<Vec<TransferFunction<D>>>) -> Result<Self, Error> {
+        let outputs = rows.len();
+        let inputs = rows.first().map_or(0, Vec::len);
+        if inputs == 0 {
+            return Err(Error::InvalidData {
+                what: "rows",
+                index: 0,
+                reason: "a transfer matrix needs at least one entry",
+            });
+        }
+        if let Some(i) = rows.iter().position(|r| r.len() != inputs) {
+            return Err(Error::LengthMismatch {
+                what: "transfer matrix row",
+                expected: inputs,
+                found: rows[i].len(),
+            });
+        }
+        let entries: Vec<_> = rows.into_iter().flatten().collect();
+        let domain = entries[0].domain;
+        if let Some(index) = entries.iter().position(|e| e.domain != domain) {
+            return Err(Error::InvalidData {
+                what: "rows",
+                index,
+                reason: "every entry must have the same sampling period",
+            });
+        }
+        Ok(Self {
+            outputs,
+            inputs,
+            entries,
+        })
+    }
+
+    /// The transfer matrix of a state-space model (`ss2tf` entry by entry:
+    /// each over the characteristic polynomial of `A`, as
+    /// [`TransferFunction::from_state_space`]).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidData`] for a model without inputs or outputs; the
+    /// errors of the eigenvalue computations.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Cart, DynStateSpace, MassSpring, freq::TransferMatrix};
+    ///
+    /// let plant = DynStateSpace::from(MassSpring::nominal().state_space(Cart::Two)?);
+    /// let g = TransferMatrix::from_state_space(&plant)?;
+    /// // 2 mm per newton at rest.
+    /// assert!((g.get(0, 0)?.dc_gain()? - 0.002).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "ss2tf")]
+    pub fn from_state_space(sys: &DynStateSpace<D>) -> Result<Self, Error> {
+        if sys.inputs() == 0 || sys.outputs() == 0 {
+            return Err(Error::InvalidData {
+                what: "model",
+                index: 0,
+                reason: "a transfer matrix needs at least one input and one output",
+            });
+        }
+        let den = poly::from_roots(&eigenvalues_dyn(sys.a())?);
+        let mut entries = Vec::with_capacity(sys.outputs() * sys.inputs());
+        for i in 0..sys.outputs() {
+            for j in 0..sys.inputs() {
+                entries.push(entry(sys, &den, i, j)?);
+            }
+        }
+        Ok(Self {
+            outputs: sys.outputs(),
+            inputs: sys.inputs(),
+            entries,
+        })
+    }
+
+    /// The number of outputs (rows).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{TransferFunction, TransferMatrix};
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
+    /// assert_eq!(TransferMatrix::new(vec![vec![g.clone()], vec![g]])?.outputs(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn outputs(&self) -> usize {
+        self.outputs
+    }
+
+    /// The number of inputs (columns).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{TransferFunction, TransferMatrix};
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
+    /// assert_eq!(TransferMatrix::new(vec![vec![g.clone(), g]])?.inputs(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn inputs(&self) -> usize {
+        self.inputs
+    }
+
+    /// The entry from input `input` to output `output`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::OutOfRange`] for an index past the end.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{TransferFunction, TransferMatrix};
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
+    /// let m = TransferMatrix::new(vec![vec![g.clone()]])?;
+    /// assert_eq!(m.get(0, 0)?, &g);
+    /// assert!(m.get(1, 0).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn get(&self, output: usize, input: usize) -> Result<&TransferFunction<D>, Error> {
+        if output >= self.outputs {
+            return Err(Error::OutOfRange {
+                what: "output",
+                index: output,
+                len: self.outputs,
+            });
+        }
+        if input >= self.inputs {
+            return Err(Error::OutOfRange {
+                what: "input",
+                index: input,
+                len: self.inputs,
+            });
+        }
+        Ok(&self.entries[output * self.inputs + input])
+    }
+
+    /// `G` at a complex point, `outputs × inputs`.
+    ///
+    /// # Errors
+    ///
+    /// As [`TransferFunction::evaluate`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{TransferFunction, TransferMatrix};
+    /// # use nalgebra::Complex;
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
+    /// let m = TransferMatrix::new(vec![vec![g.clone(), g]])?;
+    /// assert_eq!(m.evaluate(Complex::new(1.0, 0.0))?[(0, 1)], Complex::new(0.5, 0.0));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn evaluate(&self, s: Complex<f64>) -> Result<DMatrix<Complex<f64>>, Error> {
+        let mut out = DMatrix::zeros(self.outputs, self.inputs);
+        for i in 0..self.outputs {
+            for j in 0..self.inputs {
+                out[(i, j)] = self.entries[i * self.inputs + j].evaluate(s)?;
+            }
+        }
+        Ok(out)
+    }
+
+    /// A state-space realisation: each entry realised by
+    /// [`TransferFunction::to_state_space`] and the realisations connected
+    /// in parallel (block-diagonal `A`). Not minimal: the states are the
+    /// sum of the entries' denominator degrees.
+    ///
+    /// # Errors
+    ///
+    /// As [`TransferFunction::to_state_space`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{TransferFunction, TransferMatrix};
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
+    /// let sys = TransferMatrix::new(vec![vec![g.clone(), g]])?.to_state_space()?;
+    /// assert_eq!((sys.states(), sys.inputs(), sys.outputs()), (2, 2, 1));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "tf2ss")]
+    pub fn to_state_space(&self) -> Result<DynStateSpace<D>, Error> {
+        let parts = self
+            .entries
+            .iter()
+            .map(TransferFunction::to_state_space)
+            .collect::<Result<Vec<_>, _>>()?;
+        let n: usize = parts.iter().map(DynStateSpace::states).sum();
+        let (p, m) = (self.outputs, self.inputs);
+        let mut a = DMatrix::zeros(n, n);
+        let mut b = DMatrix::zeros(n, m);
+        let mut c = DMatrix::zeros(p, n);
+        let mut d = DMatrix::zeros(p, m);
+        let mut at = 0;
+        for (k, part) in parts.iter().enumerate() {
+            let (i, j, s) = (k / m, k % m, part.states());
+            a.view_mut((at, at), (s, s)).copy_from(part.a());
+            b.view_mut((at, j), (s, 1)).copy_from(part.b());
+            c.view_mut((i, at), (1, s)).copy_from(part.c());
+            d[(i, j)] = part.d()[(0, 0)];
+            at += s;
+        }
+        DynStateSpace::from_computed(a, b, c, d, self.entries[0].domain, "tf2ss")
+    }
+
+    pub(crate) fn entries(&self) -> &[TransferFunction<D>] {
+        &self.entries
+    }
+}
+
+impl<D: Domain> TryFrom<&DynStateSpace<D>> for TransferMatrix<D> {
+    type Error = Error;
+
+    /// [`TransferMatrix::from_state_space`].
+    fn try_from(sys: &DynStateSpace<D>) -> Result<Self, Error> {
+        Self::from_state_space(sys)
+    }
+}
+
+impl<const N: usize, const M: usize, const P: usize, D: Domain> TryFrom<&StateSpace<N, M, P, D>>
+    for TransferMatrix<D>
+{
+    type Error = Error;
+
+    /// [`TransferMatrix::from_state_space`] of the fixed-size model.
+    fn try_from(sys: &StateSpace<N, M, P, D>) -> Result<Self, Error> {
+        Self::from_state_space(&DynStateSpace::from(sys))
+    }
+}
