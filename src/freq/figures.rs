@@ -140,7 +140,10 @@ fn panel(
     for (i, (label, points)) in curves.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
         chart
-            .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
+            .draw_series(LineSeries::new(
+                points.iter().copied(),
+                color.stroke_width(2),
+            ))
             .map_err(|e| err(&e))?
             .label(*label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
@@ -196,16 +199,38 @@ pub fn bode_svg(
             .filter(|(x, _)| *x > 0.0)
             .collect::<Vec<_>>()
     };
-    let mag: Vec<(&str, Vec<(f64, f64)>)> = curves.iter().map(|(l, b)| (*l, keep(b, b.magnitude_db()))).collect();
-    let phase: Vec<(&str, Vec<(f64, f64)>)> = curves.iter().map(|(l, b)| (*l, keep(b, b.phase_deg()))).collect();
+    let mag: Vec<(&str, Vec<(f64, f64)>)> = curves
+        .iter()
+        .map(|(l, b)| (*l, keep(b, b.magnitude_db())))
+        .collect();
+    let phase: Vec<(&str, Vec<(f64, f64)>)> = curves
+        .iter()
+        .map(|(l, b)| (*l, keep(b, b.phase_deg())))
+        .collect();
     let (x0, x1) = range(mag.iter().flat_map(|(_, p)| p.iter().map(|q| q.0)), 0.0)?;
     let x0 = if x0 > 0.0 { x0 } else { x1 / 10.0 };
     let root = SVGBackend::new(path, (960, 800)).into_drawing_area();
     let err = plot_err(path);
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let (top, bottom) = root.split_vertically(400);
-    panel(&top, path, Some(title), (x0, x1), "magnitude (dB)", unit.label(), &mag)?;
-    panel(&bottom, path, None, (x0, x1), "phase (deg)", unit.label(), &phase)?;
+    panel(
+        &top,
+        path,
+        Some(title),
+        (x0, x1),
+        "magnitude (dB)",
+        unit.label(),
+        &mag,
+    )?;
+    panel(
+        &bottom,
+        path,
+        None,
+        (x0, x1),
+        "phase (deg)",
+        unit.label(),
+        &phase,
+    )?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }
@@ -232,7 +257,11 @@ pub fn bode_svg(
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[doc(alias = "nyquistplot")]
-pub fn nyquist_svg(path: impl AsRef<Path>, title: &str, curves: &[(&str, &Nyquist)]) -> Result<(), Error> {
+pub fn nyquist_svg(
+    path: impl AsRef<Path>,
+    title: &str,
+    curves: &[(&str, &Nyquist)],
+) -> Result<(), Error> {
     let path = path.as_ref();
     let err = plot_err(path);
     let points: Vec<Vec<(f64, f64)>> = curves.iter().map(|(_, n)| thin(&n.re, &n.im)).collect();
@@ -259,7 +288,10 @@ pub fn nyquist_svg(path: impl AsRef<Path>, title: &str, curves: &[(&str, &Nyquis
     for (i, ((label, _), p)) in curves.iter().zip(&points).enumerate() {
         let color = Palette99::pick(i).to_rgba();
         chart
-            .draw_series(LineSeries::new(p.iter().map(|&(x, y)| (x, -y)), color.stroke_width(1)))
+            .draw_series(LineSeries::new(
+                p.iter().map(|&(x, y)| (x, -y)),
+                color.stroke_width(1),
+            ))
             .map_err(|e| err(&e))?;
         chart
             .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))
@@ -268,7 +300,11 @@ pub fn nyquist_svg(path: impl AsRef<Path>, title: &str, curves: &[(&str, &Nyquis
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
     chart
-        .draw_series(std::iter::once(Cross::new((-1.0, 0.0), 6, RED.stroke_width(2))))
+        .draw_series(std::iter::once(Cross::new(
+            (-1.0, 0.0),
+            6,
+            RED.stroke_width(2),
+        )))
         .map_err(|e| err(&e))?
         .label("−1")
         .legend(|(x, y)| Cross::new((x + 10, y), 5, RED.stroke_width(2)));

@@ -30,7 +30,12 @@ pub(crate) struct Evaluator {
 
 impl Evaluator {
     /// Reduces the model (whose shapes and entries the caller has checked).
-    pub(crate) fn new(a: &DMatrix<f64>, b: &DMatrix<f64>, c: &DMatrix<f64>, d: &DMatrix<f64>) -> Self {
+    pub(crate) fn new(
+        a: &DMatrix<f64>,
+        b: &DMatrix<f64>,
+        c: &DMatrix<f64>,
+        d: &DMatrix<f64>,
+    ) -> Self {
         let (n, m, p) = (a.nrows(), b.ncols(), c.nrows());
         let (h, qtb, cq) = if n <= 2 {
             // Already Hessenberg.
@@ -161,8 +166,16 @@ mod tests {
             }
         }
         // Exactly at a pole: a typed error, not a NaN.
-        let mut ev = Evaluator::new(&dmatrix![0.0], &dmatrix![1.0], &dmatrix![1.0], &dmatrix![0.0]);
+        let mut ev = Evaluator::new(
+            &dmatrix![0.0],
+            &dmatrix![1.0],
+            &dmatrix![1.0],
+            &dmatrix![0.0],
+        );
         let mut out = [C64::new(0.0, 0.0)];
-        assert!(matches!(ev.eval(C64::new(0.0, 0.0), &mut out), Err(Error::Singular { .. })));
+        assert!(matches!(
+            ev.eval(C64::new(0.0, 0.0), &mut out),
+            Err(Error::Singular { .. })
+        ));
     }
 }

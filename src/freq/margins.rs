@@ -62,7 +62,9 @@ fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f
             let (dr, di) = jw_parts(den);
             let test = match kind {
                 // Im(N/D) = 0 ⇔ Ni Dr − Nr Di = 0.
-                Crossing::RealAxis => poly::sub_scaled(&poly::mul(&ni, &dr), 1.0, &poly::mul(&nr, &di)),
+                Crossing::RealAxis => {
+                    poly::sub_scaled(&poly::mul(&ni, &dr), 1.0, &poly::mul(&nr, &di))
+                }
                 // |N|² − g²|D|² = 0.
                 Crossing::Magnitude(level) => {
                     let n2 = poly::sub_scaled(&poly::mul(&nr, &nr), -1.0, &poly::mul(&ni, &ni));
@@ -70,7 +72,10 @@ fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f
                     poly::sub_scaled(&n2, level * level, &d2)
                 }
             };
-            real_roots(&test)?.into_iter().filter(|w| *w >= 0.0).collect::<Vec<_>>()
+            real_roots(&test)?
+                .into_iter()
+                .filter(|w| *w >= 0.0)
+                .collect::<Vec<_>>()
         }
         Some(dt) => {
             // On |z| = 1, 1/z = z̄: N(1/z) = rev N(z) / z^p.
@@ -99,9 +104,55 @@ fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f
                 .collect()
         }
     };
+    let period = period_of(&g.domain());
+    for w in w.iter_mut() {
+        *w = polish(*w, |w| {
+            let v = g.evaluate(point(period, w)).ok()?;
+            let f = match kind {
+                Crossing::RealAxis => v.im / v.norm(),
+                Crossing::Magnitude(level) => (v.norm() / level).ln(),
+            };
+            f.is_finite().then_some(f)
+        });
+    }
     w.sort_by(f64::total_cmp);
     w.dedup();
     Ok(w)
+}
+
+/// A crossing frequency refined by secant steps on the exact residual `f`
+/// (the polynomial's roots carry the rounding of its coefficients, ~1e-9
+/// relative near |z| = 1): at most 16 steps, kept only if the residual
+/// shrinks and the frequency moves by under 0.1 %.
+fn polish(w: f64, f: impl Fn(f64) -> Option<f64>) -> f64 {
+    if w == 0.0 {
+        return w; // exact: the real-axis polynomial is odd in ω
+    }
+    let Some(f_start) = f(w) else { return w };
+    let (mut w0, mut f0) = (w, f_start);
+    let mut w1 = w * (1.0 + 1e-7);
+    let Some(mut f1) = f(w1) else { return w };
+    for _ in 0..16 {
+        if f1 == f0 || f1 == 0.0 {
+            break;
+        }
+        let w2 = w1 - f1 * (w1 - w0) / (f1 - f0);
+        let Some(f2) = f(w2) else { break };
+        (w0, f0, w1, f1) = (w1, f1, w2, f2);
+        if (w1 - w0).abs() <= 4.0 * f64::EPSILON * w1.abs() {
+            break;
+        }
+    }
+    let (best, f_best) = if f1.abs() <= f0.abs() {
+        (w1, f1)
+    } else {
+        (w0, f0)
+    };
+    if best.is_finite() && f_best.abs() <= f_start.abs() && (best - w).abs() <= 1e-3 * w.abs() {
+        best
+    } else {
+        w
+    }
 }
 
 /// The gain margin and the phase crossover frequency it is read at.

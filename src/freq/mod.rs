@@ -87,11 +87,19 @@ pub fn logspace(start: f64, stop: f64, n: usize) -> Result<Vec<f64>, Error> {
             });
         }
     }
-    let step = if n > 1 { (stop - start) / (n - 1) as f64 } else { 0.0 };
+    let step = if n > 1 {
+        (stop - start) / (n - 1) as f64
+    } else {
+        0.0
+    };
     Ok((0..n)
         .map(|k| {
             // Exact decades stay exact: 10^k for integer exponents.
-            let e = if k + 1 == n { stop } else { start + step * k as f64 };
+            let e = if k + 1 == n {
+                stop
+            } else {
+                start + step * k as f64
+            };
             10f64.powf(e)
         })
         .collect())

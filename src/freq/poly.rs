@@ -114,7 +114,11 @@ pub(crate) fn roots(p: &[f64]) -> Result<Vec<Complex<f64>>, Error> {
     if n > 0 {
         // q(σ x) = Σ q_k σ^(n−k) x^(n−k): choose σ ≈ |q_n / q_0|^(1/n).
         let sigma = pow2_floor((q[n] / q[0]).abs().powf(1.0 / n as f64));
-        let sigma = if sigma.is_finite() && sigma > 0.0 { sigma } else { 1.0 };
+        let sigma = if sigma.is_finite() && sigma > 0.0 {
+            sigma
+        } else {
+            1.0
+        };
         let mut scaled = vec![0.0; n + 1];
         for (k, &c) in q.iter().enumerate() {
             scaled[k] = c * sigma.powi((n - k) as i32);
@@ -186,6 +190,9 @@ mod tests {
     fn trim_and_subtract() {
         assert_eq!(trim(&[0.0, 0.0, 2.0, 1.0]), &[2.0, 1.0]);
         assert_eq!(trim(&[0.0, 0.0]), &[0.0]);
-        assert_eq!(sub_scaled(&[1.0, 2.0, 3.0], 2.0, &[1.0, 1.0]), vec![1.0, 0.0, 1.0]);
+        assert_eq!(
+            sub_scaled(&[1.0, 2.0, 3.0], 2.0, &[1.0, 1.0]),
+            vec![1.0, 0.0, 1.0]
+        );
     }
 }

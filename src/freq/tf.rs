@@ -297,14 +297,12 @@ impl<D: Domain> TransferFunction<D> {
             None => Complex::new(0.0, 0.0),
             Some(_) => Complex::new(1.0, 0.0),
         };
-        self.evaluate(point)
-            .map(|g| g.re)
-            .map_err(|e| match e {
-                Error::Singular { .. } => Error::Singular {
-                    operation: "DC gain (pole at s = 0 or z = 1)",
-                },
-                e => e,
-            })
+        self.evaluate(point).map(|g| g.re).map_err(|e| match e {
+            Error::Singular { .. } => Error::Singular {
+                operation: "DC gain (pole at s = 0 or z = 1)",
+            },
+            e => e,
+        })
     }
 
     /// A state-space realisation in SciPy's `tf2ss` form (controllable
@@ -368,7 +366,8 @@ impl<D: Domain> TransferFunction<D> {
 
     /// The transfer function of a SISO state-space model, `ss2tf`: the
     /// denominator is the characteristic polynomial `det(sI − A)` (monic,
-    /// degree `n`, nothing cancelled, as SciPy's `ss2tf`), the numerator
+    /// degree `n`, nothing cancelled, as SciPy's `ss2tf`; eigenvalues
+    /// within `n ε ‖A‖_F` of zero, rounding, are put at zero), the numerator
     /// `gain · ∏(s − zᵢ)` with the model's invariant zeros and its leading
     /// coefficient (`D`, or the first non-zero Markov parameter
     /// `C A^k B`).
@@ -402,9 +401,31 @@ impl<D: Domain> TransferFunction<D> {
                 found_cols: sys.inputs(),
             });
         }
-        let den = poly::from_roots(&eigenvalues_dyn(sys.a())?);
-        entry(sys, &den, 0, 0)
+        entry(sys, &characteristic(sys)?, 0, 0)
     }
+}
+
+/// `det(sI − A)` from the eigenvalues of `A`, those within rounding of
+/// zero (`|λ| ≤ n ε ‖A‖_F`, below the eigenvalue solver's backward error)
+/// set to exactly zero, so that an integrator's constant term is exactly
+/// zero and its DC gain an error, not 1e18.
+pub(crate) fn characteristic<D: Domain>(sys: &DynStateSpace<D>) -> Result<Vec<f64>, Error> {
+    Ok(poly::from_roots(&snapped_poles(sys)?))
+}
+
+/// The eigenvalues of `A`, those within rounding of zero set to zero.
+pub(crate) fn snapped_poles<D: Domain>(sys: &DynStateSpace<D>) -> Result<Vec<Complex<f64>>, Error> {
+    let tol = sys.states() as f64 * f64::EPSILON * sys.a().norm();
+    Ok(eigenvalues_dyn(sys.a())?
+        .into_iter()
+        .map(|p| {
+            if p.norm() <= tol {
+                Complex::new(0.0, 0.0)
+            } else {
+                p
+            }
+        })
+        .collect())
 }
 
 /// The `(output, input)` entry of a model's transfer matrix over `den`.
@@ -549,7 +570,7 @@ impl<D: Domain> TransferMatrix<D> {
                 reason: "a transfer matrix needs at least one input and one output",
             });
         }
-        let den = poly::from_roots(&eigenvalues_dyn(sys.a())?);
+        let den = characteristic(sys)?;
         let mut entries = Vec::with_capacity(sys.outputs() * sys.inputs());
         for i in 0..sys.outputs() {
             for j in 0..sys.inputs() {

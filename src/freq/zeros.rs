@@ -24,7 +24,11 @@ use crate::error::Error;
 /// zero to rounding (every entry within `64 (n + 1) ε` of its scale, the
 /// bound on the rounding of forming the product), or `None` if all of the
 /// first `n` are zero (the transfer matrix is `D`).
-fn first_markov(a: &DMatrix<f64>, b: &DMatrix<f64>, c: &DMatrix<f64>) -> Option<(usize, DMatrix<f64>)> {
+fn first_markov(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+) -> Option<(usize, DMatrix<f64>)> {
     let n = a.nrows();
     let tol = 64.0 * (n as f64 + 1.0) * f64::EPSILON;
     let abs_a = a.abs();
@@ -159,7 +163,10 @@ fn pencil_zeros(
     let mut out = Vec::new();
     for i in 0..size {
         let (alpha, beta) = (sa[i], sb[i]);
-        let (alpha, beta) = (Complex::new(alpha.re, alpha.im), Complex::new(beta.re, beta.im));
+        let (alpha, beta) = (
+            Complex::new(alpha.re, alpha.im),
+            Complex::new(beta.re, beta.im),
+        );
         if beta.norm() > 0.0 && alpha.norm() <= beta.norm() * limit {
             out.push(alpha / beta);
         }

@@ -3,11 +3,10 @@
 use nalgebra::Complex;
 
 use super::poly;
-use super::tf::TransferFunction;
-use crate::analysis::eigenvalues_dyn;
+use super::tf::{TransferFunction, snapped_poles};
+use super::zeros::siso_numerator;
 use crate::error::{Error, check_dt};
 use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, period_of};
-use super::zeros::siso_numerator;
 
 /// A SISO transfer function in zero-pole-gain form,
 /// `G = gain · ∏(s − zᵢ) / ∏(s − pⱼ)` (python-control's and MATLAB's
@@ -41,7 +40,10 @@ pub struct Zpk<D: Domain = Continuous> {
 /// Checks roots: finite, and each non-real one matched by its conjugate
 /// (to `1e-9` of its modulus, as computed eigenvalues pair).
 fn check_roots(what: &'static str, r: &[Complex<f64>]) -> Result<(), Error> {
-    if let Some(index) = r.iter().position(|z| !(z.re.is_finite() && z.im.is_finite())) {
+    if let Some(index) = r
+        .iter()
+        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+    {
         return Err(Error::InvalidData {
             what,
             index,
@@ -84,7 +86,11 @@ impl Zpk<Continuous> {
     /// assert!(Zpk::continuous(&[], &[Complex::new(-1.0, 1.0)], 1.0).is_err()); // no conjugate
     /// assert!(Zpk::continuous(&[], &[Complex::new(-1.0, 1.0), Complex::new(-1.0, -1.0)], 1.0).is_ok());
     /// ```
-    pub fn continuous(zeros: &[Complex<f64>], poles: &[Complex<f64>], gain: f64) -> Result<Self, Error> {
+    pub fn continuous(
+        zeros: &[Complex<f64>],
+        poles: &[Complex<f64>],
+        gain: f64,
+    ) -> Result<Self, Error> {
         Self::with_domain(zeros, poles, gain, Continuous)
     }
 }
@@ -119,7 +125,12 @@ impl Zpk<Discrete> {
 }
 
 impl<D: Domain> Zpk<D> {
-    fn with_domain(zeros: &[Complex<f64>], poles: &[Complex<f64>], gain: f64, domain: D) -> Result<Self, Error> {
+    fn with_domain(
+        zeros: &[Complex<f64>],
+        poles: &[Complex<f64>],
+        gain: f64,
+        domain: D,
+    ) -> Result<Self, Error> {
         check_roots("zeros", zeros)?;
         check_roots("poles", poles)?;
         if !gain.is_finite() {
@@ -282,10 +293,15 @@ impl<D: Domain> Zpk<D> {
     /// ```
     #[doc(alias = "zpk2tf")]
     pub fn to_transfer_function(&self) -> Result<TransferFunction<D>, Error> {
-        let num: Vec<f64> = poly::from_roots(&self.zeros).iter().map(|c| c * self.gain).collect();
+        let num: Vec<f64> = poly::from_roots(&self.zeros)
+            .iter()
+            .map(|c| c * self.gain)
+            .collect();
         let den = poly::from_roots(&self.poles);
         if num.iter().chain(&den).any(|c| !c.is_finite()) {
-            return Err(Error::Overflow { operation: "zpk2tf" });
+            return Err(Error::Overflow {
+                operation: "zpk2tf",
+            });
         }
         TransferFunction::with_domain(&num, &den, self.domain)
     }
@@ -318,7 +334,8 @@ impl<D: Domain> Zpk<D> {
     }
 
     /// The zero-pole-gain form of a SISO state-space model (`ss2zpk`): the
-    /// poles are the eigenvalues of `A`, the zeros its invariant zeros
+    /// poles are the eigenvalues of `A` (within `n ε ‖A‖_F` of zero put at
+    /// zero, as in [`TransferFunction::from_state_space`]), the zeros its invariant zeros
     /// (nothing cancelled), the gain `D` or the first non-zero Markov
     /// parameter `C A^k B`.
     ///
@@ -350,7 +367,7 @@ impl<D: Domain> Zpk<D> {
                 found_cols: sys.inputs(),
             });
         }
-        let poles = eigenvalues_dyn(sys.a())?;
+        let poles = snapped_poles(sys)?;
         let (zeros, gain) = siso_numerator(sys.a(), sys.b(), sys.c(), sys.d(), 0, 0)?;
         Ok(Self {
             zeros,
