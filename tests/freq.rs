@@ -412,3 +412,13 @@ fn bad_input_gives_typed_errors() {
         Err(e) => assert!(matches!(e, Error::Overflow { .. }), "{e}"),
     }
 }
+
+#[test]
+fn a_discrete_phase_crossover_at_the_nyquist_frequency_counts() {
+    // L = 0.5 / (z − 1), dt = 0.01 s: real and negative only at z = −1,
+    // where L = −0.25 (python-control drops z = −1 and reports no margin).
+    let l = TransferFunction::discrete(&[0.5], &[1.0, -1.0], 0.01).unwrap();
+    let gm = stability_margins(&l).unwrap().gain.unwrap();
+    assert!((gm.margin - 4.0).abs() < 1e-12, "{gm:?}");
+    assert!((gm.frequency - std::f64::consts::PI / 0.01).abs() < 1e-9, "{gm:?}");
+}

@@ -99,8 +99,10 @@ fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f
             let tol = f64::EPSILON.powf(1.0 / (2 * m + 1) as f64);
             poly::roots(&test)?
                 .into_iter()
-                .filter(|z| (z.norm() - 1.0).abs() < tol && z.im >= 0.0)
-                .map(|z| z.im.atan2(z.re) / dt)
+                // Upper half circle, z = −1 (ω = π/dt) included whichever
+                // sign rounding gave its imaginary part.
+                .filter(|z| (z.norm() - 1.0).abs() < tol && z.im >= -1e-12)
+                .map(|z| z.im.max(0.0).atan2(z.re) / dt)
                 .collect()
         }
     };
