@@ -19,10 +19,18 @@ fn benches(c: &mut Criterion) {
         b.iter(|| bode(black_box(&dynamic), black_box(&w)).unwrap())
     });
     c.bench_function("frequency_response, lab plant, 1000 points", |b| {
-        b.iter(|| black_box(&dynamic).frequency_response(black_box(&w)).unwrap())
+        b.iter(|| {
+            black_box(&dynamic)
+                .frequency_response(black_box(&w))
+                .unwrap()
+        })
     });
     let g = TransferFunction::try_from(&plant).unwrap();
-    let l = TransferFunction::continuous(&g.num().iter().map(|c| 2000.0 * c).collect::<Vec<_>>(), g.den()).unwrap();
+    let l = TransferFunction::continuous(
+        &g.num().iter().map(|c| 2000.0 * c).collect::<Vec<_>>(),
+        g.den(),
+    )
+    .unwrap();
     c.bench_function("stability_margins, lab plant under P control", |b| {
         b.iter(|| stability_margins(black_box(&l)).unwrap())
     });

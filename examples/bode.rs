@@ -49,7 +49,11 @@ fn main() -> Result<(), ctrlab::Error> {
         None => println!("P control {kp} N/m: no gain crossover"),
     }
     match m.gain {
-        Some(g) => println!("gain margin {:.2} dB at {:.2} rad/s", g.margin_db(), g.frequency),
+        Some(g) => println!(
+            "gain margin {:.2} dB at {:.2} rad/s",
+            g.margin_db(),
+            g.frequency
+        ),
         None => println!("gain margin: none (the phase never crosses −180°)"),
     }
     if let Some(d) = m.delay {
@@ -61,7 +65,11 @@ fn main() -> Result<(), ctrlab::Error> {
 
     let n = nyquist(&l, &logspace(0.0, 3.0, 2000)?)?;
     let path = dir.join("nyquist_lab_loop.svg");
-    nyquist_svg(&path, "Lab plant under P control, 2000 N/m", &[("L(jω)", &n)])?;
+    nyquist_svg(
+        &path,
+        "Lab plant under P control, 2000 N/m",
+        &[("L(jω)", &n)],
+    )?;
     println!("wrote {}", path.display());
     Ok(())
 }

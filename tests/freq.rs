@@ -420,5 +420,8 @@ fn a_discrete_phase_crossover_at_the_nyquist_frequency_counts() {
     let l = TransferFunction::discrete(&[0.5], &[1.0, -1.0], 0.01).unwrap();
     let gm = stability_margins(&l).unwrap().gain.unwrap();
     assert!((gm.margin - 4.0).abs() < 1e-12, "{gm:?}");
-    assert!((gm.frequency - std::f64::consts::PI / 0.01).abs() < 1e-9, "{gm:?}");
+    assert!(
+        (gm.frequency - std::f64::consts::PI / 0.01).abs() < 1e-9,
+        "{gm:?}"
+    );
 }

@@ -2,9 +2,7 @@
 //! trips, conjugate symmetry of responses, agreement of the model forms,
 //! and on adversarial input no panic and `Ok` only with finite numbers.
 
-use ctrlab::freq::{
-    FrequencyDomain, TransferFunction, Zpk, bandwidth, stability_margins,
-};
+use ctrlab::freq::{FrequencyDomain, TransferFunction, Zpk, bandwidth, stability_margins};
 use ctrlab::{DynStateSpace, Error};
 use nalgebra::{Complex, DMatrix};
 use proptest::prelude::*;
@@ -17,7 +15,8 @@ fn conjugate_roots(max_real: usize, max_pairs: usize) -> impl Strategy<Value = V
         prop::collection::vec((-10.0..-0.1f64, 0.1..30.0f64), 0..=max_pairs),
     )
         .prop_map(|(real, pairs)| {
-            let mut out: Vec<Complex<f64>> = real.into_iter().map(|r| Complex::new(r, 0.0)).collect();
+            let mut out: Vec<Complex<f64>> =
+                real.into_iter().map(|r| Complex::new(r, 0.0)).collect();
             for (re, im) in pairs {
                 out.push(Complex::new(re, im));
                 out.push(Complex::new(re, -im));

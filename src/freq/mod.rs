@@ -38,6 +38,7 @@
 mod figures;
 mod kernel;
 mod margins;
+mod matrix;
 mod models;
 mod poly;
 mod response;
@@ -49,10 +50,11 @@ mod zpk;
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
 pub use figures::{FrequencyUnit, bode_svg, nyquist_svg};
 pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stability_margins};
+pub use matrix::TransferMatrix;
 pub use response::{
     Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
 };
-pub use tf::{TransferFunction, TransferMatrix};
+pub use tf::TransferFunction;
 pub use zpk::Zpk;
 
 use crate::error::Error;

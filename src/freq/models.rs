@@ -1,7 +1,8 @@
-//! Zeros of the state-space model types.
+//! Zeros of the state-space model types, and their value at a point.
 
 use nalgebra::{Complex, DMatrix};
 
+use super::kernel::Evaluator;
 use super::zeros::invariant_zeros;
 use crate::error::Error;
 use crate::model::{Domain, DynStateSpace, StateSpace};
@@ -46,7 +47,81 @@ impl<D: Domain> DynStateSpace<D> {
     }
 }
 
+/// `G(s) = C (sI − A)⁻¹ B + D` at one point.
+fn evaluate_at(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    d: &DMatrix<f64>,
+    s: Complex<f64>,
+) -> Result<DMatrix<Complex<f64>>, Error> {
+    if !(s.re.is_finite() && s.im.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: "s",
+            value: if s.re.is_finite() { s.im } else { s.re },
+            reason: "the point must be finite",
+        });
+    }
+    let (p, m) = (c.nrows(), b.ncols());
+    let mut out = vec![Complex::new(0.0, 0.0); p * m];
+    Evaluator::new(a, b, c, d).eval(s, &mut out)?;
+    Ok(DMatrix::from_row_slice(p, m, &out))
+}
+
+impl<D: Domain> DynStateSpace<D> {
+    /// The transfer matrix at one complex point, `C (sI − A)⁻¹ B + D`
+    /// (`s` in rad/s, or `z` for a discrete model), `outputs × inputs`.
+    /// For many frequencies use
+    /// [`FrequencyDomain::frequency_response`](super::FrequencyDomain::frequency_response),
+    /// which reduces `A` once.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] for a non-finite point;
+    /// [`Error::Singular`] at a pole; [`Error::Overflow`] if a value is not
+    /// finite.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::DynStateSpace;
+    /// use nalgebra::{Complex, dmatrix};
+    ///
+    /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![1.0], dmatrix![0.0])?;
+    /// assert_eq!(sys.evaluate(Complex::new(2.0, 0.0))?[(0, 0)], Complex::new(1.0, 0.0));
+    /// assert!(sys.evaluate(Complex::new(-2.0, 0.0)).is_err()); // the pole
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "evalfr")]
+    pub fn evaluate(&self, s: Complex<f64>) -> Result<DMatrix<Complex<f64>>, Error> {
+        evaluate_at(self.a(), self.b(), self.c(), self.d(), s)
+    }
+}
+
 impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M, P, D> {
+    /// The transfer matrix at one complex point, as
+    /// [`DynStateSpace::evaluate`].
+    ///
+    /// # Errors
+    ///
+    /// As [`DynStateSpace::evaluate`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Cart, MassSpring};
+    /// use nalgebra::Complex;
+    ///
+    /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+    /// assert!((plant.evaluate(Complex::new(0.0, 0.0))?[(0, 0)].re - 0.002).abs() < 1e-15);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "evalfr")]
+    pub fn evaluate(&self, s: Complex<f64>) -> Result<DMatrix<Complex<f64>>, Error> {
+        let sys = DynStateSpace::from(self);
+        evaluate_at(sys.a(), sys.b(), sys.c(), sys.d(), s)
+    }
+
     /// The invariant zeros, as [`DynStateSpace::zeros`].
     ///
     /// # Errors

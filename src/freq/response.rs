@@ -7,7 +7,8 @@ use std::f64::consts::PI;
 use nalgebra::Complex;
 
 use super::kernel::Evaluator;
-use super::tf::{TransferFunction, TransferMatrix};
+use super::matrix::TransferMatrix;
+use super::tf::TransferFunction;
 use super::zpk::Zpk;
 use crate::error::Error;
 use crate::model::{Domain, DynStateSpace, StateSpace, period_of};
@@ -287,6 +288,17 @@ pub struct Bode {
     pub phase: Vec<f64>,
 }
 
+/// `|g|`: `√(re² + im²)`, through `hypot` only where the squares
+/// under- or overflow.
+fn magnitude(g: C64) -> f64 {
+    let n2 = g.norm_sqr();
+    if n2.is_finite() && n2 >= f64::MIN_POSITIVE {
+        n2.sqrt()
+    } else {
+        g.norm()
+    }
+}
+
 /// The phase angles of `g`, unwrapped (NumPy's `unwrap` with period 2π).
 pub(crate) fn unwrapped_phase(g: &[C64]) -> Vec<f64> {
     let mut out: Vec<f64> = Vec::with_capacity(g.len());
@@ -296,11 +308,16 @@ pub(crate) fn unwrapped_phase(g: &[C64]) -> Vec<f64> {
         if k == 0 {
             out.push(raw);
         } else {
+            // Both angles are in [−π, π], so the step is within ±2π: one
+            // turn at most to take off (NumPy keeps +π for a step of +π).
             let d = raw - prev_raw;
-            let mut dd = (d + PI).rem_euclid(2.0 * PI) - PI;
-            if dd == -PI && d > 0.0 {
-                dd = PI;
-            }
+            let dd = if d > PI {
+                d - 2.0 * PI
+            } else if d < -PI {
+                d + 2.0 * PI
+            } else {
+                d
+            };
             let last = out[k - 1];
             out.push(last + dd);
         }
@@ -313,7 +330,7 @@ impl Bode {
     fn from_response(omega: &[f64], g: &[C64]) -> Self {
         Self {
             omega: omega.to_vec(),
-            magnitude: g.iter().map(|g| g.norm()).collect(),
+            magnitude: g.iter().map(|&g| magnitude(g)).collect(),
             phase: unwrapped_phase(g),
         }
     }
