@@ -145,10 +145,10 @@ proptest! {
             }
             Err(e) => prop_assert!(matches!(e, Error::InvalidData { .. } | Error::Overflow { .. }), "{e}"),
         }
-        if let Ok(d) = TransferFunction::discrete(&num, &den, 0.01) {
-            if let Ok(m) = stability_margins(&d) {
-                prop_assert!(m.phase.is_none_or(|p| p.margin.is_finite() && p.frequency.is_finite()));
-            }
+        if let Ok(d) = TransferFunction::discrete(&num, &den, 0.01)
+            && let Ok(m) = stability_margins(&d)
+        {
+            prop_assert!(m.phase.is_none_or(|p| p.margin.is_finite() && p.frequency.is_finite()));
         }
     }
 }

@@ -77,7 +77,7 @@ impl Column {
         let mut inv_sub = Vec::with_capacity(n.saturating_sub(1));
         for k in 0..n.saturating_sub(1) {
             let sub = h[(k + 1, k)];
-            if !(sub.abs() > tol) {
+            if sub.abs() <= tol || sub.is_nan() {
                 return None;
             }
             inv_sub.push(1.0 / sub);

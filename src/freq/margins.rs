@@ -284,7 +284,7 @@ pub fn stability_margins<D: Domain>(l: &TransferFunction<D>) -> Result<Margins, 
     let mut gain: Option<GainMargin> = None;
     for w in crossings(l, Crossing::RealAxis)? {
         let Ok(g) = at(w) else { continue }; // a pole on the axis
-        if !(g.re < 0.0) {
+        if g.re >= 0.0 || g.re.is_nan() {
             continue;
         }
         let candidate = GainMargin {
