@@ -10,9 +10,11 @@
 //! ones at `z = e^(jω dt)`. Polynomials are in descending powers, as
 //! python-control and MATLAB write them.
 //!
-//! A state-space frequency response reduces `A` to Hessenberg form once;
-//! each frequency is then one `O(n²)` complex solve per input, in a
-//! workspace reused across frequencies.
+//! A state-space frequency response reduces `(A, b_j)` to
+//! controller-Hessenberg form once per input; each frequency is then an
+//! `O(n²)` recurrence and one complex division per input (a pivoted
+//! Hessenberg solve where the recurrence cannot be used), in a workspace
+//! reused across frequencies.
 //!
 //! # Examples
 //!

@@ -264,7 +264,7 @@ impl FrequencyResponse {
 /// `unwrap` does (each step brought within ±π), so a grid too coarse for a
 /// fast phase change can unwrap by the wrong turn. python-control's `bode`
 /// unwraps the same way and then shifts the whole curve by a multiple of
-/// 360° to start within [−360°, 0°) (its `initial_phase`); compare phases
+/// 360° to start within (−360°, 0°] (its default `initial_phase`); compare phases
 /// modulo 360°.
 ///
 /// # Examples
