@@ -38,6 +38,10 @@
 //!   ([`place_observer`](design::place_observer), [`lqe`](design::lqe),
 //!   [`dlqe`](design::dlqe), [`Observer`](design::Observer)) and the
 //!   observer-based [`ObserverController`](design::ObserverController).
+//! - [`freq`]: transfer functions ([`TransferFunction`], [`TransferMatrix`],
+//!   [`Zpk`]) and `ss2tf`/`tf2ss`, invariant zeros, frequency responses
+//!   ([`bode`], [`nyquist`], [`frequency_response`]) in rad/s, dB and
+//!   degrees, [`stability_margins`] (gain, phase, delay) and [`bandwidth`].
 //! - [`metrics`]: [`step_info`] / [`step_info_of`] / [`step_info_mimo`]
 //!   (rise, settling and transient time, overshoot, steady state) of data
 //!   or of any model, with interpolated crossing times, under the crate's
@@ -64,7 +68,7 @@
 //!   rig on the card and the simulated rig in one call.
 //!
 //! Layers point one way: private kernels and [`model`] at the bottom;
-//! [`discretize`], [`integrate`], [`analysis`] on them; [`design`],
+//! [`discretize`], [`integrate`], [`analysis`], [`freq`] on them; [`design`],
 //! [`sim`], [`metrics`], [`data`], [`ident`], [`signal`] above; [`hw`]
 //! above those; [`lab`] on top. Units are SI throughout (m, m/s, N, V, s);
 //! the lab's millimetres appear only in printed tables and at named
@@ -96,6 +100,7 @@ pub mod data;
 pub mod design;
 pub mod discretize;
 mod error;
+pub mod freq;
 pub mod hw;
 pub mod ident;
 pub mod integrate;
@@ -118,6 +123,10 @@ pub use data::{Channel, Recording, Schema};
 pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place};
 pub use discretize::Method;
 pub use error::Error;
+pub use freq::{
+    Bode, FrequencyDomain, FrequencyResponse, Margins, TransferFunction, TransferMatrix, Zpk,
+    bandwidth, bode, frequency_response, logspace, nyquist, stability_margins,
+};
 pub use ident::{LeastSquares, LeastSquaresFit, Rls};
 pub use integrate::{Euler, Integrator, Rk4};
 pub use lab::{Cart, MassSpring};

@@ -25,7 +25,7 @@ use plotters::prelude::*;
 use crate::error::Error;
 
 /// Figure size in pixels.
-const SIZE: (u32, u32) = (960, 600);
+pub(crate) const SIZE: (u32, u32) = (960, 600);
 /// Points drawn per series at most; longer series are thinned to every k-th
 /// sample, which keeps files small and is invisible at this size.
 ///
@@ -79,7 +79,7 @@ impl<'a> Series<'a> {
 /// constant or nearly constant series still has ticks to find, and at most
 /// `f64::MAX` wide, so that its width is a number. `None` when the points
 /// themselves span more than `f64::MAX`.
-fn axis(lo: f64, hi: f64, pad: f64) -> Option<(f64, f64)> {
+pub(crate) fn axis(lo: f64, hi: f64, pad: f64) -> Option<(f64, f64)> {
     let span = hi - lo;
     if !span.is_finite() {
         return None;

@@ -1,0 +1,605 @@
+//! Frequency responses: [`FrequencyResponse`] (complex, MIMO) and its SISO
+//! views [`Bode`] and [`Nyquist`], for every model type through
+//! [`FrequencyDomain`].
+
+use std::f64::consts::PI;
+
+use nalgebra::Complex;
+
+use super::kernel::Evaluator;
+use super::matrix::TransferMatrix;
+use super::tf::TransferFunction;
+use super::zpk::Zpk;
+use crate::error::Error;
+use crate::model::{Domain, DynStateSpace, StateSpace, period_of};
+
+type C64 = Complex<f64>;
+
+/// Checks angular frequencies: every one finite.
+pub(crate) fn check_omega(omega: &[f64]) -> Result<(), Error> {
+    match omega.iter().position(|w| !w.is_finite()) {
+        None => Ok(()),
+        Some(index) => Err(Error::InvalidData {
+            what: "omega",
+            index,
+            reason: "angular frequency (rad/s) is not finite",
+        }),
+    }
+}
+
+/// The point where a model of period `period` is evaluated at `ω` rad/s:
+/// `s = jω`, or `z = e^(jω dt)`.
+pub(crate) fn point(period: Option<f64>, w: f64) -> C64 {
+    match period {
+        None => C64::new(0.0, w),
+        Some(dt) => C64::from_polar(1.0, w * dt),
+    }
+}
+
+mod sealed {
+    pub trait Sealed {}
+}
+
+/// A linear model whose frequency response can be evaluated:
+/// [`StateSpace`], [`DynStateSpace`], [`TransferFunction`],
+/// [`TransferMatrix`] and [`Zpk`], continuous or discrete.
+///
+/// Continuous models are evaluated at `s = jω`, discrete ones at
+/// `z = e^(jω dt)`, for `ω` in rad/s. Discrete responses are periodic in
+/// `ω` with period `2π/dt`; frequencies above the Nyquist frequency `π/dt`
+/// are evaluated as given (python-control's `bode` drops them).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{FrequencyDomain, TransferFunction};
+///
+/// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?; // 1/(s + 1)
+/// let r = g.frequency_response(&[0.0, 1.0])?;
+/// assert_eq!(r.response(0, 0)?[0].re, 1.0);
+/// assert!((r.response(0, 0)?[1].norm() - 0.5f64.sqrt()).abs() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[doc(alias = "freqresp")]
+pub trait FrequencyDomain: sealed::Sealed {
+    /// The complex response `G(jω)` (or `G(e^(jω dt))`) at each `ω`
+    /// (rad/s), every output and input.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidData`] (`"omega"`) for a non-finite frequency;
+    /// [`Error::Singular`] if a frequency falls exactly on a pole (an
+    /// integrator at `ω = 0`); [`Error::Overflow`] if a value is not finite.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Cart, MassSpring, freq::FrequencyDomain};
+    ///
+    /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+    /// let r = plant.frequency_response(&[0.0, 1e3])?;
+    /// assert!((r.response(0, 0)?[0].re - 0.002).abs() < 1e-15); // 2 mm/N at DC
+    /// assert!(r.response(0, 0)?[1].norm() < 2e-6); // rolled off at 1000 rad/s
+    /// assert!(plant.frequency_response(&[f64::NAN]).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "freqresp")]
+    fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error>;
+}
+
+/// A model's complex frequency response at angular frequencies `ω` (rad/s):
+/// for each output `i` and input `j`, the values `G_ij` at every `ω`
+/// (python-control's `frequency_response`, MATLAB's `freqresp`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{FrequencyDomain, TransferFunction, logspace};
+///
+/// let w = logspace(-1.0, 2.0, 301)?; // 0.1 to 100 rad/s
+/// let r = TransferFunction::continuous(&[10.0], &[1.0, 10.0])?.frequency_response(&w)?;
+/// let bode = r.bode(0, 0)?;
+/// // −3 dB and −45° at the corner, 10 rad/s (index 200).
+/// assert!((bode.magnitude_db()[200] + 3.0103).abs() < 1e-4);
+/// assert!((bode.phase_deg()[200] + 45.0).abs() < 1e-9);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrequencyResponse {
+    omega: Vec<f64>,
+    outputs: usize,
+    inputs: usize,
+    /// Channel `(i, j)` at `[(i · inputs + j) · len ..][..len]`.
+    values: Vec<C64>,
+}
+
+impl FrequencyResponse {
+    /// The angular frequencies, rad/s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// let r = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.frequency_response(&[1.0, 2.0])?;
+    /// assert_eq!(r.omega(), &[1.0, 2.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn omega(&self) -> &[f64] {
+        &self.omega
+    }
+
+    /// The frequencies in hertz, `ω / 2π`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// # use std::f64::consts::PI;
+    /// let r = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.frequency_response(&[2.0 * PI])?;
+    /// assert_eq!(r.frequency_hz(), vec![1.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn frequency_hz(&self) -> Vec<f64> {
+        self.omega.iter().map(|w| w / (2.0 * PI)).collect()
+    }
+
+    /// The number of outputs.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// let r = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.frequency_response(&[1.0])?;
+    /// assert_eq!((r.outputs(), r.inputs()), (1, 1));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn outputs(&self) -> usize {
+        self.outputs
+    }
+
+    /// The number of inputs.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// let r = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.frequency_response(&[1.0])?;
+    /// assert_eq!(r.inputs(), 1);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn inputs(&self) -> usize {
+        self.inputs
+    }
+
+    /// The complex values `G_ij(jω)` from input `input` to output
+    /// `output`, one per frequency.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::OutOfRange`] for an index past the end.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// # use nalgebra::Complex;
+    /// let r = TransferFunction::continuous(&[1.0], &[1.0, 0.0])?.frequency_response(&[2.0])?;
+    /// assert_eq!(r.response(0, 0)?, &[Complex::new(0.0, -0.5)]);
+    /// assert!(r.response(1, 0).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn response(&self, output: usize, input: usize) -> Result<&[C64], Error> {
+        if output >= self.outputs {
+            return Err(Error::OutOfRange {
+                what: "output",
+                index: output,
+                len: self.outputs,
+            });
+        }
+        if input >= self.inputs {
+            return Err(Error::OutOfRange {
+                what: "input",
+                index: input,
+                len: self.inputs,
+            });
+        }
+        let len = self.omega.len();
+        let at = (output * self.inputs + input) * len;
+        Ok(&self.values[at..at + len])
+    }
+
+    /// The Bode data of one channel: magnitude and unwrapped phase.
+    ///
+    /// # Errors
+    ///
+    /// As [`response`](Self::response).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// // 1/(s + 1)³: the phase runs on past −180° instead of jumping to +107°.
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 3.0, 3.0, 1.0])?;
+    /// let b = g.frequency_response(&[0.1, 1.0, 10.0])?.bode(0, 0)?;
+    /// assert!((b.phase_deg()[2] + 3.0 * 10f64.atan().to_degrees()).abs() < 1e-9);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn bode(&self, output: usize, input: usize) -> Result<Bode, Error> {
+        Ok(Bode::from_response(
+            &self.omega,
+            self.response(output, input)?,
+        ))
+    }
+
+    /// The Nyquist data of one channel: real and imaginary parts.
+    ///
+    /// # Errors
+    ///
+    /// As [`response`](Self::response).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// let r = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.frequency_response(&[1.0])?;
+    /// let n = r.nyquist(0, 0)?;
+    /// assert_eq!((n.re[0], n.im[0]), (0.5, -0.5));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn nyquist(&self, output: usize, input: usize) -> Result<Nyquist, Error> {
+        let g = self.response(output, input)?;
+        Ok(Nyquist {
+            omega: self.omega.clone(),
+            re: g.iter().map(|g| g.re).collect(),
+            im: g.iter().map(|g| g.im).collect(),
+        })
+    }
+}
+
+/// Bode data of a SISO channel: magnitude (absolute, in the model's units)
+/// and phase (rad, unwrapped) at each angular frequency `ω` (rad/s).
+///
+/// The phase starts at the principal value `atan2(Im G, Re G)` ∈ (−π, π]
+/// of the first point and is unwrapped in the order of `ω` as NumPy's
+/// `unwrap` does (each step brought within ±π), so a grid too coarse for a
+/// fast phase change can unwrap by the wrong turn. python-control's `bode`
+/// unwraps the same way and then shifts the whole curve by a multiple of
+/// 360° to start within (−360°, 0°] (its default `initial_phase`); compare phases
+/// modulo 360°.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{Bode, FrequencyDomain, TransferFunction};
+///
+/// let g = TransferFunction::continuous(&[1.0], &[1.0, 2.0, 1.0])?; // 1/(s + 1)²
+/// let b: Bode = g.frequency_response(&[1.0])?.bode(0, 0)?;
+/// assert!((b.magnitude_db()[0] + 6.0206).abs() < 1e-4);
+/// assert!((b.phase_deg()[0] + 90.0).abs() < 1e-12);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bode {
+    /// Angular frequencies, rad/s.
+    pub omega: Vec<f64>,
+    /// `|G|` at each frequency (absolute).
+    pub magnitude: Vec<f64>,
+    /// `∠G` at each frequency, rad, unwrapped.
+    pub phase: Vec<f64>,
+}
+
+/// `|g|`: `√(re² + im²)`, through `hypot` only where the squares
+/// under- or overflow.
+fn magnitude(g: C64) -> f64 {
+    let n2 = g.norm_sqr();
+    if n2.is_finite() && n2 >= f64::MIN_POSITIVE {
+        n2.sqrt()
+    } else {
+        g.norm()
+    }
+}
+
+/// The phase angles of `g`, unwrapped (NumPy's `unwrap` with period 2π).
+pub(crate) fn unwrapped_phase(g: &[C64]) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::with_capacity(g.len());
+    let mut prev_raw = 0.0;
+    for (k, g) in g.iter().enumerate() {
+        let raw = g.im.atan2(g.re);
+        if k == 0 {
+            out.push(raw);
+        } else {
+            // Both angles are in [−π, π], so the step is within ±2π: one
+            // turn at most to take off (NumPy keeps +π for a step of +π).
+            let d = raw - prev_raw;
+            let dd = if d > PI {
+                d - 2.0 * PI
+            } else if d < -PI {
+                d + 2.0 * PI
+            } else {
+                d
+            };
+            let last = out[k - 1];
+            out.push(last + dd);
+        }
+        prev_raw = raw;
+    }
+    out
+}
+
+impl Bode {
+    fn from_response(omega: &[f64], g: &[C64]) -> Self {
+        Self {
+            omega: omega.to_vec(),
+            magnitude: g.iter().map(|&g| magnitude(g)).collect(),
+            phase: unwrapped_phase(g),
+        }
+    }
+
+    /// The magnitude in decibels, `20 log₁₀ |G|`. An exact zero of `G`
+    /// gives `20 log₁₀(f64::MIN_POSITIVE)` ≈ −6153.6 dB, not −∞, so every
+    /// value is finite.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// let b = TransferFunction::continuous(&[10.0], &[1.0])?.frequency_response(&[1.0])?.bode(0, 0)?;
+    /// assert_eq!(b.magnitude_db(), vec![20.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn magnitude_db(&self) -> Vec<f64> {
+        self.magnitude
+            .iter()
+            .map(|m| 20.0 * m.max(f64::MIN_POSITIVE).log10())
+            .collect()
+    }
+
+    /// The unwrapped phase in degrees.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// let b = TransferFunction::continuous(&[-1.0], &[1.0])?.frequency_response(&[1.0])?.bode(0, 0)?;
+    /// assert_eq!(b.phase_deg(), vec![180.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn phase_deg(&self) -> Vec<f64> {
+        self.phase.iter().map(|p| p.to_degrees()).collect()
+    }
+
+    /// The frequencies in hertz, `ω / 2π`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
+    /// let b = TransferFunction::continuous(&[1.0], &[1.0])?.frequency_response(&[std::f64::consts::PI])?.bode(0, 0)?;
+    /// assert_eq!(b.frequency_hz(), vec![0.5]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn frequency_hz(&self) -> Vec<f64> {
+        self.omega.iter().map(|w| w / (2.0 * PI)).collect()
+    }
+}
+
+/// Nyquist data of a SISO channel: `G(jω)` split into real and imaginary
+/// parts, at each angular frequency `ω` (rad/s). The mirror image for
+/// negative frequencies is `(re, −im)`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{FrequencyDomain, TransferFunction};
+///
+/// let n = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.frequency_response(&[0.0, 1.0])?.nyquist(0, 0)?;
+/// assert_eq!(n.re, vec![1.0, 0.5]);
+/// assert_eq!(n.im, vec![0.0, -0.5]);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Nyquist {
+    /// Angular frequencies, rad/s.
+    pub omega: Vec<f64>,
+    /// `Re G` at each frequency.
+    pub re: Vec<f64>,
+    /// `Im G` at each frequency.
+    pub im: Vec<f64>,
+}
+
+/// The frequency response of any model ([`FrequencyDomain`]) at `ω`
+/// (rad/s), python-control's `frequency_response`.
+///
+/// # Errors
+///
+/// As [`FrequencyDomain::frequency_response`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{TransferFunction, frequency_response};
+///
+/// let r = frequency_response(&TransferFunction::continuous(&[2.0], &[1.0])?, &[1.0])?;
+/// assert_eq!(r.response(0, 0)?[0].re, 2.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[doc(alias = "freqresp")]
+pub fn frequency_response(
+    sys: &impl FrequencyDomain,
+    omega: &[f64],
+) -> Result<FrequencyResponse, Error> {
+    sys.frequency_response(omega)
+}
+
+/// Bode data (magnitude, unwrapped phase) of a SISO model at `ω` (rad/s).
+///
+/// # Errors
+///
+/// [`Error::DimensionMismatch`] unless the model has one input and one
+/// output; as [`FrequencyDomain::frequency_response`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Cart, MassSpring, freq::{bode, logspace}};
+///
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+/// let b = bode(&plant, &logspace(0.0, 3.0, 1000)?)?;
+/// // −54 dB (2 mm/N) at low frequency, a resonance peak 8 dB above it
+/// // near 20 rad/s (3.3 Hz).
+/// assert!((b.magnitude_db()[0] + 53.96).abs() < 0.01);
+/// assert!(b.magnitude_db().iter().any(|&m| m > -46.0));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn bode(sys: &impl FrequencyDomain, omega: &[f64]) -> Result<Bode, Error> {
+    siso(sys.frequency_response(omega)?)?.bode(0, 0)
+}
+
+/// Nyquist data of a SISO model at `ω` (rad/s).
+///
+/// # Errors
+///
+/// As [`bode`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{TransferFunction, nyquist};
+///
+/// let n = nyquist(&TransferFunction::continuous(&[1.0], &[1.0, 1.0])?, &[1.0])?;
+/// assert_eq!((n.re[0], n.im[0]), (0.5, -0.5));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn nyquist(sys: &impl FrequencyDomain, omega: &[f64]) -> Result<Nyquist, Error> {
+    siso(sys.frequency_response(omega)?)?.nyquist(0, 0)
+}
+
+fn siso(r: FrequencyResponse) -> Result<FrequencyResponse, Error> {
+    if r.outputs == 1 && r.inputs == 1 {
+        Ok(r)
+    } else {
+        Err(Error::DimensionMismatch {
+            matrix: "D",
+            expected_rows: 1,
+            expected_cols: 1,
+            found_rows: r.outputs,
+            found_cols: r.inputs,
+        })
+    }
+}
+
+/// The state-space response through the Hessenberg kernel.
+fn state_space_response<D: Domain>(
+    sys: &DynStateSpace<D>,
+    omega: &[f64],
+) -> Result<FrequencyResponse, Error> {
+    check_omega(omega)?;
+    let (p, m, len) = (sys.outputs(), sys.inputs(), omega.len());
+    let period = period_of(&sys.domain());
+    let mut ev = Evaluator::new(sys.a(), sys.b(), sys.c(), sys.d());
+    let mut values = vec![C64::new(0.0, 0.0); p * m * len];
+    let mut at = vec![C64::new(0.0, 0.0); p * m];
+    for (k, &w) in omega.iter().enumerate() {
+        ev.eval(point(period, w), &mut at)?;
+        for (ch, g) in at.iter().enumerate() {
+            values[ch * len + k] = *g;
+        }
+    }
+    Ok(FrequencyResponse {
+        omega: omega.to_vec(),
+        outputs: p,
+        inputs: m,
+        values,
+    })
+}
+
+impl<D: Domain> sealed::Sealed for DynStateSpace<D> {}
+impl<D: Domain> FrequencyDomain for DynStateSpace<D> {
+    fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
+        state_space_response(self, omega)
+    }
+}
+
+impl<const N: usize, const M: usize, const P: usize, D: Domain> sealed::Sealed
+    for StateSpace<N, M, P, D>
+{
+}
+impl<const N: usize, const M: usize, const P: usize, D: Domain> FrequencyDomain
+    for StateSpace<N, M, P, D>
+{
+    fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
+        state_space_response(&DynStateSpace::from(self), omega)
+    }
+}
+
+/// A response of SISO entries evaluated one point at a time.
+fn pointwise<D: Domain>(
+    outputs: usize,
+    inputs: usize,
+    domain: D,
+    omega: &[f64],
+    eval: impl Fn(usize, C64) -> Result<C64, Error>,
+) -> Result<FrequencyResponse, Error> {
+    check_omega(omega)?;
+    let period = period_of(&domain);
+    let len = omega.len();
+    let mut values = Vec::with_capacity(outputs * inputs * len);
+    for ch in 0..outputs * inputs {
+        for &w in omega {
+            values.push(eval(ch, point(period, w)).map_err(|e| match e {
+                Error::Singular { .. } => Error::Singular {
+                    operation: "frequency response (ω is at a pole)",
+                },
+                e => e,
+            })?);
+        }
+    }
+    Ok(FrequencyResponse {
+        omega: omega.to_vec(),
+        outputs,
+        inputs,
+        values,
+    })
+}
+
+impl<D: Domain> sealed::Sealed for TransferFunction<D> {}
+impl<D: Domain> FrequencyDomain for TransferFunction<D> {
+    fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
+        pointwise(1, 1, self.domain(), omega, |_, s| self.evaluate(s))
+    }
+}
+
+impl<D: Domain> sealed::Sealed for TransferMatrix<D> {}
+impl<D: Domain> FrequencyDomain for TransferMatrix<D> {
+    fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
+        let domain = self.entries()[0].domain();
+        pointwise(self.outputs(), self.inputs(), domain, omega, |ch, s| {
+            self.entries()[ch].evaluate(s)
+        })
+    }
+}
+
+impl<D: Domain> sealed::Sealed for Zpk<D> {}
+impl<D: Domain> FrequencyDomain for Zpk<D> {
+    fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
+        pointwise(1, 1, self.domain(), omega, |_, s| self.evaluate(s))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unwrap_follows_numpy() {
+        let g: Vec<C64> = [170.0f64, -170.0, -100.0, 10.0, 179.0, -179.0]
+            .iter()
+            .map(|d| C64::from_polar(1.0, d.to_radians()))
+            .collect();
+        let p: Vec<f64> = unwrapped_phase(&g).iter().map(|p| p.to_degrees()).collect();
+        let want = [170.0, 190.0, 260.0, 370.0, 539.0, 541.0];
+        for (p, w) in p.iter().zip(want) {
+            assert!((p - w).abs() < 1e-9, "{p} vs {w}");
+        }
+    }
+}

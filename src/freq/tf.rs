@@ -1,0 +1,461 @@
+//! SISO transfer functions: [`TransferFunction`] (numerator and
+//! denominator polynomials), with `ss2tf` and `tf2ss`.
+
+use nalgebra::{Complex, DMatrix};
+
+use super::poly;
+use super::zeros::siso_numerator;
+use crate::analysis::eigenvalues_dyn;
+use crate::error::{Error, check_dt};
+use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, period_of};
+
+/// A polynomial argument checked: non-empty, finite, leading exact zeros
+/// removed.
+pub(crate) fn check_poly(what: &'static str, p: &[f64]) -> Result<Vec<f64>, Error> {
+    if p.is_empty() {
+        return Err(Error::InvalidData {
+            what,
+            index: 0,
+            reason: "empty polynomial: give at least one coefficient",
+        });
+    }
+    if let Some(index) = p.iter().position(|c| !c.is_finite()) {
+        return Err(Error::InvalidData {
+            what,
+            index,
+            reason: "polynomial coefficient is not finite",
+        });
+    }
+    Ok(poly::trim(p).to_vec())
+}
+
+/// A SISO transfer function `G = num / den` in time domain `D`, the
+/// polynomials in descending powers of `s` (continuous) or `z` (discrete,
+/// period `dt` s), as python-control's `tf` and MATLAB's `tf` take them:
+/// `[1.0, 3.0]` is `s + 3`.
+///
+/// Leading exact zeros are dropped. The transfer function may be improper
+/// (it can still be evaluated); only [`to_state_space`](Self::to_state_space)
+/// needs it proper. Nothing is cancelled: `(s + 1) / (s + 1)` keeps both
+/// factors.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::TransferFunction;
+/// use nalgebra::Complex;
+///
+/// // 10 / (s² + 2 s + 10): ωn = √10 rad/s, ζ ≈ 0.32, DC gain 1.
+/// let g = TransferFunction::continuous(&[10.0], &[1.0, 2.0, 10.0])?;
+/// assert_eq!(g.dc_gain()?, 1.0);
+/// let at = g.evaluate(Complex::new(0.0, 10f64.sqrt()))?; // s = jωn
+/// assert!((at - Complex::new(0.0, -10f64.sqrt() / 2.0)).norm() < 1e-12);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[doc(alias = "tf")]
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferFunction<D: Domain = Continuous> {
+    num: Vec<f64>,
+    den: Vec<f64>,
+    domain: D,
+}
+
+impl TransferFunction<Continuous> {
+    /// `num(s) / den(s)`, coefficients in descending powers of `s`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidData`] (`what` = `"num"` or `"den"`) for an empty
+    /// polynomial, a non-finite coefficient (with its index), or a zero
+    /// denominator.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, freq::TransferFunction};
+    ///
+    /// let g = TransferFunction::continuous(&[0.0, 2.0], &[1.0, 1.0])?;
+    /// assert_eq!(g.num(), &[2.0]); // leading zero dropped
+    /// assert!(matches!(TransferFunction::continuous(&[1.0], &[0.0, 0.0]),
+    ///                  Err(Error::InvalidData { what: "den", .. })));
+    /// assert!(TransferFunction::continuous(&[], &[1.0]).is_err());
+    /// assert!(TransferFunction::continuous(&[f64::NAN], &[1.0]).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn continuous(num: &[f64], den: &[f64]) -> Result<Self, Error> {
+        Self::with_domain(num, den, Continuous)
+    }
+}
+
+impl TransferFunction<Discrete> {
+    /// `num(z) / den(z)` with sampling period `dt` (s), coefficients in
+    /// descending powers of `z`.
+    ///
+    /// # Errors
+    ///
+    /// As [`TransferFunction::continuous`], and [`Error::InvalidParameter`]
+    /// for a `dt` that is not finite and positive.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::freq::TransferFunction;
+    ///
+    /// // A discrete integrator-like lag, 0.5 / (z − 0.5), period 0.1 s.
+    /// let g = TransferFunction::discrete(&[0.5], &[1.0, -0.5], 0.1)?;
+    /// assert_eq!(g.dt(), 0.1);
+    /// assert_eq!(g.dc_gain()?, 1.0);
+    /// assert!(TransferFunction::discrete(&[1.0], &[1.0], -1.0).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn discrete(num: &[f64], den: &[f64], dt: f64) -> Result<Self, Error> {
+        check_dt(dt)?;
+        Self::with_domain(num, den, Discrete::new_unchecked(dt))
+    }
+
+    /// The sampling period in seconds.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::discrete(&[1.0], &[1.0, 0.0], 0.002)?.dt(), 0.002);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn dt(&self) -> f64 {
+        self.domain.dt()
+    }
+}
+
+impl<D: Domain> TransferFunction<D> {
+    pub(crate) fn with_domain(num: &[f64], den: &[f64], domain: D) -> Result<Self, Error> {
+        let num = check_poly("num", num)?;
+        let den = check_poly("den", den)?;
+        if den == [0.0] {
+            return Err(Error::InvalidData {
+                what: "den",
+                index: 0,
+                reason: "the denominator is the zero polynomial",
+            });
+        }
+        Ok(Self { num, den, domain })
+    }
+
+    /// The numerator's coefficients, descending powers.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::continuous(&[1.0, 3.0], &[1.0, 2.0, 1.0])?.num(), &[1.0, 3.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn num(&self) -> &[f64] {
+        &self.num
+    }
+
+    /// The denominator's coefficients, descending powers.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::continuous(&[1.0], &[2.0, 1.0])?.den(), &[2.0, 1.0]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn den(&self) -> &[f64] {
+        &self.den
+    }
+
+    /// The time domain: [`Continuous`], or [`Discrete`] with its period.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Continuous, freq::TransferFunction};
+    /// assert_eq!(TransferFunction::continuous(&[1.0], &[1.0, 1.0])?.domain(), Continuous);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn domain(&self) -> D {
+        self.domain
+    }
+
+    /// Whether `deg num ≤ deg den` (a state-space realisation exists).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert!(TransferFunction::continuous(&[1.0, 0.0], &[1.0, 1.0])?.is_proper());
+    /// assert!(!TransferFunction::continuous(&[1.0, 0.0, 0.0], &[1.0, 1.0])?.is_proper());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn is_proper(&self) -> bool {
+        self.num.len() <= self.den.len()
+    }
+
+    /// `G` at a complex point `s` (rad/s) or `z` (dimensionless).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] for a non-finite point;
+    /// [`Error::Singular`] if the denominator vanishes there (a pole);
+    /// [`Error::Overflow`] if the value is not finite.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, freq::TransferFunction};
+    /// use nalgebra::Complex;
+    ///
+    /// let g = TransferFunction::continuous(&[1.0], &[1.0, 0.0])?; // 1/s
+    /// assert_eq!(g.evaluate(Complex::new(0.0, 2.0))?, Complex::new(0.0, -0.5));
+    /// assert!(matches!(g.evaluate(Complex::new(0.0, 0.0)), Err(Error::Singular { .. })));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "evalfr")]
+    pub fn evaluate(&self, s: Complex<f64>) -> Result<Complex<f64>, Error> {
+        if !(s.re.is_finite() && s.im.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "s",
+                value: if s.re.is_finite() { s.im } else { s.re },
+                reason: "the point must be finite",
+            });
+        }
+        let g = poly::eval_ratio(&self.num, &self.den, s).ok_or(Error::Singular {
+            operation: "transfer function evaluation (a pole)",
+        })?;
+        if g.re.is_finite() && g.im.is_finite() {
+            Ok(g)
+        } else {
+            Err(Error::Overflow {
+                operation: "transfer function evaluation",
+            })
+        }
+    }
+
+    /// The poles: roots of the denominator, sorted by real then imaginary
+    /// part (rad/s for continuous models, `z` for discrete ones).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::NoConvergence`] or [`Error::Overflow`] from the eigenvalues
+    /// of the companion matrix.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// let p = TransferFunction::continuous(&[1.0], &[1.0, 3.0, 2.0])?.poles()?;
+    /// assert!((p[0].re + 2.0).abs() < 1e-12 && (p[1].re + 1.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "pole")]
+    pub fn poles(&self) -> Result<Vec<Complex<f64>>, Error> {
+        poly::roots(&self.den)
+    }
+
+    /// The zeros: roots of the numerator (the transmission zeros of a SISO
+    /// model), sorted as [`poles`](Self::poles). None for `G ≡ 0`.
+    ///
+    /// # Errors
+    ///
+    /// As [`poles`](Self::poles).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// let z = TransferFunction::continuous(&[2.0, 6.0], &[1.0, 3.0, 2.0])?.zeros()?;
+    /// assert_eq!(z.len(), 1);
+    /// assert!((z[0].re + 3.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "zero")]
+    pub fn zeros(&self) -> Result<Vec<Complex<f64>>, Error> {
+        poly::roots(&self.num)
+    }
+
+    /// The DC gain: `G(0)` for continuous models, `G(1)` for discrete ones.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Singular`] if there is a pole at `s = 0` (`z = 1`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::freq::TransferFunction;
+    /// assert_eq!(TransferFunction::continuous(&[4.0], &[1.0, 2.0])?.dc_gain()?, 2.0);
+    /// assert!(TransferFunction::continuous(&[1.0], &[1.0, 0.0])?.dc_gain().is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "dcgain")]
+    pub fn dc_gain(&self) -> Result<f64, Error> {
+        let point = match period_of(&self.domain) {
+            None => Complex::new(0.0, 0.0),
+            Some(_) => Complex::new(1.0, 0.0),
+        };
+        self.evaluate(point).map(|g| g.re).map_err(|e| match e {
+            Error::Singular { .. } => Error::Singular {
+                operation: "DC gain (pole at s = 0 or z = 1)",
+            },
+            e => e,
+        })
+    }
+
+    /// A state-space realisation in SciPy's `tf2ss` form (controllable
+    /// canonical form): with `den` made monic, `sⁿ + a₁ sⁿ⁻¹ + … + aₙ`,
+    /// `A` has first row `[−a₁ … −aₙ]` and ones on its subdiagonal,
+    /// `B = e₁`, `D = b₀` (the numerator's `sⁿ` coefficient) and
+    /// `C = [b₁ − b₀ a₁, …, bₙ − b₀ aₙ]`.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidData`] (`"num"`) for an improper transfer function;
+    /// [`Error::Overflow`] if normalising overflows.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::freq::TransferFunction;
+    /// use nalgebra::dmatrix;
+    ///
+    /// let g = TransferFunction::continuous(&[1.0, 3.0], &[1.0, 3.0, 2.0])?;
+    /// let sys = g.to_state_space()?;
+    /// assert_eq!(sys.a(), &dmatrix![-3.0, -2.0; 1.0, 0.0]);
+    /// assert_eq!(sys.c(), &dmatrix![1.0, 3.0]);
+    /// assert!(TransferFunction::continuous(&[1.0, 0.0], &[1.0])?.to_state_space().is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "tf2ss")]
+    pub fn to_state_space(&self) -> Result<DynStateSpace<D>, Error> {
+        if !self.is_proper() {
+            return Err(Error::InvalidData {
+                what: "num",
+                index: 0,
+                reason: "improper transfer function (numerator degree above the \
+                         denominator's): it has no state-space realisation",
+            });
+        }
+        let n = self.den.len() - 1;
+        let lead = self.den[0];
+        let den: Vec<f64> = self.den.iter().map(|c| c / lead).collect();
+        let mut num = vec![0.0; n + 1];
+        let off = n + 1 - self.num.len();
+        for (i, c) in self.num.iter().enumerate() {
+            num[off + i] = c / lead;
+        }
+        let mut a = DMatrix::zeros(n, n);
+        let mut b = DMatrix::zeros(n, 1);
+        let mut c = DMatrix::zeros(1, n);
+        for k in 0..n {
+            a[(0, k)] = -den[k + 1];
+            if k + 1 < n {
+                a[(k + 1, k)] = 1.0;
+            }
+            c[(0, k)] = num[k + 1] - num[0] * den[k + 1];
+        }
+        if n > 0 {
+            b[(0, 0)] = 1.0;
+        }
+        let d = DMatrix::from_element(1, 1, num[0]);
+        DynStateSpace::from_computed(a, b, c, d, self.domain, "tf2ss")
+    }
+
+    /// The transfer function of a SISO state-space model, `ss2tf`: the
+    /// denominator is the characteristic polynomial `det(sI − A)` (monic,
+    /// degree `n`, nothing cancelled, as SciPy's `ss2tf`; eigenvalues
+    /// within `n ε ‖A‖_F` of zero, rounding, are put at zero), the numerator
+    /// `gain · ∏(s − zᵢ)` with the model's invariant zeros and its leading
+    /// coefficient (`D`, or the first non-zero Markov parameter
+    /// `C A^k B`).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::DimensionMismatch`] (`"D"`) unless the model has one input
+    /// and one output; the errors of the eigenvalue computations.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{DynStateSpace, freq::TransferFunction};
+    /// use nalgebra::dmatrix;
+    ///
+    /// let sys = DynStateSpace::continuous(dmatrix![-3.0, -2.0; 1.0, 0.0], dmatrix![1.0; 0.0],
+    ///                                     dmatrix![1.0, 3.0], dmatrix![0.0])?;
+    /// let g = TransferFunction::from_state_space(&sys)?;
+    /// assert_eq!(g.den(), &[1.0, 3.0, 2.0]);
+    /// assert!((g.num()[0] - 1.0).abs() < 1e-12 && (g.num()[1] - 3.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[doc(alias = "ss2tf")]
+    pub fn from_state_space(sys: &DynStateSpace<D>) -> Result<Self, Error> {
+        if sys.inputs() != 1 || sys.outputs() != 1 {
+            return Err(Error::DimensionMismatch {
+                matrix: "D",
+                expected_rows: 1,
+                expected_cols: 1,
+                found_rows: sys.outputs(),
+                found_cols: sys.inputs(),
+            });
+        }
+        entry(sys, &characteristic(sys)?, 0, 0)
+    }
+}
+
+/// `det(sI − A)` from the eigenvalues of `A`, those within rounding of
+/// zero (`|λ| ≤ n ε ‖A‖_F`, below the eigenvalue solver's backward error)
+/// set to exactly zero, so that an integrator's constant term is exactly
+/// zero and its DC gain an error, not 1e18.
+pub(crate) fn characteristic<D: Domain>(sys: &DynStateSpace<D>) -> Result<Vec<f64>, Error> {
+    Ok(poly::from_roots(&snapped_poles(sys)?))
+}
+
+/// The eigenvalues of `A`, those within rounding of zero set to zero.
+pub(crate) fn snapped_poles<D: Domain>(sys: &DynStateSpace<D>) -> Result<Vec<Complex<f64>>, Error> {
+    let tol = sys.states() as f64 * f64::EPSILON * sys.a().norm();
+    Ok(eigenvalues_dyn(sys.a())?
+        .into_iter()
+        .map(|p| {
+            if p.norm() <= tol {
+                Complex::new(0.0, 0.0)
+            } else {
+                p
+            }
+        })
+        .collect())
+}
+
+/// The `(output, input)` entry of a model's transfer matrix over `den`.
+pub(crate) fn entry<D: Domain>(
+    sys: &DynStateSpace<D>,
+    den: &[f64],
+    output: usize,
+    input: usize,
+) -> Result<TransferFunction<D>, Error> {
+    let (zeros, gain) = siso_numerator(sys.a(), sys.b(), sys.c(), sys.d(), output, input)?;
+    let num: Vec<f64> = poly::from_roots(&zeros).iter().map(|c| c * gain).collect();
+    if num.iter().chain(den).any(|c| !c.is_finite()) {
+        return Err(Error::Overflow { operation: "ss2tf" });
+    }
+    TransferFunction::with_domain(&num, den, sys.domain())
+}
+
+impl<D: Domain> TryFrom<&DynStateSpace<D>> for TransferFunction<D> {
+    type Error = Error;
+
+    /// [`TransferFunction::from_state_space`].
+    fn try_from(sys: &DynStateSpace<D>) -> Result<Self, Error> {
+        Self::from_state_space(sys)
+    }
+}
+
+impl<const N: usize, D: Domain> TryFrom<&StateSpace<N, 1, 1, D>> for TransferFunction<D> {
+    type Error = Error;
+
+    /// [`TransferFunction::from_state_space`] of the fixed-size model.
+    fn try_from(sys: &StateSpace<N, 1, 1, D>) -> Result<Self, Error> {
+        Self::from_state_space(&DynStateSpace::from(sys))
+    }
+}
