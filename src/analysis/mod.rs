@@ -24,7 +24,7 @@ mod dynamic;
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::Error;
-use crate::kernels::linalg::{Lu, boundary_tolerance};
+use crate::kernels::linalg::{Lu, boundary_tolerance_dyn};
 use crate::kernels::reduce::pow2_floor;
 use crate::model::{Domain, StateSpace, period_of};
 
@@ -582,7 +582,16 @@ pub(crate) fn first_unstable<const N: usize>(
     a: &SMatrix<f64, N, N>,
     period: Option<f64>,
 ) -> Option<Complex<f64>> {
-    let normwise = boundary_tolerance(a);
+    first_unstable_dyn(poles, &DMatrix::from_column_slice(N, N, a.as_slice()), period)
+}
+
+/// [`first_unstable`] for a run-time-sized `a` (`poles` its eigenvalues).
+pub(crate) fn first_unstable_dyn(
+    poles: &[Complex<f64>],
+    a: &DMatrix<f64>,
+    period: Option<f64>,
+) -> Option<Complex<f64>> {
+    let normwise = boundary_tolerance_dyn(a);
     let outside = |p: &Complex<f64>, tol: f64| match period {
         None => p.re >= -tol,
         Some(_) => p.norm() >= 1.0 - tol,
@@ -602,11 +611,12 @@ pub(crate) fn first_unstable<const N: usize>(
 /// of `a` under relative perturbations of its entries, with `x`, `y` the
 /// right and left singular vectors of `A − p I` for its smallest singular
 /// value (its eigenvectors). `None` when the SVD fails.
-fn componentwise_tolerance<const N: usize>(a: &SMatrix<f64, N, N>, p: Complex<f64>) -> Option<f64> {
-    let shifted = DMatrix::from_fn(N, N, |i, j| {
+fn componentwise_tolerance(a: &DMatrix<f64>, p: Complex<f64>) -> Option<f64> {
+    let n = a.nrows();
+    let shifted = DMatrix::from_fn(n, n, |i, j| {
         Complex::new(a[(i, j)], 0.0) - if i == j { p } else { Complex::new(0.0, 0.0) }
     });
-    let iterations = ITERATIONS_PER_DIM * N;
+    let iterations = ITERATIONS_PER_DIM * n;
     let svd = shifted.try_svd_unordered(true, true, f64::EPSILON, iterations)?;
     if svd.singular_values.iter().any(|s| !s.is_finite()) {
         return None;
@@ -616,13 +626,13 @@ fn componentwise_tolerance<const N: usize>(a: &SMatrix<f64, N, N>, p: Complex<f6
     let x = v_t.row(k).adjoint();
     let y = u.column(k);
     let mut weighted = 0.0;
-    for i in 0..N {
-        for j in 0..N {
+    for i in 0..n {
+        for j in 0..n {
             weighted += y[i].norm() * a[(i, j)].abs() * x[j].norm();
         }
     }
     let overlap = y.dotc(&x).norm();
-    let tol = 100.0 * N as f64 * f64::EPSILON * weighted / overlap;
+    let tol = 100.0 * n as f64 * f64::EPSILON * weighted / overlap;
     tol.is_finite().then_some(tol)
 }
 

@@ -2,7 +2,7 @@
 //! typenum bounds for a generic `N` (its `lu()` needs `Const<N>: DimMin`).
 //! Keeping them here lets the public API take plain `const N: usize`.
 
-use nalgebra::{Complex, SMatrix};
+use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::Error;
 
@@ -164,19 +164,17 @@ pub(crate) fn householder_q<const N: usize>(
     q
 }
 
-/// The 1-norm (largest column sum of magnitudes).
-pub(crate) fn norm1<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> f64 {
-    m.column_iter()
-        .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
-
 /// How close to the stability boundary a computed pole of `a` must be to
 /// count as *on* it: eigenvalues are computed to about `ε ‖A‖`, so a pole
 /// within `100 N ε max(1, ‖A‖₁)` of the boundary (a rigid-body mode whose
 /// exact value is 0, say) is marginal, not stable.
-pub(crate) fn boundary_tolerance<const N: usize>(a: &SMatrix<f64, N, N>) -> f64 {
-    100.0 * N as f64 * f64::EPSILON * norm1(a).max(1.0)
+pub(crate) fn boundary_tolerance_dyn(a: &DMatrix<f64>) -> f64 {
+    // The 1-norm: largest column sum of magnitudes.
+    let norm1 = a
+        .column_iter()
+        .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    100.0 * a.nrows() as f64 * f64::EPSILON * norm1.max(1.0)
 }
 
 #[cfg(test)]
