@@ -390,10 +390,11 @@ pub(crate) fn continuous(
         }
     }
     let Some((x, iterations, residual)) = best else {
-        return Err(last_err.unwrap_or(Error::NoConvergence {
+        let err = last_err.unwrap_or(Error::NoConvergence {
             operation: "LQR Riccati doubling",
             iterations: MAX_ITERATIONS,
-        }));
+        });
+        return Err(explain(&a, &b, None).unwrap_or(err));
     };
     let gain = &r_inv_bt * &x;
     finish(&a, &b, gain, x, weight, residual, iterations, None)
@@ -433,7 +434,8 @@ pub(crate) fn discrete(
     };
     let mut g = &b * &r_inv_bt;
     symmetrize(&mut g);
-    let (x, iterations) = sda(a.clone(), g, q.clone())?;
+    let (x, iterations) = sda(a.clone(), g, q.clone())
+        .map_err(|err| explain(&a, &b, Some(1.0)).unwrap_or(err))?;
     let eval = |x: &Mat<f64>| match dare_gain(&a, &b, &r, x) {
         Ok(gain) => dare_eval(&a, &b, &q, x, &gain),
         Err(_) => (Mat::zeros(x.nrows(), x.ncols()), f64::INFINITY),
@@ -452,6 +454,42 @@ pub(crate) fn discrete(
     let (x, residual) = refine(x, steps, regularised, &eval, &newton);
     let gain = dare_gain(&a, &b, &r, &x)?;
     finish(&a, &b, gain, x, weight, residual, iterations, Some(period.unwrap_or(1.0)))
+}
+
+/// Why no solution was found, when the plant says so: the first unstable
+/// eigenvalue of `A` that the input cannot reach (`[A − λI, B]` loses rank
+/// by the PBH test, to 1e-8 of `‖A‖ + ‖B‖`), as [`Error::Unstable`].
+/// Without a stabilisable `(A, B)` the stabilising solution does not exist
+/// and the doubling diverges; this names the mode. Only run on failure:
+/// one SVD per unstable eigenvalue.
+fn explain(a: &Mat<f64>, b: &Mat<f64>, period: Option<f64>) -> Option<Error> {
+    let (n, m) = (a.nrows(), b.ncols());
+    let poles = eigenvalues_dyn(&to_nalgebra(a.as_ref())).ok()?;
+    let scale = a.norm_l2() + b.norm_l2();
+    let zero = Complex::new(0.0, 0.0);
+    let p = poles.into_iter().find(|&p| {
+        let unstable = match period {
+            None => p.re >= 0.0,
+            Some(_) => p.norm() >= 1.0,
+        };
+        let pbh = DMatrix::from_fn(n, n + m, |i, j| {
+            if j < n {
+                Complex::new(a[(i, j)], 0.0) - if i == j { p } else { zero }
+            } else {
+                Complex::new(b[(i, j - n)], 0.0)
+            }
+        });
+        unstable
+            && pbh
+                .try_svd(false, false, f64::EPSILON, 100 * (n + m))
+                .is_some_and(|svd| svd.singular_values.min() <= 1e-8 * scale)
+    })?;
+    Some(Error::Unstable {
+        operation: "LQR: no stabilising Riccati solution, (A, B) is not stabilisable \
+                    (an unstable mode the input cannot reach)",
+        re: p.re,
+        im: p.im,
+    })
 }
 
 /// Newton refinement of a Riccati solution: up to `steps` steps, each kept
