@@ -15,8 +15,9 @@ use crate::kernels::reduce::pow2_floor;
 use crate::model::{Continuous, Discrete, DynStateSpace};
 use kernels::{MAX_ITERATIONS, finite, lu, lyapunov, sda, stein, symmetrize};
 
-/// A continuous solution with a relative residual above this is retried with
-/// another Cayley shift; the best one is kept.
+/// A continuous solution with a relative residual above this after Newton
+/// refinement is retried with another Cayley shift, unless Newton stalled
+/// (the residual is then the problem's rounding floor); the best is kept.
 const GOOD_RESIDUAL: f64 = 1e-13;
 /// Newton refinement steps after the doubling, at most.
 const REFINE_STEPS: usize = 3;
@@ -54,12 +55,14 @@ const SHIFTS: [f64; 7] = [1.0, 0.5, 2.0, 0.25, 4.0, 0.1, 10.0];
 /// stabilisable and `(A, Q)` detectable, with no closed-loop pole on the
 /// stability boundary. The shift starts at
 /// `γ = max(‖A‖_F, √(‖G‖_F ‖Q‖_F))`, the scale of the Hamiltonian's
-/// eigenvalues; if the residual stays above 1e-13 a few other shifts
-/// (γ/2, 2γ, γ/4, 4γ, γ/10, 10γ) are tried and the best solution kept.
+/// eigenvalues; if the residual stays above 1e-13 and the Newton steps
+/// below could still lower it, a few other shifts (γ/2, 2γ, γ/4, 4γ,
+/// γ/10, 10γ) are tried and the best solution kept.
 ///
 /// On an ill-conditioned problem (a large `X` from nearly cancelling terms)
 /// the doubling alone can stop at a relative residual of about 1e-9. Up to
-/// three Newton steps follow it, each kept only if it lowers the residual:
+/// three Newton steps follow it (while the residual is above 4ε), each
+/// kept only if it lowers the residual:
 /// a Lyapunov equation of the closed loop for the continuous case (solved
 /// by the matrix-sign-function iteration), a Stein equation for the
 /// discrete one (squared Smith). Every step of every part costs `O(N³)` on
@@ -378,11 +381,15 @@ pub(crate) fn continuous(
         })();
         match attempt {
             Ok((x, iterations)) => {
-                let (x, res) = refine(x, REFINE_STEPS, false, &eval, &newton);
+                let (x, res, stalled) =
+                    refine(x, REFINE_STEPS, 4.0 * f64::EPSILON, false, &eval, &newton);
                 if best.as_ref().is_none_or(|(_, _, r)| res < *r) {
                     best = Some((x, iterations, res));
                 }
-                if res <= GOOD_RESIDUAL {
+                // Another shift helps only where Newton could not finish
+                // the job; at a stall the residual is the problem's floor,
+                // and every shift lands on it (7 times the cost for nothing).
+                if res <= GOOD_RESIDUAL || stalled {
                     break;
                 }
             }
@@ -451,7 +458,7 @@ pub(crate) fn discrete(
     } else {
         REFINE_STEPS
     };
-    let (x, residual) = refine(x, steps, regularised, &eval, &newton);
+    let (x, residual, _) = refine(x, steps, 4.0 * f64::EPSILON, regularised, &eval, &newton);
     let gain = dare_gain(&a, &b, &r, &x)?;
     finish(&a, &b, gain, x, weight, residual, iterations, Some(period.unwrap_or(1.0)))
 }
@@ -493,19 +500,22 @@ fn explain(a: &Mat<f64>, b: &Mat<f64>, period: Option<f64>) -> Option<Error> {
 }
 
 /// Newton refinement of a Riccati solution: up to `steps` steps, each kept
-/// only if it lowers the relative residual, and none once that is at
-/// rounding level (4ε) unless `to_stagnation`; returns `X` and its
-/// residual. `step(X, Res)` solves the correction's linear equation.
+/// only if it lowers the relative residual, and none once that is below
+/// `good` unless `to_stagnation`; returns `X`, its residual, and whether
+/// the refinement stalled (a Newton step was solved but did not lower the
+/// residual: `X` is then as accurate as rounding lets this problem be).
+/// `step(X, Res)` solves the correction's linear equation.
 fn refine(
     mut x: Mat<f64>,
     steps: usize,
+    good: f64,
     to_stagnation: bool,
     eval: &impl Fn(&Mat<f64>) -> (Mat<f64>, f64),
     step: &impl Fn(&Mat<f64>, &Mat<f64>) -> Option<Mat<f64>>,
-) -> (Mat<f64>, f64) {
+) -> (Mat<f64>, f64, bool) {
     let (mut res, mut residual) = eval(&x);
     for _ in 0..steps {
-        if residual == 0.0 || residual <= 4.0 * f64::EPSILON && !to_stagnation {
+        if residual == 0.0 || residual <= good && !to_stagnation {
             break;
         }
         let Some(delta) = step(&x, &res) else {
@@ -520,10 +530,10 @@ fn refine(
         if next_residual < residual {
             (x, res, residual) = (next, next_res, next_residual);
         } else {
-            break;
+            return (x, residual, true);
         }
     }
-    (x, residual)
+    (x, residual, false)
 }
 
 /// The solution: `riccati` is of the weights scaled by `weight` (see
