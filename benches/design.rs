@@ -103,7 +103,9 @@ fn benches(c: &mut Criterion) {
 fn random_problem(n: usize, seed: u64) -> (DynStateSpace, DMatrix<f64>, DMatrix<f64>) {
     let mut state = seed;
     let mut next = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     };
     let scale = (3.0 / n as f64).sqrt();
@@ -132,7 +134,11 @@ fn riccati(c: &mut Criterion) {
     group.finish();
 
     let data: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/riccati_fixtures.json")).unwrap(),
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/riccati_fixtures.json"
+        ))
+        .unwrap(),
     )
     .unwrap();
     let case = &data["carex"][17];

@@ -25,7 +25,9 @@ fn matrix(v: &Value) -> DMatrix<f64> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let path = std::env::args().nth(1).ok_or("usage: riccati_bench problems.json")?;
+    let path = std::env::args()
+        .nth(1)
+        .ok_or("usage: riccati_bench problems.json")?;
     let data: Value = serde_json::from_str(&std::fs::read_to_string(path)?)?;
     for case in data["cases"].as_array().ok_or("no \"cases\"")? {
         let [a, b, q, r] = ["a", "b", "q", "r"].map(|k| matrix(&case[k]));

@@ -41,7 +41,9 @@ fn real(v: &Value) -> DMatrix<f64> {
 /// `(Re, Im)` of a fixture matrix (`Im` zero when absent).
 fn parts(v: &Value) -> (DMatrix<f64>, DMatrix<f64>) {
     let re = real(&v["re"]);
-    let im = v.get("im").map_or_else(|| DMatrix::zeros(re.nrows(), re.ncols()), real);
+    let im = v
+        .get("im")
+        .map_or_else(|| DMatrix::zeros(re.nrows(), re.ncols()), real);
     (re, im)
 }
 
@@ -106,11 +108,17 @@ fn max_entry(res: &DMatrix<f64>, complex: Option<usize>) -> f64 {
 fn check(kind: &str, expected_skips: &[usize]) {
     let (cases, skipped) = cases(kind);
     assert_eq!(skipped, expected_skips, "SciPy's known failures changed");
-    println!("{kind}: case  n  required  |residual|max  ctrlab-vs-SciPy X (rel. max)  relative residual");
+    println!(
+        "{kind}: case  n  required  |residual|max  ctrlab-vs-SciPy X (rel. max)  relative residual"
+    );
     let mut failures = Vec::new();
     for case in &cases {
         let Case { a, b, q, r, .. } = case;
-        let solved = if kind == "carex" { care(a, b, q, r) } else { dare(a, b, q, r) };
+        let solved = if kind == "carex" {
+            care(a, b, q, r)
+        } else {
+            dare(a, b, q, r)
+        };
         let sol = match solved {
             Ok(sol) => sol,
             Err(e) => {
@@ -145,7 +153,8 @@ fn check(kind: &str, expected_skips: &[usize]) {
             versus.map_or("-".to_string(), |v| format!("{v:.1e}")),
             sol.residual,
         );
-        if !(worst < case.atol) {
+        // A NaN residual fails too.
+        if worst.is_nan() || worst >= case.atol {
             failures.push(format!(
                 "{kind} {}: residual entry {worst:e} ≥ {:e} (min_decimal {})",
                 case.index, case.atol, case.min_decimal
@@ -184,7 +193,9 @@ fn fixed_and_run_time_lqr_agree_on_the_lab_plant() {
     let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e4, 0.0, 1e6, 0.0]);
     let r = nalgebra::matrix![1.0];
     let fixed = lqr(&plant, &q, &r).unwrap();
-    let dynamic = DynStateSpace::from(plant).lqr(&heap(&q), &heap(&r)).unwrap();
+    let dynamic = DynStateSpace::from(plant)
+        .lqr(&heap(&q), &heap(&r))
+        .unwrap();
     assert!((heap(&fixed.gain) - &dynamic.gain).amax() <= 1e-12 * fixed.gain.amax());
     assert!((heap(&fixed.riccati) - &dynamic.riccati).amax() <= 1e-12 * fixed.riccati.amax());
     assert_eq!(fixed.poles.to_vec(), dynamic.poles);
@@ -206,16 +217,29 @@ fn typed_errors_never_panics() {
     let q = dmatrix![1.0, 0.0; 0.0, 1.0];
     let r = dmatrix![1.0];
     let mismatch = |e: Error, name: &str| matches!(e, Error::DimensionMismatch { matrix, .. } if matrix == name);
-    assert!(mismatch(care(&dmatrix![1.0, 2.0], &b, &q, &r).unwrap_err(), "A"));
+    assert!(mismatch(
+        care(&dmatrix![1.0, 2.0], &b, &q, &r).unwrap_err(),
+        "A"
+    ));
     assert!(mismatch(care(&a, &dmatrix![1.0], &q, &r).unwrap_err(), "B"));
     assert!(mismatch(dare(&a, &b, &dmatrix![1.0], &r).unwrap_err(), "Q"));
     assert!(mismatch(dare(&a, &b, &q, &q).unwrap_err(), "R"));
-    let sys = DynStateSpace::continuous(a.clone(), b.clone(), dmatrix![1.0, 0.0], dmatrix![0.0]).unwrap();
+    let sys =
+        DynStateSpace::continuous(a.clone(), b.clone(), dmatrix![1.0, 0.0], dmatrix![0.0]).unwrap();
     assert!(mismatch(sys.lqr(&r, &r).unwrap_err(), "Q"));
-    assert!(matches!(care(&dmatrix![f64::NAN, 1.0; 0.0, 0.0], &b, &q, &r), Err(Error::NonFinite { matrix: "A", .. })));
-    assert!(matches!(care(&a, &b, &q, &dmatrix![f64::INFINITY]), Err(Error::NonFinite { matrix: "R", .. })));
+    assert!(matches!(
+        care(&dmatrix![f64::NAN, 1.0; 0.0, 0.0], &b, &q, &r),
+        Err(Error::NonFinite { matrix: "A", .. })
+    ));
+    assert!(matches!(
+        care(&a, &b, &q, &dmatrix![f64::INFINITY]),
+        Err(Error::NonFinite { matrix: "R", .. })
+    ));
     let invalid = |res: Result<_, Error>, name: &str| matches!(res, Err(Error::InvalidMatrix { matrix, .. }) if matrix == name);
-    assert!(invalid(care(&a, &b, &dmatrix![1.0, 1.0; 0.0, 1.0], &r), "Q"));
+    assert!(invalid(
+        care(&a, &b, &dmatrix![1.0, 1.0; 0.0, 1.0], &r),
+        "Q"
+    ));
     assert!(invalid(care(&a, &b, &q, &dmatrix![0.0]), "R"));
     assert!(invalid(dare(&a, &b, &q, &dmatrix![-1.0]), "R"));
     // An LQR weight must be semidefinite; a bare equation's need not be.
@@ -226,13 +250,40 @@ fn typed_errors_never_panics() {
     let no_input = DMatrix::<f64>::zeros(2, 0);
     assert!(invalid(care(&a, &no_input, &q, &DMatrix::zeros(0, 0)), "R"));
     // No states: an empty, trivially stabilising solution.
-    let empty = care(&DMatrix::zeros(0, 0), &DMatrix::zeros(0, 1), &DMatrix::zeros(0, 0), &r).unwrap();
-    assert_eq!((empty.gain.shape(), empty.riccati.shape()), ((1, 0), (0, 0)));
+    let empty = care(
+        &DMatrix::zeros(0, 0),
+        &DMatrix::zeros(0, 1),
+        &DMatrix::zeros(0, 0),
+        &r,
+    )
+    .unwrap();
+    assert_eq!(
+        (empty.gain.shape(), empty.riccati.shape()),
+        ((1, 0), (0, 0))
+    );
     // An uncontrollable unstable mode: no stabilising solution.
     let stuck = care(&dmatrix![1.0, 0.0; 0.0, -1.0], &dmatrix![0.0; 1.0], &q, &r);
-    assert!(matches!(stuck, Err(Error::Unstable { .. }) | Err(Error::Singular { .. }) | Err(Error::NoConvergence { .. }) | Err(Error::Overflow { .. })), "{stuck:?}");
+    assert!(
+        matches!(
+            stuck,
+            Err(Error::Unstable { .. })
+                | Err(Error::Singular { .. })
+                | Err(Error::NoConvergence { .. })
+                | Err(Error::Overflow { .. })
+        ),
+        "{stuck:?}"
+    );
     let stuck = dare(&dmatrix![2.0, 0.0; 0.0, 0.5], &dmatrix![0.0; 1.0], &q, &r);
-    assert!(matches!(stuck, Err(Error::Unstable { .. }) | Err(Error::Singular { .. }) | Err(Error::NoConvergence { .. }) | Err(Error::Overflow { .. })), "{stuck:?}");
+    assert!(
+        matches!(
+            stuck,
+            Err(Error::Unstable { .. })
+                | Err(Error::Singular { .. })
+                | Err(Error::NoConvergence { .. })
+                | Err(Error::Overflow { .. })
+        ),
+        "{stuck:?}"
+    );
 }
 
 fn square(n: usize, scale: f64) -> impl Strategy<Value = DMatrix<f64>> {
@@ -243,8 +294,10 @@ fn problem() -> impl Strategy<Value = (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>)
     (1usize..=12, 1usize..=3).prop_flat_map(|(n, m)| {
         (
             square(n, 2.0),
-            proptest::collection::vec(-1.0..1.0f64, n * m).prop_map(move |v| DMatrix::from_vec(n, m, v)),
-            proptest::collection::vec(-1.0..1.0f64, n * n).prop_map(move |v| DMatrix::from_vec(n, n, v)),
+            proptest::collection::vec(-1.0..1.0f64, n * m)
+                .prop_map(move |v| DMatrix::from_vec(n, m, v)),
+            proptest::collection::vec(-1.0..1.0f64, n * n)
+                .prop_map(move |v| DMatrix::from_vec(n, n, v)),
         )
     })
 }

@@ -582,7 +582,11 @@ pub(crate) fn first_unstable<const N: usize>(
     a: &SMatrix<f64, N, N>,
     period: Option<f64>,
 ) -> Option<Complex<f64>> {
-    first_unstable_dyn(poles, &DMatrix::from_column_slice(N, N, a.as_slice()), period)
+    first_unstable_dyn(
+        poles,
+        &DMatrix::from_column_slice(N, N, a.as_slice()),
+        period,
+    )
 }
 
 /// [`first_unstable`] for a run-time-sized `a` (`poles` its eigenvalues).

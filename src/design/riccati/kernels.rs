@@ -35,7 +35,7 @@ pub(super) fn lu(a: MatRef<'_, f64>, operation: &'static str) -> Result<PartialP
         max_pivot = max_pivot.max(p);
         min_pivot = min_pivot.min(p);
     }
-    if n > 0 && min_pivot <= n as f64 * f64::EPSILON * max_pivot || max_pivot == 0.0 && n > 0 {
+    if n > 0 && (min_pivot <= n as f64 * f64::EPSILON * max_pivot || max_pivot == 0.0) {
         return Err(Error::Singular { operation });
     }
     Ok(lu)
@@ -164,7 +164,13 @@ pub(super) fn lyapunov(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64
                 f_next[(i, j)] *= 0.5 * k;
             }
         }
-        gemm(&mut f_next, Accum::Add, tmp.as_ref(), e_inv.transpose(), 0.5 / k);
+        gemm(
+            &mut f_next,
+            Accum::Add,
+            tmp.as_ref(),
+            e_inv.transpose(),
+            0.5 / k,
+        );
         std::mem::swap(&mut f, &mut f_next);
         let mut change = 0.0;
         for j in 0..n {
@@ -216,7 +222,13 @@ pub(super) fn stein(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64>> 
     let mut update = Mat::<f64>::zeros(n, n);
     for _ in 0..SMITH_ITERATIONS {
         gemm(&mut tmp, Accum::Replace, x.as_ref(), t.as_ref(), 1.0);
-        gemm(&mut update, Accum::Replace, t.transpose(), tmp.as_ref(), 1.0);
+        gemm(
+            &mut update,
+            Accum::Replace,
+            t.transpose(),
+            tmp.as_ref(),
+            1.0,
+        );
         x += &update;
         let (u, s) = (update.norm_l2(), x.norm_l2());
         if !u.is_finite() || !s.is_finite() {
@@ -238,7 +250,9 @@ mod tests {
 
     #[test]
     fn lyapunov_and_stein_solve_their_equations() {
-        let a = Mat::from_fn(3, 3, |i, j| [[-2.0, 1.0, 0.0], [0.0, -1.0, 3.0], [0.5, 0.0, -4.0]][i][j]);
+        let a = Mat::from_fn(3, 3, |i, j| {
+            [[-2.0, 1.0, 0.0], [0.0, -1.0, 3.0], [0.5, 0.0, -4.0]][i][j]
+        });
         let c = Mat::from_fn(3, 3, |i, j| if i == j { 1.0 + i as f64 } else { 0.2 });
         let x = lyapunov(a.as_ref(), c.as_ref()).unwrap();
         let res = a.transpose() * &x + &x * &a + &c;

@@ -5,8 +5,8 @@
 
 mod kernels;
 
-use faer::{Mat, MatRef};
 use faer::linalg::solvers::{DenseSolveCore, Solve};
+use faer::{Mat, MatRef};
 use nalgebra::{Complex, DMatrix};
 
 use crate::analysis::{eigenvalues_dyn, first_unstable_dyn};
@@ -303,7 +303,12 @@ impl DynStateSpace<Discrete> {
     }
 }
 
-fn check_weight_shapes(n: usize, m: usize, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<(), Error> {
+fn check_weight_shapes(
+    n: usize,
+    m: usize,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<(), Error> {
     check_shape("Q", q, n, n)?;
     check_shape("R", r, m, m)
 }
@@ -441,8 +446,8 @@ pub(crate) fn discrete(
     };
     let mut g = &b * &r_inv_bt;
     symmetrize(&mut g);
-    let (x, iterations) = sda(a.clone(), g, q.clone())
-        .map_err(|err| explain(&a, &b, Some(1.0)).unwrap_or(err))?;
+    let (x, iterations) =
+        sda(a.clone(), g, q.clone()).map_err(|err| explain(&a, &b, Some(1.0)).unwrap_or(err))?;
     let eval = |x: &Mat<f64>| match dare_gain(&a, &b, &r, x) {
         Ok(gain) => dare_eval(&a, &b, &q, x, &gain),
         Err(_) => (Mat::zeros(x.nrows(), x.ncols()), f64::INFINITY),
@@ -460,7 +465,16 @@ pub(crate) fn discrete(
     };
     let (x, residual, _) = refine(x, steps, 4.0 * f64::EPSILON, regularised, &eval, &newton);
     let gain = dare_gain(&a, &b, &r, &x)?;
-    finish(&a, &b, gain, x, weight, residual, iterations, Some(period.unwrap_or(1.0)))
+    finish(
+        &a,
+        &b,
+        gain,
+        x,
+        weight,
+        residual,
+        iterations,
+        Some(period.unwrap_or(1.0)),
+    )
 }
 
 /// Why no solution was found, when the plant says so: the first unstable
@@ -595,11 +609,7 @@ fn balance_weights(q: &DMatrix<f64>, r: &DMatrix<f64>) -> (Mat<f64>, Mat<f64>, f
     } else {
         1.0 / sr
     };
-    (
-        to_faer(q) * faer::Scale(c),
-        to_faer(r) * faer::Scale(c),
-        c,
-    )
+    (to_faer(q) * faer::Scale(c), to_faer(r) * faer::Scale(c), c)
 }
 
 /// The CARE left side `Aᵀ X + X A − X G X + Q` and its relative norm.
@@ -686,8 +696,7 @@ pub(crate) fn check_weights(
             reason: "must be symmetric",
         });
     }
-    if matches!(weights, Weights::Regulator(_))
-        && min_symmetric_eigenvalue(&q)? < -1e-12 * q.norm()
+    if matches!(weights, Weights::Regulator(_)) && min_symmetric_eigenvalue(&q)? < -1e-12 * q.norm()
     {
         return Err(Error::InvalidMatrix {
             matrix: q_name,
