@@ -1,15 +1,18 @@
 //! Design and control-update costs: the observer + LQI controller's
 //! per-period update (the 2 ms loop's work), the full-state integral
 //! controller's, and the design functions (`place` for 4 states and
-//! 2 inputs, `dlqe`, `dlqi`).
+//! 2 inputs, `dlqe`, `dlqi`), and the Riccati solvers: `lqr` on the lab
+//! plant (N = 4), `DynStateSpace::lqr` on seeded random problems at
+//! N = 20, 60, 100, and `care` on SciPy's CAREX 18 (N = 100). The same
+//! problems against SciPy in one run: `scripts/riccati_vs_scipy.py`.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ctrlab::design::{AntiWindup, IntegralFeedback, dlqe, dlqi, place};
-use ctrlab::{Controller, StateSpace};
-use nalgebra::{Complex, SMatrix, matrix, vector};
+use ctrlab::design::{AntiWindup, IntegralFeedback, care, dlqe, dlqi, lqr, place};
+use ctrlab::{Cart, Controller, DynStateSpace, MassSpring, StateSpace};
+use nalgebra::{Complex, DMatrix, SMatrix, matrix, vector};
 use std::hint::black_box;
 
 fn benches(c: &mut Criterion) {
@@ -94,5 +97,63 @@ fn benches(c: &mut Criterion) {
     });
 }
 
-criterion_group!(design, benches);
+/// A seeded stabilisable problem: `A` with uniform entries of variance
+/// about 1/n plus 0.2 I (some modes unstable), `B` n × n/10, `Q = I`,
+/// `R = I`. A small LCG keeps the bench free of a random-number crate.
+fn random_problem(n: usize, seed: u64) -> (DynStateSpace, DMatrix<f64>, DMatrix<f64>) {
+    let mut state = seed;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let scale = (3.0 / n as f64).sqrt();
+    let a = DMatrix::from_fn(n, n, |i, j| next() * scale + if i == j { 0.2 } else { 0.0 });
+    let m = (n / 10).max(1);
+    let b = DMatrix::from_fn(n, m, |_, _| next());
+    let sys = DynStateSpace::continuous(a, b, DMatrix::zeros(0, n), DMatrix::zeros(0, m)).unwrap();
+    (sys, DMatrix::identity(n, n), DMatrix::identity(m, m))
+}
+
+fn riccati(c: &mut Criterion) {
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
+    let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0]);
+    let r = matrix![1.0];
+    c.bench_function("lqr (lab plant, 4 states)", |b| {
+        b.iter(|| lqr(black_box(&plant), &q, &r).unwrap())
+    });
+    let mut group = c.benchmark_group("DynStateSpace::lqr (random, seeded)");
+    group.sample_size(10);
+    for n in [20, 60, 100] {
+        let (sys, q, r) = random_problem(n, n as u64);
+        group.bench_function(format!("n = {n}"), |b| {
+            b.iter(|| sys.lqr(black_box(&q), &r).unwrap())
+        });
+    }
+    group.finish();
+
+    let data: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/riccati_fixtures.json"
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    let case = &data["carex"][17];
+    let m = |k: &str| {
+        let rows: Vec<Vec<f64>> = serde_json::from_value(case[k]["re"].clone()).unwrap();
+        DMatrix::from_fn(rows.len(), rows[0].len(), |i, j| rows[i][j])
+    };
+    let [a, b_, q, r] = ["a", "b", "q", "r"].map(m);
+    let mut group = c.benchmark_group("care");
+    group.sample_size(10);
+    group.bench_function("CAREX 18 (n = 100)", |b| {
+        b.iter(|| care(black_box(&a), &b_, &q, &r).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(design, benches, riccati);
 criterion_main!(design);

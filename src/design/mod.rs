@@ -1,7 +1,9 @@
 //! Controllers and their design: the [`Controller`] trait that simulation and
 //! hardware both drive, [`OpenLoop`], [`StateFeedback`] (`u = N r − K x`),
 //! pole placement by [`acker`] (one input) and [`place`] (any number of
-//! inputs, robust), and optimal gains by [`lqr`] / [`dlqr`].
+//! inputs, robust), and optimal gains by [`lqr`] / [`dlqr`] — on run-time
+//! models by `DynStateSpace::lqr`, and the bare Riccati equations by
+//! [`care`] / [`dare`] (all `O(N³)`, one implementation; see [`DynLqr`]).
 //!
 //! Beyond static state feedback:
 //!
@@ -45,6 +47,7 @@ mod kalman;
 mod lqr;
 mod observer;
 mod place;
+mod riccati;
 mod robust_place;
 
 pub use compensator::{ObserverController, SelectOutputs};
@@ -55,4 +58,5 @@ pub use kalman::{Lqe, dlqe, lqe};
 pub use lqr::{Lqr, dlqr, lqr};
 pub use observer::{EstimatorForm, Observer};
 pub use place::acker;
+pub use riccati::{DynLqr, care, dare};
 pub use robust_place::{place, place_observer};
