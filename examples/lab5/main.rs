@@ -40,6 +40,7 @@ mod card;
 mod design;
 mod excitation;
 mod figures;
+mod frequency;
 mod identification;
 #[path = "../common/lab_tables.rs"]
 mod lab_tables;
@@ -272,6 +273,7 @@ fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::e
         truth,
         report,
     )?;
+    frequency::section(backend, &ident, report)?;
     let tables = rig::rig_tables();
     let mut rig_results = Vec::new();
     for table in &tables {

@@ -72,6 +72,21 @@ impl Report {
         Ok(())
     }
 
+    /// Writes a Bode figure (magnitude in dB, phase in degrees, against Hz)
+    /// of the curves and links it from the report.
+    #[cfg(feature = "plot")]
+    pub fn bode(
+        &mut self,
+        file: &str,
+        title: &str,
+        curves: &[(&str, &ctrlab::freq::Bode)],
+    ) -> Result<(), ctrlab::Error> {
+        use ctrlab::freq::{FrequencyUnit, bode_svg};
+        bode_svg(self.out.join(file), title, FrequencyUnit::Hertz, curves)?;
+        self.add(&format!("![{title}]({file})\n"));
+        Ok(())
+    }
+
     /// Writes the rig runs as small multiples (position over the setpoint,
     /// applied voltage beneath) and links the figure.
     pub fn runs(
