@@ -291,7 +291,7 @@ pub fn spa(
             );
         }
         // A spectrum below rounding of its lag-0 term is no input power.
-        if !(phi_u > 1e-12 * scale) {
+        if phi_u.is_nan() || phi_u <= 1e-12 * scale {
             return Err(Error::InvalidData {
                 what: "u",
                 index: 0,
