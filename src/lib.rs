@@ -13,8 +13,11 @@
 //! - [`model`]: [`StateSpace`] with its sizes and time domain in the type,
 //!   [`DynStateSpace`] with its sizes chosen at run time (the same
 //!   analysis, discretisation, responses, step metrics and pole placement,
-//!   as methods, by the same code), and the [`Dynamics`] trait any plant
-//!   implements.
+//!   as methods, by the same code; [`series`](DynStateSpace::series),
+//!   [`parallel`](DynStateSpace::parallel),
+//!   [`feedback`](DynStateSpace::feedback) and
+//!   [`append`](DynStateSpace::append)), and the [`Dynamics`] trait any
+//!   plant implements.
 //! - [`discretize`]: ZOH (exact), Tustin, forward and backward Euler, and
 //!   [`expm`](discretize::expm).
 //! - [`integrate`]: the [`Rk4`] and [`Euler`] steppers.
@@ -32,7 +35,8 @@
 //!   observability.
 //! - [`design`]: the [`Controller`] trait (measurements and reference in,
 //!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
-//!   [`acker`], [`place`], [`lqr`], [`dlqr`]; integral action
+//!   [`acker`], [`place`], [`lqr`], [`dlqr`], Riccati solvers that scale
+//!   ([`care`](design::care), [`dare`](design::dare)); integral action
 //!   ([`lqi`](design::lqi), [`IntegralFeedback`](design::IntegralFeedback)
 //!   with anti-windup), observers and Kalman filters
 //!   ([`place_observer`](design::place_observer), [`lqe`](design::lqe),
@@ -53,7 +57,8 @@
 //! - [`data`]: [`Recording`]s (time stamps, inputs as applied, measurements,
 //!   each a named [`Channel`] with its unit) and their CSV form.
 //! - [`ident`]: least squares by QR ([`LeastSquares`]) and recursive least
-//!   squares ([`Rls`]).
+//!   squares ([`Rls`]); frequency responses from data
+//!   ([`etfe`](ident::etfe), [`spa`](ident::spa)).
 //!
 //! Hardware:
 //!
