@@ -2,7 +2,7 @@
 //! periodic multisine, and its Blackman–Tukey smoothing) under the
 //! identified model's Bode plot, with the two modes located on each.
 
-use ctrlab::freq::{Bode, bode, logspace};
+use ctrlab::freq::{bode, logspace};
 use ctrlab::ident::{FrequencyEstimate, etfe, spa};
 use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::{SVector, vector};
@@ -71,26 +71,6 @@ fn estimates(
     raw.response.truncate(keep);
     let smooth = spa(u, y, PERIOD, Some((SPA_WINDOW / PERIOD) as usize), w)?;
     Ok((raw, smooth))
-}
-
-/// A measured estimate as Bode data (phase unwrapped from the first bin).
-fn as_bode(g: &FrequencyEstimate) -> Bode {
-    let mut phase: Vec<f64> = Vec::with_capacity(g.response.len());
-    for r in &g.response {
-        let raw = r.im.atan2(r.re);
-        let p = match phase.last() {
-            Some(&prev) => {
-                raw + std::f64::consts::TAU * ((prev - raw) / std::f64::consts::TAU).round()
-            }
-            None => raw,
-        };
-        phase.push(p);
-    }
-    Bode {
-        omega: g.omega.clone(),
-        magnitude: g.magnitude(),
-        phase,
-    }
 }
 
 /// Runs the multisine, estimates the response from u (V) to x2 (m), and
@@ -208,9 +188,11 @@ pub fn section(
     ));
     #[cfg(feature = "plot")]
     {
-        let measured_bode = as_bode(&measured);
-        let smoothed_bode = as_bode(&smoothed);
-        let simulated_bode = as_bode(&simulated_smooth);
+        use ctrlab::freq::Bode;
+        let measured_bode = Bode::from_response(&measured.omega, &measured.response)?;
+        let smoothed_bode = Bode::from_response(&smoothed.omega, &smoothed.response)?;
+        let simulated_bode =
+            Bode::from_response(&simulated_smooth.omega, &simulated_smooth.response)?;
         let mut curves: Vec<(&str, &Bode)> = vec![
             ("identified model, linear part", &model_bode),
             (
@@ -234,7 +216,7 @@ pub fn section(
     }
     #[cfg(not(feature = "plot"))]
     {
-        let _ = (&measured, as_bode);
+        let _ = &measured;
         report.add("(figure `bode.svg` needs the `plot` feature, on by default)\n");
     }
     Ok(())

@@ -3,6 +3,7 @@
 
 use nalgebra::{Complex, DMatrix};
 
+use super::response::check_channel;
 use super::tf::{TransferFunction, characteristic, entry};
 use crate::error::Error;
 use crate::model::{Continuous, Domain, DynStateSpace, StateSpace};
@@ -175,20 +176,7 @@ impl<D: Domain> TransferMatrix<D> {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn get(&self, output: usize, input: usize) -> Result<&TransferFunction<D>, Error> {
-        if output >= self.outputs {
-            return Err(Error::OutOfRange {
-                what: "output",
-                index: output,
-                len: self.outputs,
-            });
-        }
-        if input >= self.inputs {
-            return Err(Error::OutOfRange {
-                what: "input",
-                index: input,
-                len: self.inputs,
-            });
-        }
+        check_channel(output, input, self.outputs, self.inputs)?;
         Ok(&self.entries[output * self.inputs + input])
     }
 

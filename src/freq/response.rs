@@ -16,6 +16,30 @@ use crate::model::{Domain, DynStateSpace, StateSpace, period_of};
 type C64 = Complex<f64>;
 
 /// Checks angular frequencies: every one finite.
+/// Checks an `(output, input)` pair against a `outputs × inputs` response.
+pub(crate) fn check_channel(
+    output: usize,
+    input: usize,
+    outputs: usize,
+    inputs: usize,
+) -> Result<(), Error> {
+    if output >= outputs {
+        return Err(Error::OutOfRange {
+            what: "output",
+            index: output,
+            len: outputs,
+        });
+    }
+    if input >= inputs {
+        return Err(Error::OutOfRange {
+            what: "input",
+            index: input,
+            len: inputs,
+        });
+    }
+    Ok(())
+}
+
 pub(crate) fn check_omega(omega: &[f64]) -> Result<(), Error> {
     match omega.iter().position(|w| !w.is_finite()) {
         None => Ok(()),
@@ -189,20 +213,7 @@ impl FrequencyResponse {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn response(&self, output: usize, input: usize) -> Result<&[C64], Error> {
-        if output >= self.outputs {
-            return Err(Error::OutOfRange {
-                what: "output",
-                index: output,
-                len: self.outputs,
-            });
-        }
-        if input >= self.inputs {
-            return Err(Error::OutOfRange {
-                what: "input",
-                index: input,
-                len: self.inputs,
-            });
-        }
+        check_channel(output, input, self.outputs, self.inputs)?;
         let len = self.omega.len();
         let at = (output * self.inputs + input) * len;
         Ok(&self.values[at..at + len])
@@ -225,7 +236,7 @@ impl FrequencyResponse {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn bode(&self, output: usize, input: usize) -> Result<Bode, Error> {
-        Ok(Bode::from_response(
+        Ok(Bode::from_checked(
             &self.omega,
             self.response(output, input)?,
         ))
@@ -327,7 +338,41 @@ pub(crate) fn unwrapped_phase(g: &[C64]) -> Vec<f64> {
 }
 
 impl Bode {
-    fn from_response(omega: &[f64], g: &[C64]) -> Self {
+    /// Bode data of complex response values `g` at `omega` (rad/s): the
+    /// magnitudes, and the phases unwrapped along the given order as
+    /// [`bode`] unwraps them. For responses computed elsewhere, such as an
+    /// estimate from data ([`ident::etfe`](crate::ident::etfe)).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::LengthMismatch`] if `g` does not have one value per
+    /// frequency.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::freq::Bode;
+    /// use nalgebra::Complex;
+    ///
+    /// // Three points going once around the origin: the phase keeps falling.
+    /// let g = [Complex::new(0.0, -1.0), Complex::new(-1.0, 0.0), Complex::new(0.0, 1.0)];
+    /// let b = Bode::from_response(&[1.0, 2.0, 3.0], &g)?;
+    /// assert_eq!(b.magnitude, vec![1.0; 3]);
+    /// assert!((b.phase_deg()[2] + 270.0).abs() < 1e-12);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn from_response(omega: &[f64], g: &[C64]) -> Result<Self, Error> {
+        if g.len() != omega.len() {
+            return Err(Error::LengthMismatch {
+                what: "g",
+                expected: omega.len(),
+                found: g.len(),
+            });
+        }
+        Ok(Self::from_checked(omega, g))
+    }
+
+    fn from_checked(omega: &[f64], g: &[C64]) -> Self {
         Self {
             omega: omega.to_vec(),
             magnitude: g.iter().map(|&g| magnitude(g)).collect(),
