@@ -51,11 +51,19 @@ where
             if pivot == 0.0 || !pivot.is_finite() {
                 return Err(Error::Singular { operation });
             }
-            for i in k + 1..n {
-                let l = lu[(i, k)] / pivot;
-                lu[(i, k)] = l;
-                for j in k + 1..n {
-                    lu[(i, j)] -= l * lu[(k, j)];
+            // Column-major storage: the multipliers (column k below the
+            // diagonal), then the rank-one update one column at a time, so
+            // the inner loop runs down contiguous memory.
+            let data = lu.as_mut_slice();
+            let (left, right) = data.split_at_mut((k + 1) * n);
+            let multipliers = &mut left[k * n + k + 1..];
+            for l in multipliers.iter_mut() {
+                *l /= pivot;
+            }
+            for column in right.chunks_exact_mut(n) {
+                let u = column[k];
+                for (x, l) in column[k + 1..].iter_mut().zip(multipliers.iter()) {
+                    *x -= l * u;
                 }
             }
         }
@@ -76,22 +84,24 @@ where
         for (i, &p) in self.perm.iter().enumerate() {
             x.set_row(i, &b.row(p));
         }
-        for c in 0..cols.value() {
-            // Forward substitution with unit-diagonal L.
-            for i in 0..n {
-                let mut s = x[(i, c)];
-                for j in 0..i {
-                    s -= self.lu[(i, j)] * x[(j, c)];
+        let lu = self.lu.as_slice();
+        for x in x.as_mut_slice().chunks_exact_mut(n.max(1)) {
+            // Forward substitution with unit-diagonal L, then back
+            // substitution with U, both by columns of the factors
+            // (contiguous in column-major storage).
+            for j in 0..n {
+                let xj = x[j];
+                let (_, below) = x.split_at_mut(j + 1);
+                for (xi, l) in below.iter_mut().zip(&lu[j * n + j + 1..(j + 1) * n]) {
+                    *xi -= l * xj;
                 }
-                x[(i, c)] = s;
             }
-            // Back substitution with U.
-            for i in (0..n).rev() {
-                let mut s = x[(i, c)];
-                for j in i + 1..n {
-                    s -= self.lu[(i, j)] * x[(j, c)];
+            for j in (0..n).rev() {
+                let xj = x[j] / lu[j * n + j];
+                x[j] = xj;
+                for (xi, u) in x[..j].iter_mut().zip(&lu[j * n..j * n + j]) {
+                    *xi -= u * xj;
                 }
-                x[(i, c)] = s / self.lu[(i, i)];
             }
         }
         x
