@@ -1,9 +1,9 @@
 //! Linear-quadratic regulators on fixed-size models: a front end to the
 //! run-time Riccati solvers of [`super::riccati`].
 
-use nalgebra::{Complex, DMatrix, SMatrix};
+use nalgebra::{Complex, Const, DMatrix, SMatrix};
 
-use super::riccati::{self, DynLqr, Weights};
+use super::riccati::{self, Solution, Weights};
 use crate::error::Error;
 use crate::model::{Continuous, Discrete, StateSpace};
 
@@ -86,14 +86,8 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
     q: &SMatrix<f64, N, N>,
     r: &SMatrix<f64, M, M>,
 ) -> Result<Lqr<N, M>, Error> {
-    let sol = riccati::continuous(
-        &heap(sys.a()),
-        &heap(sys.b()),
-        &heap(q),
-        &heap(r),
-        Weights::Regulator(["Q", "R"]),
-    )?;
-    Ok(fixed(&sol))
+    let sol = riccati::continuous(sys.a(), sys.b(), q, r, Weights::Regulator(["Q", "R"]))?;
+    Ok(fixed(sol))
 }
 
 /// Discrete-time LQR: the gain `K = (R + Bᵀ X B)⁻¹ Bᵀ X A` minimising
@@ -125,28 +119,28 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
     r: &SMatrix<f64, M, M>,
 ) -> Result<Lqr<N, M>, Error> {
     let sol = riccati::discrete(
-        &heap(sys.a()),
-        &heap(sys.b()),
-        &heap(q),
-        &heap(r),
+        sys.a(),
+        sys.b(),
+        q,
+        r,
         Weights::Regulator(["Q", "R"]),
         Some(sys.dt()),
     )?;
-    Ok(fixed(&sol))
+    Ok(fixed(sol))
 }
 
 fn heap<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> DMatrix<f64> {
     DMatrix::from_column_slice(R, C, m.as_slice())
 }
 
-/// The run-time solution in fixed-size form; its sizes are `N` and `M` by
-/// construction.
-fn fixed<const N: usize, const M: usize>(sol: &DynLqr) -> Lqr<N, M> {
+/// The solver's solution in the fixed-size result (`N` poles by
+/// construction).
+fn fixed<const N: usize, const M: usize>(sol: Solution<Const<N>, Const<M>>) -> Lqr<N, M> {
     let mut poles = [Complex::new(0.0, 0.0); N];
     poles.copy_from_slice(&sol.poles);
     Lqr {
-        gain: SMatrix::from_fn(|i, j| sol.gain[(i, j)]),
-        riccati: SMatrix::from_fn(|i, j| sol.riccati[(i, j)]),
+        gain: sol.gain,
+        riccati: sol.riccati,
         poles,
         residual: sol.residual,
         iterations: sol.iterations,

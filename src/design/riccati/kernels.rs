@@ -1,12 +1,14 @@
-//! The O(N³) kernels of the Riccati solvers, on faer matrices: LU with the
-//! crate's singularity test, the structure-preserving doubling, and the
-//! Lyapunov and Stein solves of the Newton refinement.
+//! The O(N³) kernels of the Riccati solvers, written once over nalgebra's
+//! [`Dim`]: a fixed-size caller (`Const<N>`) works on stack matrices and
+//! allocates nothing here, a run-time-sized one (`Dyn`) gets the same
+//! arithmetic on the heap, with nalgebra's cache-blocked `gemm`
+//! (matrixmultiply) for products above 5 × 5. The structure-preserving
+//! doubling, and the Lyapunov and Stein solves of the Newton refinement.
 
-use faer::linalg::matmul::matmul;
-use faer::linalg::solvers::{DenseSolveCore, PartialPivLu, Solve};
-use faer::{Accum, Mat, MatRef, Par};
+use nalgebra::{DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
 use crate::error::Error;
+use crate::kernels::linalg::Lu;
 
 /// Doubling steps allowed; quadratic convergence needs far fewer (about
 /// `log2` of the ratio of the fastest to the slowest closed-loop mode, +6).
@@ -20,29 +22,14 @@ const SIGN_ITERATIONS: usize = 60;
 /// series has `2^k` terms, so 64 covers any spectral radius below `1 − 2⁻⁵⁸`.
 const SMITH_ITERATIONS: usize = 64;
 
-/// `P A = L U`, refused (as [`crate::kernels::linalg::Lu`] refuses) when the
-/// smallest pivot is negligible against the largest (`≤ N ε max`) or any is
-/// not finite: the matrix is singular to working precision.
-pub(super) fn lu(a: MatRef<'_, f64>, operation: &'static str) -> Result<PartialPivLu<f64>, Error> {
-    let lu = PartialPivLu::new(a);
-    let n = a.nrows();
-    let (mut max_pivot, mut min_pivot) = (0.0f64, f64::INFINITY);
-    for i in 0..n {
-        let p = lu.U()[(i, i)].abs();
-        if !p.is_finite() {
-            return Err(Error::Singular { operation });
-        }
-        max_pivot = max_pivot.max(p);
-        min_pivot = min_pivot.min(p);
-    }
-    if n > 0 && (min_pivot <= n as f64 * f64::EPSILON * max_pivot || max_pivot == 0.0) {
-        return Err(Error::Singular { operation });
-    }
-    Ok(lu)
-}
+/// The square matrices of one Riccati problem with `N` states.
+pub(super) type Square<N> = OMatrix<f64, N, N>;
 
 /// `m ← (m + mᵀ) / 2`, in place.
-pub(super) fn symmetrize(m: &mut Mat<f64>) {
+pub(super) fn symmetrize<N: Dim>(m: &mut Square<N>)
+where
+    DefaultAllocator: Allocator<N, N>,
+{
     let n = m.nrows();
     for j in 0..n {
         for i in 0..j {
@@ -53,19 +40,70 @@ pub(super) fn symmetrize(m: &mut Mat<f64>) {
     }
 }
 
-/// `dst ← alpha · lhs · rhs` (or `dst += …` with `Accum::Add`), single-threaded.
-pub(super) fn gemm(
-    dst: &mut Mat<f64>,
-    accum: Accum,
-    lhs: MatRef<'_, f64>,
-    rhs: MatRef<'_, f64>,
-    alpha: f64,
-) {
-    matmul(dst.as_mut(), accum, lhs, rhs, alpha, Par::Seq);
+/// Every entry finite.
+pub(super) fn finite<R: Dim, C: Dim>(m: &OMatrix<f64, R, C>) -> bool
+where
+    DefaultAllocator: Allocator<R, C>,
+{
+    m.iter().all(|v| v.is_finite())
 }
 
-pub(super) fn finite(m: MatRef<'_, f64>) -> bool {
-    (0..m.ncols()).all(|j| (0..m.nrows()).all(|i| m[(i, j)].is_finite()))
+/// The Frobenius norm; rescaled by the largest entry where the plain sum
+/// of squares overflows or underflows (entries near `f64::MAX`, or tiny
+/// ones), which nalgebra's `norm` does not do.
+pub(super) fn fro<R: Dim, C: Dim>(m: &OMatrix<f64, R, C>) -> f64
+where
+    DefaultAllocator: Allocator<R, C>,
+{
+    let plain: f64 = m.iter().map(|v| v * v).sum();
+    if plain.is_finite() && plain >= f64::MIN_POSITIVE {
+        return plain.sqrt();
+    }
+    let max = m.amax();
+    if max == 0.0 || !max.is_finite() {
+        return max;
+    }
+    let s: f64 = m.iter().map(|v| (v / max).powi(2)).sum();
+    max * s.sqrt()
+}
+
+/// `‖a − b‖_F`, without forming `a − b`.
+fn fro_diff<N: Dim>(a: &Square<N>, b: &Square<N>) -> f64
+where
+    DefaultAllocator: Allocator<N, N>,
+{
+    let max = a
+        .iter()
+        .zip(b.iter())
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    if max == 0.0 || !max.is_finite() {
+        return max;
+    }
+    let s: f64 = a
+        .iter()
+        .zip(b.iter())
+        .map(|(x, y)| ((x - y) / max).powi(2))
+        .sum();
+    max * s.sqrt()
+}
+
+/// `dst ← alpha · lhsᵀ · rhs + beta · dst`. The transpose is formed first
+/// so a run-time-sized product goes through the blocked `gemm`, not
+/// nalgebra's column-dot `gemm_tr`.
+fn gemm_tn<N: Dim>(dst: &mut Square<N>, alpha: f64, lhs: &Square<N>, rhs: &Square<N>, beta: f64)
+where
+    DefaultAllocator: Allocator<N, N>,
+{
+    dst.gemm(alpha, &lhs.transpose(), rhs, beta);
+}
+
+/// `a⁻¹`, refused as [`Lu::new`] refuses a singular matrix.
+pub(super) fn inverse<N: Dim>(a: &Square<N>, operation: &'static str) -> Result<Square<N>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
+    let (dim, _) = a.shape_generic();
+    Ok(Lu::new(a, operation)?.solve(&Square::<N>::identity_generic(dim, dim)))
 }
 
 /// The structure-preserving doubling algorithm of Chu, Fan and Lin (2005)
@@ -75,54 +113,53 @@ pub(super) fn finite(m: MatRef<'_, f64>) -> bool {
 /// W = I + G H,  E ← E W⁻¹ E,  G ← G + E W⁻¹ G Eᵀ,  H ← H + Eᵀ H W⁻¹ E
 /// ```
 ///
-/// returning `H` at convergence and the steps taken. One LU of `W` and one
-/// solve with `2N` right-hand sides per step; the products go to buffers
+/// returning `H` at convergence and the steps taken. One LU of `W` and
+/// solves for `W⁻¹ E`, `W⁻¹ G` per step; the products go to buffers
 /// allocated once.
-pub(super) fn sda(
-    mut e: Mat<f64>,
-    mut g: Mat<f64>,
-    mut h: Mat<f64>,
-) -> Result<(Mat<f64>, usize), Error> {
+pub(super) fn sda<N: Dim>(
+    mut e: Square<N>,
+    mut g: Square<N>,
+    mut h: Square<N>,
+) -> Result<(Square<N>, usize), Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
     let n = e.nrows();
-    let mut w = Mat::<f64>::zeros(n, n);
-    let mut rhs = Mat::<f64>::zeros(n, 2 * n);
-    let mut tmp = Mat::<f64>::zeros(n, n);
-    let mut h_next = Mat::<f64>::zeros(n, n);
+    let (dim, _) = e.shape_generic();
+    let mut w = Square::<N>::zeros_generic(dim, dim);
+    let mut tmp = Square::<N>::zeros_generic(dim, dim);
+    let mut h_next = Square::<N>::zeros_generic(dim, dim);
     for it in 1..=MAX_ITERATIONS {
         // W = I + G H: nonsingular for G, H positive semidefinite.
-        gemm(&mut w, Accum::Replace, g.as_ref(), h.as_ref(), 1.0);
+        w.gemm(1.0, &g, &h, 0.0);
         for i in 0..n {
             w[(i, i)] += 1.0;
         }
-        let w_lu = lu(w.as_ref(), "Riccati doubling (I + G H)")?;
-        // [W⁻¹ E, W⁻¹ G] in one solve.
-        rhs.as_mut().subcols_mut(0, n).copy_from(&e);
-        rhs.as_mut().subcols_mut(n, n).copy_from(&g);
-        w_lu.solve_in_place(rhs.as_mut());
-        let (w_e, w_g) = (rhs.as_ref().subcols(0, n), rhs.as_ref().subcols(n, n));
+        let w_lu = Lu::new(&w, "Riccati doubling (I + G H)")?;
+        let (w_e, w_g) = (w_lu.solve(&e), w_lu.solve(&g));
         // H + Eᵀ (H W⁻¹ E)
-        gemm(&mut tmp, Accum::Replace, h.as_ref(), w_e, 1.0);
+        tmp.gemm(1.0, &h, &w_e, 0.0);
         h_next.copy_from(&h);
-        gemm(&mut h_next, Accum::Add, e.transpose(), tmp.as_ref(), 1.0);
+        gemm_tn(&mut h_next, 1.0, &e, &tmp, 1.0);
         symmetrize(&mut h_next);
-        // G + E (W⁻¹ G Eᵀ)
-        gemm(&mut tmp, Accum::Replace, w_g, e.transpose(), 1.0);
-        let e_old = e.clone();
-        gemm(&mut g, Accum::Add, e_old.as_ref(), tmp.as_ref(), 1.0);
+        // G + E (W⁻¹ G Eᵀ), with the old E.
+        tmp.gemm(1.0, &w_g, &e.transpose(), 0.0);
+        g.gemm(1.0, &e, &tmp, 1.0);
         symmetrize(&mut g);
         // E W⁻¹ E
-        gemm(&mut e, Accum::Replace, e_old.as_ref(), w_e, 1.0);
-        let step = (&h_next - &h).norm_l2();
+        tmp.gemm(1.0, &e, &w_e, 0.0);
+        std::mem::swap(&mut e, &mut tmp);
+        let step = fro_diff(&h_next, &h);
         std::mem::swap(&mut h, &mut h_next);
         // Only H must stay finite: E (and G) may grow without bound on a
         // mode the input cannot reach while H still converges, and the
         // caller's stability check then names that mode.
-        if !finite(h.as_ref()) {
+        if !finite(&h) {
             return Err(Error::Overflow {
                 operation: "Riccati doubling",
             });
         }
-        if step <= STEP_RTOL * h.norm_l2() {
+        if step <= STEP_RTOL * fro(&h) {
             return Ok((h, it));
         }
     }
@@ -139,49 +176,38 @@ pub(super) fn sda(
 /// `sign(Z) = [−I 2X; 0 I]`. One inverse and two products per step,
 /// norm-scaled (`c = √(‖E⁻¹‖/‖E‖)`) until near convergence. `None` if `A` is
 /// singular, not stable (`E` does not tend to `−I`), or the steps run out.
-pub(super) fn lyapunov(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64>> {
+pub(super) fn lyapunov<N: Dim>(a: &Square<N>, c: &Square<N>) -> Option<Square<N>>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
     let n = a.nrows();
-    let mut e = a.transpose().to_owned();
-    let mut f = c.to_owned();
-    let mut tmp = Mat::<f64>::zeros(n, n);
-    let mut f_next = Mat::<f64>::zeros(n, n);
+    let (dim, _) = a.shape_generic();
+    let mut e = a.transpose();
+    let mut f = c.clone();
+    let mut tmp = Square::<N>::zeros_generic(dim, dim);
     let mut scaled = true;
     let mut last = false;
     for _ in 0..SIGN_ITERATIONS {
-        let e_inv = lu(e.as_ref(), "Lyapunov sign iteration").ok()?.inverse();
+        let e_inv = inverse(&e, "Lyapunov sign iteration").ok()?;
         let k = if scaled {
-            (e_inv.norm_l2() / e.norm_l2()).sqrt()
+            (fro(&e_inv) / fro(&e)).sqrt()
         } else {
             1.0
         };
         if !k.is_finite() || k == 0.0 {
             return None;
         }
-        gemm(&mut tmp, Accum::Replace, e_inv.as_ref(), f.as_ref(), 1.0);
-        f_next.copy_from(&f);
-        for j in 0..n {
-            for i in 0..n {
-                f_next[(i, j)] *= 0.5 * k;
-            }
-        }
-        gemm(
-            &mut f_next,
-            Accum::Add,
-            tmp.as_ref(),
-            e_inv.transpose(),
-            0.5 / k,
-        );
-        std::mem::swap(&mut f, &mut f_next);
+        // F ← (k F + E⁻¹ F E⁻ᵀ / k) / 2
+        tmp.gemm(1.0, &e_inv, &f, 0.0);
+        f.gemm(0.5 / k, &tmp, &e_inv.transpose(), 0.5 * k);
         let mut change = 0.0;
-        for j in 0..n {
-            for i in 0..n {
-                let next = 0.5 * (k * e[(i, j)] + e_inv[(i, j)] / k);
-                change += (next - e[(i, j)]).powi(2);
-                e[(i, j)] = next;
-            }
+        for (e, inv) in e.iter_mut().zip(e_inv.iter()) {
+            let next = 0.5 * (k * *e + inv / k);
+            change += (next - *e).powi(2);
+            *e = next;
         }
         let change = change.sqrt();
-        if !finite(f.as_ref()) || !change.is_finite() {
+        if !finite(&f) || !change.is_finite() {
             return None;
         }
         if last {
@@ -189,10 +215,10 @@ pub(super) fn lyapunov(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64
         }
         // Quadratic convergence: once a step is below √ε, one more
         // (unscaled) step reaches rounding level.
-        if change <= 1e-2 * e.norm_l2() {
+        if change <= 1e-2 * fro(&e) {
             scaled = false;
         }
-        last = change <= 1e-8 * e.norm_l2();
+        last = change <= 1e-8 * fro(&e);
     }
     // sign(Aᵀ) = −I exactly when A is stable.
     let mut off = 0.0;
@@ -205,7 +231,7 @@ pub(super) fn lyapunov(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64
     if !last || off.sqrt() > 1e-6 * (n as f64).sqrt() {
         return None;
     }
-    let mut x = f * faer::Scale(0.5);
+    let mut x = f * 0.5;
     symmetrize(&mut x);
     Some(x)
 }
@@ -214,23 +240,20 @@ pub(super) fn lyapunov(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64
 /// spectral radius below 1, by squared Smith (doubling):
 /// `X = Σ (Aᵀ)ᵏ C Aᵏ` summed as `X ← X + Tᵀ X T`, `T ← T²`. `None` if the
 /// series has not converged after [`SMITH_ITERATIONS`] steps or overflows.
-pub(super) fn stein(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64>> {
-    let n = a.nrows();
-    let mut x = c.to_owned();
-    let mut t = a.to_owned();
-    let mut tmp = Mat::<f64>::zeros(n, n);
-    let mut update = Mat::<f64>::zeros(n, n);
+pub(super) fn stein<N: Dim>(a: &Square<N>, c: &Square<N>) -> Option<Square<N>>
+where
+    DefaultAllocator: Allocator<N, N>,
+{
+    let (dim, _) = a.shape_generic();
+    let mut x = c.clone();
+    let mut t = a.clone();
+    let mut tmp = Square::<N>::zeros_generic(dim, dim);
+    let mut update = Square::<N>::zeros_generic(dim, dim);
     for _ in 0..SMITH_ITERATIONS {
-        gemm(&mut tmp, Accum::Replace, x.as_ref(), t.as_ref(), 1.0);
-        gemm(
-            &mut update,
-            Accum::Replace,
-            t.transpose(),
-            tmp.as_ref(),
-            1.0,
-        );
+        tmp.gemm(1.0, &x, &t, 0.0);
+        gemm_tn(&mut update, 1.0, &t, &tmp, 0.0);
         x += &update;
-        let (u, s) = (update.norm_l2(), x.norm_l2());
+        let (u, s) = (fro(&update), fro(&x));
         if !u.is_finite() || !s.is_finite() {
             return None;
         }
@@ -238,7 +261,7 @@ pub(super) fn stein(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64>> 
             symmetrize(&mut x);
             return Some(x);
         }
-        gemm(&mut tmp, Accum::Replace, t.as_ref(), t.as_ref(), 1.0);
+        tmp.gemm(1.0, &t, &t, 0.0);
         std::mem::swap(&mut t, &mut tmp);
     }
     None
@@ -247,25 +270,38 @@ pub(super) fn stein(a: MatRef<'_, f64>, c: MatRef<'_, f64>) -> Option<Mat<f64>> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::{DMatrix, matrix};
 
     #[test]
     fn lyapunov_and_stein_solve_their_equations() {
-        let a = Mat::from_fn(3, 3, |i, j| {
-            [[-2.0, 1.0, 0.0], [0.0, -1.0, 3.0], [0.5, 0.0, -4.0]][i][j]
-        });
-        let c = Mat::from_fn(3, 3, |i, j| if i == j { 1.0 + i as f64 } else { 0.2 });
-        let x = lyapunov(a.as_ref(), c.as_ref()).unwrap();
-        let res = a.transpose() * &x + &x * &a + &c;
-        assert!(res.norm_l2() < 1e-13 * c.norm_l2(), "{res:?}");
+        let a = matrix![-2.0, 1.0, 0.0; 0.0, -1.0, 3.0; 0.5, 0.0, -4.0];
+        let c = nalgebra::Matrix3::from_fn(|i, j| if i == j { 1.0 + i as f64 } else { 0.2 });
+        let x = lyapunov(&a, &c).unwrap();
+        let res = a.transpose() * x + x * a + c;
+        assert!(res.norm() < 1e-13 * c.norm(), "{res:?}");
         // Unstable A: no solution by this route.
-        let unstable = &a * faer::Scale(-1.0);
-        assert!(lyapunov(unstable.as_ref(), c.as_ref()).is_none());
+        assert!(lyapunov(&(-a), &c).is_none());
 
-        let d = &a * faer::Scale(0.2);
-        let x = stein(d.as_ref(), c.as_ref()).unwrap();
-        let res = &x - d.transpose() * &x * &d - &c;
-        assert!(res.norm_l2() < 1e-14 * c.norm_l2(), "{res:?}");
-        let big = &a * faer::Scale(2.0);
-        assert!(stein(big.as_ref(), c.as_ref()).is_none());
+        let d = a * 0.2;
+        let x = stein(&d, &c).unwrap();
+        let res = x - d.transpose() * x * d - c;
+        assert!(res.norm() < 1e-14 * c.norm(), "{res:?}");
+        assert!(stein(&(a * 2.0), &c).is_none());
+
+        // The same solves sized at run time give the same numbers.
+        let heap = |m: &nalgebra::Matrix3<f64>| DMatrix::from_column_slice(3, 3, m.as_slice());
+        let x_dyn = lyapunov(&heap(&a), &heap(&c)).unwrap();
+        assert_eq!(x_dyn.as_slice(), lyapunov(&a, &c).unwrap().as_slice());
+    }
+
+    #[test]
+    fn fro_does_not_overflow_near_f64_max() {
+        let m = matrix![f64::MAX, f64::MAX; 0.0, 0.0];
+        assert!(fro(&m).is_infinite()); // √2 · MAX exceeds MAX.
+        let m = matrix![1e300, 1e300; 0.0, 0.0];
+        assert!((fro(&m) / (1e300 * 2f64.sqrt()) - 1.0).abs() < 1e-15);
+        let m = matrix![3e-300, 4e-300; 0.0, 0.0];
+        assert!((fro(&m) / 5e-300 - 1.0).abs() < 1e-15);
+        assert_eq!(fro(&matrix![3.0, 4.0]), 5.0);
     }
 }

@@ -5,15 +5,14 @@
 
 mod kernels;
 
-use faer::linalg::solvers::{DenseSolveCore, Solve};
-use faer::{Mat, MatRef};
-use nalgebra::{Complex, DMatrix};
+use nalgebra::{Complex, DMatrix, DefaultAllocator, Dim, Dyn, OMatrix, allocator::Allocator};
 
 use crate::analysis::{eigenvalues_dyn, first_unstable_dyn};
 use crate::error::{Error, check_finite_dyn, check_shape};
+use crate::kernels::linalg::Lu;
 use crate::kernels::reduce::pow2_floor;
 use crate::model::{Continuous, Discrete, DynStateSpace};
-use kernels::{MAX_ITERATIONS, finite, lu, lyapunov, sda, stein, symmetrize};
+use kernels::{MAX_ITERATIONS, Square, finite, fro, inverse, lyapunov, sda, stein, symmetrize};
 
 /// A continuous solution with a relative residual above this after Newton
 /// refinement is retried with another Cayley shift, unless Newton stalled
@@ -65,9 +64,11 @@ const SHIFTS: [f64; 7] = [1.0, 0.5, 2.0, 0.25, 4.0, 0.1, 10.0];
 /// kept only if it lowers the residual:
 /// a Lyapunov equation of the closed loop for the continuous case (solved
 /// by the matrix-sign-function iteration), a Stein equation for the
-/// discrete one (squared Smith). Every step of every part costs `O(N³)` on
-/// faer's dense kernels: LU solves, products and inverses, no `N² × N²`
-/// system.
+/// discrete one (squared Smith). Every step of every part costs `O(N³)`:
+/// LU solves, products and inverses, no `N² × N²` system. The code is
+/// generic over nalgebra's dimensions, so the fixed-size [`lqr`](super::lqr)
+/// runs it on stack matrices and `DynStateSpace::lqr` on heap ones, with
+/// cache-blocked products (matrixmultiply) at large `N`.
 ///
 /// A discrete equation with a singular (positive semidefinite) `R`, which
 /// only [`dare`] accepts, is first solved with `R + δ I`
@@ -173,7 +174,7 @@ pub fn care(
     r: &DMatrix<f64>,
 ) -> Result<DynLqr, Error> {
     check_problem(a, b, q, r)?;
-    continuous(a, b, q, r, Weights::Equation)
+    continuous(a, b, q, r, Weights::Equation).map(DynLqr::from)
 }
 
 /// Discrete-time algebraic Riccati equation
@@ -222,7 +223,7 @@ pub fn dare(
     r: &DMatrix<f64>,
 ) -> Result<DynLqr, Error> {
     check_problem(a, b, q, r)?;
-    discrete(a, b, q, r, Weights::Equation, None)
+    discrete(a, b, q, r, Weights::Equation, None).map(DynLqr::from)
 }
 
 impl DynStateSpace<Continuous> {
@@ -258,7 +259,7 @@ impl DynStateSpace<Continuous> {
     /// ```
     pub fn lqr(&self, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<DynLqr, Error> {
         check_weight_shapes(self.states(), self.inputs(), q, r)?;
-        continuous(self.a(), self.b(), q, r, Weights::Regulator(["Q", "R"]))
+        continuous(self.a(), self.b(), q, r, Weights::Regulator(["Q", "R"])).map(DynLqr::from)
     }
 }
 
@@ -300,6 +301,7 @@ impl DynStateSpace<Discrete> {
             Weights::Regulator(["Q", "R"]),
             Some(self.dt()),
         )
+        .map(DynLqr::from)
     }
 }
 
@@ -327,59 +329,105 @@ fn check_problem(
     check_finite_dyn("B", b)
 }
 
-fn to_faer(m: &DMatrix<f64>) -> Mat<f64> {
-    Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)])
+/// The allocations one Riccati problem with `N` states and `M` inputs
+/// needs; implemented for every pair of dimensions nalgebra can allocate,
+/// `Const` (stack) or `Dyn` (heap).
+pub(crate) trait RiccatiAlloc<N: Dim, M: Dim>:
+    Allocator<N, N> + Allocator<N, M> + Allocator<M, N> + Allocator<M, M> + Allocator<N> + Allocator<M>
+{
+}
+impl<N: Dim, M: Dim, T> RiccatiAlloc<N, M> for T where
+    T: Allocator<N, N>
+        + Allocator<N, M>
+        + Allocator<M, N>
+        + Allocator<M, M>
+        + Allocator<N>
+        + Allocator<M>
+{
 }
 
-fn to_nalgebra(m: MatRef<'_, f64>) -> DMatrix<f64> {
-    DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)])
+/// A solution in the caller's matrix sizes; [`DynLqr`] and the fixed-size
+/// [`Lqr`](super::Lqr) are built from it.
+pub(crate) struct Solution<N: Dim, M: Dim>
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
+    pub(crate) gain: OMatrix<f64, M, N>,
+    pub(crate) riccati: Square<N>,
+    pub(crate) poles: Vec<Complex<f64>>,
+    pub(crate) residual: f64,
+    pub(crate) iterations: usize,
+}
+
+impl From<Solution<Dyn, Dyn>> for DynLqr {
+    fn from(s: Solution<Dyn, Dyn>) -> Self {
+        Self {
+            gain: s.gain,
+            riccati: s.riccati,
+            poles: s.poles,
+            residual: s.residual,
+            iterations: s.iterations,
+        }
+    }
+}
+
+/// A copy on the heap, for the checks and diagnostics written for
+/// run-time-sized matrices (outside the iterations).
+fn heap<R: Dim, C: Dim>(m: &OMatrix<f64, R, C>) -> DMatrix<f64>
+where
+    DefaultAllocator: Allocator<R, C>,
+{
+    DMatrix::from_iterator(m.nrows(), m.ncols(), m.iter().copied())
 }
 
 /// The continuous solver behind [`care`], `DynStateSpace::lqr` and the
 /// fixed-size [`lqr`](super::lqr); shapes already checked.
-pub(crate) fn continuous(
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
-    q: &DMatrix<f64>,
-    r: &DMatrix<f64>,
+pub(crate) fn continuous<N: Dim, M: Dim>(
+    a: &Square<N>,
+    b: &OMatrix<f64, N, M>,
+    q: &Square<N>,
+    r: &OMatrix<f64, M, M>,
     weights: Weights,
-) -> Result<DynLqr, Error> {
-    check_weights(q, r, weights, true)?;
+) -> Result<Solution<N, M>, Error>
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
+    check_weights(&heap(q), &heap(r), weights, true)?;
     let (q, r, weight) = balance_weights(q, r);
-    let (a, b) = (to_faer(a), to_faer(b));
-    let n = a.nrows();
-    let r_inv_bt = lu(r.as_ref(), "LQR (R)")?.solve(b.transpose());
-    let mut g = &b * &r_inv_bt;
+    let (dim, _) = a.shape_generic();
+    let r_inv_bt = Lu::new(&r, "LQR (R)")?.solve(&b.transpose());
+    let mut g = b * &r_inv_bt;
     symmetrize(&mut g);
-    let eval = |x: &Mat<f64>| care_eval(&a, &b, &r_inv_bt, &q, x);
+    let eval = |x: &Square<N>| care_eval(a, b, &r_inv_bt, &q, x);
     // Newton step: (A − G X)ᵀ Δ + Δ (A − G X) + Res(X) = 0.
-    let newton = |x: &Mat<f64>, res: &Mat<f64>| {
-        let a_c = &a - &b * (&r_inv_bt * x);
-        lyapunov(a_c.as_ref(), res.as_ref())
+    let newton = |x: &Square<N>, res: &Square<N>| {
+        let a_c = a - b * (&r_inv_bt * x);
+        lyapunov(&a_c, res)
     };
 
-    let scale = a.norm_l2().max((g.norm_l2() * q.norm_l2()).sqrt());
+    let scale = fro(a).max((fro(&g) * fro(&q)).sqrt());
     let gamma0 = if scale > 0.0 && scale.is_finite() {
         scale
     } else {
         1.0
     };
-    let id = Mat::<f64>::identity(n, n);
-    let mut best: Option<(Mat<f64>, usize, f64)> = None;
+    let id = Square::<N>::identity_generic(dim, dim);
+    let mut best: Option<(Square<N>, usize, f64)> = None;
     let mut last_err = None;
     for factor in SHIFTS {
         let gamma = gamma0 * factor;
         let attempt = (|| {
-            let a_g = &a - &id * faer::Scale(gamma);
-            let a_g_lu = lu(a_g.as_ref(), "LQR Cayley transform (A − γI)")?;
-            let a_g_inv_g = a_g_lu.solve(&g);
+            let a_g = a - &id * gamma;
+            let a_g_inv_g = Lu::new(&a_g, "LQR Cayley transform (A − γI)")?.solve(&g);
             let w = a_g.transpose() + &q * &a_g_inv_g;
-            let w_inv = lu(w.as_ref(), "LQR Cayley transform (W)")?.inverse();
-            let e0 = &id + w_inv.transpose() * faer::Scale(2.0 * gamma);
-            let mut g0 = &a_g_inv_g * &w_inv * faer::Scale(2.0 * gamma);
+            let w_inv = inverse(&w, "LQR Cayley transform (W)")?;
+            let e0 = &id + w_inv.transpose() * (2.0 * gamma);
+            let mut g0 = &a_g_inv_g * &w_inv * (2.0 * gamma);
             // H₀ = 2γ W⁻¹ Q A_γ⁻¹; Q A_γ⁻¹ = (A_γ⁻ᵀ Q)ᵀ as Q is symmetric.
-            let q_a_inv = a_g_lu.solve_transpose(&q).transpose().to_owned();
-            let mut h0 = &w_inv * &q_a_inv * faer::Scale(2.0 * gamma);
+            let q_a_inv = Lu::new(&a_g.transpose(), "LQR Cayley transform (A − γI)")?
+                .solve(&q)
+                .transpose();
+            let mut h0 = &w_inv * &q_a_inv * (2.0 * gamma);
             symmetrize(&mut g0);
             symmetrize(&mut h0);
             sda(e0, g0, h0)
@@ -406,57 +454,59 @@ pub(crate) fn continuous(
             operation: "LQR Riccati doubling",
             iterations: MAX_ITERATIONS,
         });
-        return Err(explain(&a, &b, None).unwrap_or(err));
+        return Err(explain(a, b, None).unwrap_or(err));
     };
     let gain = &r_inv_bt * &x;
-    finish(&a, &b, gain, x, weight, residual, iterations, None)
+    finish(a, b, gain, x, weight, residual, iterations, None)
 }
 
 /// The discrete solver behind [`dare`], `DynStateSpace::lqr` and the
 /// fixed-size [`dlqr`](super::dlqr); shapes already checked. `period` is
 /// the model's (`None` for a bare equation).
-pub(crate) fn discrete(
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
-    q: &DMatrix<f64>,
-    r: &DMatrix<f64>,
+pub(crate) fn discrete<N: Dim, M: Dim>(
+    a: &Square<N>,
+    b: &OMatrix<f64, N, M>,
+    q: &Square<N>,
+    r: &OMatrix<f64, M, M>,
     weights: Weights,
     period: Option<f64>,
-) -> Result<DynLqr, Error> {
-    check_weights(q, r, weights, false)?;
+) -> Result<Solution<N, M>, Error>
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
+    check_weights(&heap(q), &heap(r), weights, false)?;
     let (q, r, weight) = balance_weights(q, r);
-    let (a, b) = (to_faer(a), to_faer(b));
-    let m = b.ncols();
+    let (m, _) = r.shape_generic();
     // A singular R (accepted for an equation only) is regularised for the
     // doubling, which needs R⁻¹; Newton on the true equation then removes δ.
-    let (r_inv_bt, regularised) = match lu(r.as_ref(), "LQR (R)") {
-        Ok(r_lu) => (r_lu.solve(b.transpose()), false),
+    let (r_inv_bt, regularised) = match Lu::new(&r, "LQR (R)") {
+        Ok(r_lu) => (r_lu.solve(&b.transpose()), false),
         Err(e) if matches!(weights, Weights::Regulator(_)) => return Err(e),
         Err(_) => {
-            let delta = 1e-8 * (r.norm_l2() + b.norm_l2().powi(2) * q.norm_l2());
+            let delta = 1e-8 * (fro(&r) + fro(b).powi(2) * fro(&q));
             let delta = if delta > 0.0 && delta.is_finite() {
                 delta
             } else {
                 1.0
             };
-            let r_reg = &r + Mat::<f64>::identity(m, m) * faer::Scale(delta);
-            let r_lu = lu(r_reg.as_ref(), "DLQR (R + δI)")?;
-            (r_lu.solve(b.transpose()), true)
+            let r_reg = &r + OMatrix::<f64, M, M>::identity_generic(m, m) * delta;
+            let r_lu = Lu::new(&r_reg, "DLQR (R + δI)")?;
+            (r_lu.solve(&b.transpose()), true)
         }
     };
-    let mut g = &b * &r_inv_bt;
+    let mut g = b * &r_inv_bt;
     symmetrize(&mut g);
     let (x, iterations) =
-        sda(a.clone(), g, q.clone()).map_err(|err| explain(&a, &b, Some(1.0)).unwrap_or(err))?;
-    let eval = |x: &Mat<f64>| match dare_gain(&a, &b, &r, x) {
-        Ok(gain) => dare_eval(&a, &b, &q, x, &gain),
-        Err(_) => (Mat::zeros(x.nrows(), x.ncols()), f64::INFINITY),
+        sda(a.clone(), g, q.clone()).map_err(|err| explain(a, b, Some(1.0)).unwrap_or(err))?;
+    let eval = |x: &Square<N>| match dare_gain(a, b, &r, x) {
+        Ok(gain) => dare_eval(a, b, &q, x, &gain),
+        Err(_) => (x * 0.0, f64::INFINITY),
     };
     // Newton (Hewer) step: Δ − A_clᵀ Δ A_cl = Res(X), A_cl = A − B K(X).
-    let newton = |x: &Mat<f64>, res: &Mat<f64>| {
-        let gain = dare_gain(&a, &b, &r, x).ok()?;
-        let a_cl = &a - &b * &gain;
-        stein(a_cl.as_ref(), res.as_ref())
+    let newton = |x: &Square<N>, res: &Square<N>| {
+        let gain = dare_gain(a, b, &r, x).ok()?;
+        let a_cl = a - b * &gain;
+        stein(&a_cl, res)
     };
     let steps = if regularised {
         REGULARISED_REFINE_STEPS
@@ -464,10 +514,10 @@ pub(crate) fn discrete(
         REFINE_STEPS
     };
     let (x, residual, _) = refine(x, steps, 4.0 * f64::EPSILON, regularised, &eval, &newton);
-    let gain = dare_gain(&a, &b, &r, &x)?;
+    let gain = dare_gain(a, b, &r, &x)?;
     finish(
-        &a,
-        &b,
+        a,
+        b,
         gain,
         x,
         weight,
@@ -483,10 +533,18 @@ pub(crate) fn discrete(
 /// Without a stabilisable `(A, B)` the stabilising solution does not exist
 /// and the doubling diverges; this names the mode. Only run on failure:
 /// one SVD per unstable eigenvalue.
-fn explain(a: &Mat<f64>, b: &Mat<f64>, period: Option<f64>) -> Option<Error> {
+fn explain<N: Dim, M: Dim>(
+    a: &Square<N>,
+    b: &OMatrix<f64, N, M>,
+    period: Option<f64>,
+) -> Option<Error>
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
+    let (a, b) = (heap(a), heap(b));
     let (n, m) = (a.nrows(), b.ncols());
-    let poles = eigenvalues_dyn(&to_nalgebra(a.as_ref())).ok()?;
-    let scale = a.norm_l2() + b.norm_l2();
+    let poles = eigenvalues_dyn(&a).ok()?;
+    let scale = fro(&a) + fro(&b);
     let zero = Complex::new(0.0, 0.0);
     let p = poles.into_iter().find(|&p| {
         let unstable = match period {
@@ -519,14 +577,17 @@ fn explain(a: &Mat<f64>, b: &Mat<f64>, period: Option<f64>) -> Option<Error> {
 /// the refinement stalled (a Newton step was solved but did not lower the
 /// residual: `X` is then as accurate as rounding lets this problem be).
 /// `step(X, Res)` solves the correction's linear equation.
-fn refine(
-    mut x: Mat<f64>,
+fn refine<N: Dim>(
+    mut x: Square<N>,
     steps: usize,
     good: f64,
     to_stagnation: bool,
-    eval: &impl Fn(&Mat<f64>) -> (Mat<f64>, f64),
-    step: &impl Fn(&Mat<f64>, &Mat<f64>) -> Option<Mat<f64>>,
-) -> (Mat<f64>, f64, bool) {
+    eval: &impl Fn(&Square<N>) -> (Square<N>, f64),
+    step: &impl Fn(&Square<N>, &Square<N>) -> Option<Square<N>>,
+) -> (Square<N>, f64, bool)
+where
+    DefaultAllocator: Allocator<N, N>,
+{
     let (mut res, mut residual) = eval(&x);
     for _ in 0..steps {
         if residual == 0.0 || residual <= good && !to_stagnation {
@@ -535,7 +596,7 @@ fn refine(
         let Some(delta) = step(&x, &res) else {
             break;
         };
-        if !finite(delta.as_ref()) {
+        if !finite(&delta) {
             break;
         }
         let mut next = &x + &delta;
@@ -554,28 +615,31 @@ fn refine(
 /// [`balance_weights`]) and is scaled back here; the closed loop must be
 /// stable in the domain of `period` (`None`: continuous).
 #[allow(clippy::too_many_arguments)]
-fn finish(
-    a: &Mat<f64>,
-    b: &Mat<f64>,
-    gain: Mat<f64>,
-    riccati: Mat<f64>,
+fn finish<N: Dim, M: Dim>(
+    a: &Square<N>,
+    b: &OMatrix<f64, N, M>,
+    gain: OMatrix<f64, M, N>,
+    riccati: Square<N>,
     weight: f64,
     residual: f64,
     iterations: usize,
     period: Option<f64>,
-) -> Result<DynLqr, Error> {
-    if !finite(gain.as_ref()) {
+) -> Result<Solution<N, M>, Error>
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
+    if !finite(&gain) {
         return Err(Error::Overflow {
             operation: "LQR gain",
         });
     }
-    let riccati = riccati * faer::Scale(1.0 / weight);
-    if !finite(riccati.as_ref()) {
+    let riccati = riccati * (1.0 / weight);
+    if !finite(&riccati) {
         return Err(Error::Overflow {
             operation: "LQR Riccati solution (X exceeds f64::MAX for these weights)",
         });
     }
-    let a_cl = to_nalgebra((a - b * &gain).as_ref());
+    let a_cl = heap(&(a - b * &gain));
     let poles = eigenvalues_dyn(&a_cl)?;
     if let Some(p) = first_unstable_dyn(&poles, &a_cl, period) {
         return Err(Error::Unstable {
@@ -585,9 +649,9 @@ fn finish(
             im: p.im,
         });
     }
-    Ok(DynLqr {
-        gain: to_nalgebra(gain.as_ref()),
-        riccati: to_nalgebra(riccati.as_ref()),
+    Ok(Solution {
+        gain,
+        riccati,
         poles,
         residual,
         iterations,
@@ -598,7 +662,13 @@ fn finish(
 /// their largest entries near 1 (the LQR problem does not change when both
 /// weights are scaled alike: `X` scales with them, `K` not at all), and
 /// `c`. Weights of 1e308 then neither overflow nor make `R⁻¹` underflow.
-fn balance_weights(q: &DMatrix<f64>, r: &DMatrix<f64>) -> (Mat<f64>, Mat<f64>, f64) {
+fn balance_weights<N: Dim, M: Dim>(
+    q: &Square<N>,
+    r: &OMatrix<f64, M, M>,
+) -> (Square<N>, OMatrix<f64, M, M>, f64)
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
     let (q_max, r_max) = (q.amax(), r.amax());
     let (sq, sr) = (pow2_floor(q_max), pow2_floor(r_max));
     // 1 / √(sq sr), rounded to a power of two, without forming sq sr.
@@ -609,7 +679,7 @@ fn balance_weights(q: &DMatrix<f64>, r: &DMatrix<f64>) -> (Mat<f64>, Mat<f64>, f
     } else {
         1.0 / sr
     };
-    (to_faer(q) * faer::Scale(c), to_faer(r) * faer::Scale(c), c)
+    (q * c, r * c, c)
 }
 
 /// The CARE left side `Aᵀ X + X A − X G X + Q` and its relative norm.
@@ -617,46 +687,55 @@ fn balance_weights(q: &DMatrix<f64>, r: &DMatrix<f64>) -> (Mat<f64>, Mat<f64>, f
 /// `X G X` is formed as `(X B)(R⁻¹ Bᵀ X)`: with a large `X`, the product
 /// `(X G) X` loses about `ε ‖X G‖ ‖X‖`, which can be a 1e-9 part of the
 /// result, while the factored form stays near `ε ‖X G X‖`.
-fn care_eval(
-    a: &Mat<f64>,
-    b: &Mat<f64>,
-    r_inv_bt: &Mat<f64>,
-    q: &Mat<f64>,
-    x: &Mat<f64>,
-) -> (Mat<f64>, f64) {
+fn care_eval<N: Dim, M: Dim>(
+    a: &Square<N>,
+    b: &OMatrix<f64, N, M>,
+    r_inv_bt: &OMatrix<f64, M, N>,
+    q: &Square<N>,
+    x: &Square<N>,
+) -> (Square<N>, f64)
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
     let at_x = a.transpose() * x;
     let xgx = (x * b) * (r_inv_bt * x);
     let lhs = &at_x + at_x.transpose() - &xgx + q;
-    let rel = relative(
-        lhs.norm_l2(),
-        &[2.0 * at_x.norm_l2(), xgx.norm_l2(), q.norm_l2()],
-    );
+    let rel = relative(fro(&lhs), &[2.0 * fro(&at_x), fro(&xgx), fro(q)]);
     (lhs, rel)
 }
 
 /// `K = (R + Bᵀ X B)⁻¹ Bᵀ X A`.
-fn dare_gain(a: &Mat<f64>, b: &Mat<f64>, r: &Mat<f64>, x: &Mat<f64>) -> Result<Mat<f64>, Error> {
+fn dare_gain<N: Dim, M: Dim>(
+    a: &Square<N>,
+    b: &OMatrix<f64, N, M>,
+    r: &OMatrix<f64, M, M>,
+    x: &Square<N>,
+) -> Result<OMatrix<f64, M, N>, Error>
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
     let bt_x = b.transpose() * x;
     let s = r + &bt_x * b;
-    Ok(lu(s.as_ref(), "DLQR (R + Bᵀ X B)")?.solve(&bt_x * a))
+    Ok(Lu::new(&s, "DLQR (R + Bᵀ X B)")?.solve(&(&bt_x * a)))
 }
 
 /// The DARE residual `Aᵀ X A − Aᵀ X B K + Q − X` (with `K` the optimal gain
 /// for `X`) and its relative norm.
-fn dare_eval(
-    a: &Mat<f64>,
-    b: &Mat<f64>,
-    q: &Mat<f64>,
-    x: &Mat<f64>,
-    gain: &Mat<f64>,
-) -> (Mat<f64>, f64) {
-    let atxa = a.transpose() * (x * a);
-    let cross = (a.transpose() * (x * b)) * gain;
+fn dare_eval<N: Dim, M: Dim>(
+    a: &Square<N>,
+    b: &OMatrix<f64, N, M>,
+    q: &Square<N>,
+    x: &Square<N>,
+    gain: &OMatrix<f64, M, N>,
+) -> (Square<N>, f64)
+where
+    DefaultAllocator: RiccatiAlloc<N, M>,
+{
+    let at = a.transpose();
+    let atxa = &at * (x * a);
+    let cross = (&at * (x * b)) * gain;
     let lhs = &atxa - &cross + q - x;
-    let rel = relative(
-        lhs.norm_l2(),
-        &[atxa.norm_l2(), x.norm_l2(), cross.norm_l2(), q.norm_l2()],
-    );
+    let rel = relative(fro(&lhs), &[fro(&atxa), fro(x), fro(&cross), fro(q)]);
     (lhs, rel)
 }
 
