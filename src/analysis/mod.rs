@@ -203,6 +203,9 @@ pub(crate) fn eigenvalues<const N: usize>(
     Ok(out)
 }
 
+/// Up to this size `eigenvalues_dyn` tries nalgebra's Schur before faer's.
+const SMALL_EIGEN: usize = 8;
+
 /// Eigenvalues of a square run-time-sized matrix, sorted as [`eigenvalues`]
 /// sorts them. The one implementation behind every model's `poles()`.
 pub(crate) fn eigenvalues_dyn(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, Error> {
@@ -212,25 +215,32 @@ pub(crate) fn eigenvalues_dyn(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, Err
         return Ok(Vec::new());
     }
     let iterations = ITERATIONS_PER_DIM * n;
-    // faer's multishift QR (exceptional shifts, aggressive early deflation)
-    // first: it converges where nalgebra's Francis iteration stalls (a
-    // repeated, non-defective eigenvalue; CAREX 6's 30 states) and is the
-    // faster at large n. nalgebra's Schur is the fallback.
-    let view = faer::MatRef::from_column_major_slice(a.as_slice(), n, n);
-    let mut out: Vec<Complex<f64>> = match view.eigenvalues() {
-        Ok(values) => values.iter().map(|e| Complex::new(e.re, e.im)).collect(),
-        Err(_) => a
-            .clone()
+    let nalgebra_schur = || {
+        a.clone()
             .try_schur(f64::EPSILON, iterations)
-            .ok_or(Error::NoConvergence {
-                operation: "Schur decomposition (eigenvalues)",
-                iterations,
-            })?
-            .complex_eigenvalues()
-            .iter()
-            .copied()
-            .collect(),
+            .map(|s| s.complex_eigenvalues().iter().copied().collect::<Vec<_>>())
     };
+    // faer's multishift QR (exceptional shifts, aggressive early deflation)
+    // converges where nalgebra's Francis iteration stalls (a repeated,
+    // non-defective eigenvalue; CAREX 6's 30 states) and is the faster at
+    // large n; at small n its set-up costs more than the whole of
+    // nalgebra's iteration (a 4-state LQR spent a fifth of its time
+    // there), so nalgebra goes first there and faer is the fallback.
+    let faer_qr = || {
+        faer::MatRef::from_column_major_slice(a.as_slice(), n, n)
+            .eigenvalues()
+            .ok()
+            .map(|v| v.iter().map(|e| Complex::new(e.re, e.im)).collect())
+    };
+    let values = if n <= SMALL_EIGEN {
+        nalgebra_schur().or_else(faer_qr)
+    } else {
+        faer_qr().or_else(nalgebra_schur)
+    };
+    let mut out: Vec<Complex<f64>> = values.ok_or(Error::NoConvergence {
+        operation: "Schur decomposition (eigenvalues)",
+        iterations,
+    })?;
     if out.iter().any(|p| !(p.re.is_finite() && p.im.is_finite())) {
         return Err(Error::Overflow {
             operation: "eigenvalues",
