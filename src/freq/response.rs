@@ -543,13 +543,8 @@ fn state_space_response<D: Domain>(
     let period = period_of(&sys.domain());
     let mut ev = Evaluator::new(sys.a(), sys.b(), sys.c(), sys.d());
     let mut values = vec![C64::new(0.0, 0.0); p * m * len];
-    let mut at = vec![C64::new(0.0, 0.0); p * m];
-    for (k, &w) in omega.iter().enumerate() {
-        ev.eval(point(period, w), &mut at)?;
-        for (ch, g) in at.iter().enumerate() {
-            values[ch * len + k] = *g;
-        }
-    }
+    let points: Vec<C64> = omega.iter().map(|&w| point(period, w)).collect();
+    ev.eval_many(&points, &mut values)?;
     Ok(FrequencyResponse {
         omega: omega.to_vec(),
         outputs: p,
