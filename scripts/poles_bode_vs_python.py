@@ -1,0 +1,78 @@
+"""ctrlab's `poles()` at N = 100 against NumPy's `eigvals` (LAPACK dgeev),
+and its 1000-point Bode of the lab plant against python-control's
+frequency response, on the same data in the same run.
+
+    python3 scripts/poles_bode_vs_python.py
+
+Builds and runs `examples/poles_bode_bench.rs` (release) on a seeded
+100 × 100 matrix with N(0, 1) entries written to a temporary JSON file,
+times NumPy and python-control on the same inputs, and prints one table.
+Times are medians (wall clock, one thread: OPENBLAS_NUM_THREADS=1 etc.).
+"""
+
+import os
+
+for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(var, "1")
+
+import json  # noqa: E402
+import subprocess  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+REPEATS = 20
+
+
+def median_time(f, repeats):
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        f()
+        times.append(time.perf_counter() - t)
+    return sorted(times)[len(times) // 2]
+
+
+def main():
+    a = np.random.default_rng(1).standard_normal((100, 100))
+    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+        json.dump({"a": a.tolist(), "repeats": REPEATS}, f)
+        path = f.name
+    out = subprocess.run(
+        ["cargo", "run", "--quiet", "--release", "--example", "poles_bode_bench", "--", path],
+        cwd=ROOT, check=True, capture_output=True, text=True,
+    ).stdout
+    os.unlink(path)
+    mine = json.loads(next(line for line in out.splitlines() if line.startswith("{")))
+
+    numpy_poles = median_time(lambda: np.linalg.eigvals(a), REPEATS)
+    largest = np.linalg.eigvals(a).real.max()
+    print(f"{'what':<40} {'ctrlab':>10} {'Python':>10}")
+    print(f"{'poles, N = 100 (ms) vs numpy eigvals':<40} {mine['poles_median_s'] * 1e3:10.3f} "
+          f"{numpy_poles * 1e3:10.3f}   (largest Re: {mine['largest_pole_re']:.12f} / {largest:.12f})")
+
+    try:
+        import control
+    except ImportError:
+        print("python-control not installed: no frequency-response comparison")
+        return
+    with open(os.path.join(ROOT, "tests/data/mass_spring_nominal.json")) as f:
+        d = json.load(f)
+    pa, pb = np.array(d["a"], float), np.array(d["b"], float).reshape(4, -1)
+    pc = np.array([mine["plant_c"]], float)
+    sys = control.ss(pa, pb, pc, np.zeros((1, pb.shape[1])))
+    w = np.logspace(0, 3, 1000)
+
+    def response():
+        r = control.frequency_response(sys, w)
+        return r.magnitude, r.phase
+
+    t = median_time(response, 10 * REPEATS)
+    print(f"{'1000-point Bode, lab plant (µs)':<40} {mine['bode_median_s'] * 1e6:10.1f} "
+          f"{t * 1e6:10.1f}   (python-control frequency_response)")
+
+
+if __name__ == "__main__":
+    main()
