@@ -233,22 +233,22 @@ impl Evaluator {
             // A short last chunk repeats its last point in the spare lanes.
             let points: [C64; LANES] = std::array::from_fn(|q| s[start + q.min(count - 1)]);
             let mut bad = [self.columns.is_none() || n == 0; LANES];
-            if let Some(columns) = &self.columns {
-                if n > 0 {
-                    for (j, col) in columns.iter().enumerate() {
-                        lanes_column(
-                            col,
-                            n,
-                            p,
-                            &self.d[j * p..(j + 1) * p],
-                            &points,
-                            &mut lanes,
-                            &mut bad,
-                            |i, q, v| {
-                                g[i * m + j][q] = v;
-                            },
-                        );
-                    }
+            if let Some(columns) = &self.columns
+                && n > 0
+            {
+                for (j, col) in columns.iter().enumerate() {
+                    lanes_column(
+                        col,
+                        n,
+                        p,
+                        &self.d[j * p..(j + 1) * p],
+                        &points,
+                        &mut lanes,
+                        &mut bad,
+                        |i, q, v| {
+                            g[i * m + j][q] = v;
+                        },
+                    );
                 }
             }
             for q in 0..count {
@@ -295,7 +295,8 @@ fn lanes_column(
             xr[k - 1][q] = vr;
             xi[k - 1][q] = vi;
             // `eval` rescales above 1e100 and gives up on a non-finite size.
-            bad[q] |= !(vr.abs().max(vi.abs()) <= 1e100);
+            let size = vr.abs().max(vi.abs());
+            bad[q] |= size > 1e100 || !size.is_finite();
         }
     }
     let (tr, ti) = lanes_row(h, n, 0, s, xr, xi);
