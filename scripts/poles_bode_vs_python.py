@@ -11,28 +11,18 @@ Times are medians (wall clock, one thread: OPENBLAS_NUM_THREADS=1 etc.).
 """
 
 import os
+import sys
 
-for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(var, "1")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from timing import ROOT, median_time  # noqa: E402  (sets the BLAS threads first)
 
 import json  # noqa: E402
 import subprocess  # noqa: E402
 import tempfile  # noqa: E402
-import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REPEATS = 20
-
-
-def median_time(f, repeats):
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        f()
-        times.append(time.perf_counter() - t)
-    return sorted(times)[len(times) // 2]
 
 
 def main():

@@ -20,20 +20,18 @@ a lightly damped chain at n = 100, and SciPy's CAREX 18 (n = 100).
 """
 
 import os
+import sys
 
-for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(var, "1")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from timing import ROOT, median_time  # noqa: E402  (sets the BLAS threads first)
 
 import json  # noqa: E402
 import subprocess  # noqa: E402
-import sys  # noqa: E402
 import tempfile  # noqa: E402
-import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 from scipy.linalg import solve_continuous_are  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def lab_plant():
@@ -63,15 +61,6 @@ def carex18():
     with open(os.path.join(ROOT, "tests/data/riccati_fixtures.json")) as f:
         case = json.load(f)["carex"][17]
     return tuple(np.array(case[k]["re"], float) for k in "abqr")
-
-
-def median_time(f, repeats):
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        f()
-        times.append(time.perf_counter() - t)
-    return sorted(times)[len(times) // 2]
 
 
 def main():

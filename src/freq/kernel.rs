@@ -503,12 +503,19 @@ mod tests {
     use super::*;
     use nalgebra::dmatrix;
 
+    /// A 4-state model with 2 inputs, 3 outputs and some feedthrough.
+    fn mimo() -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+        (
+            dmatrix![-1.0, 2.0, 0.5, 0.0; -3.0, -0.2, 1.0, 4.0; 0.1, 0.0, -2.0, 1.0; 1.0, 1.0, -1.0, -0.5],
+            dmatrix![1.0, 0.0; 0.0, 1.0; 1.0, 1.0; 0.5, -1.0],
+            dmatrix![1.0, 0.0, 0.0, 1.0; 0.0, 2.0, -1.0, 0.0; 1.0, 1.0, 1.0, 1.0],
+            dmatrix![0.0, 0.1; 0.2, 0.0; 0.0, 0.0],
+        )
+    }
+
     #[test]
     fn matches_a_direct_solve() {
-        let a = dmatrix![-1.0, 2.0, 0.5, 0.0; -3.0, -0.2, 1.0, 4.0; 0.1, 0.0, -2.0, 1.0; 1.0, 1.0, -1.0, -0.5];
-        let b = dmatrix![1.0, 0.0; 0.0, 1.0; 1.0, 1.0; 0.5, -1.0];
-        let c = dmatrix![1.0, 0.0, 0.0, 1.0; 0.0, 2.0, -1.0, 0.0; 1.0, 1.0, 1.0, 1.0];
-        let d = dmatrix![0.0, 0.1; 0.2, 0.0; 0.0, 0.0];
+        let (a, b, c, d) = mimo();
         let mut ev = Evaluator::new(&a, &b, &c, &d);
         assert!(ev.columns.is_some());
         let s = C64::new(0.3, 1.7);
@@ -556,10 +563,7 @@ mod tests {
     /// the pivoted solve, and the same first error.
     #[test]
     fn eval_many_is_eval_bit_for_bit() {
-        let a = dmatrix![-1.0, 2.0, 0.5, 0.0; -3.0, -0.2, 1.0, 4.0; 0.1, 0.0, -2.0, 1.0; 1.0, 1.0, -1.0, -0.5];
-        let b = dmatrix![1.0, 0.0; 0.0, 1.0; 1.0, 1.0; 0.5, -1.0];
-        let c = dmatrix![1.0, 0.0, 0.0, 1.0; 0.0, 2.0, -1.0, 0.0; 1.0, 1.0, 1.0, 1.0];
-        let d = dmatrix![0.0, 0.1; 0.2, 0.0; 0.0, 0.0];
+        let (a, b, c, d) = mimo();
         // 21 points (two full chunks and a short one): imaginary-axis and
         // unit-circle points, and 1e120 j, where the recurrence rescales.
         let mut s: Vec<C64> = (0..19)
