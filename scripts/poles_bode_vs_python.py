@@ -14,11 +14,9 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from timing import ROOT, median_time  # noqa: E402  (sets the BLAS threads first)
+from timing import ROOT, median_time, run_example  # noqa: E402  (sets the BLAS threads first)
 
 import json  # noqa: E402
-import subprocess  # noqa: E402
-import tempfile  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -27,15 +25,7 @@ REPEATS = 20
 
 def main():
     a = np.random.default_rng(1).standard_normal((100, 100))
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump({"a": a.tolist(), "repeats": REPEATS}, f)
-        path = f.name
-    out = subprocess.run(
-        ["cargo", "run", "--quiet", "--release", "--example", "poles_bode_bench", "--", path],
-        cwd=ROOT, check=True, capture_output=True, text=True,
-    ).stdout
-    os.unlink(path)
-    mine = json.loads(next(line for line in out.splitlines() if line.startswith("{")))
+    [mine] = run_example("poles_bode_bench", {"a": a.tolist(), "repeats": REPEATS})
 
     numpy_poles = median_time(lambda: np.linalg.eigvals(a), REPEATS)
     largest = np.linalg.eigvals(a).real.max()

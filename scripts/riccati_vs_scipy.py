@@ -23,11 +23,9 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from timing import ROOT, median_time  # noqa: E402  (sets the BLAS threads first)
+from timing import ROOT, median_time, run_example  # noqa: E402  (sets the BLAS threads first)
 
 import json  # noqa: E402
-import subprocess  # noqa: E402
-import tempfile  # noqa: E402
 
 import numpy as np  # noqa: E402
 from scipy.linalg import solve_continuous_are  # noqa: E402
@@ -77,15 +75,7 @@ def main():
          "q": p[2].tolist(), "r": p[3].tolist(), "repeats": reps}
         for name, p, reps in problems
     ]
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump({"cases": cases}, f)
-        path = f.name
-    out = subprocess.run(
-        ["cargo", "run", "--quiet", "--release", "--example", "riccati_bench", "--", path],
-        cwd=ROOT, check=True, capture_output=True, text=True,
-    ).stdout
-    os.unlink(path)
-    ours = [json.loads(line) for line in out.splitlines() if line.startswith("{")]
+    ours = run_example("riccati_bench", {"cases": cases})
 
     print(f"{'problem':<18} {'ctrlab (ms)':>12} {'SciPy (ms)':>11} {'ratio':>6}  "
           f"{'ctrlab |res|max':>15} {'SciPy |res|max':>15}")

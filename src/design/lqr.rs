@@ -1,5 +1,5 @@
 //! Linear-quadratic regulators on fixed-size models: a front end to the
-//! run-time Riccati solvers of [`super::riccati`].
+//! Riccati solvers of [`super::riccati`], which run here on stack matrices.
 
 use nalgebra::{Complex, Const, DMatrix, SMatrix};
 
@@ -12,9 +12,10 @@ use crate::model::{Continuous, Discrete, StateSpace};
 ///
 /// # Method
 ///
-/// The fixed-size front end of the run-time solvers: the method (doubling,
+/// The fixed-size front end of the solvers behind `DynStateSpace::lqr`,
+/// the same code on stack matrices: the method (doubling,
 /// after a Cayley transform in continuous time, then Newton refinement, all
-/// `O(N³)`) is described on [`DynLqr`], which [`care`](super::care),
+/// `O(N³)`) is described on [`DynLqr`](super::DynLqr), which [`care`](super::care),
 /// [`dare`](super::dare) and `DynStateSpace::lqr` return.
 ///
 /// Every solution's closed loop is checked: one that is not stable is
