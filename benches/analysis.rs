@@ -1,6 +1,6 @@
 //! Analysis of models sized at run time: `poles` of a 100-state model
-//! (issue target: under 5 ms) and of the lab plant, and a 30-state
-//! `is_controllable`.
+//! (issue target: under 5 ms) and of the lab plant, the lab plant's
+//! `dc_gain`, and a 30-state `is_controllable`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::signal::Rng;
@@ -24,6 +24,9 @@ fn benches(c: &mut Criterion) {
     let lab = MassSpring::nominal().state_space(Cart::Two).unwrap();
     c.bench_function("poles, lab plant (4 states, fixed size)", |b| {
         b.iter(|| black_box(&lab).poles().unwrap())
+    });
+    c.bench_function("dc_gain, lab plant (4 states, fixed size)", |b| {
+        b.iter(|| black_box(&lab).dc_gain().unwrap())
     });
     let mid = random(30, 2, 2);
     c.bench_function("is_controllable, 30 states (run-time sized)", |b| {

@@ -86,6 +86,21 @@ fn rk4_step_allocates_nothing() {
     assert!(x.norm() > 0.0);
 }
 
+/// The fixed-size `dc_gain` runs the shared code on stack matrices (it
+/// used to copy the model to the heap first).
+#[test]
+fn dc_gain_allocates_nothing() {
+    let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
+    let d = sys.discretize(0.002, Method::Zoh).unwrap();
+    let mut gains = (0.0, 0.0);
+    let n = allocations(|| {
+        gains = (sys.dc_gain().unwrap()[(0, 0)], d.dc_gain().unwrap()[(0, 0)]);
+    });
+    assert_eq!(n, 0);
+    // 2 mm per newton on cart 2, kept by ZOH.
+    assert!((gains.0 - 0.002).abs() < 1e-12 && (gains.1 - 0.002).abs() < 1e-12);
+}
+
 #[test]
 fn zoh_discretisation_allocates_nothing() {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();

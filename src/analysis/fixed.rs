@@ -5,7 +5,7 @@ use nalgebra::{Complex, DMatrix, SMatrix};
 
 #[cfg(doc)]
 use super::rank;
-use super::{Damping, damping_of, eigenvalues};
+use super::{Damping, damping_of, eigenvalues, gain};
 use crate::error::Error;
 use crate::model::{Domain, DynStateSpace, StateSpace, period_of};
 
@@ -230,8 +230,13 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// ```
     #[doc(alias = "dcgain")]
     pub fn dc_gain(&self) -> Result<SMatrix<f64, P, M>, Error> {
-        let gain = DynStateSpace::from(self).dc_gain()?;
-        Ok(SMatrix::from_column_slice(gain.as_slice()))
+        gain::dc_gain(
+            self.a(),
+            self.b(),
+            self.c(),
+            self.d(),
+            period_of(&self.domain()),
+        )
     }
 
     /// [`Damping`] (natural frequency, damping ratio, time constant) of each

@@ -1,7 +1,7 @@
-//! The DC gain, on run-time-sized matrices (the one implementation behind
-//! both model types' `dc_gain`).
+//! The DC gain, written once over nalgebra's dimensions: both model types'
+//! `dc_gain` (a fixed-size model's on stack matrices, without allocating).
 
-use nalgebra::DMatrix;
+use nalgebra::{DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
 use crate::error::Error;
 use crate::kernels::linalg::Lu;
@@ -9,21 +9,25 @@ use crate::kernels::reduce::pow2_floor;
 
 /// The steady-state gain of `(A, B, C, D)`: `−C A⁻¹ B + D` in continuous
 /// time (`period = None`), `C (I − A)⁻¹ B + D` in discrete time.
-pub(crate) fn dc_gain(
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
-    c: &DMatrix<f64>,
-    d: &DMatrix<f64>,
+pub(crate) fn dc_gain<N: Dim, M: Dim, P: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
+    c: &OMatrix<f64, P, N>,
+    d: &OMatrix<f64, P, M>,
     period: Option<f64>,
-) -> Result<DMatrix<f64>, Error> {
+) -> Result<OMatrix<f64, P, M>, Error>
+where
+    DefaultAllocator:
+        Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M> + Allocator<N>,
+{
     let g = match period {
         None => {
             let x = gain_solve(a.clone(), b.clone(), "DC gain (pole at s = 0)")?;
             d - c * x
         }
         Some(_) => {
-            let n = a.nrows();
-            let i_minus_a = DMatrix::identity(n, n) - a;
+            let (n, _) = a.shape_generic();
+            let i_minus_a = OMatrix::<f64, N, N>::identity_generic(n, n) - a;
             let x = gain_solve(i_minus_a, b.clone(), "DC gain (pole at z = 1)")?;
             c * x + d
         }
@@ -44,22 +48,28 @@ pub(crate) fn dc_gain(
 /// by powers of two (each row's largest entry in [1, 2)), and the test is
 /// the Skeel condition number `‖ |m⁻¹| |m| ‖∞`, which no such scaling
 /// changes: `diag(−1, −1e12)` is perfectly conditioned.
-fn gain_solve(
-    mut m: DMatrix<f64>,
-    mut b: DMatrix<f64>,
+fn gain_solve<N: Dim, M: Dim>(
+    mut m: OMatrix<f64, N, N>,
+    mut b: OMatrix<f64, N, M>,
     operation: &'static str,
-) -> Result<DMatrix<f64>, Error> {
-    let n = m.nrows();
-    for i in 0..n {
+) -> Result<OMatrix<f64, N, M>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N>,
+{
+    let (dim, _) = m.shape_generic();
+    for i in 0..dim.value() {
         let f = 1.0 / pow2_floor(m.row(i).amax());
         m.row_mut(i).scale_mut(f);
         b.row_mut(i).scale_mut(f);
     }
     let lu = Lu::new(&m, operation)?;
-    let skeel = (lu.solve(&DMatrix::identity(n, n)).abs() * m.abs())
-        .row_iter()
-        .map(|r| r.sum())
-        .fold(0.0, f64::max);
+    let skeel = (lu
+        .solve(&OMatrix::<f64, N, N>::identity_generic(dim, dim))
+        .abs()
+        * m.abs())
+    .row_iter()
+    .map(|r| r.sum())
+    .fold(0.0, f64::max);
     if !skeel.is_finite() || skeel * f64::EPSILON > 1e-4 {
         return Err(Error::Singular { operation });
     }
