@@ -1,7 +1,9 @@
 //! Pole placement for single-input systems, Ackermann's formula, and the
 //! validation of target poles that [`place`](super::place) shares.
 
-use nalgebra::{Complex, DMatrix, SMatrix};
+use nalgebra::{
+    Complex, DMatrix, DefaultAllocator, Dim, OMatrix, SMatrix, U1, allocator::Allocator,
+};
 
 use crate::analysis::{eigenvalues_dyn, scaled_krylov_rank};
 use crate::error::Error;
@@ -55,10 +57,7 @@ pub fn acker<const N: usize, const P: usize, D: Domain>(
     sys: &StateSpace<N, 1, P, D>,
     poles: &[Complex<f64>; N],
 ) -> Result<SMatrix<f64, 1, N>, Error> {
-    let a = DMatrix::from_column_slice(N, N, sys.a().as_slice());
-    let b = DMatrix::from_column_slice(N, 1, sys.b().as_slice());
-    let k = acker_pair(&a, &b, poles)?;
-    Ok(SMatrix::from_row_slice(k.as_slice()))
+    acker_pair(sys.a(), sys.b(), poles)
 }
 
 impl<D: Domain> DynStateSpace<D> {
@@ -99,7 +98,8 @@ impl<D: Domain> DynStateSpace<D> {
             });
         }
         check_targets(poles, n)?;
-        acker_pair(self.a(), self.b(), poles)
+        let k = acker_pair(self.a(), self.b(), poles)?;
+        Ok(DMatrix::from_row_slice(1, n, k.as_slice()))
     }
 }
 
@@ -117,20 +117,25 @@ pub(crate) fn check_targets(poles: &[Complex<f64>], states: usize) -> Result<(),
 }
 
 /// [`acker`] on a bare pair `(A, b)`, `b` one column, one target per state
-/// (the callers' checks): the gain as a `1 × n` matrix.
-fn acker_pair(
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
+/// (the callers' checks): the gain as a `1 × n` row. Written once over
+/// nalgebra's dimensions, so a fixed-size model's runs on the stack.
+fn acker_pair<N: Dim, M: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
     poles: &[Complex<f64>],
-) -> Result<DMatrix<f64>, Error> {
-    let n = a.nrows();
+) -> Result<OMatrix<f64, U1, N>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N> + Allocator<U1, N>,
+{
+    let (dim, _) = a.shape_generic();
+    let n = dim.value();
     let coeffs = real_polynomial(poles)?;
     // Controllability matrix [B, A B, …, A^(N−1) B], each new column
     // divided by a power of two s_j as it is formed (so that it cannot
     // overflow, and the LU's pivot test sees no units): 𝒞 = 𝒞̃ S with
     // S = diag(s₀, s₀s₁, …), so the last row of 𝒞⁻¹ = S⁻¹ 𝒞̃⁻¹ is that of
     // 𝒞̃⁻¹ divided by s₀ s₁ … s_(N−1).
-    let mut ctrb = DMatrix::zeros(n, n);
+    let mut ctrb = OMatrix::<f64, N, N>::zeros_generic(dim, dim);
     let mut col = b.column(0).into_owned();
     let mut last_scale = 1.0;
     for j in 0..n {
@@ -146,11 +151,16 @@ fn acker_pair(
         });
     }
     // φ(A) by Horner: coeffs are monic, highest power first.
-    let mut phi = DMatrix::identity(n, n);
+    let mut phi = OMatrix::<f64, N, N>::identity_generic(dim, dim);
+    let mut product = phi.clone();
     for &c in &coeffs[1..] {
-        phi = a * phi + DMatrix::identity(n, n) * c;
+        product.gemm(1.0, a, &phi, 0.0);
+        std::mem::swap(&mut phi, &mut product);
+        for i in 0..n {
+            phi[(i, i)] += c;
+        }
     }
-    let mut last = DMatrix::zeros(1, n);
+    let mut last = OMatrix::<f64, U1, N>::zeros_generic(U1, dim);
     if n > 0 {
         last[n - 1] = 1.0;
     }
@@ -161,7 +171,7 @@ fn acker_pair(
     let row = match Lu::solve_right(&ctrb, &last, "Ackermann (controllability matrix)") {
         Ok(row) => row,
         Err(lu) => {
-            let rank = scaled_krylov_rank(a, b)?;
+            let rank = scaled_krylov_rank(&heap(a), &heap(b))?;
             return Err(if rank < n {
                 Error::Uncontrollable { rank, states: n }
             } else {
@@ -175,8 +185,18 @@ fn acker_pair(
             operation: "Ackermann gain",
         });
     }
-    check_placement(&(a - b * &k), poles)?;
+    // A − b K, with b's one column.
+    let a_cl = DMatrix::from_fn(n, n, |i, j| a[(i, j)] - b[(i, 0)] * k[j]);
+    check_placement(&a_cl, poles)?;
     Ok(k)
+}
+
+/// A copy on the heap, for the code written for run-time-sized matrices.
+fn heap<R: Dim, C: Dim>(m: &OMatrix<f64, R, C>) -> DMatrix<f64>
+where
+    DefaultAllocator: Allocator<R, C>,
+{
+    DMatrix::from_iterator(m.nrows(), m.ncols(), m.iter().copied())
 }
 
 /// Largest distance, relative to the largest target, between the poles of
