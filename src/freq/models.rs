@@ -3,6 +3,7 @@
 use nalgebra::{Complex, DMatrix};
 
 use super::kernel::Evaluator;
+use super::tf::check_point;
 use super::zeros::invariant_zeros;
 use crate::error::Error;
 use crate::model::{Domain, DynStateSpace, StateSpace};
@@ -55,13 +56,7 @@ fn evaluate_at(
     d: &DMatrix<f64>,
     s: Complex<f64>,
 ) -> Result<DMatrix<Complex<f64>>, Error> {
-    if !(s.re.is_finite() && s.im.is_finite()) {
-        return Err(Error::InvalidParameter {
-            name: "s",
-            value: if s.re.is_finite() { s.im } else { s.re },
-            reason: "the point must be finite",
-        });
-    }
+    check_point(s)?;
     let (p, m) = (c.nrows(), b.ncols());
     let mut out = vec![Complex::new(0.0, 0.0); p * m];
     Evaluator::new(a, b, c, d).eval(s, &mut out)?;

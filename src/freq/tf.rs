@@ -9,6 +9,29 @@ use crate::analysis::eigenvalues_dyn;
 use crate::error::{Error, check_dt};
 use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, period_of};
 
+/// A finite evaluation point, or [`Error::InvalidParameter`] named `"s"`
+/// with the offending part.
+pub(crate) fn check_point(s: Complex<f64>) -> Result<(), Error> {
+    if s.re.is_finite() && s.im.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name: "s",
+            value: if s.re.is_finite() { s.im } else { s.re },
+            reason: "the point must be finite",
+        })
+    }
+}
+
+/// Where a model of `domain` is evaluated for its DC gain: `s = 0`
+/// (continuous) or `z = 1` (discrete).
+pub(crate) fn dc_point<D: Domain>(domain: &D) -> Complex<f64> {
+    match period_of(domain) {
+        None => Complex::new(0.0, 0.0),
+        Some(_) => Complex::new(1.0, 0.0),
+    }
+}
+
 /// A polynomial argument checked: non-empty, finite, leading exact zeros
 /// removed.
 pub(crate) fn check_poly(what: &'static str, p: &[f64]) -> Result<Vec<f64>, Error> {
@@ -215,13 +238,7 @@ impl<D: Domain> TransferFunction<D> {
     /// ```
     #[doc(alias = "evalfr")]
     pub fn evaluate(&self, s: Complex<f64>) -> Result<Complex<f64>, Error> {
-        if !(s.re.is_finite() && s.im.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "s",
-                value: if s.re.is_finite() { s.im } else { s.re },
-                reason: "the point must be finite",
-            });
-        }
+        check_point(s)?;
         let g = poly::eval_ratio(&self.num, &self.den, s).ok_or(Error::Singular {
             operation: "transfer function evaluation (a pole)",
         })?;
@@ -292,10 +309,7 @@ impl<D: Domain> TransferFunction<D> {
     /// ```
     #[doc(alias = "dcgain")]
     pub fn dc_gain(&self) -> Result<f64, Error> {
-        let point = match period_of(&self.domain) {
-            None => Complex::new(0.0, 0.0),
-            Some(_) => Complex::new(1.0, 0.0),
-        };
+        let point = dc_point(&self.domain);
         self.evaluate(point).map(|g| g.re).map_err(|e| match e {
             Error::Singular { .. } => Error::Singular {
                 operation: "DC gain (pole at s = 0 or z = 1)",

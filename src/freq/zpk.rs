@@ -3,10 +3,10 @@
 use nalgebra::Complex;
 
 use super::poly;
-use super::tf::{TransferFunction, snapped_poles};
+use super::tf::{TransferFunction, check_point, dc_point, snapped_poles};
 use super::zeros::siso_numerator;
 use crate::error::{Error, check_dt};
-use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, period_of};
+use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace};
 
 /// A SISO transfer function in zero-pole-gain form,
 /// `G = gain · ∏(s − zᵢ) / ∏(s − pⱼ)` (python-control's and MATLAB's
@@ -223,13 +223,7 @@ impl<D: Domain> Zpk<D> {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn evaluate(&self, s: Complex<f64>) -> Result<Complex<f64>, Error> {
-        if !(s.re.is_finite() && s.im.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "s",
-                value: if s.re.is_finite() { s.im } else { s.re },
-                reason: "the point must be finite",
-            });
-        }
+        check_point(s)?;
         let mut g = Complex::new(self.gain, 0.0);
         for z in &self.zeros {
             g *= s - z;
@@ -268,10 +262,7 @@ impl<D: Domain> Zpk<D> {
     /// ```
     #[doc(alias = "dcgain")]
     pub fn dc_gain(&self) -> Result<f64, Error> {
-        let point = match period_of(&self.domain) {
-            None => Complex::new(0.0, 0.0),
-            Some(_) => Complex::new(1.0, 0.0),
-        };
+        let point = dc_point(&self.domain);
         self.evaluate(point).map(|g| g.re)
     }
 
