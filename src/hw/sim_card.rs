@@ -108,6 +108,13 @@ pub struct SimulatedCard<D, const N: usize> {
     last_kick_nanos: u64,
     /// `config.watchdog_timeout` in ns, rounded once.
     watchdog_nanos: Option<u64>,
+    /// `config.pwm_delay` in ns, rounded once.
+    delay_nanos: u64,
+    /// The earliest instant (ns) a pending write or the watchdog may act
+    /// (`u64::MAX` if none): before it, advancing only integrates. Kept by
+    /// `refresh_next_event` whenever a write is
+    /// queued or applied or the watchdog is kicked.
+    next_event: u64,
     rng: Rng,
 }
 
@@ -155,6 +162,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
         let watchdog_nanos = config
             .watchdog_timeout
             .map(|timeout| (timeout * 1e9).round() as u64);
+        let delay_nanos = (config.pwm_delay * 1e9).round() as u64;
         let mut card = Self {
             state: config.initial_state,
             rng: Rng::new(config.seed),
@@ -171,7 +179,10 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
             offset: [0; ENCODER_CHANNELS],
             last_kick_nanos: t_nanos,
             watchdog_nanos,
+            delay_nanos,
+            next_event: u64::MAX,
         };
+        card.refresh_next_event();
         card.latch();
         Ok(card)
     }
@@ -277,8 +288,10 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
         if now <= self.t_nanos {
             // Another register access in the same instant (the loop reads
             // several per tick): nothing to integrate, only writes or a
-            // watchdog trip due now.
-            self.advance_to(now);
+            // watchdog trip due now, if any.
+            if now >= self.next_event {
+                self.advance_to(now);
+            }
             return Ok(());
         }
         let behind = (now - self.t_nanos) as f64 * 1e-9;
@@ -290,6 +303,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
         if let Some(i) = self.state.iter().position(|v| !v.is_finite()) {
             let (value, at) = (self.state[i], self.time());
             (self.t_nanos, self.state, self.duty, self.pending) = before;
+            self.refresh_next_event();
             return Err(self.diverged(i, value, at));
         }
         Ok(())
@@ -415,11 +429,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// the voltage, tripping the watchdog at its deadline on the way.
     fn advance_to(&mut self, target: u64) {
         // The common case, every access of a tick: nothing due on the way.
-        if self.pending.iter().all(Option::is_none)
-            && self
-                .watchdog_deadline()
-                .is_none_or(|deadline| deadline > target)
-        {
+        if target < self.next_event {
             self.integrate_to(target);
             return;
         }
@@ -456,7 +466,20 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
                 _ => break,
             }
         }
+        self.refresh_next_event();
         self.integrate_to(target);
+    }
+
+    /// Recomputes `next_event`: the earliest pending
+    /// write, or the watchdog's deadline if sooner (whether or not a trip
+    /// there would change an output; `advance_to` decides that).
+    fn refresh_next_event(&mut self) {
+        let write = self.pending.iter().flatten().map(|&(_, at)| at).min();
+        self.next_event = write
+            .into_iter()
+            .chain(self.watchdog_deadline())
+            .min()
+            .unwrap_or(u64::MAX);
     }
 
     fn integrate_to(&mut self, target: u64) {
@@ -534,6 +557,7 @@ impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
                 let map = self.config.map;
                 if value & map.watchdog_bit != 0 {
                     self.last_kick_nanos = self.t_nanos;
+                    self.refresh_next_event();
                 }
                 if value & map.clear_bit != 0 {
                     self.clear();
@@ -545,7 +569,7 @@ impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
             Reg::PwmLow(n) => self.pwm_low[n] = value,
             Reg::PwmHigh(n) => {
                 let duty = duty_from_bytes(self.pwm_low[n], value);
-                let delay = (self.config.pwm_delay * 1e9).round() as u64;
+                let delay = self.delay_nanos;
                 if delay == 0 {
                     let expired = self
                         .watchdog_deadline()
@@ -555,6 +579,7 @@ impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
                     // The drive takes the new duty `pwm_delay` later; a
                     // newer write replaces one still pending.
                     self.pending[n] = Some((duty, self.t_nanos.saturating_add(delay)));
+                    self.refresh_next_event();
                 }
             }
             Reg::Open | Reg::Id | Reg::Encoder(..) => {}
