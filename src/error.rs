@@ -410,11 +410,15 @@ impl Error {
     }
 }
 
-/// Checks a run-time-sized matrix's entries as [`check_finite`] does.
-pub(crate) fn check_finite_dyn(
+/// Checks a matrix's entries as [`check_finite`] does, for any size
+/// (run-time sized, or fixed inside code written over nalgebra's `Dim`).
+pub(crate) fn check_finite_dyn<R: nalgebra::Dim, C: nalgebra::Dim, S>(
     matrix: &'static str,
-    m: &nalgebra::DMatrix<f64>,
-) -> Result<(), Error> {
+    m: &nalgebra::Matrix<f64, R, C, S>,
+) -> Result<(), Error>
+where
+    S: nalgebra::RawStorage<f64, R, C>,
+{
     match m.iter().position(|v| !v.is_finite()) {
         None => Ok(()),
         Some(i) => Err(Error::NonFinite {

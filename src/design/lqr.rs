@@ -1,7 +1,7 @@
 //! Linear-quadratic regulators on fixed-size models: a front end to the
 //! Riccati solvers of [`super::riccati`], which run here on stack matrices.
 
-use nalgebra::{Complex, Const, DMatrix, SMatrix};
+use nalgebra::{Complex, Const, SMatrix};
 
 use super::riccati::{self, Solution, Weights};
 use crate::error::Error;
@@ -130,10 +130,6 @@ pub fn dlqr<const N: usize, const M: usize, const P: usize>(
     Ok(fixed(sol))
 }
 
-fn heap<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> DMatrix<f64> {
-    DMatrix::from_column_slice(R, C, m.as_slice())
-}
-
 /// The solver's solution in the fixed-size result (`N` poles by
 /// construction).
 fn fixed<const N: usize, const M: usize>(sol: Solution<Const<N>, Const<M>>) -> Lqr<N, M> {
@@ -160,5 +156,5 @@ pub(crate) fn check_weights<const N: usize, const M: usize>(
     r: &SMatrix<f64, M, M>,
     names: [&'static str; 2],
 ) -> Result<(), Error> {
-    riccati::check_weights(&heap(q), &heap(r), Weights::Regulator(names), true)
+    riccati::check_weights(q, r, Weights::Regulator(names), true)
 }

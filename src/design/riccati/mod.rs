@@ -6,7 +6,8 @@
 mod kernels;
 mod solver;
 
-use nalgebra::{Complex, DMatrix};
+use nalgebra::allocator::Allocator;
+use nalgebra::{Cholesky, Complex, DMatrix, DefaultAllocator, Dim, OMatrix};
 
 use crate::error::{Error, check_finite_dyn, check_shape};
 use crate::kernels::reduce::pow2_floor;
@@ -317,12 +318,25 @@ fn check_problem(
 
 /// Checks the weights for `weights`; `continuous` says whether `R` must be
 /// definite even for a bare equation (its inverse is in the equation).
-pub(crate) fn check_weights(
-    q: &DMatrix<f64>,
-    r: &DMatrix<f64>,
+/// Written over nalgebra's `Dim`, so a fixed-size design checks on the
+/// stack.
+///
+/// Definiteness is tested by Cholesky factorisations of shifted copies
+/// (each weight first scaled to a largest entry in `[1, 2)`, so its norm
+/// cannot overflow): `Q + δ I` with `δ = 1e-12 ‖Q‖_F` factors exactly when
+/// the smallest eigenvalue of `Q` is above `−δ`, and `R − δ I` with
+/// `δ = ε m ‖R‖_F` when that of `R` is above `δ`; this agrees with
+/// comparing the smallest eigenvalue up to rounding at the boundary, at a
+/// fraction of the cost.
+pub(crate) fn check_weights<N: Dim, M: Dim>(
+    q: &OMatrix<f64, N, N>,
+    r: &OMatrix<f64, M, M>,
     weights: Weights,
     continuous: bool,
-) -> Result<(), Error> {
+) -> Result<(), Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<M, M>,
+{
     let [q_name, r_name] = match weights {
         Weights::Regulator(names) => names,
         Weights::Equation => ["Q", "R"],
@@ -333,36 +347,33 @@ pub(crate) fn check_weights(
     // f64::MAX must not overflow.
     let q = q / pow2_floor(q.amax());
     let r = r / pow2_floor(r.amax());
-    let symmetric_enough = |m: &DMatrix<f64>| (m - m.transpose()).norm() <= 1e-12 * m.norm();
-    if !symmetric_enough(&q) {
+    if (&q - q.transpose()).norm() > 1e-12 * q.norm() {
         return Err(Error::InvalidMatrix {
             matrix: q_name,
             reason: "must be symmetric",
         });
     }
-    if !symmetric_enough(&r) {
+    if (&r - r.transpose()).norm() > 1e-12 * r.norm() {
         return Err(Error::InvalidMatrix {
             matrix: r_name,
             reason: "must be symmetric",
         });
     }
-    if matches!(weights, Weights::Regulator(_)) && min_symmetric_eigenvalue(&q)? < -1e-12 * q.norm()
-    {
+    if matches!(weights, Weights::Regulator(_)) && !semidefinite(&q) {
         return Err(Error::InvalidMatrix {
             matrix: q_name,
             reason: "must be positive semidefinite",
         });
     }
     let m = r.nrows();
-    let min_r = min_symmetric_eigenvalue(&r)?;
     if matches!(weights, Weights::Regulator(_)) || continuous {
-        if min_r <= f64::EPSILON * m as f64 * r.norm() || m == 0 {
+        if m == 0 || !definite(&r, f64::EPSILON * m as f64 * r.norm()) {
             return Err(Error::InvalidMatrix {
                 matrix: r_name,
                 reason: "must be positive definite",
             });
         }
-    } else if min_r < -1e-12 * r.norm() || m == 0 {
+    } else if m == 0 || !semidefinite(&r) {
         return Err(Error::InvalidMatrix {
             matrix: r_name,
             reason: "must be positive semidefinite",
@@ -371,21 +382,83 @@ pub(crate) fn check_weights(
     Ok(())
 }
 
-fn min_symmetric_eigenvalue(m: &DMatrix<f64>) -> Result<f64, Error> {
-    if m.is_empty() {
-        return Ok(0.0);
+/// Whether the symmetric `m` has no eigenvalue below `−1e-12 ‖m‖_F`.
+fn semidefinite<D: Dim>(m: &OMatrix<f64, D, D>) -> bool
+where
+    DefaultAllocator: Allocator<D, D>,
+{
+    m.norm() == 0.0 || definite(m, -1e-12 * m.norm())
+}
+
+/// Whether the symmetric `m − shift I` is positive definite (its Cholesky
+/// factorisation exists).
+fn definite<D: Dim>(m: &OMatrix<f64, D, D>, shift: f64) -> bool
+where
+    DefaultAllocator: Allocator<D, D>,
+{
+    let mut shifted = m.clone();
+    for i in 0..m.nrows() {
+        shifted[(i, i)] -= shift;
     }
-    let iterations = 200 * m.nrows();
-    let eig = m
-        .clone()
-        .try_symmetric_eigen(f64::EPSILON, iterations)
-        .ok_or(Error::NoConvergence {
-            operation: "symmetric eigenvalues",
-            iterations,
-        })?;
-    Ok(eig
-        .eigenvalues
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min))
+    Cholesky::new(shifted).is_some()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::signal::Rng;
+    use nalgebra::DVector;
+
+    /// `V diag(λ) Vᵀ` with a random orthogonal `V`, the largest `|λ|` 1 and
+    /// the smallest eigenvalue `lowest` (relative to `‖·‖_F`).
+    fn symmetric_with(n: usize, lowest: f64, rng: &mut Rng) -> DMatrix<f64> {
+        let v = DMatrix::from_fn(n, n, |_, _| rng.gaussian()).qr().q();
+        let mut lambda = DVector::from_fn(n, |_, _| 0.1 + 0.9 * rng.uniform());
+        lambda[0] = 1.0;
+        // ‖·‖_F is ‖λ‖₂; set the last eigenvalue to `lowest` times it.
+        let rest = lambda.rows(0, n - 1).norm();
+        lambda[n - 1] = lowest * rest / (1.0 - lowest * lowest).sqrt();
+        &v * DMatrix::from_diagonal(&lambda) * v.transpose()
+    }
+
+    #[test]
+    fn cholesky_definiteness_agrees_with_the_smallest_eigenvalue() {
+        let mut rng = Rng::new(11);
+        let r1 = DMatrix::identity(1, 1);
+        let q1 = DMatrix::identity(1, 1);
+        let regulator = Weights::Regulator(["Q", "R"]);
+        for n in 2..=7 {
+            for _ in 0..40 {
+                let scale = 10f64.powf(rng.uniform() * 200.0 - 100.0);
+                // Q: semidefinite down to −1e-12 ‖Q‖ (decided 100× away).
+                for (lowest, ok) in [(-1e-10, false), (-1e-14, true), (0.0, true), (0.3, true)] {
+                    let q = symmetric_with(n, lowest, &mut rng) * scale;
+                    let res = check_weights(&q, &r1, regulator, true);
+                    assert_eq!(res.is_ok(), ok, "Q, n = {n}, λmin = {lowest}·‖Q‖: {res:?}");
+                }
+                // R: definite above ε m ‖R‖ for a regulator, semidefinite
+                // for a discrete equation.
+                for (lowest, definite, semidefinite) in [
+                    (1e-13, true, true),
+                    (-1e-14, false, true),
+                    (-1e-10, false, false),
+                    (0.3, true, true),
+                ] {
+                    let r = symmetric_with(n, lowest, &mut rng) * scale;
+                    let lqr = check_weights(&q1, &r, regulator, true);
+                    assert_eq!(
+                        lqr.is_ok(),
+                        definite,
+                        "R, n = {n}, λmin = {lowest}·‖R‖: {lqr:?}"
+                    );
+                    let equation = check_weights(&q1, &r, Weights::Equation, false);
+                    assert_eq!(
+                        equation.is_ok(),
+                        semidefinite,
+                        "R (equation), n = {n}, λmin = {lowest}·‖R‖"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -89,7 +89,7 @@ pub(crate) fn continuous<N: Dim, M: Dim>(
 where
     DefaultAllocator: RiccatiAlloc<N, M>,
 {
-    check_weights(&heap(q), &heap(r), weights, true)?;
+    check_weights(q, r, weights, true)?;
     let (q, r, weight) = balance_weights(q, r);
     let (dim, _) = a.shape_generic();
     let r_inv_bt = Lu::new(&r, "LQR (R)")?.solve(&b.transpose());
@@ -171,7 +171,7 @@ pub(crate) fn discrete<N: Dim, M: Dim>(
 where
     DefaultAllocator: RiccatiAlloc<N, M>,
 {
-    check_weights(&heap(q), &heap(r), weights, false)?;
+    check_weights(q, r, weights, false)?;
     let (q, r, weight) = balance_weights(q, r);
     let (m, _) = r.shape_generic();
     // A singular R (accepted for an equation only) is regularised for the
