@@ -67,11 +67,16 @@ where
     max * s.sqrt()
 }
 
-/// `‖a − b‖_F`, without forming `a − b`.
+/// `‖a − b‖_F`, without forming `a − b`; rescaled as [`fro`] rescales only
+/// where the plain sum of squares overflows or underflows.
 fn fro_diff<N: Dim>(a: &Square<N>, b: &Square<N>) -> f64
 where
     DefaultAllocator: Allocator<N, N>,
 {
+    let plain: f64 = a.iter().zip(b.iter()).map(|(x, y)| (x - y) * (x - y)).sum();
+    if plain.is_finite() && plain >= f64::MIN_POSITIVE {
+        return plain.sqrt();
+    }
     let max = a
         .iter()
         .zip(b.iter())
