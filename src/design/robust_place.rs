@@ -8,7 +8,7 @@ use nalgebra::{
 use super::place::{check_targets, conjugate_pairs, heap};
 use crate::analysis::{eigenvalues_dyn, krylov, rank};
 use crate::error::Error;
-use crate::kernels::linalg::{Lu, householder_q};
+use crate::kernels::linalg::{Lu, dotc, householder_q, mul, norm};
 use crate::model::{Domain, DynStateSpace, StateSpace};
 
 /// Sweeps over all eigenvectors at most (SciPy's `place_poles` default).
@@ -278,7 +278,7 @@ where
         .copy_from(&b.map(|v| Complex::new(v, 0.0)));
     let u = householder_q(&padded, m).map(|c| c.re);
     let ut = u.transpose();
-    let z = (&ut * b).rows_generic(0, dim_m).into_owned();
+    let z = mul(&ut, b).rows_generic(0, dim_m).into_owned();
     let z_max = z.amax();
     if (0..m).any(|i| z[(i, i)].abs() <= n as f64 * f64::EPSILON * z_max) || z_max == 0.0 {
         return Err(rank_error);
@@ -288,11 +288,11 @@ where
     let x = if m == n {
         OMatrix::identity_generic(dim_n, dim_n)
     } else {
-        real_columns(&eigenvectors(&(&ut * a), &u, &targets, dim_m), &targets)
+        real_columns(&eigenvectors(&mul(&ut, a), &u, &targets, dim_m), &targets)
     };
     let lambda = real_block_form(&targets, dim_n);
     // A − B K = X Λ X⁻¹.
-    let closed = Lu::solve_right(&x, &(&x * lambda), "pole placement (eigenvector matrix)")
+    let closed = Lu::solve_right(&x, &mul(&x, &lambda), "pole placement (eigenvector matrix)")
         .map_err(|_| {
             uncontrollable_or(
                 a,
@@ -302,14 +302,14 @@ where
                 },
             )
         })?;
-    let rows = (&ut * (a - closed)).rows_generic(0, dim_m).into_owned();
+    let rows = mul(&ut, &(a - closed)).rows_generic(0, dim_m).into_owned();
     let k = z_lu.solve(&rows);
     if k.iter().any(|v| !v.is_finite()) {
         return Err(Error::Overflow {
             operation: "pole placement gain",
         });
     }
-    check_placed(&heap(&(a - b * &k)), &targets).map_err(|e| uncontrollable_or(a, b, e))?;
+    check_placed(&heap(&(a - mul(b, &k))), &targets).map_err(|e| uncontrollable_or(a, b, e))?;
     Ok(k)
 }
 
@@ -348,7 +348,7 @@ where
             .into_owned();
         // SciPy's start: the normalised sum of the basis vectors.
         let start = basis.column_sum();
-        let start = &start / Complex::new(start.norm().max(f64::MIN_POSITIVE), 0.0);
+        let start = &start / Complex::new(norm(&start).max(f64::MIN_POSITIVE), 0.0);
         x.set_column(j, &start);
         if lambda.im != 0.0 {
             x.set_column(j + 1, &start.map(|c| c.conj()));
@@ -439,7 +439,7 @@ where
     let b = basis_h * u.map(|c| c.conj());
     let mu = dominant_rank_two(&a, &b)?;
     let direction = basis * mu;
-    let along = direction.dotc(&x.column(j));
+    let along = dotc(&direction, &x.column(j));
     if along.norm() > NEGLIGIBLE {
         unit(direction * along)
     } else {
@@ -455,8 +455,8 @@ where
     DefaultAllocator: Allocator<M>,
 {
     let e1 = unit(a.clone()).or_else(|| unit(b.clone()))?;
-    let rest = b - &e1 * e1.dotc(b);
-    let e2 = if rest.norm() > NEGLIGIBLE * b.norm() {
+    let rest = b - &e1 * dotc(&e1, b);
+    let e2 = if norm(&rest) > NEGLIGIBLE * norm(b) {
         unit(rest)
     } else {
         None
@@ -465,7 +465,7 @@ where
         return Some(e1);
     };
     // h = Eᴴ (a aᴴ − b bᴴ) E with E = [e1 e2].
-    let (a1, a2, b1, b2) = (e1.dotc(a), e2.dotc(a), e1.dotc(b), e2.dotc(b));
+    let (a1, a2, b1, b2) = (dotc(&e1, a), dotc(&e2, a), dotc(&e1, b), dotc(&e2, b));
     let p = a1.norm_sqr() - b1.norm_sqr();
     let s = a2.norm_sqr() - b2.norm_sqr();
     let q = a1 * a2.conj() - b1 * b2.conj();
@@ -496,7 +496,7 @@ fn unit<R: Dim>(v: CVector<R>) -> Option<CVector<R>>
 where
     DefaultAllocator: Allocator<R>,
 {
-    let length = v.norm();
+    let length = norm(&v);
     (length > NEGLIGIBLE).then(|| v / Complex::new(length, 0.0))
 }
 
