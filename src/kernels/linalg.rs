@@ -184,14 +184,22 @@ where
             v[i] /= v_norm;
         }
         // R ← H R and Q ← Q H with H = I − 2 v vᴴ.
+        // The sums as plain loops: `Sum for Complex` is not inlined, and
+        // was a sixth of `place`'s time. Same terms, same order.
         for c in 0..n {
-            let dot: Complex<f64> = (j..n).map(|i| v[i].conj() * r[(i, c)]).sum();
+            let mut dot = Complex::new(0.0, 0.0);
+            for i in j..n {
+                dot += v[i].conj() * r[(i, c)];
+            }
             for i in j..n {
                 r[(i, c)] -= v[i] * dot * 2.0;
             }
         }
         for row in 0..n {
-            let dot: Complex<f64> = (j..n).map(|i| q[(row, i)] * v[i]).sum();
+            let mut dot = Complex::new(0.0, 0.0);
+            for i in j..n {
+                dot += q[(row, i)] * v[i];
+            }
             for i in j..n {
                 q[(row, i)] -= dot * v[i].conj() * 2.0;
             }
