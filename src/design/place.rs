@@ -192,7 +192,7 @@ where
 }
 
 /// A copy on the heap, for the code written for run-time-sized matrices.
-fn heap<R: Dim, C: Dim>(m: &OMatrix<f64, R, C>) -> DMatrix<f64>
+pub(crate) fn heap<R: Dim, C: Dim>(m: &OMatrix<f64, R, C>) -> DMatrix<f64>
 where
     DefaultAllocator: Allocator<R, C>,
 {

@@ -1,12 +1,14 @@
 //! Pole placement for multi-input systems by the robust method of Kautsky,
 //! Nichols and Van Dooren (method 0), and its dual for observers.
 
-use nalgebra::{Complex, DMatrix, DVector, SMatrix};
+use nalgebra::{
+    Complex, DMatrix, DefaultAllocator, Dim, OMatrix, OVector, SMatrix, U1, allocator::Allocator,
+};
 
-use super::place::{check_targets, conjugate_pairs};
+use super::place::{check_targets, conjugate_pairs, heap};
 use crate::analysis::{eigenvalues_dyn, krylov, rank};
 use crate::error::Error;
-use crate::kernels::linalg::{Lu, householder_q};
+use crate::kernels::linalg::{Lu, dotc, householder_q, mul, norm};
 use crate::model::{Domain, DynStateSpace, StateSpace};
 
 /// Sweeps over all eigenvectors at most (SciPy's `place_poles` default).
@@ -21,13 +23,8 @@ const NEGLIGIBLE: f64 = 1e-8;
 /// target: python-control's own test of `place` checks six decimals.
 pub(crate) const PLACE_TOL: f64 = 1e-6;
 
-type CMatrix = DMatrix<Complex<f64>>;
-type CVector = DVector<Complex<f64>>;
-
-/// A run-time-sized copy of a fixed-size matrix.
-fn heap<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> DMatrix<f64> {
-    DMatrix::from_column_slice(R, C, m.as_slice())
-}
+type CMatrix<R, C> = OMatrix<Complex<f64>, R, C>;
+type CVector<R> = OVector<Complex<f64>, R>;
 
 /// The state gain `K` that puts the poles of `A − B K` at `poles`, for any
 /// number of inputs, by the robust eigenvector method of Kautsky, Nichols
@@ -98,8 +95,7 @@ pub fn place<const N: usize, const M: usize, const P: usize, D: Domain>(
     sys: &StateSpace<N, M, P, D>,
     poles: &[Complex<f64>; N],
 ) -> Result<SMatrix<f64, M, N>, Error> {
-    let k = place_pair(&heap(sys.a()), &heap(sys.b()), poles)?;
-    Ok(SMatrix::from_column_slice(k.as_slice()))
+    place_pair(sys.a(), sys.b(), poles)
 }
 
 /// The observer gain `L` that puts the poles of `A − L C` at `poles`: a
@@ -137,8 +133,7 @@ pub fn place_observer<const N: usize, const M: usize, const P: usize, D: Domain>
     sys: &StateSpace<N, M, P, D>,
     poles: &[Complex<f64>; N],
 ) -> Result<SMatrix<f64, N, P>, Error> {
-    let l = observer_pair(&heap(sys.a()), &heap(sys.c()), poles)?;
-    Ok(SMatrix::from_column_slice(l.as_slice()))
+    observer_pair(sys.a(), sys.c(), poles)
 }
 
 impl<D: Domain> DynStateSpace<D> {
@@ -207,12 +202,32 @@ impl<D: Domain> DynStateSpace<D> {
     }
 }
 
+/// The allocations placement needs for `N` states and `M` inputs (of any
+/// element type): one bound to write instead of six.
+trait Sizes<N: Dim, M: Dim>:
+    Allocator<N, N> + Allocator<N, M> + Allocator<M, N> + Allocator<M, M> + Allocator<N> + Allocator<M>
+{
+}
+
+impl<N: Dim, M: Dim, T> Sizes<N, M> for T where
+    T: Allocator<N, N>
+        + Allocator<N, M>
+        + Allocator<M, N>
+        + Allocator<M, M>
+        + Allocator<N>
+        + Allocator<M>
+{
+}
+
 /// [`place_observer`] on a bare pair `(A, C)`.
-fn observer_pair(
-    a: &DMatrix<f64>,
-    c: &DMatrix<f64>,
+fn observer_pair<N: Dim, P: Dim>(
+    a: &OMatrix<f64, N, N>,
+    c: &OMatrix<f64, P, N>,
     poles: &[Complex<f64>],
-) -> Result<DMatrix<f64>, Error> {
+) -> Result<OMatrix<f64, N, P>, Error>
+where
+    DefaultAllocator: Sizes<N, P>,
+{
     place_pair(&a.transpose(), &c.transpose(), poles)
         .map(|k| k.transpose())
         .map_err(|e| match e {
@@ -226,13 +241,18 @@ fn observer_pair(
 }
 
 /// [`place`] on a bare pair `(A, B)` with one target per state (the
-/// callers' check).
-fn place_pair(
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
+/// callers' check). Written once over nalgebra's dimensions, so a
+/// fixed-size model's sweeps run on stack matrices.
+fn place_pair<N: Dim, M: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
     poles: &[Complex<f64>],
-) -> Result<DMatrix<f64>, Error> {
-    let (n, m) = b.shape();
+) -> Result<OMatrix<f64, M, N>, Error>
+where
+    DefaultAllocator: Sizes<N, M>,
+{
+    let (dim_n, dim_m) = b.shape_generic();
+    let (n, m) = (dim_n.value(), dim_m.value());
     let targets = conjugate_pairs(poles)?;
     if let Some(p) = targets
         .iter()
@@ -252,12 +272,13 @@ fn place_pair(
         return Err(rank_error);
     }
     // B = U [Z; 0]: U from Householder reflections of B's columns.
-    let mut padded = CMatrix::zeros(n, n);
+    let mut padded = CMatrix::zeros_generic(dim_n, dim_n);
     padded
-        .columns_mut(0, m)
+        .columns_generic_mut(0, dim_m)
         .copy_from(&b.map(|v| Complex::new(v, 0.0)));
     let u = householder_q(&padded, m).map(|c| c.re);
-    let z = (u.transpose() * b).rows(0, m).into_owned();
+    let ut = u.transpose();
+    let z = mul(&ut, b).rows_generic(0, dim_m).into_owned();
     let z_max = z.amax();
     if (0..m).any(|i| z[(i, i)].abs() <= n as f64 * f64::EPSILON * z_max) || z_max == 0.0 {
         return Err(rank_error);
@@ -265,13 +286,13 @@ fn place_pair(
     let z_lu = Lu::new(&z, "pole placement (B)")?;
 
     let x = if m == n {
-        DMatrix::identity(n, n)
+        OMatrix::identity_generic(dim_n, dim_n)
     } else {
-        real_columns(&eigenvectors(a, &u, &targets, m), &targets)
+        real_columns(&eigenvectors(&mul(&ut, a), &u, &targets, dim_m), &targets)
     };
-    let lambda = real_block_form(&targets);
+    let lambda = real_block_form(&targets, dim_n);
     // A − B K = X Λ X⁻¹.
-    let closed = Lu::solve_right(&x, &(&x * lambda), "pole placement (eigenvector matrix)")
+    let closed = Lu::solve_right(&x, &mul(&x, &lambda), "pole placement (eigenvector matrix)")
         .map_err(|_| {
             uncontrollable_or(
                 a,
@@ -281,51 +302,59 @@ fn place_pair(
                 },
             )
         })?;
-    let rows = (u.transpose() * (a - closed)).rows(0, m).into_owned();
+    let rows = mul(&ut, &(a - closed)).rows_generic(0, dim_m).into_owned();
     let k = z_lu.solve(&rows);
     if k.iter().any(|v| !v.is_finite()) {
         return Err(Error::Overflow {
             operation: "pole placement gain",
         });
     }
-    check_placed(&(a - b * &k), &targets).map_err(|e| uncontrollable_or(a, b, e))?;
+    check_placed(&heap(&(a - mul(b, &k))), &targets).map_err(|e| uncontrollable_or(a, b, e))?;
     Ok(k)
 }
 
 /// The closed-loop eigenvectors, one per target (complex; a conjugate
 /// pair's second the conjugate of the first), by KNV method 0 when there is
 /// a choice (`m > 1`).
-fn eigenvectors(a: &DMatrix<f64>, u: &DMatrix<f64>, targets: &[Complex<f64>], m: usize) -> CMatrix {
-    let n = a.nrows();
-    let ut_a = u.transpose() * a;
-    let mut bases = vec![CMatrix::zeros(n, m); n];
-    let mut x = CMatrix::zeros(n, n);
+fn eigenvectors<N: Dim, M: Dim>(
+    ut_a: &OMatrix<f64, N, N>,
+    u: &OMatrix<f64, N, N>,
+    targets: &[Complex<f64>],
+    dim_m: M,
+) -> CMatrix<N, N>
+where
+    DefaultAllocator: Sizes<N, M>,
+{
+    let (dim_n, _) = u.shape_generic();
+    let (n, m) = (dim_n.value(), dim_m.value());
+    // (j, basis of S_j) per real target and per pair, whose second
+    // column is kept the conjugate of the first.
+    let mut bases = Vec::with_capacity(n);
+    let mut x = CMatrix::zeros_generic(dim_n, dim_n);
     let mut j = 0;
     while j < n {
         let lambda = targets[j];
         // S_j = ker W, W = U₁ᵀ (A − λ I): the last m columns of the Q of
         // a QR of Wᴴ span it.
-        let mut wh = CMatrix::zeros(n, n);
+        let mut wh = CMatrix::zeros_generic(dim_n, dim_n);
         for col in 0..n - m {
             for row in 0..n {
                 let w = Complex::new(ut_a[(m + col, row)], 0.0) - lambda * u[(row, m + col)];
                 wh[(row, col)] = w.conj();
             }
         }
-        let basis = householder_q(&wh, n - m).columns(n - m, m).into_owned();
+        let basis = householder_q(&wh, n - m)
+            .columns_generic(n - m, dim_m)
+            .into_owned();
         // SciPy's start: the normalised sum of the basis vectors.
         let start = basis.column_sum();
-        let start = &start / Complex::new(start.norm().max(f64::MIN_POSITIVE), 0.0);
+        let start = &start / Complex::new(norm(&start).max(f64::MIN_POSITIVE), 0.0);
         x.set_column(j, &start);
         if lambda.im != 0.0 {
-            bases[j + 1] = basis.map(|c| c.conj());
             x.set_column(j + 1, &start.map(|c| c.conj()));
-            bases[j] = basis;
-            j += 2;
-        } else {
-            bases[j] = basis;
-            j += 1;
         }
+        bases.push((j, basis));
+        j += if lambda.im != 0.0 { 2 } else { 1 };
     }
     if m == 1 {
         return x;
@@ -333,20 +362,19 @@ fn eigenvectors(a: &DMatrix<f64>, u: &DMatrix<f64>, targets: &[Complex<f64>], m:
     let floor = f64::EPSILON.sqrt();
     let mut det_before = det_abs(&real_columns(&x, targets));
     for _ in 0..MAX_SWEEPS {
-        let mut j = 0;
-        while j < n {
-            let y = if targets[j].im == 0.0 {
-                knv_update(&x, &bases[j], j)
+        for (j, basis) in &bases {
+            let (j, pair) = (*j, targets[*j].im != 0.0);
+            let y = if pair {
+                pair_update(&x, basis, targets, j)
             } else {
-                pair_update(&x, &bases[j], targets, j)
+                knv_update(&x, basis, j)
             };
             if let Some(y) = y {
-                if targets[j].im != 0.0 {
+                if pair {
                     x.set_column(j + 1, &y.map(|c| c.conj()));
                 }
                 x.set_column(j, &y);
             }
-            j += if targets[j].im != 0.0 { 2 } else { 1 };
         }
         let det = det_abs(&real_columns(&x, targets)).max(floor);
         let change = ((det - det_before) / det).abs();
@@ -362,7 +390,14 @@ fn eigenvectors(a: &DMatrix<f64>, u: &DMatrix<f64>, targets: &[Complex<f64>], m:
 /// its space `S_j` closest to the normal of the other eigenvectors' span;
 /// `None` to keep the old one when the normal is (nearly) orthogonal to
 /// `S_j`.
-fn knv_update(x: &CMatrix, basis: &CMatrix, j: usize) -> Option<CVector> {
+fn knv_update<N: Dim, M: Dim>(
+    x: &CMatrix<N, N>,
+    basis: &CMatrix<N, M>,
+    j: usize,
+) -> Option<CVector<N>>
+where
+    DefaultAllocator: Sizes<N, M>,
+{
     let n = x.ncols();
     let mut others = x.clone();
     others.swap_columns(j, n - 1);
@@ -377,13 +412,17 @@ fn knv_update(x: &CMatrix, basis: &CMatrix, j: usize) -> Option<CVector> {
 /// `xᴴ (u uᴴ − ū uᵀ) x`; over `x = S μ`, `‖μ‖ = 1`, it is largest at the
 /// dominant eigenvector of the Hermitian `Sᴴ (u uᴴ − ū uᵀ) S`. The old `x`
 /// is projected on that direction (keeping its phase).
-fn pair_update(
-    x: &CMatrix,
-    basis: &CMatrix,
+fn pair_update<N: Dim, M: Dim>(
+    x: &CMatrix<N, N>,
+    basis: &CMatrix<N, M>,
     targets: &[Complex<f64>],
     j: usize,
-) -> Option<CVector> {
-    let n = x.ncols();
+) -> Option<CVector<N>>
+where
+    DefaultAllocator: Sizes<N, M>,
+{
+    let (dim_n, _) = x.shape_generic();
+    let n = dim_n.value();
     if n < 3 {
         // No other columns: any x of S works as well as another.
         return None;
@@ -392,12 +431,15 @@ fn pair_update(
     others.swap_columns(j + 1, n - 1);
     others.swap_columns(j, n - 2);
     let q = householder_q(&others, n - 2);
-    let u = CVector::from_fn(n, |i, _| Complex::new(q[(i, n - 2)].re, q[(i, n - 1)].re));
-    let a = basis.adjoint() * &u;
-    let b = basis.adjoint() * u.map(|c| c.conj());
+    let u = CVector::from_fn_generic(dim_n, U1, |i, _| {
+        Complex::new(q[(i, n - 2)].re, q[(i, n - 1)].re)
+    });
+    let basis_h = basis.adjoint();
+    let a = &basis_h * &u;
+    let b = basis_h * u.map(|c| c.conj());
     let mu = dominant_rank_two(&a, &b)?;
     let direction = basis * mu;
-    let along = direction.dotc(&x.column(j));
+    let along = dotc(&direction, &x.column(j));
     if along.norm() > NEGLIGIBLE {
         unit(direction * along)
     } else {
@@ -408,10 +450,13 @@ fn pair_update(
 /// The unit eigenvector, for the eigenvalue of largest magnitude, of the
 /// rank-two Hermitian `a aᴴ − b bᴴ`: it lies in `span(a, b)`, so a 2 × 2
 /// Hermitian eigenproblem on an orthonormal basis of that span gives it.
-fn dominant_rank_two(a: &CVector, b: &CVector) -> Option<CVector> {
+fn dominant_rank_two<M: Dim>(a: &CVector<M>, b: &CVector<M>) -> Option<CVector<M>>
+where
+    DefaultAllocator: Allocator<M>,
+{
     let e1 = unit(a.clone()).or_else(|| unit(b.clone()))?;
-    let rest = b - &e1 * e1.dotc(b);
-    let e2 = if rest.norm() > NEGLIGIBLE * b.norm() {
+    let rest = b - &e1 * dotc(&e1, b);
+    let e2 = if norm(&rest) > NEGLIGIBLE * norm(b) {
         unit(rest)
     } else {
         None
@@ -420,7 +465,7 @@ fn dominant_rank_two(a: &CVector, b: &CVector) -> Option<CVector> {
         return Some(e1);
     };
     // h = Eᴴ (a aᴴ − b bᴴ) E with E = [e1 e2].
-    let (a1, a2, b1, b2) = (e1.dotc(a), e2.dotc(a), e1.dotc(b), e2.dotc(b));
+    let (a1, a2, b1, b2) = (dotc(&e1, a), dotc(&e2, a), dotc(&e1, b), dotc(&e2, b));
     let p = a1.norm_sqr() - b1.norm_sqr();
     let s = a2.norm_sqr() - b2.norm_sqr();
     let q = a1 * a2.conj() - b1 * b2.conj();
@@ -447,14 +492,20 @@ fn dominant_rank_two(a: &CVector, b: &CVector) -> Option<CVector> {
 }
 
 /// `v / ‖v‖`, or `None` for a negligible `v`.
-fn unit(v: CVector) -> Option<CVector> {
-    let norm = v.norm();
-    (norm > NEGLIGIBLE).then(|| v / Complex::new(norm, 0.0))
+fn unit<R: Dim>(v: CVector<R>) -> Option<CVector<R>>
+where
+    DefaultAllocator: Allocator<R>,
+{
+    let length = norm(&v);
+    (length > NEGLIGIBLE).then(|| v / Complex::new(length, 0.0))
 }
 
 /// The real form of the eigenvector matrix: a real target's eigenvector as
 /// is, a pair's as its real and imaginary parts.
-fn real_columns(x: &CMatrix, targets: &[Complex<f64>]) -> DMatrix<f64> {
+fn real_columns<N: Dim>(x: &CMatrix<N, N>, targets: &[Complex<f64>]) -> OMatrix<f64, N, N>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
     let mut out = x.map(|c| c.re);
     let mut j = 0;
     while j < targets.len() {
@@ -471,11 +522,13 @@ fn real_columns(x: &CMatrix, targets: &[Complex<f64>]) -> DMatrix<f64> {
 /// `Λ` in real block form to match [`real_columns`]: `a` on the diagonal
 /// for a real target, `[[a, b], [−b, a]]` for a pair `a ± b i`
 /// (`A (xr + i xi) = (a + b i)(xr + i xi)` is `A [xr xi] = [xr xi] [[a, b], [−b, a]]`).
-fn real_block_form(targets: &[Complex<f64>]) -> DMatrix<f64> {
-    let n = targets.len();
-    let mut lambda = DMatrix::zeros(n, n);
+fn real_block_form<N: Dim>(targets: &[Complex<f64>], dim: N) -> OMatrix<f64, N, N>
+where
+    DefaultAllocator: Allocator<N, N>,
+{
+    let mut lambda = OMatrix::zeros_generic(dim, dim);
     let mut j = 0;
-    while j < n {
+    while j < targets.len() {
         let p = targets[j];
         lambda[(j, j)] = p.re;
         if p.im != 0.0 {
@@ -491,12 +544,17 @@ fn real_block_form(targets: &[Complex<f64>]) -> DMatrix<f64> {
 }
 
 /// `|det X|`, 0 for a numerically singular `X`.
-fn det_abs(x: &DMatrix<f64>) -> f64 {
+fn det_abs<N: Dim>(x: &OMatrix<f64, N, N>) -> f64
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N>,
+{
     Lu::new(x, "determinant").map_or(0.0, |lu| lu.det().abs())
 }
 
 /// Every target has its own achieved pole (eigenvalue of `closed`) within
-/// `PLACE_TOL · max(1, |target|)`, matched greedily nearest first.
+/// `PLACE_TOL · max(1, |target|)`, matched greedily nearest first. Run-time
+/// sized: nalgebra's Schur needs `DimSub<U1>`, which a generic `N` cannot
+/// state.
 fn check_placed(closed: &DMatrix<f64>, targets: &[Complex<f64>]) -> Result<(), Error> {
     let achieved = eigenvalues_dyn(closed)?;
     let mut used = vec![false; achieved.len()];
@@ -521,10 +579,17 @@ fn check_placed(closed: &DMatrix<f64>, targets: &[Complex<f64>]) -> Result<(), E
 }
 
 /// [`Error::Uncontrollable`] when `(A, B)` is not controllable (the reason
-/// a placement failed), otherwise `error`.
-fn uncontrollable_or(a: &DMatrix<f64>, b: &DMatrix<f64>, error: Error) -> Error {
+/// a placement failed), otherwise `error`. An error path: on heap copies.
+fn uncontrollable_or<N: Dim, M: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
+    error: Error,
+) -> Error
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M>,
+{
     let n = a.nrows();
-    match krylov(a, b, "controllability matrix").and_then(|c| rank(&c, None)) {
+    match krylov(&heap(a), &heap(b), "controllability matrix").and_then(|c| rank(&c, None)) {
         Ok(rank) if rank < n => Error::Uncontrollable { rank, states: n },
         _ => error,
     }
