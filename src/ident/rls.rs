@@ -158,30 +158,22 @@ impl<const P: usize> Rls<P> {
         let e = y - phi.dot(&self.theta);
         let p_phi = self.p * phi;
         let q = phi.dot(&p_phi);
-        // An overflowed q (∞, or NaN from ∞ − ∞) takes the scaled path too.
-        if q.is_nan() || q > f64::MAX / 4.0 {
-            return self.scaled_update(phi, e);
-        }
-        // The textbook update, while φᵀPφ is representable.
-        let gain = p_phi / (self.forgetting + q);
-        // P is symmetric, so φᵀP = (Pφ)ᵀ.
-        let p = (self.p - gain * p_phi.transpose()) / self.forgetting;
-        self.commit(e, self.theta + gain * e, p)
-    }
-
-    /// Symmetrises `p` (against round-off drift) and stores the new state
-    /// if `e`, `θ` and `P` are finite; the state is left unchanged if not.
-    #[inline(always)]
-    fn commit(
-        &mut self,
-        e: f64,
-        theta: SVector<f64, P>,
-        p: SMatrix<f64, P, P>,
-    ) -> Result<f64, Error> {
-        let p = (p + p.transpose()) * 0.5;
-        // Non-short-circuit folds: one branch, and the checks vectorise.
-        let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
-        if !(e.is_finite() & finite(theta.as_slice()) & finite(p.as_slice())) {
+        // One compare: an overflowed q (∞, or NaN from ∞ − ∞) fails it too.
+        let (theta, mut p) = if q <= f64::MAX / 4.0 {
+            // The textbook update, while φᵀPφ is representable.
+            let gain = p_phi / (self.forgetting + q);
+            // P is symmetric, so φᵀP = (Pφ)ᵀ.
+            let p = (self.p - gain * p_phi.transpose()) / self.forgetting;
+            (self.theta + gain * e, p)
+        } else {
+            self.scaled_update(phi, e)
+        };
+        // Symmetrise to stop round-off drift.
+        p = (p + p.transpose()) * 0.5;
+        if !(e.is_finite()
+            && theta.iter().all(|v| v.is_finite())
+            && p.iter().all(|v| v.is_finite()))
+        {
             return Err(Error::Overflow {
                 operation: "RLS update",
             });
@@ -196,11 +188,14 @@ impl<const P: usize> Rls<P> {
     /// would make the textbook gain 0): with `φ = s φ̃` (`s` a power of two,
     /// `max |φ̃|` in `[1, 2)`) the gain is `P φ̃ (e / s) / (μ / s² + φ̃ᵀPφ̃)`
     /// and `P ← (P − P φ̃ φ̃ᵀ P c) / μ` with `c = 1 / (μ / s² + φ̃ᵀPφ̃)`: the
-    /// same algebra, without the overflow. Kept out of line, so the
-    /// common update stays as small as the textbook one.
+    /// same algebra, without the overflow. Returns `(θ, P)` before
+    /// symmetrising.
     #[cold]
-    #[inline(never)]
-    fn scaled_update(&mut self, phi: &SVector<f64, P>, e: f64) -> Result<f64, Error> {
+    fn scaled_update(
+        &self,
+        phi: &SVector<f64, P>,
+        e: f64,
+    ) -> (SVector<f64, P>, SMatrix<f64, P, P>) {
         let s = pow2_floor(phi.amax());
         let phi = phi * (1.0 / s);
         let p_phi = self.p * phi;
@@ -213,7 +208,7 @@ impl<const P: usize> Rls<P> {
             (e / s / denom, 1.0 / denom)
         };
         let p = (self.p - p_phi * (p_phi.transpose() * c)) / self.forgetting;
-        self.commit(e, self.theta + p_phi * step, p)
+        (self.theta + p_phi * step, p)
     }
 
     /// The current estimate `θ`.
