@@ -292,10 +292,10 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
 
     #[inline]
     pub(crate) fn applied(&mut self, u: &SVector<f64, M>) {
+        self.z -= self.feedthrough * u;
         let band = self.deadband;
         let excess = (self.asked - u).map(|e| e - e.clamp(-band, band));
-        // One write of `z`, after every read of `u`: `u` may live anywhere.
-        self.z += self.back * excess - self.feedthrough * u;
+        self.z += self.back * excess;
     }
 
     pub(crate) fn reset(&mut self) {
