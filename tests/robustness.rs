@@ -654,6 +654,34 @@ fn discrete_simulation_is_finite_or_an_error() {
         matches!(err, Error::InvalidParameter { name: "input", .. }),
         "{err}"
     );
+    // The input is blamed also where it does not reach a state (B = 0:
+    // ∞ · 0 is NaN) and in a model without states (only D).
+    let unreached =
+        StateSpace::discrete(matrix![0.5], matrix![0.0], matrix![1.0], matrix![1.0], 0.1).unwrap();
+    let err = ctrlab::sim::simulate_discrete(&unreached, vector![0.0], &[vector![f64::INFINITY]])
+        .unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidParameter { name: "input", .. }),
+        "{err}"
+    );
+    let gain = StateSpace::<0, 1, 1, _>::discrete(
+        nalgebra::SMatrix::zeros(),
+        nalgebra::SMatrix::zeros(),
+        nalgebra::SMatrix::zeros(),
+        matrix![2.0],
+        0.1,
+    )
+    .unwrap();
+    let err = ctrlab::sim::simulate_discrete(
+        &gain,
+        nalgebra::SVector::zeros(),
+        &[vector![1.0], vector![f64::NAN]],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidParameter { name: "input", .. }),
+        "{err}"
+    );
     let err =
         ctrlab::sim::simulate_discrete_feedback(&d, vector![0.0], usize::MAX, |_, _| vector![0.0])
             .unwrap_err();

@@ -574,7 +574,9 @@ where
     let mut x = x0;
     for k in 0..steps {
         let u = control(k, &x);
-        check_input(&u, b.ncols())?;
+        if u.len() != b.ncols() {
+            check_input(&u, b.ncols())?;
+        }
         ts.push(k as f64 * dt);
         let y = c * &x + d * &u;
         let next = a * &x + b * &u;
@@ -582,8 +584,12 @@ where
         ys.push(y);
         x = next;
         // Stop at the first overflow: a controller would otherwise see
-        // infinities and the error would blame its input.
-        if x.iter().any(|v| !v.is_finite()) {
+        // infinities and the error would blame its input. A non-finite
+        // input makes every entry of the next state non-finite, so this
+        // one check also catches it (but for a model without states); then
+        // the input is blamed.
+        if x.iter().any(|v| !v.is_finite()) || (x.is_empty() && u.iter().any(|v| !v.is_finite())) {
+            check_input(&u, b.ncols())?;
             return Err(Error::Overflow {
                 operation: DIVERGED,
             });
