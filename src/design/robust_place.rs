@@ -8,7 +8,7 @@ use nalgebra::{
 use super::place::{check_targets, conjugate_pairs, heap};
 use crate::analysis::{eigenvalues_dyn, krylov, rank};
 use crate::error::Error;
-use crate::kernels::linalg::{Lu, dotc, householder_q, mul, norm};
+use crate::kernels::linalg::{Lu, SystemAlloc, dotc, householder_q, mul, norm};
 use crate::model::{Domain, DynStateSpace, StateSpace};
 
 /// Sweeps over all eigenvectors at most (SciPy's `place_poles` default).
@@ -202,23 +202,6 @@ impl<D: Domain> DynStateSpace<D> {
     }
 }
 
-/// The allocations placement needs for `N` states and `M` inputs (of any
-/// element type): one bound to write instead of six.
-trait Sizes<N: Dim, M: Dim>:
-    Allocator<N, N> + Allocator<N, M> + Allocator<M, N> + Allocator<M, M> + Allocator<N> + Allocator<M>
-{
-}
-
-impl<N: Dim, M: Dim, T> Sizes<N, M> for T where
-    T: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<M, N>
-        + Allocator<M, M>
-        + Allocator<N>
-        + Allocator<M>
-{
-}
-
 /// [`place_observer`] on a bare pair `(A, C)`.
 fn observer_pair<N: Dim, P: Dim>(
     a: &OMatrix<f64, N, N>,
@@ -226,7 +209,7 @@ fn observer_pair<N: Dim, P: Dim>(
     poles: &[Complex<f64>],
 ) -> Result<OMatrix<f64, N, P>, Error>
 where
-    DefaultAllocator: Sizes<N, P>,
+    DefaultAllocator: SystemAlloc<N, P>,
 {
     place_pair(&a.transpose(), &c.transpose(), poles)
         .map(|k| k.transpose())
@@ -249,7 +232,7 @@ fn place_pair<N: Dim, M: Dim>(
     poles: &[Complex<f64>],
 ) -> Result<OMatrix<f64, M, N>, Error>
 where
-    DefaultAllocator: Sizes<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let (dim_n, dim_m) = b.shape_generic();
     let (n, m) = (dim_n.value(), dim_m.value());
@@ -323,7 +306,7 @@ fn eigenvectors<N: Dim, M: Dim>(
     dim_m: M,
 ) -> CMatrix<N, N>
 where
-    DefaultAllocator: Sizes<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let (dim_n, _) = u.shape_generic();
     let (n, m) = (dim_n.value(), dim_m.value());
@@ -396,7 +379,7 @@ fn knv_update<N: Dim, M: Dim>(
     j: usize,
 ) -> Option<CVector<N>>
 where
-    DefaultAllocator: Sizes<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let n = x.ncols();
     let mut others = x.clone();
@@ -419,7 +402,7 @@ fn pair_update<N: Dim, M: Dim>(
     j: usize,
 ) -> Option<CVector<N>>
 where
-    DefaultAllocator: Sizes<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let (dim_n, _) = x.shape_generic();
     let n = dim_n.value();

@@ -12,6 +12,25 @@ use nalgebra::{
 
 use crate::error::Error;
 
+/// The allocations a system with `N` states and `M` inputs needs for its
+/// matrices and vectors (of any element type): one bound instead of six,
+/// met by every pair of dimensions nalgebra can allocate, `Const` (stack)
+/// or `Dyn` (heap). Placement and the Riccati solvers are written over it.
+pub(crate) trait SystemAlloc<N: Dim, M: Dim>:
+    Allocator<N, N> + Allocator<N, M> + Allocator<M, N> + Allocator<M, M> + Allocator<N> + Allocator<M>
+{
+}
+
+impl<N: Dim, M: Dim, T> SystemAlloc<N, M> for T where
+    T: Allocator<N, N>
+        + Allocator<N, M>
+        + Allocator<M, N>
+        + Allocator<M, M>
+        + Allocator<N>
+        + Allocator<M>
+{
+}
+
 /// LU factors with partial pivoting, `P A = L U`, packed in one matrix.
 #[derive(Debug, Clone)]
 pub(crate) struct Lu<N: Dim>

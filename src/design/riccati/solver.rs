@@ -10,7 +10,7 @@ use super::kernels::{
 use super::{DynLqr, Weights, check_weights};
 use crate::analysis::{eigenvalues_dyn, first_unstable_dyn};
 use crate::error::Error;
-use crate::kernels::linalg::Lu;
+use crate::kernels::linalg::{Lu, SystemAlloc};
 use crate::kernels::reduce::pow2_floor;
 
 /// A continuous solution with a relative residual above this after Newton
@@ -26,28 +26,11 @@ const REGULARISED_REFINE_STEPS: usize = 12;
 /// Cayley shifts tried, as multiples of the Hamiltonian's scale.
 const SHIFTS: [f64; 7] = [1.0, 0.5, 2.0, 0.25, 4.0, 0.1, 10.0];
 
-/// The allocations one Riccati problem with `N` states and `M` inputs
-/// needs; implemented for every pair of dimensions nalgebra can allocate,
-/// `Const` (stack) or `Dyn` (heap).
-pub(crate) trait RiccatiAlloc<N: Dim, M: Dim>:
-    Allocator<N, N> + Allocator<N, M> + Allocator<M, N> + Allocator<M, M> + Allocator<N> + Allocator<M>
-{
-}
-impl<N: Dim, M: Dim, T> RiccatiAlloc<N, M> for T where
-    T: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<M, N>
-        + Allocator<M, M>
-        + Allocator<N>
-        + Allocator<M>
-{
-}
-
 /// A solution in the caller's matrix sizes; [`DynLqr`] and the fixed-size
 /// [`Lqr`](crate::design::Lqr) are built from it.
 pub(crate) struct Solution<N: Dim, M: Dim>
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     pub(crate) gain: OMatrix<f64, M, N>,
     pub(crate) riccati: Square<N>,
@@ -87,7 +70,7 @@ pub(crate) fn continuous<N: Dim, M: Dim>(
     weights: Weights,
 ) -> Result<Solution<N, M>, Error>
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     check_weights(q, r, weights, true)?;
     let (q, r, weight) = balance_weights(q, r);
@@ -169,7 +152,7 @@ pub(crate) fn discrete<N: Dim, M: Dim>(
     period: Option<f64>,
 ) -> Result<Solution<N, M>, Error>
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     check_weights(q, r, weights, false)?;
     let (q, r, weight) = balance_weights(q, r);
@@ -236,7 +219,7 @@ fn explain<N: Dim, M: Dim>(
     period: Option<f64>,
 ) -> Option<Error>
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let (a, b) = (heap(a), heap(b));
     let (n, m) = (a.nrows(), b.ncols());
@@ -323,7 +306,7 @@ fn finish<N: Dim, M: Dim>(
     period: Option<f64>,
 ) -> Result<Solution<N, M>, Error>
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     if !finite(&gain) {
         return Err(Error::Overflow {
@@ -364,7 +347,7 @@ fn balance_weights<N: Dim, M: Dim>(
     r: &OMatrix<f64, M, M>,
 ) -> (Square<N>, OMatrix<f64, M, M>, f64)
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let (q_max, r_max) = (q.amax(), r.amax());
     let (sq, sr) = (pow2_floor(q_max), pow2_floor(r_max));
@@ -392,7 +375,7 @@ fn care_eval<N: Dim, M: Dim>(
     x: &Square<N>,
 ) -> (Square<N>, f64)
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let at_x = a.transpose() * x;
     let xgx = (x * b) * (r_inv_bt * x);
@@ -409,7 +392,7 @@ fn dare_gain<N: Dim, M: Dim>(
     x: &Square<N>,
 ) -> Result<OMatrix<f64, M, N>, Error>
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let bt_x = b.transpose() * x;
     let s = r + &bt_x * b;
@@ -426,7 +409,7 @@ fn dare_eval<N: Dim, M: Dim>(
     gain: &OMatrix<f64, M, N>,
 ) -> (Square<N>, f64)
 where
-    DefaultAllocator: RiccatiAlloc<N, M>,
+    DefaultAllocator: SystemAlloc<N, M>,
 {
     let at = a.transpose();
     let atxa = &at * (x * a);
