@@ -4,10 +4,11 @@
 //! Everything here is a method on [`StateSpace`] and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time),
 //! except [`rank`]. These are design-time computations, not inner loops:
-//! each is written once, on run-time-sized matrices (eigenvalues through
-//! faer, singular values through nalgebra's SVD), and the fixed-size
-//! methods hand their matrices to it, so both model types give the same
-//! answers.
+//! each is written once, on run-time-sized matrices (eigenvalues by a
+//! balanced Hessenberg QR on the stack up to 8 states, then nalgebra's
+//! Schur and faer's multishift QR; singular values through nalgebra's SVD),
+//! and the fixed-size methods hand their matrices to it, so both model
+//! types give the same answers.
 //!
 //! # Examples
 //!
@@ -34,6 +35,7 @@ pub(crate) use stability::{first_unstable, first_unstable_dyn};
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::Error;
+use crate::kernels::eigen::{SMALL, small_eigenvalues, small_eigenvalues_near};
 #[cfg(doc)]
 use crate::model::StateSpace;
 
@@ -197,13 +199,67 @@ fn singular_values(m: &DMatrix<f64>, name: &'static str) -> Result<Vec<f64>, Err
 pub(crate) fn eigenvalues<const N: usize>(
     a: &SMatrix<f64, N, N>,
 ) -> Result<[Complex<f64>; N], Error> {
-    let values = eigenvalues_dyn(&DMatrix::from_column_slice(N, N, a.as_slice()))?;
     let mut out = [Complex::new(0.0, 0.0); N];
+    // The lab's sizes: the stack kernel, no copy to the heap.
+    if N <= SMALL && small_eigenvalues(a.as_slice(), N, &mut out) {
+        sort_poles(&mut out);
+        return Ok(out);
+    }
+    let values = eigenvalues_dyn(&DMatrix::from_column_slice(N, N, a.as_slice()))?;
     out.copy_from_slice(&values);
     Ok(out)
 }
 
-/// Up to this size `eigenvalues_dyn` tries nalgebra's Schur before faer's.
+/// Sorted by real part, then imaginary part.
+fn sort_poles(p: &mut [Complex<f64>]) {
+    p.sort_unstable_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+}
+
+/// The eigenvalues of a matrix, on the stack up to `SMALL` of them.
+pub(crate) struct Spectrum {
+    small: [Complex<f64>; SMALL],
+    n: usize,
+    heap: Vec<Complex<f64>>,
+}
+
+impl Spectrum {
+    pub(crate) fn as_slice(&self) -> &[Complex<f64>] {
+        if self.n <= SMALL {
+            &self.small[..self.n]
+        } else {
+            &self.heap
+        }
+    }
+}
+
+/// The eigenvalues (in no particular order) of the `n × n` column-major
+/// `a`, expected near `guesses` (a placement's targets, `n` of them): up to
+/// `SMALL` states the stack kernel with the guesses as its first shifts, so
+/// a placement that hit its targets is confirmed in about `n / 2` QR
+/// sweeps; otherwise, or if the kernel gives up, as [`eigenvalues_dyn`].
+pub(crate) fn eigenvalues_near(
+    a: &[f64],
+    n: usize,
+    guesses: &[Complex<f64>],
+) -> Result<Spectrum, Error> {
+    let mut out = Spectrum {
+        small: [Complex::new(0.0, 0.0); SMALL],
+        n,
+        heap: Vec::new(),
+    };
+    if n > SMALL || !small_eigenvalues_near(a, n, guesses, &mut out.small) {
+        let values = eigenvalues_dyn(&DMatrix::from_column_slice(n, n, a))?;
+        if n <= SMALL {
+            out.small[..n].copy_from_slice(&values);
+        } else {
+            out.heap = values;
+        }
+    }
+    Ok(out)
+}
+
+/// Up to this size `eigenvalues_dyn` tries nalgebra's Schur before faer's
+/// (after the stack kernel, which takes up to `kernels::eigen::SMALL`).
 const SMALL_EIGEN: usize = 8;
 
 /// Eigenvalues of a square run-time-sized matrix, sorted as [`eigenvalues`]
@@ -213,6 +269,17 @@ pub(crate) fn eigenvalues_dyn(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, Err
     debug_assert_eq!(n, a.ncols());
     if n == 0 {
         return Ok(Vec::new());
+    }
+    // Up to 8 states: EISPACK's balanced Hessenberg QR on the stack
+    // (`kernels::eigen`), a fraction of nalgebra's Schur at these sizes;
+    // it gives up rather than guess, and the iterations below take over.
+    if n <= SMALL {
+        let mut small = [Complex::new(0.0, 0.0); SMALL];
+        if small_eigenvalues(a.as_slice(), n, &mut small) {
+            let mut out = small[..n].to_vec();
+            sort_poles(&mut out);
+            return Ok(out);
+        }
     }
     let iterations = ITERATIONS_PER_DIM * n;
     let nalgebra_schur = || {
@@ -246,6 +313,6 @@ pub(crate) fn eigenvalues_dyn(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, Err
             operation: "eigenvalues",
         });
     }
-    out.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+    sort_poles(&mut out);
     Ok(out)
 }

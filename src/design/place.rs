@@ -5,8 +5,9 @@ use nalgebra::{
     Complex, DMatrix, DefaultAllocator, Dim, OMatrix, SMatrix, U1, allocator::Allocator,
 };
 
-use crate::analysis::{eigenvalues_dyn, scaled_krylov_rank};
+use crate::analysis::{eigenvalues_near, scaled_krylov_rank};
 use crate::error::Error;
+use crate::kernels::eigen::SMALL;
 use crate::kernels::linalg::Lu;
 use crate::kernels::reduce::pow2_floor;
 use crate::model::{Domain, DynStateSpace, StateSpace};
@@ -185,9 +186,9 @@ where
             operation: "Ackermann gain",
         });
     }
-    // A − b K, with b's one column.
-    let a_cl = DMatrix::from_fn(n, n, |i, j| a[(i, j)] - b[(i, 0)] * k[j]);
-    check_placement(&a_cl, poles)?;
+    // A − b K, with b's one column (on the stack for a fixed size).
+    let a_cl = OMatrix::<f64, N, N>::from_fn_generic(dim, dim, |i, j| a[(i, j)] - b[(i, 0)] * k[j]);
+    check_placement(a_cl.as_slice(), n, poles)?;
     Ok(k)
 }
 
@@ -209,16 +210,25 @@ const PLACEMENT_RTOL: f64 = 1e-3;
 /// but for many states or targets far from the open-loop poles the closed
 /// loop is so sensitive that the gain's rounding moves its poles by tens
 /// of percent. Such a gain is refused, not returned.
-fn check_placement(a_cl: &DMatrix<f64>, targets: &[Complex<f64>]) -> Result<(), Error> {
-    let got = eigenvalues_dyn(a_cl)?;
+fn check_placement(a_cl: &[f64], n: usize, targets: &[Complex<f64>]) -> Result<(), Error> {
+    let got = eigenvalues_near(a_cl, n, targets)?;
+    let got = got.as_slice();
     let scale = targets.iter().map(|t| t.norm()).fold(0.0, f64::max);
     // Each target against its nearest computed pole not used yet.
-    let mut used = vec![false; got.len()];
+    let (mut used_small, mut used_heap) = ([false; SMALL], Vec::new());
+    let used: &mut [bool] = if n <= SMALL {
+        &mut used_small[..n]
+    } else {
+        used_heap.resize(n, false);
+        &mut used_heap
+    };
     let mut worst = 0.0f64;
     for t in targets {
+        // Squared distances to choose (an overflow only ties), `norm`
+        // (overflow-safe) for the distance reported.
         let nearest = (0..got.len())
             .filter(|&j| !used[j])
-            .min_by(|&x, &y| (got[x] - t).norm().total_cmp(&(got[y] - t).norm()));
+            .min_by(|&x, &y| (got[x] - t).norm_sqr().total_cmp(&(got[y] - t).norm_sqr()));
         if let Some(j) = nearest {
             used[j] = true;
             worst = worst.max((got[j] - t).norm());

@@ -6,7 +6,7 @@ use nalgebra::{
 };
 
 use super::place::{check_targets, conjugate_pairs, heap};
-use crate::analysis::{eigenvalues_dyn, krylov, rank};
+use crate::analysis::{eigenvalues_near, krylov, rank};
 use crate::error::Error;
 use crate::kernels::linalg::{Lu, SystemAlloc, dotc, householder_q, mul, norm};
 use crate::model::{Domain, DynStateSpace, StateSpace};
@@ -535,11 +535,11 @@ where
 }
 
 /// Every target has its own achieved pole (eigenvalue of `closed`) within
-/// `PLACE_TOL · max(1, |target|)`, matched greedily nearest first. Run-time
-/// sized: nalgebra's Schur needs `DimSub<U1>`, which a generic `N` cannot
-/// state.
+/// `PLACE_TOL · max(1, |target|)`, matched greedily nearest first. The
+/// targets are the eigenvalue iteration's first shifts (`eigenvalues_near`).
 fn check_placed(closed: &DMatrix<f64>, targets: &[Complex<f64>]) -> Result<(), Error> {
-    let achieved = eigenvalues_dyn(closed)?;
+    let achieved = eigenvalues_near(closed.as_slice(), closed.nrows(), targets)?;
+    let achieved = achieved.as_slice();
     let mut used = vec![false; achieved.len()];
     for target in targets {
         let nearest = (0..achieved.len()).filter(|&i| !used[i]).min_by(|&x, &y| {

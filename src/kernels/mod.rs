@@ -1,7 +1,9 @@
 //! Private numeric kernels shared by the public modules: small dense
-//! factorisations on fixed-size matrices ([`linalg`]) and vectorisable
+//! factorisations on fixed-size matrices ([`linalg`]), eigenvalues of
+//! small matrices on the stack ([`eigen`]), and vectorisable
 //! reductions over long columns ([`reduce`]). Nothing here is public API;
 //! every module above may use these, and these use nothing above them.
 
+pub(crate) mod eigen;
 pub(crate) mod linalg;
 pub(crate) mod reduce;
