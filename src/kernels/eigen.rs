@@ -71,8 +71,18 @@ pub(crate) fn small_eigenvalues_near(
     out: &mut [Complex<f64>],
 ) -> bool {
     debug_assert!(n <= SMALL && a.len() == n * n && out.len() >= n);
+    eigenvalues_and_sweeps(a, n, guesses, out).is_some()
+}
+
+/// [`small_eigenvalues_near`], with the number of QR sweeps it took.
+fn eigenvalues_and_sweeps(
+    a: &[f64],
+    n: usize,
+    guesses: &[Complex<f64>],
+    out: &mut [Complex<f64>],
+) -> Option<usize> {
     if n > SMALL || a.iter().any(|v| !v.is_finite()) {
-        return false;
+        return None;
     }
     let mut w = Work {
         a: [0.0; (SMALL + 1) * (SMALL + 1)],
@@ -90,10 +100,11 @@ pub(crate) fn small_eigenvalues_near(
         } else {
             &[]
         };
-    hqr(&mut w, n, guesses, out)
-        && out[..n]
-            .iter()
-            .all(|z| z.re.is_finite() && z.im.is_finite())
+    let sweeps = hqr(&mut w, n, guesses, out)?;
+    out[..n]
+        .iter()
+        .all(|z| z.re.is_finite() && z.im.is_finite())
+        .then_some(sweeps)
 }
 
 /// Similarity scaling by powers of two (exact) so that each row and the
@@ -241,7 +252,12 @@ fn sign(a: f64, b: f64) -> f64 {
 /// in `w`, deflating 1×1 and 2×2 blocks from the bottom; eigenvalues into
 /// `out[..n]`. `false` after [`ITERATIONS`] sweeps without a deflation.
 #[allow(clippy::many_single_char_names)]
-fn hqr(w: &mut Work, n: usize, guesses: &[Complex<f64>], out: &mut [Complex<f64>]) -> bool {
+fn hqr(
+    w: &mut Work,
+    n: usize,
+    guesses: &[Complex<f64>],
+    out: &mut [Complex<f64>],
+) -> Option<usize> {
     let mut anorm = 0.0;
     for i in 1..=n {
         for j in (i.max(2) - 1)..=n {
@@ -249,8 +265,9 @@ fn hqr(w: &mut Work, n: usize, guesses: &[Complex<f64>], out: &mut [Complex<f64>
         }
     }
     if !anorm.is_finite() {
-        return false;
+        return None;
     }
+    let mut sweeps = 0;
     // Which guesses a deflated eigenvalue has matched (the nearest one).
     let mut matched = [false; SMALL];
     let mut nn = n;
@@ -298,7 +315,7 @@ fn hqr(w: &mut Work, n: usize, guesses: &[Complex<f64>], out: &mut [Complex<f64>
                     nn -= 2;
                 } else {
                     if its == ITERATIONS {
-                        return false;
+                        return None;
                     }
                     if its % 10 == 0 && its > 0 {
                         // Exceptional shift.
@@ -323,6 +340,7 @@ fn hqr(w: &mut Work, n: usize, guesses: &[Complex<f64>], out: &mut [Complex<f64>
                         ww = x * x - det;
                     }
                     its += 1;
+                    sweeps += 1;
                     // Form the shift and look for two consecutive small
                     // subdiagonal elements.
                     let mut m = nn - 2;
@@ -415,7 +433,7 @@ fn hqr(w: &mut Work, n: usize, guesses: &[Complex<f64>], out: &mut [Complex<f64>
             }
         }
     }
-    true
+    Some(sweeps)
 }
 
 #[cfg(test)]
@@ -578,6 +596,53 @@ mod tests {
         // The lab's scale trouble: diag(−1e-3, −1e12) stays exact.
         let e = eig(&[-1e-3, 0.0, 0.0, -1e12], 2);
         assert_eq!(e, [Complex::new(-1e12, 0.0), Complex::new(-1e-3, 0.0)]);
+    }
+
+    #[test]
+    fn exact_guesses_save_sweeps() {
+        // The lab plant under Ackermann's gain for −30 ± 30i, −40, −50
+        // (A − b K, column-major): the targets as first shifts confirm the
+        // poles in 2 sweeps, one per pair, against 8 with the standard
+        // shifts.
+        let a = [
+            0.0,
+            -1538.4615384615383,
+            0.0,
+            8453.72781065089,
+            1.0,
+            -7.692307692307692,
+            0.0,
+            -16.31597633136095,
+            0.0,
+            769.2307692307692,
+            0.0,
+            -6566.863905325444,
+            0.0,
+            0.0,
+            1.0,
+            -142.30769230769232,
+        ];
+        let targets = [
+            Complex::new(-30.0, 30.0),
+            Complex::new(-30.0, -30.0),
+            Complex::new(-40.0, 0.0),
+            Complex::new(-50.0, 0.0),
+        ];
+        let mut out = [Complex::new(0.0, 0.0); SMALL];
+        let plain = eigenvalues_and_sweeps(&a, 4, &[], &mut out).unwrap();
+        let guided = eigenvalues_and_sweeps(&a, 4, &targets, &mut out).unwrap();
+        let mut got = out[..4].to_vec();
+        got.sort_by(|x, y| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im)));
+        for (g, t) in got
+            .iter()
+            .zip([targets[3], targets[2], targets[1], targets[0]])
+        {
+            assert!((g - t).norm() < 1e-9, "{got:?}");
+        }
+        assert!(
+            guided <= 2 && plain >= 6,
+            "{guided} sweeps guided, {plain} plain"
+        );
     }
 
     #[test]
