@@ -308,22 +308,30 @@ proptest! {
     /// Random models with random inputs are controllable (almost surely);
     /// with `Q = CᵀC + I/10 > 0` the stabilising solution exists. Every `Ok`
     /// has a finite X, a small residual and a stable closed loop.
+    ///
+    /// "Small" is 1e-9 relative, or `1e-15 ‖X‖_F` when X is huge: a nearly
+    /// uncontrollable unstable mode makes the equation ill-conditioned, and
+    /// no method's residual then stays at 1e-9. One 11-state draw had
+    /// ‖X‖_F = 5.9e11, where ctrlab's relative residual was 5.4e-5 and
+    /// SciPy's `solve_continuous_are` 2.9e-4; over 3000 such draws SciPy's
+    /// residual exceeds 1e-9 only where ‖X‖_F > 1e5.
     #[test]
     fn random_stabilisable_problems((a, b, c) in problem()) {
         let n = a.nrows();
         let q = c.transpose() * &c + DMatrix::identity(n, n) * 0.1;
         let r = DMatrix::identity(b.ncols(), b.ncols());
         let sys = DynStateSpace::continuous(a.clone(), b.clone(), DMatrix::zeros(0, n), DMatrix::zeros(0, b.ncols())).unwrap();
+        let bound = |x: &DMatrix<f64>| 1e-9f64.max(1e-15 * x.norm());
         if let Ok(sol) = sys.lqr(&q, &r) {
             prop_assert!(sol.riccati.iter().all(|v| v.is_finite()));
-            prop_assert!(sol.residual < 1e-9, "residual {}", sol.residual);
+            prop_assert!(sol.residual < bound(&sol.riccati), "residual {}, ‖X‖ {}", sol.residual, sol.riccati.norm());
             prop_assert!(sol.poles.iter().all(|p| p.re < 0.0));
         }
         // The same plant sampled: A/2 keeps some modes outside the circle.
         let d = DynStateSpace::discrete(&a * 0.5, b, DMatrix::zeros(0, n), DMatrix::zeros(0, r.nrows()), 0.01).unwrap();
         if let Ok(sol) = d.lqr(&q, &r) {
             prop_assert!(sol.riccati.iter().all(|v| v.is_finite()));
-            prop_assert!(sol.residual < 1e-9, "residual {}", sol.residual);
+            prop_assert!(sol.residual < bound(&sol.riccati), "residual {}, ‖X‖ {}", sol.residual, sol.riccati.norm());
             prop_assert!(sol.poles.iter().all(|z| z.norm() < 1.0));
         }
     }
