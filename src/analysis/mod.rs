@@ -205,7 +205,9 @@ pub(crate) fn eigenvalues<const N: usize>(
         sort_poles(&mut out);
         return Ok(out);
     }
-    let values = eigenvalues_dyn(&DMatrix::from_column_slice(N, N, a.as_slice()))?;
+    // The kernel gave up (or N is larger): the iterations, not the same
+    // kernel again through `eigenvalues_dyn`.
+    let values = eigenvalues_iterative(&DMatrix::from_column_slice(N, N, a.as_slice()))?;
     out.copy_from_slice(&values);
     Ok(out)
 }
@@ -281,6 +283,13 @@ pub(crate) fn eigenvalues_dyn(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, Err
             return Ok(out);
         }
     }
+    eigenvalues_iterative(a)
+}
+
+/// [`eigenvalues_dyn`] without the stack kernel: nalgebra's Schur and
+/// faer's multishift QR, sorted; `a` is square and not empty.
+fn eigenvalues_iterative(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, Error> {
+    let n = a.nrows();
     let iterations = ITERATIONS_PER_DIM * n;
     let nalgebra_schur = || {
         a.clone()
