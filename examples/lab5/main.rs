@@ -55,6 +55,7 @@ use std::time::Instant;
 
 use ctrlab::hw::{RealTime, StopSignal};
 use ctrlab::lab::SimulatedRig;
+use ctrlab::lab::ident::SimulationModel;
 use identification::Identification;
 use report::Report;
 use rig::{Backend, BackendKind, RigResult, RigRow, RigTable, pct};
@@ -271,6 +272,9 @@ fn sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::e
         &ident,
         fresh.as_ref().map(|r| ("runs/excite_1_1.csv", r)),
         truth,
+        backend
+            .sim()
+            .map_or_else(SimulationModel::default, |s| s.simulation_model()),
         report,
     )?;
     frequency::section(backend, &ident, report)?;
@@ -306,7 +310,7 @@ fn offline_sections(
     let (runs, intro) = identification::log_runs(dir, &options)?;
     let ident = identification::identification(runs, &intro, None, report)?;
     let fresh = ident.runs.get(1).map(|r| (r.name.as_str(), &r.recording));
-    validation::section(&ident, fresh, None, report)?;
+    validation::section(&ident, fresh, None, SimulationModel::default(), report)?;
     report.heading(2, "Answers to the report's questions");
     answer_model(report, None, &ident);
     report.add("Tables 5 and 6 and the design on the rig need the rig: run lab5 without `--logs` (on the simulated rig, or the card with `--port`).\n");

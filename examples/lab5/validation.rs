@@ -4,7 +4,7 @@
 
 use ctrlab::Recording;
 use ctrlab::lab::MassSpring;
-use ctrlab::lab::ident::{Validation, refine, validate};
+use ctrlab::lab::ident::{SimulationModel, Validation, refine_with, validate_with};
 
 use crate::identification::Identification;
 use crate::report::Report;
@@ -27,11 +27,14 @@ fn row(name: &str, plant: &MassSpring, coulomb: [f64; 2], v: &Validation) -> Vec
 }
 
 /// `fresh`: the run the models have not seen, and its name for the text;
-/// `truth`: the simulated card's plant and Coulomb forces.
+/// `truth`: the simulated card's plant and Coulomb forces; `model`: how the
+/// rig is simulated (the simulated card's own structure, or the default
+/// for a rig whose delay and stiction are not known).
 pub fn section(
     ident: &Identification,
     fresh: Option<(&str, &Recording)>,
     truth: Option<(MassSpring, [f64; 2])>,
+    model: SimulationModel,
     report: &mut Report,
 ) -> Result<(), Box<dyn std::error::Error>> {
     report.heading(
@@ -45,7 +48,7 @@ pub fn section(
     let first = ident.runs.first().ok_or("no identification run")?;
     let rec = &first.recording;
     let separate = ident.separate.first().ok_or("no identification run")?;
-    let refined = refine(rec, separate)?;
+    let refined = refine_with(rec, separate, &model)?;
     let lab = ident.lab.first().ok_or("no identification run")?.plant();
     let ls_coulomb = separate.friction_plant().friction();
     let mut rows = Vec::new();
@@ -59,18 +62,18 @@ pub fn section(
         ),
         ("refined by output error", refined.plant, refined.coulomb),
     ] {
-        match validate(fresh, &plant, coulomb) {
+        match validate_with(fresh, &plant, coulomb, &model) {
             Ok(v) => rows.push(row(name, &plant, coulomb, &v)),
             Err(e) => failures.push(format!("{name}: {e}")),
         }
     }
     if let Some((truth, forces)) = truth
-        && let Ok(v) = validate(fresh, &truth, forces)
+        && let Ok(v) = validate_with(fresh, &truth, forces, &model)
     {
         rows.push(row("**the simulated card's truth**", &truth, forces, &v));
     }
     report.add(&format!(
-        "The first identification run (`{}`) identified three ways, each model then simulated from the input of a run it has not seen (`{fresh_name}`), from rest. **Fit** is `100 (1 − ‖x − x̂‖ / ‖x − mean x‖)` of each cart's simulated position (MATLAB's `compare`). The refinement minimises both carts' simulation error on that run over k1, k2, b1, b2, K, F1, F2 by Levenberg–Marquardt ({} simulations; fit on `{}` from {:.2} / {:.2} % to {:.2} / {:.2} %). **white** and **indep.** are the largest normalised auto- and cross-correlation (with the input) of cart 2's simulation error over 25 lags, against a 99 % bound of {:.3} for a white error independent of the input: an output-error model has no noise model, so its error is not white; a cross-correlation above the bound is dynamics the model misses (a drive's delay, and stiction above the Coulomb force, are not in it).\n",
+        "The first identification run (`{}`) identified three ways, each model then simulated from the input of a run it has not seen (`{fresh_name}`), from rest. **Fit** is `100 (1 − ‖x − x̂‖ / ‖x − mean x‖)` of each cart's simulated position (MATLAB's `compare`). The refinement minimises both carts' simulation error on that run over k1, k2, b1, b2, K, F1, F2 by Levenberg–Marquardt ({} simulations; fit on `{}` from {:.2} / {:.2} % to {:.2} / {:.2} %). **white** and **indep.** are the largest normalised auto- and cross-correlation (with the input) of cart 2's simulation error over 25 lags, against a 99 % bound of {:.3} for a white error independent of the input: an output-error model has no noise model, so its error is not white; a cross-correlation above the bound is dynamics the model misses. The simulation holds the previous input for {} ms after each sample (the drive's delay), integrates in sub-steps of at most {} ms and decides each cart's stick or slip between them, with breakaway at {:.2} / {:.2} × the Coulomb force{}.\n",
         first.name,
         refined.evaluations,
         first.name,
@@ -79,6 +82,15 @@ pub fn section(
         refined.refined.fit_percent[0],
         refined.refined.fit_percent[1],
         2.58 / (fresh.len() as f64).sqrt(),
+        model.input_delay * 1e3,
+        model.max_substep * 1e3,
+        model.stiction_ratio[0],
+        model.stiction_ratio[1],
+        if truth.is_some() {
+            " (the simulated card's own structure)"
+        } else {
+            " (the defaults: this rig's delay and stiction are not known to the program)"
+        },
     ));
     report.table(
         &[

@@ -174,7 +174,7 @@ impl MassSpring {
     }
 
     /// The state matrix `A` of equation (3), without validation.
-    fn a_matrix(&self) -> SMatrix<f64, 4, 4> {
+    pub(crate) fn a_matrix(&self) -> SMatrix<f64, 4, 4> {
         let Self {
             m1,
             m2,

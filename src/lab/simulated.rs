@@ -167,6 +167,12 @@ impl FrictionPlant {
         self.stiction
     }
 
+    /// Each cart's sliding direction for the coming step: ±1, or 0 while
+    /// it sticks (and always 0 for a cart without friction).
+    pub(crate) fn directions(&self) -> [f64; 2] {
+        self.direction
+    }
+
     /// The force that holds a cart at rest, N.
     fn breakaway(&self, cart: usize) -> f64 {
         self.stiction[cart].max(self.friction[cart])
@@ -671,6 +677,34 @@ impl SimulatedRig {
             schema: Some(schema()),
             seed: self.seed,
             ..SampledConfig::new(self.period, duration)
+        }
+    }
+
+    /// The structure that reproduces this rig in output-error validation
+    /// and refinement: its sub-step, its PWM delay and each cart's
+    /// breakaway over Coulomb force (1 for a cart without friction).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::SimulatedRig;
+    /// let m = SimulatedRig::default().simulation_model();
+    /// assert_eq!((m.max_substep, m.input_delay), (0.25e-3, 0.15e-3));
+    /// assert!(m.stiction_ratio.iter().all(|r| (r - 1.2).abs() < 1e-12));
+    /// ```
+    pub fn simulation_model(&self) -> crate::lab::ident::SimulationModel {
+        let ratio = |c: usize| {
+            let f = self.coulomb_friction[c];
+            if f > 0.0 {
+                (self.stiction[c] / f).max(1.0)
+            } else {
+                1.0
+            }
+        };
+        crate::lab::ident::SimulationModel {
+            max_substep: self.max_substep,
+            input_delay: self.pwm_delay,
+            stiction_ratio: [ratio(0), ratio(1)],
         }
     }
 

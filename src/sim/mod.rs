@@ -404,13 +404,13 @@ pub(crate) type Sampled<N, P> = (Vec<f64>, Vec<OVector<f64, N>>, Vec<OVector<f64
 /// interval: `2 ε max|t|`, two units in the last place of its largest time
 /// (each time is rounded once, `k·dt` or `t + dt`, so each interval is off
 /// by at most one such unit).
-fn grid_rounding(t: &[f64]) -> f64 {
+pub(crate) fn grid_rounding(t: &[f64]) -> f64 {
     let (first, last) = (t[0], t[t.len() - 1]);
     2.0 * f64::EPSILON * first.abs().max(last.abs())
 }
 
 /// The grid's mean step when every interval is within `tol` of it.
-fn uniform_step(t: &[f64], tol: f64) -> Option<f64> {
+pub(crate) fn uniform_step(t: &[f64], tol: f64) -> Option<f64> {
     let n = t.len().checked_sub(1).filter(|&n| n > 0)?;
     let mean = (t[n] - t[0]) / n as f64;
     (mean.is_finite() && max_step_deviation(t, mean) <= tol).then_some(mean)

@@ -124,6 +124,15 @@ pub fn friction_rig(truth: MassSpring, friction: [f64; 2], seed: u64) -> Simulat
 /// `input` (V) open loop for `duration` seconds on `sim`'s rig (card,
 /// driver, 2 ms loop) over a fresh virtual clock.
 pub fn open_loop(sim: &SimulatedRig, input: &dyn Signal, duration: f64) -> Recording {
+    try_open_loop(sim, input, duration).unwrap()
+}
+
+/// [`open_loop`], returning the loop's error (a travel limit, say).
+pub fn try_open_loop(
+    sim: &SimulatedRig,
+    input: &dyn Signal,
+    duration: f64,
+) -> Result<Recording, Box<hw::RunError>> {
     let clock = VirtualClock::new();
     let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
     let config = LoopConfig {
@@ -137,8 +146,7 @@ pub fn open_loop(sim: &SimulatedRig, input: &dyn Signal, duration: f64) -> Recor
         &Clock::Virtual(clock),
         &config,
     )
-    .unwrap()
-    .recording
+    .map(|out| out.recording)
 }
 
 /// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.

@@ -49,6 +49,7 @@ mod estimates;
 mod options;
 mod refine;
 mod regressors;
+mod simulation;
 mod timing;
 
 pub use average::{
@@ -58,7 +59,10 @@ pub use estimates::{
     Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, SeparateSpringsEstimate, Warning,
 };
 pub use options::{DEFAULT_MIN_SPEED, Options};
-pub use refine::{RESIDUAL_LAGS, Refined, ResidualTest, Validation, refine, validate};
+pub use refine::{
+    RESIDUAL_LAGS, Refined, ResidualTest, Validation, refine, refine_with, validate, validate_with,
+};
+pub use simulation::SimulationModel;
 pub use timing::{DEFAULT_MAX_JITTER, GAP_RATIO, Timing};
 
 use self::regressors::{

@@ -14,11 +14,10 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra034 as na;
 
 use super::SeparateSpringsEstimate;
+use super::simulation::{Run, SimulationModel};
 use crate::data::Recording;
 use crate::error::Error;
-use crate::integrate::{Dynamics, Integrator, Rk4};
-use crate::lab::{FrictionPlant, MassSpring};
-use nalgebra::{SVector, vector};
+use crate::lab::MassSpring;
 use std::cell::{Cell, RefCell};
 
 /// Largest lag of the residual tests, samples.
@@ -85,59 +84,7 @@ pub struct Refined {
     pub evaluations: usize,
 }
 
-/// The recording's input and positions, checked.
-struct Run<'a> {
-    t: &'a [f64],
-    u: &'a [f64],
-    x1: &'a [f64],
-    x2: &'a [f64],
-}
-
-impl<'a> Run<'a> {
-    fn of(rec: &'a Recording) -> Result<Self, Error> {
-        let run = Run {
-            t: rec.time(),
-            u: rec.channel("u")?,
-            x1: rec.channel("x1")?,
-            x2: rec.channel("x2")?,
-        };
-        if run.t.len() < 3 * RESIDUAL_LAGS {
-            return Err(Error::InvalidParameter {
-                name: "recording",
-                value: run.t.len() as f64,
-                reason: "validation needs at least 75 samples",
-            });
-        }
-        Ok(run)
-    }
-
-    /// Simulates `plant` with Coulomb forces `coulomb` from the recorded
-    /// input (held over each interval), starting at the first positions at
-    /// rest, and hands each sample's positions to `sample(k, x1, x2)` (m).
-    /// `false` if the simulation left the rig's scale (more than 1 m: a
-    /// diverging candidate); the samples after that are not visited.
-    fn simulate(
-        &self,
-        plant: &MassSpring,
-        coulomb: [f64; 2],
-        mut sample: impl FnMut(usize, f64, f64),
-    ) -> bool {
-        let mut model = FrictionPlant::new(*plant, coulomb);
-        let mut x: SVector<f64, 4> = vector![self.x1[0], 0.0, self.x2[0], 0.0];
-        for (k, &t) in self.t.iter().enumerate() {
-            sample(k, x[0], x[2]);
-            if !(x[0].abs() <= 1.0 && x[2].abs() <= 1.0) {
-                return false;
-            }
-            if let Some(&next) = self.t.get(k + 1) {
-                let u = vector![self.u[k]];
-                model.update_mode(t, &mut x, &u);
-                Rk4.step_mut(&model, t, next - t, &mut x, &u);
-            }
-        }
-        true
-    }
-
+impl Run<'_> {
     fn validation(&self, sim: &[[f64; 2]]) -> Validation {
         let n = self.t.len();
         let mut fit = [0.0; 2];
@@ -190,10 +137,11 @@ fn correlation_test(a: &[f64], b: &[f64], first: usize) -> ResidualTest {
 }
 
 /// Simulates `plant` with Coulomb forces `coulomb` (N, cart 1 and cart 2)
-/// from the recording's input `u` (held over each interval, in the unit
-/// `plant.gain` converts to newtons), starting at rest at the first
-/// recorded positions, and compares the simulated positions with the
-/// recorded `x1`, `x2` (m).
+/// from the recording's input `u` (in the unit `plant.gain` converts to
+/// newtons), starting at rest at the first recorded positions, and compares
+/// the simulated positions with the recorded `x1`, `x2` (m). The simulation
+/// is [`SimulationModel::default`]: 0.25 ms sub-steps, no input delay, no
+/// stiction above the Coulomb force; [`validate_with`] takes another.
 ///
 /// Validate on a *fresh* run, not the one identified: the fit on the
 /// identification data flatters the model.
@@ -221,9 +169,39 @@ pub fn validate(
     plant: &MassSpring,
     coulomb: [f64; 2],
 ) -> Result<Validation, Error> {
+    validate_with(rec, plant, coulomb, &SimulationModel::default())
+}
+
+/// [`validate`] with the rig simulated by `model` (its drive's delay, its
+/// stiction, its sub-step).
+///
+/// # Errors
+///
+/// Those of [`validate`], and [`Error::InvalidParameter`] for an invalid
+/// `model` or an input delay not shorter than every sampling interval.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// use ctrlab::lab::SimulatedRig;
+/// use ctrlab::lab::ident::{SimulationModel, validate_with};
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let sim = SimulatedRig::default();
+/// let model = SimulationModel { input_delay: 0.15e-3, ..SimulationModel::default() };
+/// let v = validate_with(&rec, &sim.truth, [0.0; 2], &model)?;
+/// assert!(v.fit_percent[1].is_finite());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn validate_with(
+    rec: &Recording,
+    plant: &MassSpring,
+    coulomb: [f64; 2],
+    model: &SimulationModel,
+) -> Result<Validation, Error> {
     plant.validate()?;
     check_forces(coulomb)?;
-    let run = Run::of(rec)?;
+    let run = Run::of(rec, model)?;
     let mut sim = vec![[0.0; 2]; run.t.len()];
     if !run.simulate(plant, coulomb, |k, x1, x2| sim[k] = [x1, x2]) {
         return Err(Error::Overflow {
@@ -354,16 +332,15 @@ impl LeastSquaresProblem<f64, na::Dyn, na::Dyn> for Problem<'_> {
 /// `[k1, k2, b1, b2, K, F1, F2]` with the masses held, starting from
 /// `start` (its Coulomb forces, or 1 mN where it has none), by
 /// Levenberg–Marquardt in the logarithms of the parameters (so they stay
-/// positive and the steps are relative). The simulation is
-/// [`FrictionPlant`] (Coulomb friction, breakaway at the Coulomb force) by
-/// one RK4 step per sample, input held over each interval, from rest at the
-/// first positions: a card's PWM delay and extra stiction are not in the
-/// model, and bias the refined parameters slightly.
+/// positive and the steps are relative). The simulation is that of
+/// [`validate`]: [`SimulationModel::default`], from rest at the first
+/// positions. [`refine_with`] takes the rig's own structure (its drive's
+/// delay and its stiction), without which the refined parameters are
+/// biased where the structure matters (see [`SimulationModel`]).
 ///
 /// Refine on the identification run and [`validate`] on a fresh one. The
 /// work is bounded: at most 96 candidate simulations, and 7 more for the
-/// Jacobian after each accepted step; the lab's runs take 25–50 in all
-/// (about 50 ms for 5000 samples on a quiet 2 GHz core).
+/// Jacobian after each accepted step; the lab's runs take 25–50 in all.
 ///
 /// # Errors
 ///
@@ -383,10 +360,50 @@ impl LeastSquaresProblem<f64, na::Dyn, na::Dyn> for Problem<'_> {
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refined, Error> {
+    refine_with(rec, start, &SimulationModel::default())
+}
+
+/// [`refine`] with the rig simulated by `model`: on the simulated card,
+/// [`SimulatedRig::simulation_model`](crate::lab::SimulatedRig::simulation_model).
+///
+/// # Errors
+///
+/// Those of [`refine`] and of [`validate_with`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::SimulatedRig;
+/// use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine_with};
+/// use ctrlab::signal::SquareWave;
+/// # use ctrlab::{OpenLoop, hw::{self, Clock, LoopConfig, VirtualClock}};
+/// # use nalgebra::vector;
+/// let sim = SimulatedRig::default();
+/// // A 3 s square-wave run on the simulated card (its Coulomb friction,
+/// // stiction, PWM delay and encoder noise), as `hw::run` records it.
+/// # let clock = VirtualClock::new();
+/// # let wave = SquareWave::new(8.0, 0.2)?;
+/// # use ctrlab::signal::Signal;
+/// # let config = LoopConfig { duration: 3.0, ..LoopConfig::default() };
+/// # let rig = sim.rig(&Clock::Virtual(clock.clone()))?;
+/// # let rec = hw::run(rig, OpenLoop, |t| vector![wave.value(t)], &Clock::Virtual(clock), &config)
+/// #     .map_err(|e| e.error)?.recording;
+/// let options = Options { coulomb: true, ..Options::default() };
+/// let ls = identify_separate_springs_with(&rec, 1.3, 0.7, &options)?;
+/// let r = refine_with(&rec, &ls, &sim.simulation_model())?;
+/// assert!((r.plant.gain / sim.truth.gain - 1.0).abs() < 0.01);
+/// assert!((r.coulomb[1] / sim.coulomb_friction[1] - 1.0).abs() < 0.1);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn refine_with(
+    rec: &Recording,
+    start: &SeparateSpringsEstimate,
+    model: &SimulationModel,
+) -> Result<Refined, Error> {
     let plant = start.plant();
     let coulomb = start.coulomb.map_or([0.0; 2], |c| [c[0].value, c[1].value]);
-    let start_validation = validate(rec, &plant, coulomb.map(|f| f.max(0.0)))?;
-    let run = Run::of(rec)?;
+    let start_validation = validate_with(rec, &plant, coulomb.map(|f| f.max(0.0)), model)?;
+    let run = Run::of(rec, model)?;
     let n = run.t.len();
     let p0 = [
         plant.k1, plant.k2, plant.b1, plant.b2, plant.gain, coulomb[0], coulomb[1],
@@ -417,7 +434,7 @@ pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refine
         });
     }
     let (refined_plant, refined_coulomb) = problem.model(&problem.q);
-    let refined = validate(rec, &refined_plant, refined_coulomb)?;
+    let refined = validate_with(rec, &refined_plant, refined_coulomb, model)?;
     // Never worse than the start on its own data: LM only accepts
     // decreasing steps, but the clamp could in principle mislead it.
     if refined.rms_error[0].hypot(refined.rms_error[1])
