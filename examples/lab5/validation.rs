@@ -4,7 +4,7 @@
 
 use ctrlab::Recording;
 use ctrlab::lab::MassSpring;
-use ctrlab::lab::ident::{SimulationModel, Validation, refine_with, validate_with};
+use ctrlab::lab::ident::{SimulationModel, Spread, Validation, refine_with, validate_with};
 
 use crate::identification::Identification;
 use crate::report::Report;
@@ -123,5 +123,54 @@ pub fn section(
         bias(lab.b2, p.b2),
         bias(lab.gain, p.gain),
     ));
+    spread(ident, truth, &model, report)
+}
+
+/// Every run refined: the refined parameters' mean ± spread over the
+/// runs, their uncertainty (the refinement gives no standard errors).
+fn spread(
+    ident: &Identification,
+    truth: Option<(MassSpring, [f64; 2])>,
+    model: &SimulationModel,
+    report: &mut Report,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut values: Vec<[f64; 7]> = Vec::new();
+    for (run, separate) in ident.runs.iter().zip(&ident.separate) {
+        let r = refine_with(&run.recording, separate, model)?;
+        let p = r.plant;
+        values.push([p.k1, p.k2, p.b1, p.b2, p.gain, r.coulomb[0], r.coulomb[1]]);
+    }
+    if values.len() < 2 {
+        return Ok(());
+    }
+    let digits = [1, 1, 3, 3, 4, 3, 3];
+    let mut row = vec![format!("refined, mean ± spread over {} runs", values.len())];
+    for (i, d) in digits.iter().enumerate() {
+        let column: Vec<f64> = values.iter().map(|v| v[i]).collect();
+        let s = Spread::of(&column)?;
+        row.push(format!("{:.*} ± {:.*}", d, s.mean, d, s.std_dev));
+    }
+    let mut rows = vec![row];
+    if let Some((t, f)) = truth {
+        let want = [t.k1, t.k2, t.b1, t.b2, t.gain, f[0], f[1]];
+        let mut row = vec!["**the simulated card's truth**".to_string()];
+        row.extend(digits.iter().zip(want).map(|(d, v)| format!("{v:.*}", d)));
+        rows.push(row);
+    }
+    report.heading(3, "The refined parameters over every run");
+    report.add("Every identification run refined the same way. The refinement reports no standard errors: its simulation decides stick and slip between sub-steps, as the card does, so the simulation error jumps as the parameters move (at one run's optimum a 2e-5 relative change of K tripled it), and derivative-based standard errors came out 2–9× smaller than the spread of seeded runs. The spread across runs below is the refined parameters' uncertainty.\n");
+    report.table(
+        &[
+            "",
+            "k1 (N/m)",
+            "k2 (N/m)",
+            "b1 (N·s/m)",
+            "b2 (N·s/m)",
+            "K (N/V)",
+            "F1 (N)",
+            "F2 (N)",
+        ],
+        &rows,
+    );
     Ok(())
 }
