@@ -568,7 +568,6 @@ where
     DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
     DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
 {
-    let mut ts = Vec::with_capacity(steps);
     let mut xs = Vec::with_capacity(steps);
     let mut ys = Vec::with_capacity(steps);
     let mut x = x0;
@@ -577,7 +576,6 @@ where
         if u.len() != b.ncols() {
             check_input(&u, b.ncols())?;
         }
-        ts.push(k as f64 * dt);
         let y = c * &x + d * &u;
         let next = a * &x + b * &u;
         xs.push(x);
@@ -595,6 +593,10 @@ where
             });
         }
     }
+    // The times after the loop, which then stores one sequence less: from
+    // an i64 (one conversion instruction; `steps` ≤ MAX_SAMPLES), the same
+    // `k · dt` as before.
+    let ts = (0..steps as i64).map(|k| k as f64 * dt).collect();
     // Folds without early exit, which vectorise.
     let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
     if ys.iter().fold(true, |ok, y| ok & finite(y.as_slice())) {
