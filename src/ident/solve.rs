@@ -9,7 +9,7 @@ use nalgebra::{DMatrix, DVector};
 use super::covariance::{Scratch, newey_west};
 use super::{Covariance, LeastSquaresFit};
 use crate::error::Error;
-use crate::kernels::reduce::{dot, first_non_finite, max_abs, pow2_floor, sum_by};
+use crate::kernels::reduce::{dot, first_non_finite, max_abs, pow2_floor, sum_by, zip_sum};
 
 /// How [`solve_augmented`] solves and what it reports.
 #[derive(Debug, Clone, Copy)]
@@ -361,11 +361,7 @@ fn influence(
         let e_z = binary_exponent(max_abs(z));
         let f = pow2(-e_z);
         let qz = DVector::from_fn(p, |j, _| {
-            phi[j * m..(j + 1) * m]
-                .iter()
-                .zip(z)
-                .map(|(q, z)| q * (z * f))
-                .sum::<f64>()
+            zip_sum(&phi[j * m..(j + 1) * m], z, |q, z| q * (z * f))
         });
         (rinv * qz, e_z)
     });

@@ -46,6 +46,13 @@ pub(crate) fn sum_by(x: &[f64], f: impl Fn(f64) -> f64) -> f64 {
 /// accumulators.
 #[inline]
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    zip_sum(a, b, |a, b| a * b)
+}
+
+/// `Σ f(a[k], b[k])` over the shorter length, with eight independent
+/// accumulators.
+#[inline]
+pub(crate) fn zip_sum(a: &[f64], b: &[f64], f: impl Fn(f64, f64) -> f64) -> f64 {
     let n = a.len().min(b.len());
     let (a, b) = (&a[..n], &b[..n]);
     let mut acc: Pairs = [[0.0; 2]; LANES / 2];
@@ -54,12 +61,12 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
         .remainder()
         .iter()
         .zip(cb.remainder())
-        .map(|(a, b)| a * b)
+        .map(|(&a, &b)| f(a, b))
         .sum();
     for (a, b) in ca.zip(cb) {
         for (j, p) in acc.iter_mut().enumerate() {
             for (l, v) in p.iter_mut().enumerate() {
-                *v += a[2 * j + l] * b[2 * j + l];
+                *v += f(a[2 * j + l], b[2 * j + l]);
             }
         }
     }
