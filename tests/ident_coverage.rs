@@ -14,7 +14,8 @@ mod common;
 use ctrlab::ident::Covariance;
 use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
-    Estimate, Options, Scheme, identify_separate_springs_with, identify_with, refine_with,
+    Bootstrap, Estimate, Options, Scheme, bootstrap, identify_separate_springs_with, identify_with,
+    refine_with,
 };
 use ctrlab::signal::SquareWave;
 use ctrlab::{MassSpring, Recording};
@@ -243,21 +244,76 @@ fn newey_west_errors_match_the_spread_and_cover_all_but_the_bias() {
 
 /// The refined model's parameters `[k1, k2, b1, b2, K, F1, F2]` for the
 /// default rig with noise `seed`: lab5's identification run, least squares
-/// with Coulomb friction, refined with the card's structure.
-fn refined(seed: u64) -> [f64; 7] {
+/// with Coulomb friction, refined with the card's structure; with
+/// `resamples`, their bootstrap standard errors (else 0).
+fn refined_with_errors(seed: u64, resamples: Option<usize>) -> Vec<Estimate> {
     let sim = SimulatedRig {
         seed,
         ..SimulatedRig::default()
     };
     let rec = record(&sim);
-    let options = Options {
+    let identification = Options {
         coulomb: true,
         ..Options::default()
     };
-    let ls = identify_separate_springs_with(&rec, sim.truth.m1, sim.truth.m2, &options).unwrap();
-    let r = refine_with(&rec, &ls, &sim.simulation_model()).unwrap();
-    let p = r.plant;
-    [p.k1, p.k2, p.b1, p.b2, p.gain, r.coulomb[0], r.coulomb[1]]
+    let ls =
+        identify_separate_springs_with(&rec, sim.truth.m1, sim.truth.m2, &identification).unwrap();
+    let model = sim.simulation_model();
+    let r = refine_with(&rec, &ls, &model).unwrap();
+    let se = resamples.map(|resamples| {
+        let options = Bootstrap {
+            resamples,
+            seed,
+            ..Bootstrap::default()
+        };
+        bootstrap(&rec, &identification, &r, &model, &options)
+            .unwrap()
+            .to_array()
+    });
+    r.parameters()
+        .into_iter()
+        .enumerate()
+        .map(|(i, value)| Estimate {
+            value,
+            std_error: se.map_or(0.0, |s| s[i]),
+        })
+        .collect()
+}
+
+fn refined(seed: u64) -> [f64; 7] {
+    let e = refined_with_errors(seed, None);
+    std::array::from_fn(|i| e[i].value)
+}
+
+/// The truth `[k1, k2, b1, b2, K, F1, F2]` of the default rig.
+fn refined_truth() -> [f64; 7] {
+    let (t, f) = (
+        SimulatedRig::default_truth(),
+        SimulatedRig::default().coulomb_friction,
+    );
+    [t.k1, t.k2, t.b1, t.b2, t.gain, f[0], f[1]]
+}
+
+/// The bootstrap's coverage of the refined parameters (the numbers in
+/// `bootstrap`'s docs and the README):
+///
+/// `RUNS=100 RESAMPLES=30 cargo test --release --test ident_coverage -- --ignored --nocapture bootstrap`
+#[test]
+#[ignore = "the measurement for the docs: run in release"]
+fn measure_bootstrap_coverage() {
+    let runs: u64 = std::env::var("RUNS").map_or(100, |v| v.parse().unwrap());
+    let resamples: usize = std::env::var("RESAMPLES").map_or(30, |v| v.parse().unwrap());
+    let started = std::time::Instant::now();
+    let estimates: Vec<Vec<Estimate>> = (1..=runs)
+        .map(|seed| refined_with_errors(seed, Some(resamples)))
+        .collect();
+    println!(
+        "{runs} runs refined and bootstrapped ({resamples} resamples) in {:.1?}",
+        started.elapsed()
+    );
+    println!("refined, default rig: k1 k2 b1 b2 K F1 F2");
+    println!("{:<16} | coverage | se / spread | bias / spread", "");
+    row("bootstrap", &coverage(&estimates, &refined_truth()), "");
 }
 
 /// The refined parameters' bias and spread over seeded runs (the numbers
@@ -272,11 +328,7 @@ fn measure_refined_spread() {
     let started = std::time::Instant::now();
     let estimates: Vec<[f64; 7]> = (1..=runs).map(refined).collect();
     println!("{runs} runs refined in {:.1?}", started.elapsed());
-    let (t, f) = (
-        SimulatedRig::default_truth(),
-        SimulatedRig::default().coulomb_friction,
-    );
-    let truth = [t.k1, t.k2, t.b1, t.b2, t.gain, f[0], f[1]];
+    let truth = refined_truth();
     for (i, name) in ["k1", "k2", "b1", "b2", "K", "F1", "F2"].iter().enumerate() {
         let errors: Vec<f64> = estimates.iter().map(|e| e[i] / truth[i] - 1.0).collect();
         let n = errors.len() as f64;

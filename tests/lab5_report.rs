@@ -221,19 +221,29 @@ fn the_validation_section_simulates_each_model_on_a_fresh_run() {
         fit(&rows[2]) > 99.5 && fit(&rows[2]) > fit(&rows[0]),
         "{rows:?}"
     );
-    // Every run refined: mean ± spread, then the truth. Measured: means
-    // within 0.15 % of the truth.
+    // Every run refined: mean ± spread, the first run ± its bootstrap
+    // standard errors, then the truth. Measured: means within 0.15 % of
+    // the truth, the bootstrap's errors as the spread (0.0005 N/V on K).
     let spread: Vec<Vec<&str>> = section(&report, "### The refined parameters over every run")
         .lines()
         .filter(|l| l.starts_with("| ") && !l.starts_with("|  |"))
         .map(|l| l.trim_matches('|').split(" | ").map(str::trim).collect())
         .collect();
-    assert_eq!(spread.len(), 2, "mean ± spread, truth: {spread:?}");
-    for (i, (got, want)) in spread[0][1..].iter().zip(&spread[1][1..]).enumerate() {
-        let first = |c: &str| c.split_whitespace().next().and_then(number);
-        let (got, want) = (first(got).unwrap(), first(want).unwrap());
-        let bound = if i < 5 { 0.01 } else { 0.1 };
-        assert!((got / want - 1.0).abs() < bound, "{spread:?}");
+    assert_eq!(
+        spread.len(),
+        3,
+        "mean ± spread, bootstrap, truth: {spread:?}"
+    );
+    let first = |c: &str| c.split_whitespace().next().and_then(number);
+    let second = |c: &str| c.split(" ± ").nth(1).and_then(number);
+    for row in &spread[..2] {
+        for (i, (got, want)) in row[1..].iter().zip(&spread[2][1..]).enumerate() {
+            let (value, want) = (first(got).unwrap(), first(want).unwrap());
+            let bound = if i < 5 { 0.01 } else { 0.1 };
+            assert!((value / want - 1.0).abs() < bound, "{spread:?}");
+            let error = second(got).unwrap();
+            assert!(error >= 0.0 && error < bound * want, "{spread:?}");
+        }
     }
 }
 

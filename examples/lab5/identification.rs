@@ -22,6 +22,14 @@ use crate::rig::{
     Backend, BackendKind, IDENT_DURATION, IDENT_HALF_PERIOD, IDENT_VOLTS, M1, M2, PERIOD, RUNS, pct,
 };
 
+/// The separate-springs identification: Central, with each cart's Coulomb
+/// friction.
+pub const SEPARATE: Options = Options {
+    scheme: Scheme::Central,
+    coulomb: true,
+    ..Options::DEFAULT
+};
+
 /// The identification input: the lab's square wave, V.
 fn square() -> SquareWave {
     SquareWave::new(IDENT_VOLTS, IDENT_HALF_PERIOD).expect("valid constants")
@@ -162,11 +170,7 @@ pub fn identification(
         "{intro} Masses known: m1 = {M1} kg, m2 = {M2} kg. **Lab** is equations (6)–(11) as the lab's MATLAB code; **Central** uses central-difference velocities, the input averaged over the hold and Numerov-weighted positions; **separate** identifies k1 ≠ k2 and each cart's Coulomb friction (Central, rows where the cart moves).\n"
     ));
     let (mut lab, mut central, mut separate) = (Vec::new(), Vec::new(), Vec::new());
-    let options = Options {
-        scheme: Scheme::Central,
-        coulomb: true,
-        ..Options::DEFAULT
-    };
+    let options = SEPARATE;
     for run in &runs {
         let rec = &run.recording;
         let context = |e: ctrlab::Error| format!("run {}: {e}", run.name);

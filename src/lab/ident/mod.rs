@@ -45,6 +45,7 @@
 //! [`hw::run`]: crate::hw::run
 
 mod average;
+mod bootstrap;
 mod estimates;
 mod options;
 mod refine;
@@ -55,6 +56,7 @@ mod timing;
 pub use average::{
     MassSpringAverage, SeparateSpringsAverage, Spread, average, average_separate_springs,
 };
+pub use bootstrap::{Bootstrap, MAX_RESAMPLES, RefinedStdErrors, bootstrap};
 pub use estimates::{
     Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, SeparateSpringsEstimate, Warning,
 };

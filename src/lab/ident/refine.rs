@@ -84,6 +84,34 @@ pub struct Refined {
     pub evaluations: usize,
 }
 
+impl Refined {
+    /// `[k1, k2, b1, b2, K, F1, F2]` (N/m, N/m, N·s/m, N·s/m, N/V, N, N):
+    /// the parameters refined, in their order.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::Recording;
+    /// use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine};
+    /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let r = refine(&rec, &identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?)?;
+    /// assert_eq!(r.parameters()[4], r.plant.gain);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn parameters(&self) -> [f64; 7] {
+        let p = &self.plant;
+        [
+            p.k1,
+            p.k2,
+            p.b1,
+            p.b2,
+            p.gain,
+            self.coulomb[0],
+            self.coulomb[1],
+        ]
+    }
+}
+
 impl Run<'_> {
     fn validation(&self, sim: &[[f64; 2]]) -> Validation {
         let n = self.t.len();
@@ -344,17 +372,21 @@ impl LeastSquaresProblem<f64, na::Dyn, na::Dyn> for Problem<'_> {
 ///
 /// # Uncertainty
 ///
-/// The refined parameters come without standard errors: the simulation
-/// decides stick and slip between sub-steps (as the simulated card does),
-/// so its error jumps as the parameters move — at one run's optimum, K
-/// raised by 2e-5 (relative) tripled the cost — and derivative-based
-/// (sandwich, Newey–West) standard errors do not see that. Tried on 100
-/// seeded runs of the default simulated card, they were 2–9× smaller than
-/// the spread of the estimates (±1.96 se covered the truth in 56–75 % of
-/// the runs, not 95 %). Use the spread across repeated runs, as lab5
-/// reports it: over 400 seeded runs of the default card (refined with its
-/// own structure), the mean errors were within 0.1 % and the spreads 0.008
-/// (k1) to 0.2 % (F2) of the truth (`tests/ident_coverage.rs`).
+/// The refinement itself gives no standard errors; [`bootstrap`] does,
+/// by repeating the identification and the refinement on resampled runs.
+/// Derivative-based (sandwich, Newey–West) ones would be wrong here: the
+/// simulation decides stick and slip between sub-steps (as the simulated
+/// card does), so its error jumps as the parameters move — at one run's
+/// optimum, K raised by 2e-5 (relative) tripled the cost — and where the
+/// refinement ends depends on where the least squares start it. Tried on
+/// 100 seeded runs of the default simulated card, they were 2–9× smaller
+/// than the spread of the estimates (±1.96 se covered the truth in 56–75 %
+/// of the runs, not 95 %). Over 400 seeded runs of the default card
+/// (refined with its own structure) the mean errors were within 0.1 % and
+/// the spreads 0.008 (k1) to 0.2 % (F2) of the truth
+/// (`tests/ident_coverage.rs`).
+///
+/// [`bootstrap`]: super::bootstrap()
 ///
 /// # Errors
 ///
