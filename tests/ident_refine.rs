@@ -398,5 +398,25 @@ fn bootstrap_errors_are_the_size_of_the_spread() {
             matches!(got, Err(Error::InvalidParameter { name: n, .. }) if n == name),
             "{bad:?}: {got:?}"
         );
-    }
+    } // A refined model that is not one: an error naming it, not a panic.
+    let mut broken = r;
+    broken.plant.k1 = f64::NAN;
+    let got = bootstrap(&rec, &options, &broken, &model, &resampling);
+    assert!(
+        matches!(got, Err(Error::InvalidParameter { name: "k1", .. })),
+        "{got:?}"
+    );
+    broken = r;
+    broken.coulomb[1] = -1.0;
+    let got = bootstrap(&rec, &options, &broken, &model, &resampling);
+    assert!(
+        matches!(
+            got,
+            Err(Error::InvalidParameter {
+                name: "coulomb",
+                ..
+            })
+        ),
+        "{got:?}"
+    );
 }

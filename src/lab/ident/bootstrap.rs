@@ -1,6 +1,7 @@
 //! Standard errors of a refined model by a moving-block bootstrap of its
 //! simulation error ([`bootstrap`]).
 
+use super::refine::check_forces;
 use super::simulation::{Run, SimulationModel};
 use super::{Options, Refined, identify_separate_springs_with, refine_with};
 use crate::data::Recording;
@@ -120,7 +121,9 @@ impl RefinedStdErrors {
 ///
 /// Those of [`validate_with`](super::validate_with) for `rec` and `model`;
 /// [`Error::InvalidParameter`] for resamples outside 2 to
-/// [`MAX_RESAMPLES`] or a block of 0 or longer than the run;
+/// [`MAX_RESAMPLES`], a block of 0 or longer than the run, or an invalid
+/// refined plant (see [`MassSpring::validate`](crate::lab::MassSpring::validate))
+/// or Coulomb force;
 /// [`Error::Overflow`] when the refined model's simulation diverges;
 /// [`Error::NoConvergence`] as [`refine`](super::refine).
 ///
@@ -162,6 +165,8 @@ pub fn bootstrap(
         });
     }
     let (plant, coulomb) = (refined.plant, refined.coulomb);
+    plant.validate()?;
+    check_forces(coulomb)?;
     let p0 = refined.parameters();
     let mut fitted = vec![[0.0; 2]; n];
     if !run.simulate(&plant, coulomb, |k, x1, x2| fitted[k] = [x1, x2]) {

@@ -239,7 +239,7 @@ pub fn validate_with(
     Ok(run.validation(&sim))
 }
 
-fn check_forces(coulomb: [f64; 2]) -> Result<(), Error> {
+pub(super) fn check_forces(coulomb: [f64; 2]) -> Result<(), Error> {
     match coulomb.iter().find(|f| !(f.is_finite() && **f >= 0.0)) {
         Some(&bad) => Err(Error::InvalidParameter {
             name: "coulomb",
