@@ -682,6 +682,18 @@ fn discrete_simulation_is_finite_or_an_error() {
         matches!(err, Error::InvalidParameter { name: "input", .. }),
         "{err}"
     );
+    // Only the output overflows, at the fourth sample (x = 1.5).
+    let output_only = StateSpace::discrete(
+        matrix![1.0],
+        matrix![0.5],
+        matrix![f64::MAX],
+        matrix![0.0],
+        0.1,
+    )
+    .unwrap();
+    let err = ctrlab::sim::simulate_discrete(&output_only, vector![0.0], &[vector![1.0]; 4])
+        .unwrap_err();
+    assert!(matches!(err, Error::Overflow { .. }), "{err}");
     let err =
         ctrlab::sim::simulate_discrete_feedback(&d, vector![0.0], usize::MAX, |_, _| vector![0.0])
             .unwrap_err();

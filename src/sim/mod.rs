@@ -568,6 +568,7 @@ where
     DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
     DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
 {
+    let mut ts = Vec::with_capacity(steps);
     let mut xs = Vec::with_capacity(steps);
     let mut ys = Vec::with_capacity(steps);
     let mut x = x0;
@@ -578,32 +579,25 @@ where
         }
         let y = c * &x + d * &u;
         let next = a * &x + b * &u;
-        xs.push(x);
-        ys.push(y);
-        x = next;
         // Stop at the first overflow: a controller would otherwise see
         // infinities and the error would blame its input. A non-finite
         // input makes every entry of the next state non-finite, so this
         // one check also catches it (but for a model without states); then
         // the input is blamed.
-        if x.iter().any(|v| !v.is_finite()) || (x.is_empty() && u.iter().any(|v| !v.is_finite())) {
+        if next.iter().chain(y.iter()).any(|v| !v.is_finite())
+            || (x.is_empty() && u.iter().any(|v| !v.is_finite()))
+        {
             check_input(&u, b.ncols())?;
             return Err(Error::Overflow {
                 operation: DIVERGED,
             });
         }
+        // Everything inside the loop, whose speed is the latency of
+        // `control` and `A x + B u`: a pass after it would cost more.
+        ts.push(k as f64 * dt);
+        xs.push(x);
+        ys.push(y);
+        x = next;
     }
-    // The times after the loop, which then stores one sequence less: from
-    // an i64 (one conversion instruction; `steps` ≤ MAX_SAMPLES), the same
-    // `k · dt` as before.
-    let ts = (0..steps as i64).map(|k| k as f64 * dt).collect();
-    // Folds without early exit, which vectorise.
-    let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
-    if ys.iter().fold(true, |ok, y| ok & finite(y.as_slice())) {
-        Ok((ts, xs, ys))
-    } else {
-        Err(Error::Overflow {
-            operation: DIVERGED,
-        })
-    }
+    Ok((ts, xs, ys))
 }
