@@ -691,8 +691,8 @@ fn discrete_simulation_is_finite_or_an_error() {
         0.1,
     )
     .unwrap();
-    let err = ctrlab::sim::simulate_discrete(&output_only, vector![0.0], &[vector![1.0]; 4])
-        .unwrap_err();
+    let err =
+        ctrlab::sim::simulate_discrete(&output_only, vector![0.0], &[vector![1.0]; 4]).unwrap_err();
     assert!(matches!(err, Error::Overflow { .. }), "{err}");
     let err =
         ctrlab::sim::simulate_discrete_feedback(&d, vector![0.0], usize::MAX, |_, _| vector![0.0])
