@@ -498,7 +498,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
     #[test]
-    fn central_recovers_plausible_plants_within_0_6_percent(
+    fn central_recovers_plausible_plants_within_0_6_percent_b2_1_percent(
         m1 in 1.0f64..1.6, m2 in 0.5f64..0.9, k in 700.0f64..1200.0,
         b1 in 8.0f64..16.0, b2 in 4.0f64..8.0, gain in 6.0f64..10.0,
         half in 0.15f64..0.3,
@@ -506,11 +506,21 @@ proptest! {
         let plant = MassSpring { m1, m2, k1: k, k2: k, b1, b2, gain };
         let rec = simulated(&plant, 2.0, half, 5.0, 0.0, 1);
         let c = identify(&rec, m1, m2, Scheme::Central).unwrap();
-        for (name, got, want) in [("k12", c.k12.value, k), ("b1", c.b1.value, b1), ("K", c.gain.value, gain), ("b2", c.b2.value, b2)] {
-            // 0.6 %, not 0.5 %: proptest found b2 0.522 % off for m2 = 0.57 kg
-            // and a 0.15 s half period (the scheme's own discretisation bias:
-            // noise-free data; the case is in the regressions file).
-            prop_assert!(rel(got, want) < 0.006, "{name}: {got} vs {want} ({:.3} %)", rel(got, want) * 100.0);
+        // The scheme's own error on noise-free quantised data, which is a
+        // deterministic but erratic function of the plant and the wave.
+        // Measured on 2026-11-26 over 200 000 uniform draws of this box: the
+        // worst k12 0.059 %, b1 0.189 %, K 0.461 %, b2 0.919 % (m2 = 0.66 kg,
+        // a 0.172 s half period). b2, the weakest regressor, exceeded 0.6 %
+        // (this test's first bound) on 37 draws, 0.7 % on 11, 0.8 % on 6 and
+        // 0.9 % on one: at 24 cases per run, CI failed about once in 230
+        // runs (b2 0.739 % in one). Hence 1 % for b2, 0.6 % for the others.
+        for (name, got, want, bound) in [
+            ("k12", c.k12.value, k, 0.006),
+            ("b1", c.b1.value, b1, 0.006),
+            ("K", c.gain.value, gain, 0.006),
+            ("b2", c.b2.value, b2, 0.01),
+        ] {
+            prop_assert!(rel(got, want) < bound, "{name}: {got} vs {want} ({:.3} %)", rel(got, want) * 100.0);
         }
     }
 
