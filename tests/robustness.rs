@@ -682,6 +682,26 @@ fn discrete_simulation_is_finite_or_an_error() {
         matches!(err, Error::InvalidParameter { name: "input", .. }),
         "{err}"
     );
+    // A period so long that the third sample's time overflows.
+    let eons = StateSpace::discrete(
+        matrix![0.5],
+        matrix![1.0],
+        matrix![1.0],
+        matrix![0.0],
+        1e308,
+    )
+    .unwrap();
+    assert_eq!(
+        ctrlab::sim::simulate_discrete(&eons, vector![0.0], &[vector![0.0]; 2])
+            .unwrap()
+            .t[1],
+        1e308
+    );
+    let err = ctrlab::sim::simulate_discrete(&eons, vector![0.0], &[vector![0.0]; 3]).unwrap_err();
+    assert!(
+        matches!(err, Error::InvalidParameter { name: "dt", .. }),
+        "{err}"
+    );
     // Only the output overflows, at the fourth sample (x = 1.5).
     let output_only = StateSpace::discrete(
         matrix![1.0],

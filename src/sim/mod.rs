@@ -568,6 +568,14 @@ where
     DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
     DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
 {
+    // The times grow with k: the last one finite makes every one finite.
+    if steps > 0 && !((steps - 1) as f64 * dt).is_finite() {
+        return Err(Error::InvalidParameter {
+            name: "dt",
+            value: dt,
+            reason: "the last sample time (steps − 1) · dt exceeds f64::MAX s",
+        });
+    }
     let mut ts = Vec::with_capacity(steps);
     let mut xs = Vec::with_capacity(steps);
     let mut ys = Vec::with_capacity(steps);
