@@ -149,6 +149,14 @@ proptest! {
                 }
             }
         }
+        // Discrete, any period: `Ok` holds finite times, states and outputs.
+        if let Ok(d) = StateSpace::discrete(a, b, SMatrix::<f64, 1, 3>::from_element(1.0), SMatrix::<f64, 1, 1>::zeros(), dt)
+            && let Ok(r) = ctrlab::sim::simulate_discrete(&d, x0, &[SVector::from_element(u); 8])
+        {
+            prop_assert!(finite_all(&r.t));
+            prop_assert!(r.x.iter().all(|x| finite_all(x.as_slice())));
+            prop_assert!(r.y.iter().all(|y| finite_all(y.as_slice())));
+        }
         // Any grid at all, sorted or not.
         for solver in [Solver::Zoh, Solver::Rk4 { substeps: 1 << 40 }, Solver::Rk4 { substeps: 2 }] {
             if let Ok(r) = simulate(&sys, &grid, x0, |_| SVector::from_element(u), solver) {
@@ -251,7 +259,7 @@ proptest! {
         if let Ok(r) = initial_response(&sys, t_end, dt, x0) {
             prop_assert!(finite_response(&r.y));
         }
-        if let Ok(d) = StateSpace::discrete(a, b, SMatrix::from_element(1.0), SMatrix::zeros(), dt) {
+        if let Ok(d) = StateSpace::discrete(a, b, SMatrix::<f64, 1, 3>::from_element(1.0), SMatrix::<f64, 1, 1>::zeros(), dt) {
             if let Ok(r) = impulse_response(&d, t_end, dt) {
                 prop_assert!(finite_response(&r.y));
             }
