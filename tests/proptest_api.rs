@@ -259,7 +259,7 @@ proptest! {
         if let Ok(r) = initial_response(&sys, t_end, dt, x0) {
             prop_assert!(finite_response(&r.y));
         }
-        if let Ok(d) = StateSpace::discrete(a, b, SMatrix::<f64, 1, 3>::from_element(1.0), SMatrix::<f64, 1, 1>::zeros(), dt) {
+        if let Ok(d) = StateSpace::discrete(a, b, SMatrix::from_element(1.0), SMatrix::zeros(), dt) {
             if let Ok(r) = impulse_response(&d, t_end, dt) {
                 prop_assert!(finite_response(&r.y));
             }
