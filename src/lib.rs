@@ -106,10 +106,14 @@ pub mod design;
 pub mod discretize;
 mod error;
 pub mod freq;
+#[cfg(feature = "hw")]
+#[cfg_attr(docsrs, doc(cfg(feature = "hw")))]
 pub mod hw;
 pub mod ident;
 pub mod integrate;
 mod kernels;
+#[cfg(feature = "lab")]
+#[cfg_attr(docsrs, doc(cfg(feature = "lab")))]
 pub mod lab;
 pub mod metrics;
 pub mod model;
@@ -134,6 +138,7 @@ pub use freq::{
 };
 pub use ident::{LeastSquares, LeastSquaresFit, Rls};
 pub use integrate::{Euler, Integrator, Rk4};
+#[cfg(feature = "lab")]
 pub use lab::{Cart, MassSpring};
 pub use metrics::{StepInfo, StepInfoOptions, step_info, step_info_mimo, step_info_of};
 pub use model::{Continuous, Discrete, Domain, DynStateSpace, Dynamics, StateSpace};

@@ -3,6 +3,9 @@
 //! This file is its own test binary, so the allocator sees only these tests;
 //! the count is per thread, so tests running in parallel do not disturb it.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};

@@ -1,6 +1,9 @@
 //! Poles, stability, DC gain, damping and rank tests against the fixture and
 //! closed-form values.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::analysis::rank;

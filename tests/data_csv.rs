@@ -1,6 +1,9 @@
 //! `Recording` CSV: units, round trip, and one test per malformed-input case;
 //! `Schema` and `Recording::from_columns` refusals.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::data::{Channel, Schema};
 use ctrlab::lab::ident::{MIN_SAMPLES, Scheme, identify};
 use ctrlab::{Error, Recording};

@@ -2,6 +2,9 @@
 //! fixture, Ackermann on random systems, and both Riccati equations against
 //! their own residuals and closed-form scalar solutions.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::{

@@ -4,6 +4,9 @@
 //! setpoint to within an encoder count despite Coulomb friction, where the
 //! lab's own law cannot.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use common::{

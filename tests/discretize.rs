@@ -1,5 +1,8 @@
 //! Discretisation against SciPy's `cont2discrete` and analytic invariants.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::discretize::expm;

@@ -4,6 +4,9 @@
 //! (`tests/data/dyn_fixtures.json`, from `gen_dyn_fixtures.py`), and
 //! adversarial sizes and values (no panic; `Ok` only with finite numbers).
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::design::{StateFeedback, acker, place, place_observer};
 use ctrlab::discretize::{expm, expm_dyn};
 use ctrlab::sim::{Solver, impulse_response, initial_response, simulate, step_response, time_grid};

@@ -16,6 +16,9 @@
 //! unless a test says otherwise, behind a [`RecordingPort`] so the bus
 //! traffic can be checked.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use std::time::Duration;
 
 use ctrlab::hw::testing::{Cycle, RecordingPort, RegisterFile};

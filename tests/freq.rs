@@ -2,6 +2,9 @@
 //! (`tests/data/freq_fixtures.json`, from `gen_freq_fixtures.py`), and its
 //! answers to bad input.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::freq::{
     FrequencyDomain, TransferFunction, TransferMatrix, Zpk, bandwidth, bode, logspace, nyquist,
     stability_margins,

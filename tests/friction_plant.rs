@@ -4,6 +4,9 @@
 //! same RK4 steps and mode updates, in runs where the carts stick, break
 //! away and reverse.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::integrate::{Dynamics, Integrator, Rk4};
 use ctrlab::lab::{FrictionPlant, MassSpring, SimulatedRig};
 use ctrlab::signal::{Prbs, Signal, SquareWave};

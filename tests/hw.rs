@@ -2,6 +2,9 @@
 //! across ±2³¹, error context, and the ppdev ioctl numbers. The simulated
 //! card and the rig are in `hw_sim.rs`.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::hw::testing::{Cycle, RecordingPort, RegisterFile};
 use ctrlab::hw::{CycleKind, HwError, Pc104, RegisterMap, duty_from_bytes, pwm_bytes};
 use ctrlab::lab::{Calibration, MassSpringRig};

@@ -7,6 +7,9 @@
 //! the truth exactly, and this test checks the identification pipeline on
 //! rig data, not how friction biases it.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::OpenLoop;
 use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
 use ctrlab::lab::SimulatedRig;

@@ -8,6 +8,9 @@
 //! meant to look like the lab's run on the realistic default rig. The
 //! fault-injection tests of issue 9 are in `faults.rs`.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
     Clock, EppPort, HwError, HwErrorKind, LoopConfig, Pc104, Rig, SimulatedCard, VirtualClock, run,

@@ -9,6 +9,9 @@
 //! lab's rig as it behaves (friction dead band, travel limits under full
 //! drive, the PWM delay) run on the realistic [`SimulatedRig::default`].
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
     Clock, CycleKind, EppPort, HwError, HwErrorKind, Pc104, Rig, SIMULATED_CARD_ID, SimulatedCard,

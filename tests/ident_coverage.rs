@@ -9,6 +9,9 @@
 //! friction's stick–slip) is a bias common to every run, which no standard
 //! error covers.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::ident::Covariance;

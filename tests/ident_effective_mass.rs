@@ -2,6 +2,9 @@
 //! simulated rig (Coulomb friction with stiction above it, PWM delay,
 //! quantised and noisy encoders) whose motor adds inertia to cart 2.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use common::{friction_rig, open_loop};

@@ -1,6 +1,9 @@
 //! The lab's identification (`lab::ident`) against the NumPy fixture and
 //! against data simulated here from known parameters.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::data::{Channel, Schema};

@@ -4,6 +4,9 @@
 //! reproduces a fresh run at least as well as the least-squares one, and
 //! its parameters are within the bounds of the truth.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use common::{friction_rig, open_loop, try_open_loop};

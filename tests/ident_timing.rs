@@ -3,6 +3,9 @@
 //! each segment with its own period), and carts with Coulomb friction
 //! (`Options::coulomb`).
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use std::sync::{Mutex, MutexGuard, OnceLock};
 use std::time::Duration;
 

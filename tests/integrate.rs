@@ -1,5 +1,8 @@
 //! RK4's order of accuracy against the exact (ZOH) solution.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::{Cart, Dynamics, Euler, Integrator, MassSpring, Method, Rk4};
 use nalgebra::{SVector, vector};
 

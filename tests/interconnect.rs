@@ -3,6 +3,9 @@
 //! tests/data/gen_interconnect_fixtures.py): the result's matrices (same
 //! state order as python-control), its poles and its DC gain.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::model::Sign;
 use ctrlab::{Continuous, Discrete, DynStateSpace, Error};
 use nalgebra::{DMatrix, dmatrix};

@@ -3,6 +3,9 @@
 //! filter to the spec by the section's search on predictions, run the
 //! design through `hw::run`, and judge the recorded step against the spec.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use common::lqi_design::{self, Design, Metrics, Spec};

@@ -5,6 +5,9 @@
 //! rig's truth here; `.ci/run` runs lab5 on them and checks its offline
 //! report with `LAB5_LOGS_REPORT`.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use std::fmt::Write as _;

@@ -1,6 +1,9 @@
 //! The lab's per-millimetre gains and back: `from_lab_gains` and
 //! `to_lab_gains` / `LabGains::state_feedback` are inverses.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::lab::LabGains;
 use ctrlab::{Cart, Controller, Error, MassSpring, StateFeedback, lqr};
 use nalgebra::{SMatrix, matrix, vector};

@@ -1,6 +1,9 @@
 //! Step metrics against python-control's step_info rows (fixture), closed-form
 //! responses, and arbitrary input (never a panic).
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::metrics::step_info_channel;

@@ -1,5 +1,8 @@
 //! The typed model and the lab's plant against the python-control fixture.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::{Cart, Error, MassSpring, StateSpace};

@@ -1,6 +1,9 @@
 //! `Display` for `StateSpace`: the header of each domain, precision, and
 //! every matrix entry in its place.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::{Cart, MassSpring, Method, StateSpace};
 use nalgebra::{DMatrix, SMatrix, matrix};
 use proptest::prelude::*;

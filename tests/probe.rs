@@ -1,6 +1,9 @@
 //! The bring-up probe (`hw::probe`) against the simulated card, a port
 //! with no card, and an operator who says no.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::hw::probe::{Hands, Operator, Probe, ProbeError, ProbeOptions};
 use ctrlab::hw::testing::{RecordingPort, RegisterFile};
 use ctrlab::hw::{Clock, CycleKind, RegisterMap, SimulatedCard, VirtualClock};

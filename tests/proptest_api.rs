@@ -4,6 +4,9 @@
 //! numbers inside. Inputs mix ordinary values with the extremes that broke
 //! the crate before: ±f64::MAX, 1e±308, subnormals, zeros, NaN and ±inf.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::design::{StateFeedback, acker, dlqr, lqr};
 use ctrlab::discretize::expm;
 use ctrlab::ident::{LeastSquares, Rls};

@@ -12,6 +12,9 @@
 //! Fixtures: `tests/data/riccati_fixtures.json`, from
 //! `tests/data/gen_riccati_fixtures.py` (see `tests/data/README.md`).
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 #[path = "common/mod.rs"]
 mod common;
 

@@ -2,6 +2,9 @@
 //! be wrong (wrong type, missing, unknown, refused value) named by its
 //! dotted key.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::Error;
 use ctrlab::hw::RegisterMap;
 use ctrlab::lab::{Calibration, RigConfig};

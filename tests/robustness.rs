@@ -2,6 +2,9 @@
 //! input never panics, hangs, or comes back as a non-finite number inside
 //! `Ok`, and answers do not depend on the units a model is written in.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 use ctrlab::design::{acker, lqr};
 use ctrlab::discretize::expm;
 use ctrlab::hw::{Clock, HwErrorKind, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};

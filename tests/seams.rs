@@ -6,6 +6,9 @@
 //! outside the crate around the library's observer, plug into both; and the
 //! rig's recording survives a CSV round trip.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use common::{last, run_on_rig, saturated, simulate_on};

@@ -1,6 +1,9 @@
 //! Simulation: solvers agree with each other and with analytic responses;
 //! bad grids and inputs are errors.
 
+// Built on the two-cart lab (its plant, simulated rig or card).
+#![cfg(feature = "lab")]
+
 mod common;
 
 use ctrlab::signal::{Signal, SquareWave};

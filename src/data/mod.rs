@@ -650,6 +650,7 @@ impl Recording {
 
     /// Touches every column's spare capacity so its pages are mapped (and,
     /// under `mlockall`, locked) before a real-time loop pushes into it.
+    #[cfg(feature = "hw")]
     pub(crate) fn prefault(&mut self) {
         for col in std::iter::once(&mut self.t).chain(self.columns.iter_mut()) {
             let (len, capacity) = (col.len(), col.capacity());

@@ -35,10 +35,12 @@ mod rls;
 mod solve;
 mod spectral;
 
+#[cfg(feature = "lab")]
 pub(crate) use covariance::newey_west;
 pub use covariance::{Covariance, MAX_LAGS, newey_west_lags};
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};
 pub use rls::Rls;
+#[cfg(feature = "lab")]
 pub(crate) use solve::{SolveOptions, Workspace, solve_augmented};
 pub use spectral::{
     ETFE_MIN_INPUT, FrequencyEstimate, MAX_SPECTRAL_SAMPLES, SPA_DEFAULT_LAG, etfe, spa,

@@ -41,7 +41,9 @@ pub(crate) struct Workspace {
 #[derive(Debug, Clone)]
 pub(crate) struct Solved {
     pub fit: LeastSquaresFit,
-    /// `g` of [`SolveOptions::also`].
+    /// `g` of [`SolveOptions::also`] (read by the lab's two-stage
+    /// identification only).
+    #[cfg_attr(not(feature = "lab"), allow(dead_code))]
     pub also: Option<DVector<f64>>,
 }
 

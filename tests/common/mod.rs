@@ -1,6 +1,7 @@
 //! Shared helpers for the integration tests: loading the reference fixtures.
 #![allow(dead_code)]
 
+use ctrlab::StateSpace;
 use nalgebra::{SMatrix, matrix};
 use serde_json::Value;
 
@@ -58,124 +59,9 @@ pub fn rel_frobenius<const R: usize, const C: usize>(
     (got - want).norm() / want.norm()
 }
 
-/// LQI with a Kalman filter on the rig's positions, as lab5 designs it.
-#[path = "../../examples/common/lqi_design.rs"]
-pub mod lqi_design;
-
-use ctrlab::data::Recording;
-use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-use ctrlab::lab::SimulatedRig;
-use ctrlab::signal::Signal;
-use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
-use nalgebra::vector;
-
-/// The rig's sampling period, s.
-pub const PERIOD: f64 = 0.002;
-
-/// `controller` toward `setpoint` (m, cart 2) for `duration` seconds
-/// through the sampled-data simulator with `sim`'s plant, sensor and drive.
-pub fn simulate_on<C: Controller<4, 1, 1>>(
-    sim: &SimulatedRig,
-    controller: C,
-    setpoint: f64,
-    duration: f64,
-) -> Recording {
-    lqi_design::predict(sim, controller, setpoint, duration).unwrap()
-}
-
-/// `controller` toward `setpoint` for `duration` seconds on `sim`'s rig
-/// (card, driver, 2 ms loop) over a fresh virtual clock, with no overrun.
-pub fn run_on_rig<C: Controller<4, 1, 1>>(
-    sim: &SimulatedRig,
-    controller: C,
-    setpoint: f64,
-    duration: f64,
-) -> Recording {
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration,
-        ..LoopConfig::default()
-    };
-    let out = hw::run(
-        rig,
-        controller,
-        |_| vector![setpoint],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .unwrap();
-    assert_eq!(out.stats.overruns, 0);
-    out.recording
-}
-
-/// The default simulated rig with plant `truth`, Coulomb friction
-/// `friction` (N, cart 1 and 2) and stiction 20 % above it, noise `seed`.
-pub fn friction_rig(truth: MassSpring, friction: [f64; 2], seed: u64) -> SimulatedRig {
-    SimulatedRig {
-        truth,
-        coulomb_friction: friction,
-        stiction: friction.map(|f| 1.2 * f),
-        seed,
-        ..SimulatedRig::default()
-    }
-}
-
-/// `input` (V) open loop for `duration` seconds on `sim`'s rig (card,
-/// driver, 2 ms loop) over a fresh virtual clock.
-pub fn open_loop(sim: &SimulatedRig, input: &dyn Signal, duration: f64) -> Recording {
-    try_open_loop(sim, input, duration).unwrap()
-}
-
-/// [`open_loop`], returning the loop's error (a travel limit, say).
-pub fn try_open_loop(
-    sim: &SimulatedRig,
-    input: &dyn Signal,
-    duration: f64,
-) -> Result<Recording, Box<hw::RunError>> {
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration,
-        ..LoopConfig::default()
-    };
-    hw::run(
-        rig,
-        ctrlab::OpenLoop,
-        |t| vector![input.value(t)],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .map(|out| out.recording)
-}
-
-/// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.
-pub fn position_model() -> StateSpace<4, 1, 2, Discrete> {
-    lqi_design::position_model(&MassSpring::nominal(), PERIOD).unwrap()
-}
-
-/// LQI on cart 2 (weights 1e7 on x2, 1e10 on its integral, 1 on u) with a
-/// current-form Kalman filter on both positions (force noise 10 V², each
-/// position read to a count of `metres_per_count`), back-calculation
-/// anti-windup past the drive's 24 mV step; it uses only `[x1, x2]` of the
-/// rig's `[x1, v1, x2, v2]`. The construction lab5's Design section uses.
-pub fn positions_lqi(metres_per_count: f64) -> lqi_design::PositionsLqi {
-    let q = lqi_design::weights(Cart::Two, 1e7);
-    lqi_design::positions_lqi(&position_model(), Cart::Two, &q, metres_per_count)
-        .unwrap()
-        .controller
-}
-
-/// Last value of channel `name`.
-pub fn last(rec: &Recording, name: &str) -> f64 {
-    *rec.channel(name).unwrap().last().unwrap()
-}
-
-/// Number of samples where the applied input is at the drive's ±24 V.
-pub fn saturated(rec: &Recording) -> usize {
-    rec.channel("u")
-        .unwrap()
-        .iter()
-        .filter(|u| u.abs() >= 24.0)
-        .count()
-}
+// Helpers on the two-cart lab's plant, simulated rig and LQI design.
+#[cfg(feature = "lab")]
+mod lab;
+#[cfg(feature = "lab")]
+#[allow(unused_imports)] // each test binary uses some of them
+pub use lab::*;
