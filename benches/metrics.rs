@@ -4,7 +4,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Cart, MassSpring, Method, StateFeedback, StepInfoOptions, acker, dlqr, step_info};
+use ctrlab::{
+    Cart, Discretization, MassSpring, StateFeedback, StepInfoOptions, acker, dlqr, step_info,
+};
 use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 use std::hint::black_box;
 
@@ -43,7 +45,7 @@ fn benches(c: &mut Criterion) {
         b.iter(|| acker(black_box(&plant), black_box(&targets)).unwrap())
     });
 
-    let d = plant.discretize(0.002, Method::Zoh).unwrap();
+    let d = plant.discretize(0.002, Discretization::Zoh).unwrap();
     let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e4, 1.0, 1e6, 1.0]);
     let rw = matrix![1.0];
     c.bench_function("dlqr, 4 states (SDA)", |b| {

@@ -4,7 +4,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::sim::{simulate_discrete_feedback, step_response};
-use ctrlab::{Cart, Integrator, MassSpring, Method, Rk4};
+use ctrlab::{Cart, Discretization, Integrator, MassSpring, Rk4};
 use nalgebra::{SMatrix, SVector, vector};
 use std::hint::black_box;
 
@@ -12,7 +12,7 @@ const STEPS: usize = 5000;
 
 fn benches(c: &mut Criterion) {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
-    let d = sys.discretize(0.002, Method::Zoh).unwrap();
+    let d = sys.discretize(0.002, Discretization::Zoh).unwrap();
     // The lab's gain [0 0 10 0.1] per mm, in SI: u = K (G r - x).
     let k = SMatrix::<f64, 1, 4>::new(0.0, 0.0, 10_000.0, 100.0);
     let target = vector![0.0, 0.0, 0.030, 0.0];
@@ -66,7 +66,7 @@ fn benches(c: &mut Criterion) {
     });
 
     c.bench_function("ZOH discretisation (4 states)", |b| {
-        b.iter(|| black_box(&sys).discretize(black_box(0.002), Method::Zoh))
+        b.iter(|| black_box(&sys).discretize(black_box(0.002), Discretization::Zoh))
     });
 
     c.bench_function("step_response_40001", |b| {

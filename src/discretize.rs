@@ -1,6 +1,6 @@
-//! Continuous → discrete conversion: [`Method::Zoh`] (exact for a
-//! zero-order-held input), [`Method::Tustin`], [`Method::ForwardEuler`] and
-//! [`Method::BackwardEuler`], plus the matrix exponential [`expm`].
+//! Continuous → discrete conversion: [`Discretization::Zoh`] (exact for a
+//! zero-order-held input), [`Discretization::Tustin`], [`Discretization::ForwardEuler`] and
+//! [`Discretization::BackwardEuler`], plus the matrix exponential [`expm`].
 //!
 //! The definitions match SciPy's `cont2discrete` (methods `zoh`, `bilinear`,
 //! `euler`, `backward_diff`); the reference fixtures in `tests/data/` check it.
@@ -29,7 +29,7 @@ use crate::model::{Continuous, Discrete, DynStateSpace, StateSpace};
 /// change `C` and `D` as well; ZOH and forward Euler keep them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
-pub enum Method {
+pub enum Discretization {
     /// Zero-order hold, exact when the input is constant over each period:
     /// `[[Ad, Bd], [0, I]] = exp([[A, B], [0, 0]] h)`.
     Zoh,
@@ -59,12 +59,12 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Method, StateSpace};
+    /// use ctrlab::{Discretization, StateSpace};
     /// use nalgebra::matrix;
     ///
     /// // x' = -x + u held for 0.1 s: Ad = e^-0.1, Bd = 1 - e^-0.1.
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
-    /// let d = sys.discretize(0.1, Method::Zoh)?;
+    /// let d = sys.discretize(0.1, Discretization::Zoh)?;
     /// assert!((d.a()[(0, 0)] - (-0.1f64).exp()).abs() < 1e-15);
     /// assert!((d.b()[(0, 0)] - (1.0 - (-0.1f64).exp())).abs() < 1e-15);
     /// assert_eq!(d.dt(), 0.1);
@@ -74,7 +74,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     pub fn discretize(
         &self,
         dt: f64,
-        method: Method,
+        method: Discretization,
     ) -> Result<StateSpace<N, M, P, Discrete>, Error> {
         check_dt(dt)?;
         let ((ad, bd, cd, dd), operation) =
@@ -99,23 +99,27 @@ impl DynStateSpace<Continuous> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{DynStateSpace, Method};
+    /// use ctrlab::{DynStateSpace, Discretization};
     /// use nalgebra::dmatrix;
     ///
     /// // x' = -x + u held for 0.1 s: Ad = e^-0.1, Bd = 1 - e^-0.1.
     /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
-    /// let d = sys.discretize(0.1, Method::Zoh)?;
+    /// let d = sys.discretize(0.1, Discretization::Zoh)?;
     /// assert!((d.a()[(0, 0)] - (-0.1f64).exp()).abs() < 1e-15);
     /// assert!((d.b()[(0, 0)] - (1.0 - (-0.1f64).exp())).abs() < 1e-15);
     /// assert_eq!(d.dt(), 0.1);
     /// // Tustin changes C and D too: Dd = α C Bd with α = ½.
-    /// let t = sys.discretize(0.1, Method::Tustin)?;
+    /// let t = sys.discretize(0.1, Discretization::Tustin)?;
     /// assert!((t.d()[(0, 0)] - 0.5 * t.b()[(0, 0)]).abs() < 1e-15);
-    /// assert!(sys.discretize(0.0, Method::Zoh).is_err());
+    /// assert!(sys.discretize(0.0, Discretization::Zoh).is_err());
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     #[doc(alias = "c2d")]
-    pub fn discretize(&self, dt: f64, method: Method) -> Result<DynStateSpace<Discrete>, Error> {
+    pub fn discretize(
+        &self,
+        dt: f64,
+        method: Discretization,
+    ) -> Result<DynStateSpace<Discrete>, Error> {
         check_dt(dt)?;
         let ((ad, bd, cd, dd), operation) =
             discretize_parts(self.a(), self.b(), self.c(), self.d(), dt, method)?;
@@ -139,7 +143,7 @@ fn discretize_parts<N: Dim, M: Dim, P: Dim>(
     c: &OMatrix<f64, P, N>,
     d: &OMatrix<f64, P, M>,
     dt: f64,
-    method: Method,
+    method: Discretization,
 ) -> Result<(Parts<N, M, P>, &'static str), Error>
 where
     DefaultAllocator: Allocator<N, N>
@@ -150,14 +154,14 @@ where
         + Allocator<N>,
 {
     match method {
-        Method::Zoh => {
+        Discretization::Zoh => {
             const OP: &str = "ZOH discretisation";
             let (ad, bd) = zoh(a, b, dt)?;
             Ok(((ad, bd, c.clone(), d.clone()), OP))
         }
-        Method::Tustin => gbt(a, b, c, d, dt, 0.5, "Tustin discretisation"),
-        Method::ForwardEuler => gbt(a, b, c, d, dt, 0.0, "forward Euler discretisation"),
-        Method::BackwardEuler => gbt(a, b, c, d, dt, 1.0, "backward Euler discretisation"),
+        Discretization::Tustin => gbt(a, b, c, d, dt, 0.5, "Tustin discretisation"),
+        Discretization::ForwardEuler => gbt(a, b, c, d, dt, 0.0, "forward Euler discretisation"),
+        Discretization::BackwardEuler => gbt(a, b, c, d, dt, 1.0, "backward Euler discretisation"),
     }
 }
 
@@ -361,7 +365,7 @@ where
 }
 
 /// The matrix exponential `exp(A)` by scaling and squaring a degree-6 Padé
-/// approximant (the algorithm behind [`Method::Zoh`]).
+/// approximant (the algorithm behind [`Discretization::Zoh`]).
 ///
 /// # Errors
 ///

@@ -1,6 +1,5 @@
 //! Fixed-step ODE integration: the [`Rk4`] and [`Euler`] steppers for any
-//! [`Dynamics`] (the plant trait lives in [`model`](crate::model) and is
-//! re-exported here).
+//! [`Dynamics`](crate::Dynamics) (the plant trait, in [`model`](crate::model)).
 //!
 //! Steppers hold the input constant over a step (a zero-order hold, as a
 //! sampled-data controller applies it). Stage vectors live on the stack, so a
@@ -8,7 +7,7 @@
 
 use nalgebra::SVector;
 
-pub use crate::model::Dynamics;
+use crate::model::Dynamics;
 
 /// A fixed-step integrator. The input `u` is held constant over the step.
 ///

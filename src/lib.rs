@@ -83,11 +83,11 @@
 //! ## Example
 //!
 //! ```
-//! use ctrlab::{Cart, MassSpring, Method, sim::step_response};
+//! use ctrlab::{Cart, MassSpring, Discretization, sim::step_response};
 //!
 //! let plant = MassSpring::nominal().state_space(Cart::Two)?;
 //! // The discrete model the 2 ms control loop sees.
-//! let discrete = plant.discretize(0.002, Method::Zoh)?;
+//! let discrete = plant.discretize(0.002, Discretization::Zoh)?;
 //! assert_eq!(discrete.dt(), 0.002);
 //!
 //! // A 1 N step on cart 2 settles at 2 mm (two 1000 N/m springs in series).
@@ -120,6 +120,7 @@ pub mod model;
 #[cfg(feature = "plot")]
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
 pub mod plot;
+pub mod prelude;
 pub mod signal;
 pub mod sim;
 
@@ -130,7 +131,7 @@ pub use nalgebra;
 pub use analysis::Damping;
 pub use data::{Channel, Recording, Schema};
 pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place};
-pub use discretize::Method;
+pub use discretize::Discretization;
 pub use error::Error;
 pub use freq::{
     Bode, FrequencyDomain, FrequencyResponse, Margins, TransferFunction, TransferMatrix, Zpk,

@@ -11,7 +11,7 @@ mod common;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use ctrlab::{Cart, Integrator, MassSpring, Method, Rk4};
+use ctrlab::{Cart, Discretization, Integrator, MassSpring, Rk4};
 use nalgebra::{SVector, vector};
 
 struct Counting;
@@ -61,7 +61,7 @@ fn discrete_step_allocates_nothing() {
     let d = MassSpring::nominal()
         .state_space(Cart::Two)
         .unwrap()
-        .discretize(0.002, Method::Zoh)
+        .discretize(0.002, Discretization::Zoh)
         .unwrap();
     let mut x = SVector::<f64, 4>::zeros();
     let n = allocations(|| {
@@ -94,7 +94,7 @@ fn rk4_step_allocates_nothing() {
 #[test]
 fn dc_gain_allocates_nothing() {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
-    let d = sys.discretize(0.002, Method::Zoh).unwrap();
+    let d = sys.discretize(0.002, Discretization::Zoh).unwrap();
     let mut gains = (0.0, 0.0);
     let n = allocations(|| {
         gains = (sys.dc_gain().unwrap()[(0, 0)], d.dc_gain().unwrap()[(0, 0)]);
@@ -109,7 +109,7 @@ fn zoh_discretisation_allocates_nothing() {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let mut ad00 = 0.0;
     let n = allocations(|| {
-        let d = sys.discretize(0.002, Method::Zoh).unwrap();
+        let d = sys.discretize(0.002, Discretization::Zoh).unwrap();
         ad00 = d.a()[(0, 0)];
     });
     assert_eq!(n, 0);
@@ -181,7 +181,7 @@ fn state_feedback_update_allocates_nothing() {
     let d = MassSpring::nominal()
         .state_space(Cart::Two)
         .unwrap()
-        .discretize(0.002, Method::Zoh)
+        .discretize(0.002, Discretization::Zoh)
         .unwrap();
     let mut x = SVector::<f64, 4>::zeros();
     let n = allocations(|| {

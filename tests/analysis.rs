@@ -7,7 +7,7 @@
 mod common;
 
 use ctrlab::analysis::rank;
-use ctrlab::{Cart, Error, MassSpring, Method, StateSpace, dlqr, lqr};
+use ctrlab::{Cart, Discretization, Error, MassSpring, StateSpace, dlqr, lqr};
 use nalgebra::{Complex, DMatrix, SMatrix, dmatrix, matrix};
 use proptest::prelude::*;
 
@@ -40,7 +40,7 @@ fn dc_gain_is_the_static_deflection() {
         let g = sys.dc_gain().unwrap()[(0, 0)];
         assert!((g - want).abs() <= 1e-14 * want, "{output:?}");
         // ZOH preserves the DC gain exactly (in exact arithmetic).
-        let d = sys.discretize(0.002, Method::Zoh).unwrap();
+        let d = sys.discretize(0.002, Discretization::Zoh).unwrap();
         assert!((d.dc_gain().unwrap()[(0, 0)] - want).abs() <= 1e-10 * want);
     }
 }
@@ -73,7 +73,7 @@ fn stability_in_both_domains() {
     assert!(plant.is_stable().unwrap());
     assert!(
         plant
-            .discretize(0.002, Method::Zoh)
+            .discretize(0.002, Discretization::Zoh)
             .unwrap()
             .is_stable()
             .unwrap()
@@ -88,7 +88,7 @@ fn stability_in_both_domains() {
     assert!(!unstable.is_stable().unwrap());
     assert!(
         !unstable
-            .discretize(0.01, Method::Zoh)
+            .discretize(0.01, Discretization::Zoh)
             .unwrap()
             .is_stable()
             .unwrap()
@@ -119,7 +119,7 @@ fn damping_of_a_second_order_system_and_its_discretisation() {
         assert!((d.time_constant - 1.0 / (zeta * wn)).abs() < 1e-12);
     }
     // ZOH maps s to e^(s dt); damp maps it back.
-    let d = sys.discretize(0.01, Method::Zoh).unwrap();
+    let d = sys.discretize(0.01, Discretization::Zoh).unwrap();
     for p in d.damping().unwrap() {
         assert!((p.natural_frequency - wn).abs() < 1e-9);
         assert!((p.damping_ratio - zeta).abs() < 1e-9);
@@ -246,7 +246,7 @@ fn a_rigid_body_mode_is_neither_stable_nor_given_a_dc_gain() {
             matches!(sys.dc_gain(), Err(Error::Singular { .. })),
             "k2 = {k2}"
         );
-        let d = sys.discretize(0.002, Method::Zoh).unwrap();
+        let d = sys.discretize(0.002, Discretization::Zoh).unwrap();
         assert!(!d.is_stable().unwrap(), "k2 = {k2}");
         assert!(
             matches!(d.dc_gain(), Err(Error::Singular { .. })),
@@ -257,7 +257,7 @@ fn a_rigid_body_mode_is_neither_stable_nor_given_a_dc_gain() {
     // A slow but genuine pole keeps its stability and its gain.
     let slow =
         StateSpace::continuous(matrix![-1e-6], matrix![1e-6], matrix![1.0], matrix![0.0]).unwrap();
-    let d = slow.discretize(0.002, Method::Zoh).unwrap();
+    let d = slow.discretize(0.002, Discretization::Zoh).unwrap();
     assert!(slow.is_stable().unwrap() && d.is_stable().unwrap());
     assert!((slow.dc_gain().unwrap()[(0, 0)] - 1.0).abs() < 1e-12);
     assert!((d.dc_gain().unwrap()[(0, 0)] - 1.0).abs() < 1e-6);
@@ -335,7 +335,7 @@ fn unstable_pole_is_the_first_pole_on_or_outside_the_boundary() {
         accumulator.unstable_pole().unwrap(),
         Some(Complex::new(1.0, 0.0))
     );
-    let d = plant.discretize(0.002, Method::Zoh).unwrap();
+    let d = plant.discretize(0.002, Discretization::Zoh).unwrap();
     assert_eq!(d.unstable_pole().unwrap(), None);
     let halving =
         StateSpace::discrete(matrix![-0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1).unwrap();

@@ -8,7 +8,8 @@
 mod common;
 
 use ctrlab::{
-    Cart, Controller, Error, MassSpring, Method, StateFeedback, StateSpace, acker, dlqr, lqr,
+    Cart, Controller, Discretization, Error, MassSpring, StateFeedback, StateSpace, acker, dlqr,
+    lqr,
 };
 use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 use proptest::prelude::*;
@@ -119,7 +120,7 @@ fn prefilter_removes_the_steady_state_error() {
 
     // The same constructor on the discrete plant (`with_prefilter` takes
     // either domain; `with_prefilter_discrete` was merged into it).
-    let d = plant.discretize(0.002, Method::Zoh).unwrap();
+    let d = plant.discretize(0.002, Discretization::Zoh).unwrap();
     let cd = StateFeedback::with_prefilter(&d, k).unwrap();
     let dcd = cd.closed_loop(&d).unwrap().dc_gain().unwrap()[(0, 0)];
     assert!((dcd - 1.0).abs() < 1e-12);
@@ -311,7 +312,7 @@ fn lqr_on_the_lab_plant_satisfies_the_riccati_equation() {
     assert!((sol.riccati - sol.riccati.transpose()).norm() <= 1e-12 * sol.riccati.norm());
     assert!(sol.riccati.cholesky().is_some());
 
-    let d = plant.discretize(0.002, Method::Zoh).unwrap();
+    let d = plant.discretize(0.002, Discretization::Zoh).unwrap();
     let dsol = dlqr(&d, &q, &r).unwrap();
     let dres = dare_residual(d.a(), d.b(), &q, &r, &dsol.riccati);
     assert!(dres < 1e-9, "residual {dres}");
@@ -337,7 +338,7 @@ fn lqr_stabilises_an_unstable_plant() {
     let cl = StateSpace::continuous(a - b * sol.gain, b, *sys.c(), *sys.d()).unwrap();
     assert!(cl.is_stable().unwrap(), "poles {:?}", cl.poles().unwrap());
 
-    let d = sys.discretize(0.05, Method::Zoh).unwrap();
+    let d = sys.discretize(0.05, Discretization::Zoh).unwrap();
     assert!(!d.is_stable().unwrap());
     let dsol = dlqr(&d, &q, &r).unwrap();
     assert!(dare_residual(d.a(), d.b(), &q, &r, &dsol.riccati) < 1e-9);
@@ -513,7 +514,7 @@ proptest! {
         let sol = lqr(&c, &q, &r).unwrap();
         prop_assert!(care_residual(&a, &b, &q, &r, &sol.riccati) < 1e-9);
         prop_assert!(sol.poles.iter().all(|p| p.re < 0.0));
-        let d = c.discretize(0.1, Method::Zoh).unwrap();
+        let d = c.discretize(0.1, Discretization::Zoh).unwrap();
         // Sampling squeezes the controllability matrix (A_d ≈ I + A dt,
         // B_d ≈ B dt), so a plant that passed above can be nearly
         // unstabilisable once discretised: then X is ~1e10 × Q, its terms

@@ -6,7 +6,7 @@
 mod common;
 
 use ctrlab::discretize::expm;
-use ctrlab::{Cart, Error, MassSpring, Method, StateSpace};
+use ctrlab::{Cart, Discretization, Error, MassSpring, StateSpace};
 use nalgebra::{SMatrix, matrix};
 use proptest::prelude::*;
 
@@ -18,10 +18,10 @@ fn all_four_methods_match_scipy_to_1e10() {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let table = &fx["discretised_dt_0_002"];
     for (key, method) in [
-        ("zoh", Method::Zoh),
-        ("bilinear", Method::Tustin),
-        ("euler", Method::ForwardEuler),
-        ("backward_diff", Method::BackwardEuler),
+        ("zoh", Discretization::Zoh),
+        ("bilinear", Discretization::Tustin),
+        ("euler", Discretization::ForwardEuler),
+        ("backward_diff", Discretization::BackwardEuler),
     ] {
         let d = sys.discretize(DT, method).unwrap();
         let ad = common::matrix::<4, 4>(&table[key]["ad"]);
@@ -46,7 +46,7 @@ fn zoh_of_a_double_integrator_is_analytic() {
     )
     .unwrap();
     let h = 0.37;
-    let d = sys.discretize(h, Method::Zoh).unwrap();
+    let d = sys.discretize(h, Discretization::Zoh).unwrap();
     assert!((d.a() - matrix![1.0, h; 0.0, 1.0]).norm() < 1e-15);
     assert!((d.b() - matrix![h * h / 2.0; h]).norm() < 1e-15);
 }
@@ -70,17 +70,17 @@ fn tustin_and_backward_euler_refuse_a_singular_inverse() {
     let tustin =
         StateSpace::continuous(matrix![2.0 / h], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
     assert!(matches!(
-        tustin.discretize(h, Method::Tustin),
+        tustin.discretize(h, Discretization::Tustin),
         Err(Error::Singular { .. })
     ));
     let backward =
         StateSpace::continuous(matrix![1.0 / h], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
     assert!(matches!(
-        backward.discretize(h, Method::BackwardEuler),
+        backward.discretize(h, Discretization::BackwardEuler),
         Err(Error::Singular { .. })
     ));
     // Forward Euler inverts nothing.
-    assert!(backward.discretize(h, Method::ForwardEuler).is_ok());
+    assert!(backward.discretize(h, Discretization::ForwardEuler).is_ok());
 }
 
 #[test]
@@ -88,10 +88,10 @@ fn bad_time_steps_and_overflow_are_errors() {
     let sys = MassSpring::nominal().state_space(Cart::One).unwrap();
     for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         for method in [
-            Method::Zoh,
-            Method::Tustin,
-            Method::ForwardEuler,
-            Method::BackwardEuler,
+            Discretization::Zoh,
+            Discretization::Tustin,
+            Discretization::ForwardEuler,
+            Discretization::BackwardEuler,
         ] {
             assert!(
                 matches!(
@@ -106,7 +106,7 @@ fn bad_time_steps_and_overflow_are_errors() {
     let unstable =
         StateSpace::continuous(matrix![1000.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
     assert!(matches!(
-        unstable.discretize(1e6, Method::Zoh),
+        unstable.discretize(1e6, Discretization::Zoh),
         Err(Error::Overflow { .. })
     ));
     assert!(matches!(
@@ -120,7 +120,10 @@ fn tustin_and_backward_euler_transform_c_and_d_like_scipy() {
     // SciPy gbt: Cd = C (I - αhA)^-1, Dd = D + α C Bd. Check the identities
     // directly on the nominal plant.
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
-    for (method, alpha) in [(Method::Tustin, 0.5), (Method::BackwardEuler, 1.0)] {
+    for (method, alpha) in [
+        (Discretization::Tustin, 0.5),
+        (Discretization::BackwardEuler, 1.0),
+    ] {
         let d = sys.discretize(DT, method).unwrap();
         let ima = SMatrix::<f64, 4, 4>::identity() - sys.a() * (alpha * DT);
         assert!((d.c() * ima - sys.c()).norm() < 1e-14);
@@ -146,7 +149,7 @@ proptest! {
         let a = SMatrix::<f64, 3, 3>::from_diagonal(&poles.into());
         let b = matrix![1.0; 1.0; 1.0];
         let sys = StateSpace::continuous(a, b, matrix![1.0, 1.0, 1.0], matrix![0.0]).unwrap();
-        let d = sys.discretize(dt, Method::Zoh).unwrap();
+        let d = sys.discretize(dt, Discretization::Zoh).unwrap();
         // exp is conditioned by ‖A dt‖: rounding λ·dt alone moves e^(λ dt) by
         // a relative |λ dt|·ε, and scaling and squaring runs s ≈ log2(4‖A dt‖)
         // squarings on every entry, each of which can double its relative
@@ -179,7 +182,7 @@ proptest! {
         let abscissa = m.complex_eigenvalues().iter().map(|z| z.re).fold(f64::MIN, f64::max);
         let a = m - SMatrix::<f64, 4, 4>::identity() * (abscissa + shift);
         let sys = StateSpace::continuous(a, matrix![0.0; 0.0; 0.0; 1.0], matrix![1.0, 0.0, 0.0, 0.0], matrix![0.0]).unwrap();
-        let d = sys.discretize(dt, Method::Tustin).unwrap();
+        let d = sys.discretize(dt, Discretization::Tustin).unwrap();
         let rho = spectral_radius(d.a());
         prop_assert!(rho < 1.0, "spectral radius {rho}");
     }

@@ -11,7 +11,7 @@ use ctrlab::design::{StateFeedback, acker, place, place_observer};
 use ctrlab::discretize::{expm, expm_dyn};
 use ctrlab::sim::{Solver, impulse_response, initial_response, simulate, step_response, time_grid};
 use ctrlab::{
-    Cart, Continuous, Discrete, DynStateSpace, Error, MassSpring, Method, StateSpace,
+    Cart, Continuous, Discrete, Discretization, DynStateSpace, Error, MassSpring, StateSpace,
     StepInfoOptions, step_info, step_info_of,
 };
 use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector, dvector, vector};
@@ -102,10 +102,10 @@ fn discretisation_agrees_bit_for_bit() {
     let fixed = plant();
     let dynamic = DynStateSpace::from(&fixed);
     for method in [
-        Method::Zoh,
-        Method::Tustin,
-        Method::ForwardEuler,
-        Method::BackwardEuler,
+        Discretization::Zoh,
+        Discretization::Tustin,
+        Discretization::ForwardEuler,
+        Discretization::BackwardEuler,
     ] {
         for dt in [0.0005, 0.002, 0.1, 3.0] {
             let f = fixed.discretize(dt, method).unwrap();
@@ -193,8 +193,8 @@ fn responses_agree_with_the_fixed_size_functions() {
             .fold(0.0, f64::max);
 
     // The discrete model: steps, pulses, the free response, feedback.
-    let fd = fixed.discretize(0.002, Method::Zoh).unwrap();
-    let dd = dynamic.discretize(0.002, Method::Zoh).unwrap();
+    let fd = fixed.discretize(0.002, Discretization::Zoh).unwrap();
+    let dd = dynamic.discretize(0.002, Discretization::Zoh).unwrap();
     let discrete = [
         rel(
             &outputs(&dd.step_response(1.0, 0.002).unwrap().y),
@@ -256,8 +256,8 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     assert!(metrics <= ROUNDING);
     // The response's own figures estimate the final value from the data.
     assert!((from_response.overshoot - f.overshoot).abs() < 0.1);
-    let fd = cl.discretize(0.002, Method::Zoh).unwrap();
-    let dd = dcl.discretize(0.002, Method::Zoh).unwrap();
+    let fd = cl.discretize(0.002, Discretization::Zoh).unwrap();
+    let dd = dcl.discretize(0.002, Discretization::Zoh).unwrap();
     let (a, b) = (
         step_info_of(&fd, 2.0, 0.002, &options).unwrap(),
         dd.step_info(2.0, 0.002, &options).unwrap(),
@@ -280,7 +280,10 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
         place(&fixed, &targets).unwrap().as_slice(),
     );
     let observed = fixed
-        .with_output(ctrlab::lab::positions(), nalgebra::matrix![0.0; 0.0])
+        .with_output(
+            ctrlab::lab::position_output_matrix(),
+            nalgebra::matrix![0.0; 0.0],
+        )
         .unwrap();
     let observer_targets = [-100.0, -100.0, -150.0, -150.0].map(|re| Complex::new(re, 0.0));
     let kl = rel(
@@ -294,7 +297,7 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     );
     // And on the ZOH model, in the z-plane.
     let z_targets = targets.map(|s| (s * 0.002).exp());
-    let fz = fixed.discretize(0.002, Method::Zoh).unwrap();
+    let fz = fixed.discretize(0.002, Discretization::Zoh).unwrap();
     let dz = DynStateSpace::from(&fz);
     let kz = rel(
         dz.place(&z_targets).unwrap().as_slice(),
@@ -388,8 +391,8 @@ fn a_chain_sized_at_run_time_matches_python_control() {
     assert!(sys.is_stable().unwrap());
 
     let dt = fx["dt"].as_f64().unwrap();
-    let zoh = sys.discretize(dt, Method::Zoh).unwrap();
-    let tustin = sys.discretize(dt, Method::Tustin).unwrap();
+    let zoh = sys.discretize(dt, Discretization::Zoh).unwrap();
+    let tustin = sys.discretize(dt, Discretization::Tustin).unwrap();
     let mut c2d = 0.0f64;
     for (got, want) in [(&zoh, &fx["zoh"]), (&tustin, &fx["tustin"])] {
         for (m, key) in [
@@ -537,7 +540,7 @@ fn wrong_sizes_are_errors_not_panics() {
         ]),
         Err(Error::NonFinite { matrix: "x0", .. })
     ));
-    let d = sys.discretize(0.01, Method::Zoh).unwrap();
+    let d = sys.discretize(0.01, Discretization::Zoh).unwrap();
     assert!(matches!(
         d.simulate_feedback(&DVector::zeros(7), 5, |_, _| DVector::zeros(3)),
         Err(Error::LengthMismatch { what: "input", .. })
@@ -623,7 +626,7 @@ proptest! {
         if let Ok(ds) = sys.damping() {
             prop_assert!(ds.iter().all(|d| !d.natural_frequency.is_nan() && !d.damping_ratio.is_nan()));
         }
-        for method in [Method::Zoh, Method::Tustin, Method::ForwardEuler, Method::BackwardEuler] {
+        for method in [Discretization::Zoh, Discretization::Tustin, Discretization::ForwardEuler, Discretization::BackwardEuler] {
             if let Ok(z) = sys.discretize(dt, method) {
                 prop_assert!(finite(z.a()) && finite(z.b()) && finite(z.c()) && finite(z.d()));
                 if let Ok(g) = z.dc_gain() { prop_assert!(finite(&g)); }
@@ -671,7 +674,7 @@ proptest! {
             (Ok(f), Ok(d)) => prop_assert!(rel(d.as_slice(), f.as_slice()) <= 1e-9),
             (f, d) => prop_assert_eq!(f.is_ok(), d.is_ok()),
         }
-        match (fixed.discretize(dt, Method::Zoh), dynamic.discretize(dt, Method::Zoh)) {
+        match (fixed.discretize(dt, Discretization::Zoh), dynamic.discretize(dt, Discretization::Zoh)) {
             (Ok(f), Ok(d)) => prop_assert_eq!(f.a().as_slice(), d.a().as_slice()),
             (f, d) => prop_assert_eq!(f.is_ok(), d.is_ok()),
         }

@@ -7,7 +7,8 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::integrate::{Dynamics, Integrator, Rk4};
+use ctrlab::Dynamics;
+use ctrlab::integrate::{Integrator, Rk4};
 use ctrlab::lab::{FrictionPlant, MassSpring, SimulatedRig};
 use ctrlab::signal::{Prbs, Signal, SquareWave};
 use nalgebra::{SVector, vector};

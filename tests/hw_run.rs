@@ -18,7 +18,8 @@ use ctrlab::hw::{
 use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::{
-    Cart, Controller, MassSpring, Method, OpenLoop, StateFeedback, StepInfoOptions, step_info,
+    Cart, Controller, Discretization, MassSpring, OpenLoop, StateFeedback, StepInfoOptions,
+    step_info,
 };
 use nalgebra::{SVector, vector};
 use proptest::prelude::*;
@@ -77,7 +78,7 @@ fn sampled_simulation(
     let d = plant
         .state_space(Cart::Two)
         .unwrap()
-        .discretize(PERIOD, Method::Zoh)
+        .discretize(PERIOD, Discretization::Zoh)
         .unwrap();
     let mut x = SVector::<f64, 4>::zeros();
     let mut previous = x;

@@ -18,7 +18,7 @@ use ctrlab::hw::{
     VirtualClock,
 };
 use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
-use ctrlab::{Cart, MassSpring, Method};
+use ctrlab::{Cart, Discretization, MassSpring};
 use nalgebra::{SVector, vector};
 
 /// 80 mm per 8192 counts.
@@ -77,7 +77,7 @@ fn plant_matches_the_exact_zoh_discretisation() {
     let d = truth
         .state_space(Cart::Two)
         .unwrap()
-        .discretize(0.002, Method::Zoh)
+        .discretize(0.002, Discretization::Zoh)
         .unwrap();
     let mut x = SVector::<f64, 4>::zeros();
     let mut scale = 1e-3f64;

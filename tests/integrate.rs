@@ -3,7 +3,7 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::{Cart, Dynamics, Euler, Integrator, MassSpring, Method, Rk4};
+use ctrlab::{Cart, Discretization, Dynamics, Euler, Integrator, MassSpring, Rk4};
 use nalgebra::{SVector, vector};
 
 /// Max-norm error of `steps` steps of `integrator` over [0, t_end] from rest
@@ -11,7 +11,7 @@ use nalgebra::{SVector, vector};
 fn error<I: Integrator>(integrator: I, f: &impl Dynamics<4, 1>, t_end: f64, steps: usize) -> f64 {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
     let exact = sys
-        .discretize(t_end, Method::Zoh)
+        .discretize(t_end, Discretization::Zoh)
         .unwrap()
         .advance(&SVector::zeros(), &vector![10.0]);
     let h = t_end / steps as f64;

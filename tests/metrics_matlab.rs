@@ -30,7 +30,7 @@
 //! 0.1 %.
 
 use ctrlab::metrics::{Definition, StepInfo, step_info_mimo};
-use ctrlab::{Error, Method, StateSpace, StepInfoOptions, step_info_of};
+use ctrlab::{Discretization, Error, StateSpace, StepInfoOptions, step_info_of};
 use nalgebra::{SMatrix, matrix};
 
 /// MATLAB's figures for one channel, in the order it prints them.
@@ -410,7 +410,7 @@ fn discrete_models_settle_at_samples() {
     // 39.1); 10 % → 90 %: k = 2 (a² ≤ 0.9) to k = 24 (a^24 ≤ 0.1).
     let lag =
         StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
-    let d = lag.discretize(0.1, Method::Zoh).unwrap();
+    let d = lag.discretize(0.1, Discretization::Zoh).unwrap();
     for options in [StepInfoOptions::default(), StepInfoOptions::matlab()] {
         let info = step_info_of(&d, 10.0, 0.1, &options).unwrap();
         assert!((info.settling_time - 4.0).abs() < 1e-12, "{info:?}");

@@ -221,8 +221,8 @@ proptest! {
         prop_assert_eq!(disc.is_ok(), all_finite && dt.is_finite() && dt > 0.0);
         // Discretising whatever was accepted must not panic either.
         if let Ok(sys) = cont {
-            for method in [ctrlab::Method::Zoh, ctrlab::Method::Tustin,
-                           ctrlab::Method::ForwardEuler, ctrlab::Method::BackwardEuler] {
+            for method in [ctrlab::Discretization::Zoh, ctrlab::Discretization::Tustin,
+                           ctrlab::Discretization::ForwardEuler, ctrlab::Discretization::BackwardEuler] {
                 if let Ok(d) = sys.discretize(dt, method) {
                     prop_assert!(d.a().iter().all(|v| v.is_finite()));
                 }

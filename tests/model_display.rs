@@ -4,7 +4,7 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::{Cart, MassSpring, Method, StateSpace};
+use ctrlab::{Cart, Discretization, MassSpring, StateSpace};
 use nalgebra::{DMatrix, SMatrix, matrix};
 use proptest::prelude::*;
 
@@ -106,7 +106,7 @@ fn discrete_header_shows_the_period() {
     let d = MassSpring::nominal()
         .state_space(Cart::One)
         .unwrap()
-        .discretize(0.002, Method::Zoh)
+        .discretize(0.002, Discretization::Zoh)
         .unwrap();
     let text = format!("{d}");
     let (header, _) = blocks(&text);

@@ -17,7 +17,9 @@ use ctrlab::sim::{
     SampledConfig, Solver, impulse_response, initial_response, run_sampled, simulate,
     step_response, time_grid,
 };
-use ctrlab::{MassSpring, Method, Recording, StateSpace, StepInfoOptions, step_info, step_info_of};
+use ctrlab::{
+    Discretization, MassSpring, Recording, StateSpace, StepInfoOptions, step_info, step_info_of,
+};
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 use proptest::prelude::*;
 
@@ -108,7 +110,7 @@ proptest! {
     fn discretisation_and_expm(a in matrix::<3, 3>(wild()), b in matrix::<3, 1>(wild()), dt in wild()) {
         if let Ok(e) = expm(&a) { prop_assert!(finite_all(e.as_slice())); }
         let Some(sys) = model(a, b, SMatrix::from_element(1.0)) else { return Ok(()) };
-        for method in [Method::Zoh, Method::Tustin, Method::ForwardEuler, Method::BackwardEuler] {
+        for method in [Discretization::Zoh, Discretization::Tustin, Discretization::ForwardEuler, Discretization::BackwardEuler] {
             if let Ok(d) = sys.discretize(dt, method) {
                 for m in [d.a().as_slice(), d.b().as_slice(), d.c().as_slice(), d.d().as_slice()] {
                     prop_assert!(finite_all(m));
@@ -236,7 +238,7 @@ proptest! {
                 prop_assert_eq!(&all[0][0], &step_info_of(&sys, t_end, dt, &options));
             }
             // The same model sampled at dt: its own grid.
-            if let Ok(d) = sys.discretize(dt, Method::Zoh)
+            if let Ok(d) = sys.discretize(dt, Discretization::Zoh)
                 && let Ok(info) = step_info_of(&d, t_end, dt, &options)
             {
                 prop_assert!(finite_all(&[info.rise_time, info.settling_time, info.transient_time, info.overshoot, info.peak]));
@@ -287,7 +289,7 @@ proptest! {
         if let Ok(sol) = lqr(&sys, &q, &r) {
             prop_assert!(finite_all(sol.gain.as_slice()) && finite_all(sol.riccati.as_slice()) && finite_c(&sol.poles));
         }
-        if let Ok(d) = sys.discretize(dt, Method::Zoh)
+        if let Ok(d) = sys.discretize(dt, Discretization::Zoh)
             && let Ok(sol) = dlqr(&d, &q, &r)
         {
             prop_assert!(finite_all(sol.gain.as_slice()) && finite_all(sol.riccati.as_slice()));

@@ -14,7 +14,7 @@ mod common;
 
 use common::matrix;
 use ctrlab::sim::{impulse_response, initial_response, step_response};
-use ctrlab::{Domain, Error, Method, Response, StateSpace};
+use ctrlab::{Discretization, Domain, Error, Response, StateSpace};
 use nalgebra::{SVector, matrix, vector};
 use serde_json::Value;
 
@@ -180,7 +180,7 @@ fn first_order_responses_are_analytic() {
     // Its exact discretisation: y[k] = C A^(k−1) B / dt for the impulse,
     // and the continuous step and free responses at the samples.
     let h = 0.05;
-    let d = sys.discretize(h, Method::Zoh).unwrap();
+    let d = sys.discretize(h, Discretization::Zoh).unwrap();
     let (ad, bd) = (d.a()[(0, 0)], d.b()[(0, 0)]);
     let step = step_response(&d, t_end, h).unwrap();
     let impulse = impulse_response(&d, t_end, h).unwrap();

@@ -180,7 +180,7 @@ fn scipy_darex_cases_to_scipy_precision() {
 // ---- LQR on run-time models, errors, and random problems ----
 
 use ctrlab::design::{dlqr, lqr};
-use ctrlab::{Cart, DynStateSpace, Error, MassSpring, Method};
+use ctrlab::{Cart, Discretization, DynStateSpace, Error, MassSpring};
 use nalgebra::{SMatrix, dmatrix, vector};
 use proptest::prelude::*;
 
@@ -204,7 +204,7 @@ fn fixed_and_run_time_lqr_agree_on_the_lab_plant() {
     assert_eq!(fixed.poles.to_vec(), dynamic.poles);
     assert!(fixed.residual < 1e-12 && dynamic.residual < 1e-12);
 
-    let d = plant.discretize(0.002, Method::Zoh).unwrap();
+    let d = plant.discretize(0.002, Discretization::Zoh).unwrap();
     let fixed = dlqr(&d, &q, &r).unwrap();
     let dynamic = DynStateSpace::from(d).lqr(&heap(&q), &heap(&r)).unwrap();
     assert!((heap(&fixed.gain) - &dynamic.gain).amax() <= 1e-12 * fixed.gain.amax());

@@ -621,7 +621,7 @@ fn step_response_on_a_long_grid_matches_the_discrete_model() {
     let (t_end, dt) = (20.0, 0.0005);
     let r = step_response(&sys, t_end, dt).unwrap();
     assert_eq!(r.len(), 40_001);
-    let d = sys.discretize(dt, ctrlab::Method::Zoh).unwrap();
+    let d = sys.discretize(dt, ctrlab::Discretization::Zoh).unwrap();
     let disc = ctrlab::sim::simulate_discrete(
         &d,
         nalgebra::SVector::zeros(),

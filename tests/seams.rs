@@ -17,7 +17,7 @@ use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqe
 use ctrlab::hw::{self, Clock, HwErrorKind, LoopConfig, VirtualClock};
 use ctrlab::lab::{self, SimulatedRig};
 use ctrlab::sim::run_sampled;
-use ctrlab::{Cart, Controller, Error, MassSpring, Method, StateFeedback, StateSpace};
+use ctrlab::{Cart, Controller, Discretization, Error, MassSpring, StateFeedback, StateSpace};
 use nalgebra::{SMatrix, SVector, matrix, vector};
 
 /// The rig's sampling period, s.
@@ -181,7 +181,7 @@ fn plant_model() -> StateSpace<4, 1, 1, ctrlab::Discrete> {
     MassSpring::nominal()
         .state_space(Cart::Two)
         .unwrap()
-        .discretize(PERIOD, Method::Zoh)
+        .discretize(PERIOD, Discretization::Zoh)
         .unwrap()
 }
 
@@ -267,7 +267,7 @@ impl ObserverFeedback {
     /// 2 ms one).
     fn new(period: f64) -> Self {
         let model = plant_model()
-            .with_output(lab::positions(), matrix![0.0; 0.0])
+            .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])
             .unwrap();
         Self {
             law: lab_law(),
@@ -283,7 +283,7 @@ impl ObserverFeedback {
     /// The Kalman gain `L` the observer runs with.
     fn gain() -> SMatrix<f64, 4, 2> {
         let model = plant_model()
-            .with_output(lab::positions(), matrix![0.0; 0.0])
+            .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])
             .unwrap();
         let qn = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1.0, 100.0, 1.0, 100.0]);
         let rn = SMatrix::<f64, 2, 2>::identity() * 1e-4;

@@ -10,7 +10,7 @@ use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{
     Solver, simulate, simulate_discrete, simulate_discrete_feedback, step_response, time_grid,
 };
-use ctrlab::{Cart, Error, MassSpring, Method, StateSpace};
+use ctrlab::{Cart, Discretization, Error, MassSpring, StateSpace};
 use nalgebra::{SVector, matrix, vector};
 
 #[test]
@@ -56,7 +56,7 @@ fn first_order_step_response_is_analytic() {
 #[test]
 fn discrete_simulation_matches_the_continuous_one_at_the_samples() {
     let sys = MassSpring::nominal().state_space(Cart::One).unwrap();
-    let d = sys.discretize(0.002, Method::Zoh).unwrap();
+    let d = sys.discretize(0.002, Discretization::Zoh).unwrap();
     let inputs = vec![vector![5.0]; 500];
     let disc = simulate_discrete(&d, SVector::zeros(), &inputs).unwrap();
     let t = time_grid(0.998, 0.002).unwrap();

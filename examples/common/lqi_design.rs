@@ -12,7 +12,7 @@ use ctrlab::design::{
 use ctrlab::lab::{self, Cart, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::{SMatrix, SVector, matrix, vector};
 use ctrlab::sim::run_sampled;
-use ctrlab::{Discrete, Error, Method, Recording, StateSpace, StepInfoOptions, step_info};
+use ctrlab::{Discrete, Discretization, Error, Recording, StateSpace, StepInfoOptions, step_info};
 
 /// The controller on the rig's `[x1, v1, x2, v2]`: positions only.
 pub type PositionsLqi = SelectOutputs<ObserverController<4, 1, 2, 1>, 4, 2>;
@@ -48,8 +48,8 @@ pub fn position_model(
 ) -> Result<StateSpace<4, 1, 2, Discrete>, Error> {
     plant
         .state_space(Cart::Two)?
-        .with_output(lab::positions(), matrix![0.0; 0.0])?
-        .discretize(period, Method::Zoh)
+        .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?
+        .discretize(period, Discretization::Zoh)
 }
 
 /// The LQI weights for `cart`: `rho` on its position (1/m²), `rho ·
@@ -72,7 +72,7 @@ pub fn positions_lqi(
     metres_per_count: f64,
 ) -> Result<Lqi, Error> {
     // Integrate the tracked cart's position, one of the two measured.
-    let h = cart.selection() * lab::positions().transpose();
+    let h = cart.selection() * lab::position_output_matrix().transpose();
     let tracked = model.with_output(h * model.c(), matrix![0.0])?;
     let lqi = dlqi(&tracked, q, &matrix![1.0])?;
     let rn = SMatrix::<f64, 2, 2>::identity() * (metres_per_count * metres_per_count / 12.0);
@@ -80,7 +80,7 @@ pub fn positions_lqi(
     let observer = Observer::new(model, kf.gain, EstimatorForm::Current)?;
     let controller = ObserverController::new(observer, &lqi.gain, h, ANTI_WINDUP)?;
     Ok(Lqi {
-        controller: SelectOutputs::new(controller, lab::positions())?,
+        controller: SelectOutputs::new(controller, lab::position_output_matrix())?,
         gain: lqi.gain,
         poles: lqi.poles,
     })

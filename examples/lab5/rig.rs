@@ -328,7 +328,7 @@ pub fn rig_table(
     let sys = model.state_space(table.cart)?;
     // The rig samples every 2 ms: the loop that can be stable or not is the
     // sampled one, so predict with the ZOH-discretised model.
-    let sampled = sys.discretize(PERIOD, ctrlab::Method::Zoh)?;
+    let sampled = sys.discretize(PERIOD, ctrlab::Discretization::Zoh)?;
     let idx = table.cart.state_index();
     let channel = if idx == 0 { "x1" } else { "x2" };
     let setpoint = table.setpoint_mm / 1e3;

@@ -215,7 +215,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Cart, Error, MassSpring, Method, StateSpace};
+    /// use ctrlab::{Cart, Error, MassSpring, Discretization, StateSpace};
     /// use nalgebra::matrix;
     ///
     /// let lag = StateSpace::continuous(matrix![-2.0], matrix![4.0], matrix![1.0], matrix![0.0])?;
@@ -224,7 +224,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     /// assert!(matches!(integrator.dc_gain(), Err(Error::Singular { .. })));
     ///
     /// // ZOH keeps the DC gain: 2 mm per newton on cart 2.
-    /// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
+    /// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
     /// assert!((d.dc_gain()?[(0, 0)] - 0.002).abs() < 1e-12);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```

@@ -151,7 +151,7 @@ impl<const N: usize> StateFeedback<N, 1, 1> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Cart, MassSpring, Method, StateSpace, design::StateFeedback};
+    /// use ctrlab::{Cart, MassSpring, Discretization, StateSpace, design::StateFeedback};
     /// use nalgebra::matrix;
     ///
     /// let plant = MassSpring::nominal().state_space(Cart::Two)?;

@@ -139,10 +139,10 @@ pub fn lqi<const N: usize, const M: usize, const P: usize, const NA: usize>(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Cart, Method, design::dlqi};
+/// use ctrlab::{MassSpring, Cart, Discretization, design::dlqi};
 /// use nalgebra::{SMatrix, matrix, vector};
 ///
-/// let plant = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
 /// let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
 /// let sol = dlqi(&plant, &q, &matrix![1.0])?;
 /// assert!(sol.poles.iter().all(|z| z.norm() < 1.0));
@@ -334,11 +334,11 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Controller, MassSpring, Cart, Method};
+/// use ctrlab::{Controller, MassSpring, Cart, Discretization};
 /// use ctrlab::design::{AntiWindup, IntegralFeedback, dlqi};
 /// use nalgebra::{SMatrix, matrix, vector};
 ///
-/// let plant = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
 /// let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
 /// let sol = dlqi(&plant, &q, &matrix![1.0])?;
 /// let mut c = IntegralFeedback::new(&plant, &sol.gain, AntiWindup::BackCalculation { tracking: 0.01, deadband: 0.0 })?;

@@ -108,7 +108,7 @@ pub struct Lqe<const N: usize, const P: usize> {
 /// use nalgebra::{matrix, SMatrix};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
-///     .with_output(lab::positions(), matrix![0.0; 0.0])?;
+///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?;
 /// let count = 0.080 / 8192.0; // m
 /// let rn = SMatrix::<f64, 2, 2>::identity() * (count * count / 12.0);
 /// let kf = lqe(&plant, plant.b(), &matrix![1.0], &rn)?;
@@ -140,12 +140,12 @@ pub fn lqe<const N: usize, const M: usize, const P: usize, const W: usize>(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Cart, Method, design::dlqe, lab};
+/// use ctrlab::{MassSpring, Cart, Discretization, design::dlqe, lab};
 /// use nalgebra::{matrix, SMatrix};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
-///     .with_output(lab::positions(), matrix![0.0; 0.0])?
-///     .discretize(0.002, Method::Zoh)?;
+///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?
+///     .discretize(0.002, Discretization::Zoh)?;
 /// let rn = SMatrix::<f64, 2, 2>::identity() * 1e-11;
 /// let kf = dlqe(&plant, plant.b(), &matrix![1.0], &rn)?;
 /// assert!(kf.poles.iter().all(|z| z.norm() < 1.0));

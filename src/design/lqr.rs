@@ -10,7 +10,7 @@ use crate::model::{Continuous, Discrete, StateSpace};
 /// A solved linear-quadratic regulator: the gain, the Riccati solution, the
 /// closed-loop poles, and how well the Riccati equation is satisfied.
 ///
-/// # Method
+/// # Discretization
 ///
 /// The fixed-size front end of the solvers behind `DynStateSpace::lqr`,
 /// the same code on stack matrices: the method (doubling,
@@ -104,10 +104,10 @@ pub fn lqr<const N: usize, const M: usize, const P: usize>(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Method, Cart, design::dlqr};
+/// use ctrlab::{MassSpring, Discretization, Cart, design::dlqr};
 /// use nalgebra::{SMatrix, matrix, vector};
 ///
-/// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
+/// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
 /// let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e4, 0.0, 1e6, 0.0]);
 /// let sol = dlqr(&d, &q, &matrix![1.0])?;
 /// assert!(sol.poles.iter().all(|z| z.norm() < 1.0));

@@ -39,24 +39,24 @@
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
-mod compensator;
 mod controller;
 mod feedback;
 mod integral;
 mod kalman;
 mod lqr;
 mod observer;
+mod observer_controller;
 mod place;
 mod riccati;
 mod robust_place;
 
-pub use compensator::{ObserverController, SelectOutputs};
 pub use controller::{Controller, OpenLoop};
 pub use feedback::StateFeedback;
 pub use integral::{AntiWindup, IntegralFeedback, augment_integral, dlqi, lqi};
 pub use kalman::{Lqe, dlqe, lqe};
 pub use lqr::{Lqr, dlqr, lqr};
 pub use observer::{EstimatorForm, Observer};
+pub use observer_controller::{ObserverController, SelectOutputs};
 pub use place::acker;
 pub use riccati::{DynLqr, care, dare};
 pub use robust_place::{place, place_observer};

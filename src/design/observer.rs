@@ -55,13 +55,13 @@ pub enum EstimatorForm {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Cart, Method, lab};
+/// use ctrlab::{MassSpring, Cart, Discretization, lab};
 /// use ctrlab::design::{EstimatorForm, Observer, place_observer};
 /// use nalgebra::{Complex, matrix, vector};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
-///     .with_output(lab::positions(), matrix![0.0; 0.0])?
-///     .discretize(0.002, Method::Zoh)?;
+///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?
+///     .discretize(0.002, Discretization::Zoh)?;
 /// let poles = [0.6, 0.6, 0.7, 0.7].map(|z| Complex::new(z, 0.0));
 /// let mut obs = Observer::new(&plant, place_observer(&plant, &poles)?, EstimatorForm::Current)?;
 ///

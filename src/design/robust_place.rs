@@ -34,7 +34,7 @@ type CVector<R> = OVector<Complex<f64>, R>;
 /// MATLAB's and python-control's `place` (python-control through SciPy's
 /// `place_poles`, which uses the Tits–Yang refinement of the same idea).
 ///
-/// # Method
+/// # Discretization
 ///
 /// With `B = [U₀ U₁] [Z; 0]` (QR, `B` of full column rank `M`), the
 /// eigenvector `x_j` of a target `λ_j` can be any vector of
@@ -120,7 +120,7 @@ pub fn place<const N: usize, const M: usize, const P: usize, D: Domain>(
 /// use nalgebra::{Complex, matrix};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
-///     .with_output(ctrlab::lab::positions(), matrix![0.0; 0.0])?;
+///     .with_output(ctrlab::lab::position_output_matrix(), matrix![0.0; 0.0])?;
 /// let targets = [-100.0, -100.0, -150.0, -150.0].map(|re| Complex::new(re, 0.0));
 /// let l = place_observer(&plant, &targets)?;
 /// let error_dynamics = plant.a() - l * plant.c();

@@ -36,26 +36,26 @@
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
-#[cfg(feature = "plot")]
-mod figures;
 mod kernel;
 mod margins;
 mod matrix;
 mod models;
 mod poly;
 mod response;
+#[cfg(feature = "plot")]
+mod svg;
 mod tf;
 mod zeros;
 mod zpk;
 
-#[cfg(feature = "plot")]
-#[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
-pub use figures::{FrequencyUnit, bode_svg, nyquist_svg};
 pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stability_margins};
 pub use matrix::TransferMatrix;
 pub use response::{
     Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
 };
+#[cfg(feature = "plot")]
+#[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
+pub use svg::{FrequencyUnit, bode_svg, nyquist_svg};
 pub use tf::TransferFunction;
 pub use zpk::Zpk;
 

@@ -31,7 +31,8 @@ use crate::sim::SampledConfig;
 /// # Examples
 ///
 /// ```
-/// use ctrlab::integrate::{Dynamics, Integrator, Rk4};
+/// use ctrlab::Dynamics;
+/// use ctrlab::integrate::{Integrator, Rk4};
 /// use ctrlab::lab::{FrictionPlant, MassSpring};
 /// use nalgebra::vector;
 ///

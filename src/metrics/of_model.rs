@@ -1,7 +1,7 @@
 //! Step figures of a model ([`step_info_of`], [`step_info_mimo`]) and of a
 //! recording's channel ([`step_info_channel`]).
 
-use super::step_info::{Crossings, figures};
+use super::step_info::{Crossings, measure};
 use super::{StepInfo, StepInfoOptions, step_info};
 use crate::data::Recording;
 use crate::error::Error;
@@ -28,7 +28,7 @@ use crate::sim::step_response;
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Cart, Method, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
+/// use ctrlab::{MassSpring, Cart, Discretization, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?.closed_loop(&plant)?;
@@ -37,7 +37,7 @@ use crate::sim::step_response;
 /// assert!((info.overshoot - 5.03).abs() < 0.5 && (info.settling_time - 0.2).abs() < 0.01);
 ///
 /// // The same loop sampled every 2 ms: its figures are sample times.
-/// let d = cl.discretize(0.002, Method::Zoh)?;
+/// let d = cl.discretize(0.002, Discretization::Zoh)?;
 /// let di = step_info_of(&d, 2.0, d.dt(), &StepInfoOptions::default())?;
 /// assert!((di.settling_time / 0.002 - (di.settling_time / 0.002).round()).abs() < 1e-9);
 /// assert!((di.settling_time - info.settling_time).abs() <= 0.002);
@@ -179,7 +179,7 @@ fn channels_dyn<D: Domain>(
                 .map(|(j, r)| {
                     let y: Vec<f64> = r.y.iter().map(|y| y[i]).collect();
                     let final_value = options.final_value.or(gain.as_ref().map(|g| g[(i, j)]));
-                    figures(
+                    measure(
                         &r.t,
                         &y,
                         &StepInfoOptions {

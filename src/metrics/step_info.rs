@@ -32,7 +32,7 @@ use crate::error::Error;
 /// assert!(matches!(err, Error::NotSettled { .. }));
 /// ```
 pub fn step_info(t: &[f64], y: &[f64], options: &StepInfoOptions) -> Result<StepInfo, Error> {
-    figures(t, y, options, Crossings::Interpolated)
+    measure(t, y, options, Crossings::Interpolated)
 }
 
 /// How a crossing time between two samples is found.
@@ -46,7 +46,7 @@ pub(super) enum Crossings {
 }
 
 /// [`step_info`] with the crossing rule of the data's kind.
-pub(super) fn figures(
+pub(super) fn measure(
     t: &[f64],
     y: &[f64],
     options: &StepInfoOptions,
@@ -248,13 +248,13 @@ pub(super) fn figures(
         steady_state_value: yf,
         steady_state_error: options.reference.map(|r| r - yf),
     };
-    check_figures(&info)?;
+    check_measured(&info)?;
     Ok(info)
 }
 
 /// Every figure must be a finite number: a peak a googol of steps away,
 /// or times spanning more than `f64::MAX` seconds, are errors, not `inf`.
-fn check_figures(info: &StepInfo) -> Result<(), Error> {
+fn check_measured(info: &StepInfo) -> Result<(), Error> {
     let figures = [
         (info.rise_time, "step metrics: rise time overflows"),
         (info.settling_time, "step metrics: settling time overflows"),

@@ -21,7 +21,8 @@ use super::{Continuous, StateSpace};
 /// # Examples
 ///
 /// ```
-/// use ctrlab::integrate::{Dynamics, Rk4, Integrator};
+/// use ctrlab::Dynamics;
+/// use ctrlab::integrate::{Integrator, Rk4};
 /// use nalgebra::{SVector, vector};
 ///
 /// // A pendulum, x = [angle (rad), rate (rad/s)], u = torque/inertia (rad/s²).
@@ -48,7 +49,7 @@ pub trait Dynamics<const N: usize, const M: usize> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::integrate::Dynamics;
+    /// use ctrlab::Dynamics;
     /// use nalgebra::{SVector, vector};
     ///
     /// /// x' = u, but x never goes below zero (a hard stop).

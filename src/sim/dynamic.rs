@@ -150,7 +150,7 @@ impl<D: Domain> DynStateSpace<D> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{DynStateSpace, Method};
+    /// use ctrlab::{DynStateSpace, Discretization};
     /// use nalgebra::dmatrix;
     ///
     /// // First-order lag, τ = 0.5 s: y(τ) = 1 − e^−1.
@@ -158,7 +158,7 @@ impl<D: Domain> DynStateSpace<D> {
     /// let r = sys.step_response(1.0, 0.5)?;
     /// assert!((r.y[1][0] - (1.0 - (-1.0f64).exp())).abs() < 1e-14);
     /// // Its exact discretisation has the same response at the samples.
-    /// let d = sys.discretize(0.5, Method::Zoh)?;
+    /// let d = sys.discretize(0.5, Discretization::Zoh)?;
     /// assert!((d.step_response(1.0, 0.5)?.y[1][0] - r.y[1][0]).abs() < 1e-14);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```

@@ -84,7 +84,7 @@ fn respond<const N: usize, const M: usize, const P: usize, D: Domain>(
 /// assert!((r.y[1][0] - (1.0 - (-1.0f64).exp())).abs() < 1e-14);
 ///
 /// // Its exact discretisation has the same step response at the samples.
-/// let d = sys.discretize(0.5, ctrlab::Method::Zoh)?;
+/// let d = sys.discretize(0.5, ctrlab::Discretization::Zoh)?;
 /// let rd = step_response(&d, 1.0, d.dt())?;
 /// assert!((rd.y[1][0] - r.y[1][0]).abs() < 1e-14);
 /// # Ok::<(), ctrlab::Error>(())
@@ -125,7 +125,7 @@ pub fn step_response<const N: usize, const P: usize, D: Domain>(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Method, StateSpace, sim::impulse_response};
+/// use ctrlab::{Discretization, StateSpace, sim::impulse_response};
 /// use nalgebra::matrix;
 ///
 /// // A lag 1/(τ s + 1), τ = 0.5 s: g(t) = e^{−t/τ} / τ.
@@ -134,7 +134,7 @@ pub fn step_response<const N: usize, const P: usize, D: Domain>(
 /// assert!((r.y[1][0] - 2.0 * (-1.0f64).exp()).abs() < 1e-14);
 ///
 /// // Discrete: y[1] = C B / dt.
-/// let d = sys.discretize(0.1, Method::Zoh)?;
+/// let d = sys.discretize(0.1, Discretization::Zoh)?;
 /// let rd = impulse_response(&d, 1.0, 0.1)?;
 /// assert_eq!(rd.y[0][0], 0.0);
 /// assert!((rd.y[1][0] - d.b()[(0, 0)] / 0.1).abs() < 1e-12);

@@ -20,7 +20,7 @@ pub(crate) use solver::{Solution, continuous, discrete};
 /// [`Lqr`](super::Lqr), returned by [`care`], [`dare`] and
 /// [`DynStateSpace::lqr`].
 ///
-/// # Method
+/// # Discretization
 ///
 /// The discrete equation
 /// `X = Aᵀ X A − Aᵀ X B (R + Bᵀ X B)⁻¹ Bᵀ X A + Q` is the fixed point of the
@@ -266,10 +266,10 @@ impl DynStateSpace<Discrete> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Cart, DynStateSpace, MassSpring, Method};
+    /// use ctrlab::{Cart, DynStateSpace, MassSpring, Discretization};
     /// use nalgebra::{DMatrix, dmatrix, dvector};
     ///
-    /// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Method::Zoh)?;
+    /// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
     /// let plant = DynStateSpace::from(d);
     /// let q = DMatrix::from_diagonal(&dvector![1e4, 0.0, 1e6, 0.0]);
     /// let sol = plant.lqr(&q, &dmatrix![1.0])?;

@@ -133,7 +133,7 @@ impl MassSpringEstimate {
     }
 
     /// The identified plant with its Coulomb friction, a nonlinear
-    /// [`Dynamics`](crate::integrate::Dynamics) to simulate (breakaway at
+    /// [`Dynamics`](crate::Dynamics) to simulate (breakaway at
     /// the Coulomb force; a negative force estimate taken as 0, none
     /// without [`Options::coulomb`](super::Options::coulomb)).
     /// [`plant`](Self::plant) is its linear part, for design.
@@ -269,7 +269,7 @@ impl SeparateSpringsEstimate {
     }
 
     /// The identified plant with its Coulomb friction, a nonlinear
-    /// [`Dynamics`](crate::integrate::Dynamics) to simulate (breakaway at
+    /// [`Dynamics`](crate::Dynamics) to simulate (breakaway at
     /// the Coulomb force; a negative force estimate taken as 0, none
     /// without [`Options::coulomb`](super::Options::coulomb)).
     /// [`plant`](Self::plant) is its linear part, for design.

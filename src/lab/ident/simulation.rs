@@ -9,8 +9,9 @@ use nalgebra::{SMatrix, SVector, U3, U4, vector};
 use crate::data::Recording;
 use crate::discretize::zoh;
 use crate::error::Error;
-use crate::integrate::{Dynamics, Integrator, Rk4};
+use crate::integrate::{Integrator, Rk4};
 use crate::lab::{FrictionPlant, MassSpring};
+use crate::model::Dynamics;
 use crate::sim::{grid_rounding, uniform_step};
 
 /// Fewest samples a run must have: three times the residual tests' lags.

@@ -44,13 +44,13 @@ use crate::error::{Error, check_finite};
 /// model itself:
 ///
 /// ```
-/// use ctrlab::{Controller, MassSpring, Cart, Method, lab};
+/// use ctrlab::{Controller, MassSpring, Cart, Discretization, lab};
 /// use ctrlab::design::{AntiWindup, EstimatorForm, Observer, ObserverController, dlqe, dlqi};
 /// use nalgebra::{SMatrix, matrix, vector};
 ///
 /// let model = MassSpring::nominal().state_space(Cart::Two)?
-///     .with_output(lab::positions(), matrix![0.0; 0.0])?
-///     .discretize(0.002, Method::Zoh)?;
+///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?
+///     .discretize(0.002, Discretization::Zoh)?;
 /// // Integrate x2, the second measurement.
 /// let h = matrix![0.0, 1.0];
 /// let tracked = model.with_output(h * model.c(), matrix![0.0])?;
@@ -208,7 +208,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize> Controller<
 ///
 /// On the lab's rig, whose measurements are `[x1, v1, x2, v2]` with the
 /// speeds differenced from encoder counts (one count per 2 ms is 4.9 mm/s),
-/// `SelectOutputs::new(c, lab::positions())` runs an observer-based
+/// `SelectOutputs::new(c, lab::position_output_matrix())` runs an observer-based
 /// controller on the positions alone.
 ///
 /// # Examples
@@ -219,7 +219,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize> Controller<
 ///
 /// // A law on [x1, x2] only, given the rig's four measurements.
 /// let law = StateFeedback::new(matrix![1.0, 2.0], vector![0.0])?;
-/// let mut c = SelectOutputs::new(law, ctrlab::lab::positions())?;
+/// let mut c = SelectOutputs::new(law, ctrlab::lab::position_output_matrix())?;
 /// let u = c.update(&vector![0.1, 99.0, 0.2, -99.0], &vector![0.0]);
 /// assert!((u[0] + 0.5).abs() < 1e-15); // the speeds are ignored
 /// # Ok::<(), ctrlab::Error>(())
@@ -256,7 +256,7 @@ impl<C, const P: usize, const Q: usize> SelectOutputs<C, P, Q> {
     ///
     /// ```
     /// use ctrlab::{OpenLoop, design::SelectOutputs};
-    /// let c = SelectOutputs::new(OpenLoop, ctrlab::lab::positions())?;
+    /// let c = SelectOutputs::new(OpenLoop, ctrlab::lab::position_output_matrix())?;
     /// assert_eq!(*c.inner(), OpenLoop);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
