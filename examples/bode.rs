@@ -15,7 +15,7 @@ use ctrlab::freq::{
 };
 use ctrlab::{Cart, MassSpring};
 
-fn main() -> Result<(), ctrlab::Error> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "docs".into()));
     let plant = MassSpring::nominal().state_space(Cart::Two)?;
 

@@ -124,7 +124,7 @@ fn run_row(plant: &MassSpring, table: &Table, kf: [f64; 4]) -> Result<Row, Error
     }
 }
 
-fn main() -> Result<(), Error> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let plant = MassSpring::nominal();
     for table in tables() {
         println!("{}", table.name);
@@ -185,7 +185,7 @@ fn plot(
     table: &Table,
     rows: &[(String, Vec<f64>, Vec<f64>)],
     longest_settling: f64,
-) -> Result<(), Error> {
+) -> Result<(), Box<dyn std::error::Error>> {
     use ctrlab::plot::{Series, responses_svg};
     if rows.is_empty() {
         return Ok(());
@@ -203,10 +203,7 @@ fn plot(
     let setpoint_y = [table.setpoint_mm; 2];
     series.push(Series::new("setpoint", &setpoint_t, &setpoint_y));
     let dir = std::path::Path::new("target").join("state_feedback");
-    std::fs::create_dir_all(&dir).map_err(|e| Error::Plot {
-        path: dir.display().to_string(),
-        reason: e.to_string(),
-    })?;
+    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let path = dir.join(table.file);
     let unstable = table.rows.len() - rows.len();
     let title = if unstable > 0 {

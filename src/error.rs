@@ -181,14 +181,6 @@ pub enum Error {
         /// Iterations spent.
         iterations: usize,
     },
-    /// Writing a figure failed (feature `plot`).
-    #[error("cannot write figure {path}: {reason}")]
-    Plot {
-        /// The file being written.
-        path: String,
-        /// The backend's message.
-        reason: String,
-    },
     /// A CSV recording is malformed: a missing or unit-less time column, a
     /// column in encoder counts without a calibration, a row of the wrong
     /// width, a value that is not a finite number (or holds a thousands

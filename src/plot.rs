@@ -15,14 +15,101 @@
 //! let path = std::env::temp_dir().join("ctrlab_plot_doc.svg");
 //! responses_svg(&path, "First order", "t (s)", "y", &[Series::new("τ = 0.2 s", &t, &y)])?;
 //! assert!(std::fs::read_to_string(&path).unwrap().contains("<svg"));
-//! # Ok::<(), ctrlab::Error>(())
+//! # Ok::<(), ctrlab::plot::PlotError>(())
 //! ```
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use plotters::prelude::*;
 
 use crate::error::Error;
+
+/// Why a figure was not written: data that cannot be drawn (a numeric
+/// [`Error`]), or the file (the backend's error, kept as the source).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::plot::{PlotError, PlotErrorKind, Series, responses_svg};
+///
+/// let dir = std::env::temp_dir().join("ctrlab_plot_error_doc");
+/// std::fs::create_dir_all(&dir)?;
+/// // A directory is not a file: the write fails, and says where.
+/// let err = responses_svg(&dir, "t", "t (s)", "y", &[Series::new("y", &[0.0, 1.0], &[0.0, 1.0])])
+///     .unwrap_err();
+/// assert_eq!(err.kind(), PlotErrorKind::Write);
+/// assert!(err.to_string().contains("ctrlab_plot_error_doc"));
+/// assert!(std::error::Error::source(&err).is_some());
+/// // Nothing finite to draw is the data's fault.
+/// let err = responses_svg(dir.join("nan.svg"), "t", "t (s)", "y", &[Series::new("y", &[f64::NAN], &[0.0])])
+///     .unwrap_err();
+/// assert_eq!(err.kind(), PlotErrorKind::Data);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlotError {
+    /// The data cannot be drawn (no finite point, lengths that differ, a
+    /// range no axis can hold).
+    #[error(transparent)]
+    Data(#[from] Error),
+    /// Writing the figure failed.
+    #[error("cannot write figure {}: {source}", path.display())]
+    Write {
+        /// The file being written.
+        path: PathBuf,
+        /// The drawing backend's error (an I/O error underneath).
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+}
+
+/// The category of a [`PlotError`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::plot::{PlotError, PlotErrorKind};
+/// let e = PlotError::from(ctrlab::Error::Singular { operation: "x" });
+/// assert_eq!(e.kind(), PlotErrorKind::Data);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum PlotErrorKind {
+    /// [`PlotError::Data`].
+    Data,
+    /// [`PlotError::Write`].
+    Write,
+}
+
+impl PlotError {
+    /// What kind of failure this is.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::plot::{PlotError, PlotErrorKind};
+    /// let e = PlotError::from(ctrlab::Error::Singular { operation: "x" });
+    /// assert_eq!(e.kind(), PlotErrorKind::Data);
+    /// ```
+    pub fn kind(&self) -> PlotErrorKind {
+        match self {
+            PlotError::Data(_) => PlotErrorKind::Data,
+            PlotError::Write { .. } => PlotErrorKind::Write,
+        }
+    }
+}
+
+/// A [`PlotError::Write`] for `path` from the backend's error.
+pub(crate) fn write_error<E>(path: &Path, source: E) -> PlotError
+where
+    E: std::error::Error + Send + Sync + 'static,
+{
+    PlotError::Write {
+        path: path.to_path_buf(),
+        source: Box::new(source),
+    }
+}
 
 /// Figure size in pixels.
 pub(crate) const SIZE: (u32, u32) = (960, 600);
@@ -102,19 +189,19 @@ pub(crate) fn axis(lo: f64, hi: f64, pad: f64) -> Option<(f64, f64)> {
 ///
 /// # Errors
 ///
-/// [`Error::LengthMismatch`] if a series' `t` and `y` differ in length;
-/// [`Error::InvalidData`] if there is no finite point at all, or the points
-/// span more than `f64::MAX` (`y` from −1e308 to 1e308);
-/// [`Error::Plot`] if the file cannot be written.
+/// [`PlotError::Data`] with [`Error::LengthMismatch`] if a series' `t` and
+/// `y` differ in length, with [`Error::InvalidData`] if there is no finite
+/// point at all, or the points span more than `f64::MAX` (`y` from −1e308
+/// to 1e308); [`PlotError::Write`] if the file cannot be written.
 ///
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Error, plot::{Series, responses_svg}};
+/// use ctrlab::{Error, plot::{PlotError, Series, responses_svg}};
 ///
 /// let path = std::env::temp_dir().join("ctrlab_plot_mismatch.svg");
 /// let err = responses_svg(&path, "bad", "t", "y", &[Series::new("s", &[0.0, 1.0], &[0.0])]).unwrap_err();
-/// assert!(matches!(err, Error::LengthMismatch { .. }));
+/// assert!(matches!(err, PlotError::Data(Error::LengthMismatch { .. })));
 /// ```
 pub fn responses_svg(
     path: impl AsRef<Path>,
@@ -122,7 +209,7 @@ pub fn responses_svg(
     x_label: &str,
     y_label: &str,
     series: &[Series<'_>],
-) -> Result<(), Error> {
+) -> Result<(), PlotError> {
     let path = path.as_ref();
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
@@ -132,11 +219,11 @@ pub fn responses_svg(
     );
     for s in series {
         if s.t.len() != s.y.len() {
-            return Err(Error::LengthMismatch {
+            return Err(PlotError::Data(Error::LengthMismatch {
                 what: "series y",
                 expected: s.t.len(),
                 found: s.y.len(),
-            });
+            }));
         }
         for (&t, &y) in s.t.iter().zip(s.y) {
             if t.is_finite() && y.is_finite() {
@@ -148,11 +235,11 @@ pub fn responses_svg(
         }
     }
     if !(x0.is_finite() && y0.is_finite()) {
-        return Err(Error::InvalidData {
+        return Err(PlotError::Data(Error::InvalidData {
             what: "series",
             index: 0,
             reason: "no finite point to plot",
-        });
+        }));
     }
     let too_wide = |what| Error::InvalidData {
         what,
@@ -162,19 +249,16 @@ pub fn responses_svg(
     let (x0, x1) = axis(x0, x1, 0.0).ok_or_else(|| too_wide("series t"))?;
     let (y0, y1) = axis(y0, y1, 0.05).ok_or_else(|| too_wide("series y"))?;
 
-    let plot_err = |e: &dyn std::fmt::Display| Error::Plot {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    };
+    let plot_err = |e| write_error(path, e);
     let root = SVGBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| plot_err(&e))?;
+    root.fill(&WHITE).map_err(plot_err)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(44)
         .y_label_area_size(64)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| plot_err(&e))?;
+        .map_err(plot_err)?;
     chart
         .configure_mesh()
         .x_desc(x_label)
@@ -182,7 +266,7 @@ pub fn responses_svg(
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
         .draw()
-        .map_err(|e| plot_err(&e))?;
+        .map_err(plot_err)?;
     for (i, s) in series.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
         // Every k-th sample (and the last), at most MAX_POINTS per series.
@@ -198,7 +282,7 @@ pub fn responses_svg(
                 .map(|(&t, &y)| (t, y));
         chart
             .draw_series(LineSeries::new(points, color.stroke_width(2)))
-            .map_err(|e| plot_err(&e))?
+            .map_err(plot_err)?
             .label(s.label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
@@ -209,7 +293,7 @@ pub fn responses_svg(
         .label_font(("sans-serif", 14))
         .position(SeriesLabelPosition::LowerRight)
         .draw()
-        .map_err(|e| plot_err(&e))?;
-    root.present().map_err(|e| plot_err(&e))?;
+        .map_err(plot_err)?;
+    root.present().map_err(plot_err)?;
     Ok(())
 }

@@ -2,7 +2,7 @@
 #![cfg(feature = "plot")]
 
 use ctrlab::Error;
-use ctrlab::plot::{MAX_POINTS, Series, responses_svg};
+use ctrlab::plot::{MAX_POINTS, PlotError, Series, responses_svg};
 
 fn temp_svg(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("ctrlab-plot-{}", std::process::id()));
@@ -68,19 +68,19 @@ fn bad_series_and_unwritable_paths_are_errors() {
     let path = temp_svg("bad.svg");
     assert!(matches!(
         responses_svg(&path, "", "", "", &[Series::new("s", &[0.0, 1.0], &[0.0])]),
-        Err(Error::LengthMismatch {
+        Err(PlotError::Data(Error::LengthMismatch {
             expected: 2,
             found: 1,
             ..
-        })
+        }))
     ));
     assert!(matches!(
         responses_svg(&path, "", "", "", &[Series::new("s", &[f64::NAN], &[0.0])]),
-        Err(Error::InvalidData { .. })
+        Err(PlotError::Data(Error::InvalidData { .. }))
     ));
     assert!(matches!(
         responses_svg(&path, "", "", "", &[]),
-        Err(Error::InvalidData { .. })
+        Err(PlotError::Data(Error::InvalidData { .. }))
     ));
     let nowhere = temp_svg("no/such/dir/x.svg");
     assert!(matches!(
@@ -91,6 +91,17 @@ fn bad_series_and_unwritable_paths_are_errors() {
             "",
             &[Series::new("s", &[0.0, 1.0], &[0.0, 1.0])]
         ),
-        Err(Error::Plot { .. })
+        Err(PlotError::Write { .. })
     ));
+    // The backend's I/O error is kept as the source, and the path is named.
+    let err = responses_svg(
+        &nowhere,
+        "",
+        "",
+        "",
+        &[Series::new("s", &[0.0, 1.0], &[0.0, 1.0])],
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("no/such/dir"), "{err}");
+    assert!(std::error::Error::source(&err).is_some());
 }

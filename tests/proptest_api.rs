@@ -389,7 +389,7 @@ proptest! {
         match responses_svg(&path, "p", "t", "y", &[Series::new("s", &t[..n], &y[..n])]) {
             Ok(()) => prop_assert!(std::fs::read_to_string(&path).unwrap().contains("<svg")),
             Err(e) => {
-                let expected = matches!(e, ctrlab::Error::InvalidData { .. } | ctrlab::Error::LengthMismatch { .. } | ctrlab::Error::Plot { .. });
+                let expected = matches!(e, ctrlab::plot::PlotError::Data(ctrlab::Error::InvalidData { .. } | ctrlab::Error::LengthMismatch { .. }) | ctrlab::plot::PlotError::Write { .. });
                 prop_assert!(expected, "{}", e);
             }
         }

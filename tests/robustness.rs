@@ -151,7 +151,13 @@ fn plots_of_huge_ranges_finish() {
         (&[-1e308, 1e308][..], &[0.0, 1.0][..]),
     ] {
         let err = responses_svg(&path, "wide", "t", "y", &[Series::new("s", t, y)]).unwrap_err();
-        assert!(matches!(err, Error::InvalidData { .. }), "{err}");
+        assert!(
+            matches!(
+                err,
+                ctrlab::plot::PlotError::Data(Error::InvalidData { .. })
+            ),
+            "{err}"
+        );
     }
 }
 

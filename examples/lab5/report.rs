@@ -50,7 +50,7 @@ impl Report {
         x_label: &str,
         y_label: &str,
         series: &[(String, Vec<f64>, Vec<f64>)],
-    ) -> Result<(), ctrlab::Error> {
+    ) -> Result<(), Box<dyn std::error::Error>> {
         #[cfg(feature = "plot")]
         {
             use ctrlab::plot::{Series, responses_svg};
@@ -80,7 +80,7 @@ impl Report {
         file: &str,
         title: &str,
         curves: &[(&str, &ctrlab::freq::Bode)],
-    ) -> Result<(), ctrlab::Error> {
+    ) -> Result<(), Box<dyn std::error::Error>> {
         use ctrlab::freq::{FrequencyUnit, bode_svg};
         bode_svg(self.out.join(file), title, FrequencyUnit::Hertz, curves)?;
         self.add(&format!("![{title}]({file})\n"));

@@ -1,14 +1,14 @@
 //! Tables 1 and 2: the nominal model in simulation.
 
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Cart, Error, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Cart, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
 use nalgebra::{SVector, vector};
 
 use crate::lab_tables::{self, fmt_kf, fmt_poles};
 use crate::report::Report;
 
 /// Table 1: static deflection under F = 10…50 N, simulated to rest.
-pub fn table1(report: &mut Report) -> Result<(), Error> {
+pub fn table1(report: &mut Report) -> Result<(), Box<dyn std::error::Error>> {
     let plant = MassSpring::nominal();
     let sys = plant.state_space(Cart::Two)?;
     // The slowest pole decays at 3.70 /s: after 10 s what is left is e^-37.
@@ -61,7 +61,7 @@ pub struct Measured {
 }
 
 /// Table 2: state feedback on the nominal model, continuous closed loop.
-pub fn table2(report: &mut Report) -> Result<Vec<Measured>, Error> {
+pub fn table2(report: &mut Report) -> Result<Vec<Measured>, Box<dyn std::error::Error>> {
     let plant = MassSpring::nominal().state_space(Cart::Two)?;
     let setpoint_mm = 30.0;
     report.heading(

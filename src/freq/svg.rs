@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::response::{Bode, Nyquist};
 use crate::error::Error;
-use crate::plot::{MAX_POINTS, axis};
+use crate::plot::{MAX_POINTS, PlotError, axis, write_error};
 
 /// The unit of a Bode figure's frequency axis.
 ///
@@ -62,13 +62,6 @@ impl FrequencyUnit {
     }
 }
 
-fn plot_err(path: &Path) -> impl Fn(&dyn std::fmt::Display) -> Error + '_ {
-    move |e| Error::Plot {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    }
-}
-
 fn no_points() -> Error {
     Error::InvalidData {
         what: "series",
@@ -116,8 +109,8 @@ fn panel(
     y_label: &str,
     x_label: &str,
     curves: &[(&str, Vec<(f64, f64)>)],
-) -> Result<(), Error> {
-    let err = plot_err(path);
+) -> Result<(), PlotError> {
+    let err = |e| write_error(path, e);
     let (y0, y1) = range(curves.iter().flat_map(|(_, p)| p.iter().map(|q| q.1)), 0.05)?;
     let mut builder = ChartBuilder::on(area);
     if let Some(c) = caption {
@@ -128,7 +121,7 @@ fn panel(
         .x_label_area_size(44)
         .y_label_area_size(64)
         .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
-        .map_err(|e| err(&e))?;
+        .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc(x_label)
@@ -136,7 +129,7 @@ fn panel(
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
         .draw()
-        .map_err(|e| err(&e))?;
+        .map_err(err)?;
     for (i, (label, points)) in curves.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
         chart
@@ -144,7 +137,7 @@ fn panel(
                 points.iter().copied(),
                 color.stroke_width(2),
             ))
-            .map_err(|e| err(&e))?
+            .map_err(err)?
             .label(*label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
@@ -155,7 +148,7 @@ fn panel(
         .label_font(("sans-serif", 14))
         .position(SeriesLabelPosition::LowerLeft)
         .draw()
-        .map_err(|e| err(&e))?;
+        .map_err(err)?;
     Ok(())
 }
 
@@ -167,8 +160,9 @@ fn panel(
 ///
 /// # Errors
 ///
-/// [`Error::InvalidData`] if there is no finite point at a positive
-/// frequency; [`Error::Plot`] if the file cannot be written.
+/// [`PlotError::Data`] with [`Error::InvalidData`] if there is no finite
+/// point at a positive frequency; [`PlotError::Write`] if the file cannot
+/// be written.
 ///
 /// # Examples
 ///
@@ -189,7 +183,7 @@ pub fn bode_svg(
     title: &str,
     unit: FrequencyUnit,
     curves: &[(&str, &Bode)],
-) -> Result<(), Error> {
+) -> Result<(), PlotError> {
     let path = path.as_ref();
     let scale = unit.scale();
     let keep = |b: &Bode, y: Vec<f64>| {
@@ -210,8 +204,8 @@ pub fn bode_svg(
     let (x0, x1) = range(mag.iter().flat_map(|(_, p)| p.iter().map(|q| q.0)), 0.0)?;
     let x0 = if x0 > 0.0 { x0 } else { x1 / 10.0 };
     let root = SVGBackend::new(path, (960, 800)).into_drawing_area();
-    let err = plot_err(path);
-    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let err = |e| write_error(path, e);
+    root.fill(&WHITE).map_err(err)?;
     let (top, bottom) = root.split_vertically(400);
     panel(
         &top,
@@ -231,7 +225,7 @@ pub fn bode_svg(
         unit.label(),
         &phase,
     )?;
-    root.present().map_err(|e| err(&e))?;
+    root.present().map_err(err)?;
     Ok(())
 }
 
@@ -241,8 +235,9 @@ pub fn bode_svg(
 ///
 /// # Errors
 ///
-/// [`Error::InvalidData`] if there is no finite point, or the points span
-/// more than `f64::MAX`; [`Error::Plot`] if the file cannot be written.
+/// [`PlotError::Data`] with [`Error::InvalidData`] if there is no finite
+/// point, or the points span more than `f64::MAX`; [`PlotError::Write`] if
+/// the file cannot be written.
 ///
 /// # Examples
 ///
@@ -261,22 +256,22 @@ pub fn nyquist_svg(
     path: impl AsRef<Path>,
     title: &str,
     curves: &[(&str, &Nyquist)],
-) -> Result<(), Error> {
+) -> Result<(), PlotError> {
     let path = path.as_ref();
-    let err = plot_err(path);
+    let err = |e| write_error(path, e);
     let points: Vec<Vec<(f64, f64)>> = curves.iter().map(|(_, n)| thin(&n.re, &n.im)).collect();
     let all = || points.iter().flatten();
     let (x0, x1) = range(all().map(|p| p.0).chain([-1.0]), 0.05)?;
     let (y0, y1) = range(all().flat_map(|p| [p.1, -p.1]).chain([0.0]), 0.05)?;
     let root = SVGBackend::new(path, crate::plot::SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
+    root.fill(&WHITE).map_err(err)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(44)
         .y_label_area_size(64)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(&e))?;
+        .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc("Re G")
@@ -284,7 +279,7 @@ pub fn nyquist_svg(
         .label_style(("sans-serif", 14))
         .axis_desc_style(("sans-serif", 16))
         .draw()
-        .map_err(|e| err(&e))?;
+        .map_err(err)?;
     for (i, ((label, _), p)) in curves.iter().zip(&points).enumerate() {
         let color = Palette99::pick(i).to_rgba();
         chart
@@ -292,10 +287,10 @@ pub fn nyquist_svg(
                 p.iter().map(|&(x, y)| (x, -y)),
                 color.stroke_width(1),
             ))
-            .map_err(|e| err(&e))?;
+            .map_err(err)?;
         chart
             .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))
-            .map_err(|e| err(&e))?
+            .map_err(err)?
             .label(*label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
@@ -305,7 +300,7 @@ pub fn nyquist_svg(
             6,
             RED.stroke_width(2),
         )))
-        .map_err(|e| err(&e))?
+        .map_err(err)?
         .label("−1")
         .legend(|(x, y)| Cross::new((x + 10, y), 5, RED.stroke_width(2)));
     chart
@@ -315,7 +310,7 @@ pub fn nyquist_svg(
         .label_font(("sans-serif", 14))
         .position(SeriesLabelPosition::LowerRight)
         .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
+        .map_err(err)?;
+    root.present().map_err(err)?;
     Ok(())
 }
