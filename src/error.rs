@@ -304,6 +304,75 @@ pub enum Error {
     },
 }
 
+/// The category of an [`Error`], for callers that branch on what happened
+/// rather than on the details (as embedded-hal's error kinds).
+///
+/// `#[non_exhaustive]`: match with a wildcard arm.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Error, ErrorKind};
+///
+/// let e = Error::InvalidParameter { name: "dt", value: -1.0, reason: "must be > 0" };
+/// assert_eq!(e.kind(), ErrorKind::InvalidInput);
+/// assert_eq!(Error::Singular { operation: "Tustin" }.kind(), ErrorKind::Numerical);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// An argument is out of its domain: a parameter, a matrix's entries or
+    /// shape, data, a pole, an index, too few samples.
+    InvalidInput,
+    /// The computation cannot be done to working precision: a singular or
+    /// ill-conditioned matrix, an overflow, an iteration that did not
+    /// converge, a rank-deficient regressor, a pole placed elsewhere.
+    Numerical,
+    /// The model lacks a property the operation needs: stability,
+    /// controllability, observability, or a response that settles.
+    System,
+    /// Reading or writing a file (being moved to the error types of the
+    /// modules that do I/O).
+    Io,
+}
+
+impl Error {
+    /// What kind of failure this is.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, ErrorKind};
+    /// assert_eq!(Error::Uncontrollable { rank: 3, states: 4 }.kind(), ErrorKind::System);
+    /// ```
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Error::InvalidParameter { .. }
+            | Error::NonFinite { .. }
+            | Error::InvalidData { .. }
+            | Error::LengthMismatch { .. }
+            | Error::InvalidMatrix { .. }
+            | Error::DimensionMismatch { .. }
+            | Error::TooFewSamples { .. }
+            | Error::InvalidRecording { .. }
+            | Error::Channel { .. }
+            | Error::OutOfRange { .. }
+            | Error::InvalidPole { .. } => ErrorKind::InvalidInput,
+            Error::Singular { .. }
+            | Error::Overflow { .. }
+            | Error::PoleNotPlaced { .. }
+            | Error::NoConvergence { .. }
+            | Error::RankDeficient { .. }
+            | Error::IllConditioned { .. } => ErrorKind::Numerical,
+            Error::NotSettled { .. }
+            | Error::Unstable { .. }
+            | Error::Uncontrollable { .. }
+            | Error::Unobservable { .. } => ErrorKind::System,
+            Error::Csv { .. } | Error::Toml { .. } | Error::Io { .. } => ErrorKind::Io,
+        }
+    }
+}
+
 /// Why a response did not settle ([`Error::NotSettled`]), judged from its
 /// final window: a hint at what to change, not a proof.
 ///

@@ -72,6 +72,20 @@
 //!   per-millimetre gains, its identification (equations (4)–(11)), the
 //!   rig on the card and the simulated rig in one call.
 //!
+//! ## Features
+//!
+//! | feature | default | what it adds | what it pulls |
+//! |---|---|---|---|
+//! | (core) | always | models, discretisation, analysis, frequency tools, design, simulation, metrics, recordings and CSV, identification, signals | nalgebra, faer, rustfft, csv-core, thiserror |
+//! | `hw` | via `lab` | [`hw`]: the `Rig` trait, the fixed-period loop, real-time scheduling, stop signals, the PC104 card driver and its simulation, the probe | serde, signal-hook, libc |
+//! | `lab` | yes | [`lab`]: the two-cart plant, its identification and refinement, the simulated rig, card and truth files (implies `hw`) | toml, serde_path_to_error |
+//! | `plot` | yes | `plot`, `bode_svg`, `nyquist_svg`: SVG figures | plotters (SVG backend only) |
+//! | `ppdev` | no | `hw::Ppdev`: the real card on a Linux parallel port (implies `hw`) | |
+//!
+//! A crate that wants the mathematics only depends on
+//! `ctrlab = { version = "0.3", default-features = false }`: the hardware
+//! and lab stacks and their dependencies are not compiled.
+//!
 //! Layers point one way: private kernels and [`model`] at the bottom;
 //! [`discretize`], [`integrate`], [`analysis`], [`freq`] on them; [`design`],
 //! [`sim`], [`metrics`], [`data`], [`ident`], [`signal`] above; [`hw`]
@@ -132,7 +146,7 @@ pub use analysis::Damping;
 pub use data::{Channel, Recording, Schema};
 pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place};
 pub use discretize::Discretization;
-pub use error::Error;
+pub use error::{Error, ErrorKind};
 pub use freq::{
     Bode, FrequencyDomain, FrequencyResponse, Margins, TransferFunction, TransferMatrix, Zpk,
     bandwidth, bode, frequency_response, logspace, nyquist, stability_margins,
