@@ -340,3 +340,25 @@ macro_rules! __ctrlab_stack {
         stacked
     }};
 }
+
+/// What nalgebra's macros refuse, these refuse too (the twins that compile
+/// are in `tests/nalgebra_facade.rs`).
+///
+/// A row with a trailing `,`:
+/// ```compile_fail
+/// let _: ctrlab::nalgebra::SMatrix<i32, 1, 2> = ctrlab::nalgebra::matrix![1, 2,];
+/// ```
+/// Rows of different lengths:
+/// ```compile_fail
+/// let _: ctrlab::nalgebra::DMatrix<i32> = ctrlab::nalgebra::dmatrix![1, 2; 3];
+/// ```
+/// A row without entries:
+/// ```compile_fail
+/// let _: ctrlab::nalgebra::SMatrix<i32, 2, 1> = ctrlab::nalgebra::matrix![1;; 2];
+/// ```
+/// A `,` without entries:
+/// ```compile_fail
+/// let _: ctrlab::nalgebra::SVector<i32, 0> = ctrlab::nalgebra::vector![,];
+/// ```
+#[cfg(doctest)]
+pub struct RefusedSyntax;
