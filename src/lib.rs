@@ -131,16 +131,13 @@ mod kernels;
 pub mod lab;
 pub mod metrics;
 pub mod model;
+pub mod nalgebra;
 #[cfg(feature = "plot")]
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
 pub mod plot;
 pub mod prelude;
 pub mod signal;
 pub mod sim;
-
-/// The nalgebra this crate's matrices and vectors are, re-exported so that a
-/// user need not match its version: `ctrlab::nalgebra::vector![…]`.
-pub use nalgebra;
 
 pub use analysis::Damping;
 pub use data::{Channel, Recording, Schema};
