@@ -2,20 +2,22 @@
 //! user need not depend on it, nor match its version.
 //!
 //! Everything of [nalgebra](https://docs.rs/nalgebra/0.35)'s is here under
-//! `ctrlab::nalgebra`, but its construction macros are wrapped: nalgebra's
-//! [`matrix!`], [`vector!`], [`dmatrix!`], [`dvector!`], [`point!`] and
-//! [`stack!`] are procedural macros whose expansion names `nalgebra::…`,
+//! `ctrlab::nalgebra`, but its construction macros are this crate's own:
+//! nalgebra's `matrix!`, `vector!`, `dmatrix!`, `dvector!` and `point!`
+//! are procedural macros whose expansion names `nalgebra::…`,
 //! which resolves only in a crate that depends on nalgebra itself, so in a
 //! crate that depends on ctrlab alone `ctrlab::nalgebra::vector![1.0]` would
 //! not compile.
 //!
-//! The first five here are this crate's own. They take the same syntax (a
+//! The ones here take the same syntax (a
 //! `,` between the entries of a row, a `;` between rows), produce the same
 //! types (`SMatrix<T, R, C>`, `SVector<T, N>`, `DMatrix<T>`, `DVector<T>`,
 //! `Point<T, N>`) with the entries evaluated in the same (column-major)
 //! order, and name `ctrlab::nalgebra::…`; as nalgebra's, [`matrix!`],
-//! [`vector!`] and [`point!`] work in `const` items. [`stack!`] is
-//! nalgebra's own, expanded where `nalgebra` names ctrlab's.
+//! [`vector!`] and [`point!`] work in `const` items. They also spare the
+//! core nalgebra's proc-macro crate: ctrlab builds nalgebra without its
+//! `macros` feature. (nalgebra's `stack!` is not offered: a crate that
+//! wants it depends on nalgebra with that feature.)
 //!
 //! # Examples
 //!
@@ -61,18 +63,12 @@ pub use crate::__ctrlab_matrix as matrix;
 #[doc(inline)]
 pub use crate::__ctrlab_point as point;
 #[doc(inline)]
-pub use crate::__ctrlab_stack as stack;
-#[doc(inline)]
 pub use crate::__ctrlab_vector as vector;
 
 /// What the construction macros expand to and need at run time; not API.
 #[doc(hidden)]
 pub mod __private {
     use ::nalgebra::{Const, DMatrix, DVector, Dyn, VecStorage};
-
-    /// For `stack!`: nalgebra's own, and nalgebra under the name its
-    /// expansion uses.
-    pub use ::nalgebra::{self, stack};
 
     /// A `DMatrix` of `R` rows and `C` columns from its columns, as
     /// `dmatrix!` builds it (nalgebra's expands to a column-major `vec!`).
@@ -298,47 +294,6 @@ macro_rules! __ctrlab_columns {
     ($($rows:tt)+) => {
         $crate::__ctrlab_columns!(@columns [] $($rows)+)
     };
-}
-
-/// Join matrices into a block matrix: `ctrlab::nalgebra::stack!`.
-///
-/// nalgebra's [`stack!`](https://docs.rs/nalgebra/0.35/nalgebra/macro.stack.html)
-/// itself, usable where nalgebra is not a dependency (see
-/// [the module](crate::nalgebra)): the blocks in the syntax of
-/// [`matrix!`](crate::nalgebra::matrix), a `0` for a zero block whose size
-/// the rest of its block row and column give. The result is stack-allocated
-/// where every block row and column has a block of fixed size, heap-allocated
-/// otherwise.
-///
-/// It expands inside a block that names ctrlab's nalgebra `nalgebra` (the
-/// name nalgebra's expansion uses); so within its arguments, a path
-/// `nalgebra::…` is ctrlab's nalgebra even in a crate that has another.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::nalgebra::{SMatrix, matrix, stack};
-///
-/// let a = matrix![0.0, 1.0; -4.0, -0.4];
-/// let b = matrix![0.0; 1.0];
-/// let c = matrix![1.0, 0.0];
-/// // [A B; −C 0], the 0 one row (c's) by one column (b's).
-/// let m = stack![a, b; -c, 0];
-/// let _: SMatrix<f64, 3, 3> = m;
-/// assert_eq!(m, matrix![0.0, 1.0, 0.0; -4.0, -0.4, 1.0; -1.0, 0.0, 0.0]);
-/// ```
-#[doc(hidden)]
-#[macro_export]
-macro_rules! __ctrlab_stack {
-    ($($blocks:tt)*) => {{
-        #[allow(unused_imports)]
-        use $crate::nalgebra::__private::nalgebra;
-        // nalgebra's expansion binds each block with `let ref`, which
-        // Clippy's `toplevel_ref_arg` finds in the caller's code.
-        #[allow(clippy::toplevel_ref_arg)]
-        let stacked = $crate::nalgebra::__private::stack!($($blocks)*);
-        stacked
-    }};
 }
 
 /// What nalgebra's macros refuse, these refuse too (the twins that compile

@@ -66,20 +66,6 @@ fn vectors_and_points_equal_nalgebras() {
 }
 
 #[test]
-// nalgebra's own `stack!` binds each block with `let ref`, in the caller's
-// code as far as Clippy knows; ctrlab's allows it.
-#[allow(clippy::toplevel_ref_arg)]
-fn stack_is_nalgebras() {
-    let (a, c) = (facade::matrix![1, 2; 3, 4], facade::matrix![9, 10]);
-    let d = facade::dmatrix![5, 6; 7, 8];
-    let ours = facade::stack![a, d; c, 0];
-    let theirs = nalgebra::stack![a, d; c, 0];
-    same_type(&ours, &theirs);
-    assert_eq!(ours, theirs);
-    check!(stack[a, 0; 0, c]);
-}
-
-#[test]
 fn entries_are_evaluated_in_nalgebras_order() {
     // Column by column, as nalgebra's expansion lists them.
     let order = RefCell::new(Vec::new());

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use nalgebra::{SVector, vector};
+use crate::nalgebra::{SVector, vector};
 
 use super::pc104::{ENCODER_CHANNELS, PWM_CHANNELS, duty_from_bytes};
 use super::{Clock, EppPort, HwError, SimulatedCardConfig, VirtualClock};

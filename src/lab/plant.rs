@@ -1,7 +1,7 @@
 //! The lab's plant: two carts joined by springs, the second pushed by a DC motor
 //! (LAB.md equations (1)–(3) and (14)).
 
-use nalgebra::{SMatrix, SVector, matrix};
+use crate::nalgebra::{SMatrix, SVector, matrix};
 
 use crate::error::Error;
 use crate::model::{Continuous, Dynamics, StateSpace};

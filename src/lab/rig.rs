@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use nalgebra::{SVector, vector};
+use crate::nalgebra::{SVector, vector};
 
 use super::Calibration;
 use crate::data::Schema;

@@ -4,7 +4,7 @@
 //! through the drive's delay into the two-cart plant with stick–slip
 //! friction, sub-step by sub-step as the simulated card does it.
 
-use nalgebra::{SMatrix, SVector, U3, U4, vector};
+use crate::nalgebra::{SMatrix, SVector, U3, U4, vector};
 
 use crate::data::Recording;
 use crate::discretize::zoh;
