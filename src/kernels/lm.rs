@@ -15,14 +15,16 @@
 //! (`xtol`), cosine between the residuals and the Jacobian's columns
 //! (`gtol`), or `patience · (n + 1)` residual evaluations.
 //!
-//! Why here: the `levenberg-marquardt` crate (itself a port of MINPACK,
-//! which `lab::ident::refine` used) is built on nalgebra 0.34, a second
-//! nalgebra (with simba, wide and safe_arch) beside the crate's 0.35. This
-//! kernel keeps one nalgebra in the tree. It differs from MINPACK only
-//! where MINPACK would compute with non-finite numbers: it stops with
-//! [`Termination::NonFinite`] on non-finite residuals at the start, a
-//! non-finite Jacobian or step, and treats a non-finite trial cost as a
-//! failed step; and it stops at once on residuals that are exactly zero.
+//! Why here: `lab::ident::refine` used the `levenberg-marquardt` crate
+//! (itself a port of MINPACK), whose latest release is built on nalgebra
+//! 0.34, a second nalgebra (with simba, wide and safe_arch) beside the
+//! crate's 0.35. This kernel keeps one nalgebra in the tree. It differs
+//! from MINPACK only where MINPACK would compute with non-finite numbers or
+//! divide by a zero cost: it stops with [`Termination::NonFinite`] on
+//! non-finite residuals at the start, a non-finite Jacobian or step, treats
+//! a non-finite trial cost as a failed step, and stops at once when the
+//! residuals' norm falls below the smallest normal number. `enorm`'s
+//! thresholds are those of IEEE doubles rather than MINPACK's constants.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -97,8 +99,8 @@ pub(crate) enum Termination {
     NonFinite(&'static str),
     /// The problem returned `false`.
     Aborted(&'static str),
-    /// No parameters, fewer residuals than them, a non-finite start, or
-    /// settings out of range.
+    /// No parameters, fewer residuals than them, a non-finite start,
+    /// settings out of range, or residuals or a Jacobian of the wrong size.
     InvalidInput(&'static str),
 }
 
@@ -169,6 +171,9 @@ pub(crate) fn minimize<P: LeastSquaresProblem + ?Sized>(
     if !problem.residuals(&report.x, &mut fvec) {
         return report.ending(Termination::Aborted("residuals"));
     }
+    if fvec.len() != m {
+        return report.ending(Termination::InvalidInput("residuals of another length"));
+    }
     let mut fnorm = enorm(fvec.as_slice());
     if !fnorm.is_finite() {
         return report.ending(Termination::NonFinite("residuals at the start"));
@@ -188,6 +193,9 @@ pub(crate) fn minimize<P: LeastSquaresProblem + ?Sized>(
         w.jac.fill(0.0);
         if !problem.jacobian(&report.x, &mut w.jac) {
             return report.ending(Termination::Aborted("jacobian"));
+        }
+        if w.jac.shape() != (m, n) {
+            return report.ending(Termination::InvalidInput("a Jacobian of another shape"));
         }
         if w.jac.iter().any(|v| !v.is_finite()) {
             return report.ending(Termination::NonFinite("jacobian"));
@@ -240,6 +248,9 @@ pub(crate) fn minimize<P: LeastSquaresProblem + ?Sized>(
             report.evaluations += 1;
             if !problem.residuals(&trial, &mut ftrial) {
                 return report.ending(Termination::Aborted("residuals"));
+            }
+            if ftrial.len() != m {
+                return report.ending(Termination::InvalidInput("residuals of another length"));
             }
             // A non-finite trial cost fails as an infinite one would.
             let fnorm1 = enorm(ftrial.as_slice());

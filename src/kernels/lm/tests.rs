@@ -825,3 +825,112 @@ fn enorm_neither_overflows_nor_underflows() {
     assert!(enorm(&[1.0, f64::NAN, 1e300]).is_nan());
     assert_eq!(enorm(&[1.0, f64::INFINITY]), f64::INFINITY);
 }
+
+/// Residuals or a Jacobian of the wrong size are refused, not a panic.
+struct Resizer {
+    residuals_at: usize,
+    jacobian: bool,
+    calls: usize,
+}
+
+impl LeastSquaresProblem for Resizer {
+    fn residual_count(&self) -> usize {
+        3
+    }
+    fn residuals(&mut self, x: &DVector<f64>, out: &mut DVector<f64>) -> bool {
+        self.calls += 1;
+        let len = if self.calls == self.residuals_at {
+            2
+        } else {
+            3
+        };
+        *out = DVector::from_fn(len, |i, _| x[0] - i as f64);
+        true
+    }
+    fn jacobian(&mut self, _: &DVector<f64>, out: &mut DMatrix<f64>) -> bool {
+        *out = DMatrix::from_element(3, if self.jacobian { 2 } else { 1 }, 1.0);
+        true
+    }
+}
+
+#[test]
+fn residuals_or_a_jacobian_of_the_wrong_size_are_refused() {
+    for (residuals_at, jacobian) in [(1, false), (2, false), (0, true)] {
+        let mut p = Resizer {
+            residuals_at,
+            jacobian,
+            calls: 0,
+        };
+        let r = minimize(
+            &mut p,
+            &DVector::from_element(1, 10.0),
+            &Settings::default(),
+        );
+        assert!(
+            matches!(r.termination, Termination::InvalidInput(_)),
+            "{r:?}"
+        );
+        assert!(r.termination.was_usage_issue() && r.x[0].is_finite());
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(500))]
+    /// Random quadratic problems (entries over twelve decades, with zeros;
+    /// starts up to 1e6) and settings: no panic, the evaluations within
+    /// `patience · (n + 1)`, and unless a usage issue, a finite point whose
+    /// cost is at most the start's.
+    #[test]
+    fn any_problem_ends_within_its_patience_at_a_finite_point(
+        n in 1usize..=4,
+        extra in 0usize..=4,
+        entries in proptest::collection::vec((-1.0f64..1.0, -6i32..6, 0u8..6), 3 * 8 * 4),
+        start in proptest::collection::vec((-1.0f64..1.0, 0i32..7), 4),
+        tolerances in proptest::collection::vec(proptest::sample::select(vec![0.0, 1e-16, 1e-8, 1e-2]), 3),
+        factor in proptest::sample::select(vec![1e-3, 1.0, 100.0]),
+        patience in 1usize..30,
+    ) {
+        let m = n + extra;
+        let v = |k: usize| {
+            let (x, e, z) = entries[k];
+            if z == 0 { 0.0 } else { x * 10f64.powi(e) }
+        };
+        let (a, q) = (|i: usize, j: usize| v(i * 4 + j), |i: usize| v(64 + i));
+        let c = |i: usize| v(80 + i);
+        let mut p = Closures {
+            m,
+            f: |x: &[f64], f: &mut [f64]| {
+                for (i, fi) in f.iter_mut().enumerate() {
+                    let linear: f64 = (0..n).map(|j| a(i, j) * x[j]).sum();
+                    *fi = linear + c(i) + q(i) * x[i % n] * x[i % n];
+                }
+            },
+            g: |x: &[f64], jac: &mut DMatrix<f64>| {
+                for i in 0..m {
+                    for j in 0..n {
+                        jac[(i, j)] = a(i, j);
+                    }
+                    jac[(i, i % n)] += 2.0 * q(i) * x[i % n];
+                }
+            },
+        };
+        let x0 = DVector::from_iterator(n, start.iter().take(n).map(|(x, e)| x * 10f64.powi(*e)));
+        let settings = Settings {
+            ftol: tolerances[0],
+            xtol: tolerances[1],
+            gtol: tolerances[2],
+            factor,
+            patience,
+        };
+        let mut f0 = DVector::zeros(m);
+        p.residuals(&x0, &mut f0);
+        let start_cost = 0.5 * enorm(f0.as_slice()).powi(2);
+        let r = minimize(&mut p, &x0, &settings);
+        proptest::prop_assert!(r.evaluations <= patience * (n + 1), "{r:?}");
+        if !r.termination.was_usage_issue() {
+            proptest::prop_assert!(r.x.iter().all(|v| v.is_finite()), "{r:?}");
+            proptest::prop_assert!(r.objective.is_finite(), "{r:?}");
+            proptest::prop_assert!(r.objective <= start_cost, "{r:?} from {start_cost}");
+        }
+    }
+}
