@@ -6,19 +6,17 @@
 //! reproduce the *positions*, simulated from the input alone. [`validate`]
 //! measures that on any recording (a fresh run, not the one identified);
 //! [`refine`] starts from the least-squares estimate and minimises the
-//! simulation error over the physical parameters with the
-//! Levenberg–Marquardt method of the `levenberg-marquardt` crate (MINPACK's
-//! algorithm).
+//! simulation error over the physical parameters with MINPACK's
+//! Levenberg–Marquardt method (`lmder`, the crate's own kernel).
 
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra034 as na;
+use nalgebra::{DMatrix, DVector};
 
 use super::SeparateSpringsEstimate;
 use super::simulation::{Run, SimulationModel};
 use crate::data::Recording;
 use crate::error::Error;
+use crate::kernels::lm::{self, LeastSquaresProblem, Settings};
 use crate::lab::MassSpring;
-use std::cell::{Cell, RefCell};
 
 /// Largest lag of the residual tests, samples.
 pub const RESIDUAL_LAGS: usize = 25;
@@ -260,23 +258,27 @@ const FLOOR: f64 = 1e-3;
 /// MINPACK's `lmdif1` tolerance, √ε: the optimiser stops when a step
 /// changes the cost or the parameters by less than this, relatively.
 const TOLERANCE: f64 = 1.490_116_119_384_765_6e-8;
+/// The gradient test: the optimiser stops when the residuals are this
+/// close to orthogonal to every column of the Jacobian (30 ε, the default
+/// of the `levenberg-marquardt` crate the refinement used before).
+const GTOL: f64 = 30.0 * f64::EPSILON;
 /// The relative step of the forward differences in `ln p`.
 const STEP: f64 = 1e-5;
 
 struct Problem<'a> {
     run: Run<'a>,
     masses: [f64; 2],
-    q: na::DVector<f64>,
     /// The residuals at `cached.0`, the parameters of the last
     /// [`residuals`](LeastSquaresProblem::residuals) call: the optimiser
     /// asks for the Jacobian where it has just evaluated them, so its base
     /// point costs no simulation.
-    cached: RefCell<(na::DVector<f64>, na::DVector<f64>)>,
-    evaluations: Cell<usize>,
+    cached: (DVector<f64>, DVector<f64>),
+    /// Simulations run.
+    evaluations: usize,
 }
 
 impl Problem<'_> {
-    fn model(&self, q: &na::DVector<f64>) -> (MassSpring, [f64; 2]) {
+    fn model(&self, q: &DVector<f64>) -> (MassSpring, [f64; 2]) {
         let p = |i: usize| q[i].exp();
         let plant = MassSpring {
             m1: self.masses[0],
@@ -293,8 +295,8 @@ impl Problem<'_> {
     /// Both carts' simulation errors for parameters `q` (cart 1's samples,
     /// then cart 2's), each clamped to ±1 m so that a diverging candidate
     /// is a large, finite cost.
-    fn errors(&self, q: &na::DVector<f64>, out: &mut [f64]) {
-        self.evaluations.set(self.evaluations.get() + 1);
+    fn errors(&mut self, q: &DVector<f64>, out: &mut [f64]) {
+        self.evaluations += 1;
         let (plant, coulomb) = self.model(q);
         let run = &self.run;
         let (e1, e2) = out.split_at_mut(run.t.len());
@@ -308,50 +310,40 @@ impl Problem<'_> {
     }
 }
 
-impl LeastSquaresProblem<f64, na::Dyn, na::Dyn> for Problem<'_> {
-    type ResidualStorage = na::VecStorage<f64, na::Dyn, na::U1>;
-    type JacobianStorage = na::VecStorage<f64, na::Dyn, na::Dyn>;
-    type ParameterStorage = na::VecStorage<f64, na::Dyn, na::U1>;
-
-    fn set_params(&mut self, q: &na::DVector<f64>) {
-        self.q.copy_from(q);
+impl LeastSquaresProblem for Problem<'_> {
+    fn residual_count(&self) -> usize {
+        2 * self.run.t.len()
     }
 
-    fn params(&self) -> na::DVector<f64> {
-        self.q.clone()
-    }
-
-    fn residuals(&self) -> Option<na::DVector<f64>> {
-        let mut r = na::DVector::zeros(2 * self.run.t.len());
-        self.errors(&self.q, r.as_mut_slice());
-        let mut cached = self.cached.borrow_mut();
-        cached.0.copy_from(&self.q);
-        cached.1.copy_from(&r);
-        Some(r)
+    fn residuals(&mut self, q: &DVector<f64>, out: &mut DVector<f64>) -> bool {
+        self.errors(q, out.as_mut_slice());
+        self.cached.0.copy_from(q);
+        self.cached.1.copy_from(out);
+        true
     }
 
     /// Forward differences in `ln p` with a step of [`STEP`] (a relative
     /// step in `p`): the stick–slip switching makes the simulation only
     /// piecewise smooth in the forces, so the step is well above √ε.
-    fn jacobian(&self) -> Option<na::DMatrix<f64>> {
+    fn jacobian(&mut self, q: &DVector<f64>, j: &mut DMatrix<f64>) -> bool {
         let rows = 2 * self.run.t.len();
-        let mut cached = self.cached.borrow_mut();
-        let (at, base) = &mut *cached;
-        if *at != self.q {
-            self.errors(&self.q, base.as_mut_slice());
-            at.copy_from(&self.q);
+        let empty = (DVector::zeros(0), DVector::zeros(0));
+        let (mut at, mut base) = std::mem::replace(&mut self.cached, empty);
+        if at != *q {
+            self.errors(q, base.as_mut_slice());
+            at.copy_from(q);
         }
-        let mut j = na::DMatrix::zeros(rows, PARAMETERS);
-        let mut q = self.q.clone();
+        let mut shifted = q.clone();
         for (col, column) in j.as_mut_slice().chunks_exact_mut(rows).enumerate() {
-            q[col] += STEP;
-            self.errors(&q, column);
-            q[col] = self.q[col];
+            shifted[col] += STEP;
+            self.errors(&shifted, column);
+            shifted[col] = q[col];
             for (d, b) in column.iter_mut().zip(base.iter()) {
                 *d = (*d - b) / STEP;
             }
         }
-        Some(j)
+        self.cached = (at, base);
+        true
     }
 }
 
@@ -454,32 +446,35 @@ pub fn refine_with(
     let p0 = [
         plant.k1, plant.k2, plant.b1, plant.b2, plant.gain, coulomb[0], coulomb[1],
     ];
-    let q0 = na::DVector::from_iterator(PARAMETERS, p0.iter().map(|p| p.max(FLOOR).ln()));
-    let problem = Problem {
+    let q0 = DVector::from_iterator(PARAMETERS, p0.iter().map(|p| p.max(FLOOR).ln()));
+    let mut problem = Problem {
         run,
         masses: [plant.m1, plant.m2],
-        cached: RefCell::new((q0.map(|_| f64::NAN), na::DVector::zeros(2 * n))),
-        q: q0,
-        evaluations: Cell::new(0),
+        cached: (q0.map(|_| f64::NAN), DVector::zeros(2 * n)),
+        evaluations: 0,
     };
     // Patience 12: at most 12 · (7 + 1) residual evaluations, each
     // accepted one a Jacobian of another 7 simulations. MINPACK's
     // tolerances (√ε relative in the cost and the parameters) rather than
-    // the crate's 30 ε: the encoder's quantisation and noise make the
-    // parameters uncertain far above 1e-8, and the last iterations to 30 ε
-    // only chase a Coulomb force of zero towards ln 0.
-    let (problem, report) = LevenbergMarquardt::new()
-        .with_patience(12)
-        .with_ftol(TOLERANCE)
-        .with_xtol(TOLERANCE)
-        .minimize(problem);
+    // 30 ε: the encoder's quantisation and noise make the parameters
+    // uncertain far above 1e-8, and the last iterations to 30 ε only chase
+    // a Coulomb force of zero towards ln 0. The first trust region is
+    // 100 ‖D q₀‖, D the Jacobian's column norms (MINPACK's defaults).
+    let settings = Settings {
+        ftol: TOLERANCE,
+        xtol: TOLERANCE,
+        gtol: GTOL,
+        factor: 100.0,
+        patience: 12,
+    };
+    let report = lm::minimize(&mut problem, &q0, &settings);
     if report.termination.was_usage_issue() {
         return Err(Error::NoConvergence {
             operation: "output-error refinement (Levenberg–Marquardt)",
-            iterations: report.number_of_evaluations,
+            iterations: report.evaluations,
         });
     }
-    let (refined_plant, refined_coulomb) = problem.model(&problem.q);
+    let (refined_plant, refined_coulomb) = problem.model(&report.x);
     let refined = validate_with(rec, &refined_plant, refined_coulomb, model)?;
     // Never worse than the start on its own data: LM only accepts
     // decreasing steps, but the clamp could in principle mislead it.
@@ -491,7 +486,7 @@ pub fn refine_with(
             coulomb,
             start: start_validation,
             refined: start_validation,
-            evaluations: problem.evaluations.get(),
+            evaluations: problem.evaluations,
         });
     }
     Ok(Refined {
@@ -499,6 +494,6 @@ pub fn refine_with(
         coulomb: refined_coulomb,
         start: start_validation,
         refined,
-        evaluations: problem.evaluations.get(),
+        evaluations: problem.evaluations,
     })
 }
