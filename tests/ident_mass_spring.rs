@@ -7,8 +7,10 @@
 mod common;
 
 use ctrlab::data::{Channel, Schema};
+use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
-    AverageError, MIN_SAMPLES, Options, Scheme, SpringModel, average, identify, identify_with,
+    AverageError, MIN_SAMPLES, MassSpringEstimate, Options, Scheme, SpringModel, Springs, average,
+    identify, identify_with,
 };
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate, time_grid};
@@ -380,6 +382,125 @@ fn separate_springs_on_the_fixture_find_equal_springs() {
         s.state_space().unwrap().a()[(1, 0)],
         -(s.k1().value + s.k2().value) / 1.3
     );
+}
+
+/// A fingerprint of a recording's bits (FNV-1a over the time stamps and
+/// the channels `u`, `x1`, `x2`).
+fn fingerprint(rec: &Recording) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let columns = ["u", "x1", "x2"].map(|c| rec.channel(c).unwrap());
+    for v in std::iter::once(rec.time()).chain(columns).flatten() {
+        for b in v.to_bits().to_le_bytes() {
+            h ^= u64::from(b);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
+
+/// Every number of an estimate: each spring, `b1`, `K`, `b2`, the
+/// Coulomb forces and cart 2's fitted mass when there are, each as value
+/// and standard error; then `m2`, `dt` and both stages' residual RMS.
+fn numbers(e: &MassSpringEstimate) -> Vec<f64> {
+    let springs = match e.springs {
+        Springs::Equal { k12 } => vec![k12],
+        Springs::Separate { k1, k2 } => vec![k1, k2],
+    };
+    let mut v: Vec<f64> = springs
+        .into_iter()
+        .chain([e.b1, e.gain, e.b2])
+        .chain(e.coulomb.into_iter().flatten())
+        .chain(e.m2_estimate)
+        .flat_map(|p| [p.value, p.std_error])
+        .collect();
+    v.extend([e.m2, e.dt, e.first.residual_rms, e.second.residual_rms]);
+    v
+}
+
+/// Each spring model through the one pipeline gives what the two former
+/// pipelines gave (`identify_with` for equal springs,
+/// `identify_separate_springs_with` for separate ones, before they became
+/// one), bit for bit: every number of [`numbers`], pinned in
+/// `tests/data/ident_former_pipelines.json`, on the fixture and on a 3 s
+/// square-wave run of the default simulated card (seed 11), with Lab,
+/// Central, Coulomb friction, cart 2's mass free, and both (Lab).
+#[test]
+fn each_spring_model_gives_the_former_pipelines_numbers_bit_for_bit() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/ident_former_pipelines.json"
+    );
+    let former: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let (fixture, _) = fixture();
+    let sim = SimulatedRig {
+        seed: 11,
+        ..SimulatedRig::default()
+    };
+    let card = common::open_loop(&sim, &SquareWave::new(8.0, 0.2).unwrap(), 3.0);
+    // The inputs the numbers were pinned on: a change here is not the
+    // identification's (the simulated card or the CSV reader moved).
+    for (name, rec) in [("fixture", &fixture), ("card", &card)] {
+        let want = former["fingerprints"][name].as_u64().unwrap();
+        assert_eq!(fingerprint(rec), want, "the {name} recording changed");
+    }
+    let options = |name: &str| match name {
+        "lab" => Options {
+            scheme: Scheme::Lab,
+            ..Options::DEFAULT
+        },
+        "central" => Options::DEFAULT,
+        "coulomb" => Options {
+            coulomb: true,
+            ..Options::DEFAULT
+        },
+        "free_m2" => Options {
+            free_m2: true,
+            ..Options::DEFAULT
+        },
+        "coulomb_free_m2_lab" => Options {
+            coulomb: true,
+            free_m2: true,
+            scheme: Scheme::Lab,
+            ..Options::DEFAULT
+        },
+        other => panic!("{other}"),
+    };
+    let cases = former["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 20);
+    for case in cases {
+        let text = |key: &str| case[key].as_str().unwrap();
+        let (recording, name) = (text("recording"), text("options"));
+        let springs = match text("springs") {
+            "Equal" => SpringModel::Equal,
+            _ => SpringModel::Separate,
+        };
+        let rec = if recording == "fixture" {
+            &fixture
+        } else {
+            &card
+        };
+        let options = Options {
+            springs,
+            ..options(name)
+        };
+        let est = identify_with(rec, 1.3, 0.7, &options).unwrap();
+        assert_eq!(est.springs.model(), springs);
+        let got = numbers(&est);
+        let want: Vec<f64> = serde_json::from_value(case["numbers"].clone()).unwrap();
+        let what = format!("{recording}, {springs:?}, {name}");
+        assert_eq!(got.len(), want.len(), "{what}");
+        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(
+                g.to_bits(),
+                w.to_bits(),
+                "{what}: number {i}, {g:?} vs {w:?}"
+            );
+        }
+        // `identify` keeps the lab's default: equal springs.
+        if springs == SpringModel::Equal && matches!(name, "lab" | "central") {
+            assert_eq!(identify(rec, 1.3, 0.7, options.scheme).unwrap(), est);
+        }
+    }
 }
 
 #[test]
