@@ -128,8 +128,10 @@ pub struct MassSpringAverage {
     pub coulomb: Option<[Spread; 2]>,
     /// Mass of cart 1, kg (the same in every run).
     pub m1: f64,
-    /// Mass of cart 2, kg: the one given (the same in every run, spread
-    /// 0), or the fitted ones ([`Options::free_m2`](super::Options::free_m2)).
+    /// Mass of cart 2, kg: the one given (the same in every run), or the
+    /// fitted ones ([`Options::free_m2`](super::Options::free_m2)). Given,
+    /// it is averaged like the others, so its mean and spread are the mass
+    /// and 0 to within rounding (three runs of 0.7 kg: 0.6999999999999998).
     pub m2: Spread,
     /// Number of runs averaged.
     pub runs: usize,
