@@ -12,8 +12,8 @@ use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
 use ctrlab::ident::Covariance;
 use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
-    Options, Scheme, SeparateSpringsEstimate, SimulationModel, identify,
-    identify_separate_springs_with, identify_with, refine_with,
+    MassSpringEstimate, Options, Scheme, SimulationModel, SpringModel, identify, identify_with,
+    refine_with,
 };
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate, time_grid};
@@ -67,7 +67,7 @@ fn recording() -> Recording {
 /// A 10 s square-wave run (5000 samples) of the default simulated card
 /// (Coulomb friction, stiction, PWM delay, encoder noise), its
 /// least-squares start with Coulomb friction, and the card's structure.
-fn simulated_card_run() -> (Recording, SeparateSpringsEstimate, SimulationModel) {
+fn simulated_card_run() -> (Recording, MassSpringEstimate, SimulationModel) {
     let sim = SimulatedRig::default();
     let clock = VirtualClock::new();
     let wave = SquareWave::new(8.0, 0.2).unwrap();
@@ -87,10 +87,11 @@ fn simulated_card_run() -> (Recording, SeparateSpringsEstimate, SimulationModel)
     .recording;
     assert_eq!(rec.len(), SAMPLES);
     let options = Options {
+        springs: SpringModel::Separate,
         coulomb: true,
         ..Options::default()
     };
-    let start = identify_separate_springs_with(&rec, 1.3, 0.7, &options).unwrap();
+    let start = identify_with(&rec, 1.3, 0.7, &options).unwrap();
     (rec, start, sim.simulation_model())
 }
 
@@ -114,7 +115,11 @@ fn benches(c: &mut Criterion) {
             |b| b.iter(|| identify_with(black_box(&rec), 1.3, 0.7, &options).unwrap()),
         );
     }
-    let start = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default()).unwrap();
+    let separate = Options {
+        springs: SpringModel::Separate,
+        ..Options::default()
+    };
+    let start = identify_with(&rec, 1.3, 0.7, &separate).unwrap();
     let mut slow = c.benchmark_group("refine");
     slow.sample_size(10);
     // The run is ideal sampled data (ZOH, no friction, no delay): one

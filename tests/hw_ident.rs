@@ -13,9 +13,15 @@
 use ctrlab::OpenLoop;
 use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
 use ctrlab::lab::SimulatedRig;
-use ctrlab::lab::ident::{Scheme, SeparateSpringsEstimate, Spread, identify_separate_springs};
+use ctrlab::lab::ident::{MassSpringEstimate, Options, Spread, SpringModel, identify_with};
 use ctrlab::signal::{Signal, SquareWave};
 use nalgebra::vector;
+
+/// Separate springs, Central.
+const SEPARATE: Options = Options {
+    springs: SpringModel::Separate,
+    ..Options::DEFAULT
+};
 
 #[test]
 fn five_simulated_runs_recover_the_truth_within_one_percent() {
@@ -47,18 +53,16 @@ fn five_simulated_runs_recover_the_truth_within_one_percent() {
             &loop_config,
         )
         .unwrap();
-        estimates.push(
-            identify_separate_springs(&out.recording, truth.m1, truth.m2, Scheme::Central).unwrap(),
-        );
+        estimates.push(identify_with(&out.recording, truth.m1, truth.m2, &SEPARATE).unwrap());
     }
-    let mean = |f: fn(&SeparateSpringsEstimate) -> f64| {
+    let mean = |f: fn(&MassSpringEstimate) -> f64| {
         Spread::of(&estimates.iter().map(f).collect::<Vec<_>>())
             .unwrap()
             .mean
     };
     for (name, got, want) in [
-        ("k1", mean(|e| e.k1.value), truth.k1),
-        ("k2", mean(|e| e.k2.value), truth.k2),
+        ("k1", mean(|e| e.k1().value), truth.k1),
+        ("k2", mean(|e| e.k2().value), truth.k2),
         ("b1", mean(|e| e.b1.value), truth.b1),
         ("b2", mean(|e| e.b2.value), truth.b2),
         ("K", mean(|e| e.gain.value), truth.gain),
@@ -68,5 +72,5 @@ fn five_simulated_runs_recover_the_truth_within_one_percent() {
         assert!(rel < 0.01, "{name}: {got} vs {want}");
     }
     // The seeds differ, so the runs do too.
-    assert_ne!(estimates[0].k1.value, estimates[1].k1.value);
+    assert_ne!(estimates[0].k1().value, estimates[1].k1().value);
 }

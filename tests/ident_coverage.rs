@@ -17,8 +17,7 @@ mod common;
 use ctrlab::ident::Covariance;
 use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
-    Bootstrap, Estimate, Options, Scheme, bootstrap, identify_separate_springs_with, identify_with,
-    refine_with,
+    Bootstrap, Estimate, Options, Scheme, SpringModel, bootstrap, identify_with, refine_with,
 };
 use ctrlab::signal::SquareWave;
 use ctrlab::{MassSpring, Recording};
@@ -59,7 +58,7 @@ fn equal(rec: &Recording, truth: &MassSpring, options: &Options) -> (Vec<Estimat
         _ => 0,
     };
     (
-        vec![e.k12, e.gain, e.b1, e.b2],
+        vec![e.k12().unwrap(), e.gain, e.b1, e.b2],
         [
             lags(e.first.covariance_kind),
             lags(e.second.covariance_kind),
@@ -189,9 +188,12 @@ fn measure_coverage() {
         let estimates: Vec<_> = recordings
             .iter()
             .map(|r| {
-                let e = identify_separate_springs_with(r, truth.m1, truth.m2, &options(true, kind))
-                    .unwrap();
-                vec![e.k1, e.k2, e.gain, e.b1, e.b2]
+                let options = Options {
+                    springs: SpringModel::Separate,
+                    ..options(true, kind)
+                };
+                let e = identify_with(r, truth.m1, truth.m2, &options).unwrap();
+                vec![e.k1(), e.k2(), e.gain, e.b1, e.b2]
             })
             .collect();
         row(&name, &coverage(&estimates, &want), "");
@@ -256,11 +258,11 @@ fn refined_with_errors(seed: u64, resamples: Option<usize>) -> Vec<Estimate> {
     };
     let rec = record(&sim);
     let identification = Options {
+        springs: SpringModel::Separate,
         coulomb: true,
         ..Options::default()
     };
-    let ls =
-        identify_separate_springs_with(&rec, sim.truth.m1, sim.truth.m2, &identification).unwrap();
+    let ls = identify_with(&rec, sim.truth.m1, sim.truth.m2, &identification).unwrap();
     let model = sim.simulation_model();
     let r = refine_with(&rec, &ls, &model).unwrap();
     let se = resamples.map(|resamples| {

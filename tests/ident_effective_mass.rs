@@ -10,7 +10,7 @@ mod common;
 use common::{friction_rig, open_loop};
 use ctrlab::Recording;
 use ctrlab::ident::Covariance;
-use ctrlab::lab::ident::{Options, identify_separate_springs_with, identify_with};
+use ctrlab::lab::ident::{Options, SpringModel, identify_with};
 use ctrlab::lab::{MassSpring, SimulatedRig};
 use ctrlab::signal::SquareWave;
 
@@ -32,6 +32,7 @@ fn square_run(sim: &SimulatedRig) -> Recording {
 }
 
 const FREE: Options = Options {
+    springs: SpringModel::Separate,
     coulomb: true,
     free_m2: true,
     ..Options::DEFAULT
@@ -49,7 +50,7 @@ fn a_motor_heavier_than_the_weighed_cart_is_found() {
         let sim = rig(0.85, friction, seed);
         let rec = square_run(&sim);
         let t = sim.truth;
-        let free = identify_separate_springs_with(&rec, 1.3, 0.7, &FREE).unwrap();
+        let free = identify_with(&rec, 1.3, 0.7, &FREE).unwrap();
         let m2 = free.m2_estimate.unwrap();
         assert_eq!(free.m2, m2.value);
         assert_eq!(free.plant().m2, m2.value);
@@ -78,7 +79,7 @@ fn a_motor_heavier_than_the_weighed_cart_is_found() {
             free_m2: false,
             ..FREE
         };
-        let fixed = identify_separate_springs_with(&rec, 1.3, 0.7, &weighed).unwrap();
+        let fixed = identify_with(&rec, 1.3, 0.7, &weighed).unwrap();
         assert_eq!((fixed.m2_estimate, fixed.m2), (None, 0.7));
         assert!(percent(fixed.gain.value, t.gain) > 5.0, "{:?}", fixed.gain);
     }

@@ -12,8 +12,8 @@ mod common;
 use common::{friction_rig, open_loop, try_open_loop};
 use ctrlab::hw::HwErrorKind;
 use ctrlab::lab::ident::{
-    Bootstrap, Options, Refined, SeparateSpringsEstimate, SimulationModel, bootstrap,
-    identify_separate_springs_with, refine_with, validate, validate_with,
+    Bootstrap, MassSpringEstimate, Options, Refined, SimulationModel, SpringModel, bootstrap,
+    identify_with, refine_with, validate, validate_with,
 };
 use ctrlab::lab::{MassSpring, SimulatedRig};
 use ctrlab::signal::{Prbs, SquareWave};
@@ -66,13 +66,14 @@ fn rig(gain: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {
 /// % (k1, k2, b1, b2, K; then F1, F2).
 fn refine_square_run(
     sim: &SimulatedRig,
-) -> (SeparateSpringsEstimate, Refined, [(&'static str, f64); 7]) {
+) -> (MassSpringEstimate, Refined, [(&'static str, f64); 7]) {
     let options = Options {
+        springs: SpringModel::Separate,
         coulomb: true,
         ..Options::default()
     };
     let rec = square_run(sim);
-    let ls = identify_separate_springs_with(&rec, 1.3, 0.7, &options).unwrap();
+    let ls = identify_with(&rec, 1.3, 0.7, &options).unwrap();
     let r = refine_with(&rec, &ls, &sim.simulation_model()).unwrap();
     let (t, f) = (sim.truth, sim.coulomb_friction);
     let err = |got: f64, want: f64| (got / want - 1.0) * 100.0;
@@ -334,11 +335,12 @@ fn bootstrap_errors_are_the_size_of_the_spread() {
         ..SimulatedRig::default()
     };
     let options = Options {
+        springs: SpringModel::Separate,
         coulomb: true,
         ..Options::default()
     };
     let rec = open_loop(&sim, &SquareWave::new(8.0, 0.2).unwrap(), 5.0);
-    let ls = identify_separate_springs_with(&rec, 1.3, 0.7, &options).unwrap();
+    let ls = identify_with(&rec, 1.3, 0.7, &options).unwrap();
     let model = sim.simulation_model();
     let r = refine_with(&rec, &ls, &model).unwrap();
     let resampling = Bootstrap {

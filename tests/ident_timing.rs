@@ -14,8 +14,8 @@ use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
 use ctrlab::ident::Covariance;
 use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
-    Estimate, GAP_RATIO, Options, Scheme, SeparateSpringsEstimate, Spread, identify,
-    identify_separate_springs, identify_separate_springs_with, identify_with,
+    Estimate, GAP_RATIO, MassSpringEstimate, Options, Scheme, Spread, SpringModel, identify,
+    identify_with,
 };
 use ctrlab::signal::{Rng, Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate};
@@ -108,20 +108,28 @@ fn recorded(lateness: f64, missed: &[usize], seed: u64) -> Recording {
     rec
 }
 
+/// `options` with separate springs.
+fn separate(options: Options) -> Options {
+    Options {
+        springs: SpringModel::Separate,
+        ..options
+    }
+}
+
 /// Relative errors of both identifications against the fixture plant,
 /// printed, checked against the bars of `tests/ident_mass_spring.rs` for
 /// noisy data: 0.5 % (equal springs, Central), 1 % (separate springs).
 fn check_bars(name: &str, rec: &Recording) {
     let p = fixture_plant();
     let e = identify(rec, p.m1, p.m2, Scheme::Central).unwrap();
-    let s = identify_separate_springs(rec, p.m1, p.m2, Scheme::Central).unwrap();
+    let s = identify_with(rec, p.m1, p.m2, &separate(Options::default())).unwrap();
     for (what, got, want, bar) in [
-        ("k12", e.k12.value, p.k1, 0.005),
+        ("k12", e.k12().unwrap().value, p.k1, 0.005),
         ("b1", e.b1.value, p.b1, 0.005),
         ("K", e.gain.value, p.gain, 0.005),
         ("b2", e.b2.value, p.b2, 0.005),
-        ("separate k1", s.k1.value, p.k1, 0.01),
-        ("separate k2", s.k2.value, p.k2, 0.01),
+        ("separate k1", s.k1().value, p.k1, 0.01),
+        ("separate k2", s.k2().value, p.k2, 0.01),
         ("separate b1", s.b1.value, p.b1, 0.01),
         ("separate K", s.gain.value, p.gain, 0.01),
         ("separate b2", s.b2.value, p.b2, 0.01),
@@ -232,11 +240,9 @@ fn uniform_recordings_take_the_old_path() {
         assert_eq!(a.coulomb, None);
         assert_eq!(a.dt, rec.sample_period().unwrap());
         assert_eq!(a.first.rows, rec.len() - 2);
-        let s = identify_separate_springs(&rec, 1.3, 0.7, scheme).unwrap();
-        assert_eq!(
-            s,
-            identify_separate_springs_with(&rec, 1.3, 0.7, &options).unwrap()
-        );
+        let s = identify_with(&rec, 1.3, 0.7, &separate(options)).unwrap();
+        assert_eq!(s.springs.model(), SpringModel::Separate);
+        assert_eq!(s.first.theta.len(), 3);
     }
     assert_eq!(Options::default().scheme, Scheme::Central);
 }
@@ -353,7 +359,7 @@ fn bad_recordings_and_options_are_typed_errors() {
         ),
     ] {
         let rec = recorded(0.0, &[], 1);
-        match identify_separate_springs_with(&rec, 1.3, 0.7, &options) {
+        match identify_with(&rec, 1.3, 0.7, &separate(options)) {
             Err(Error::InvalidParameter { name: n, .. }) => assert_eq!(n, name),
             other => panic!("{other:?}"),
         }
@@ -392,14 +398,14 @@ proptest! {
             t += step * 1e-3;
             rec.push(t, &[(k % 7) as f64 - 3.0], &[x1, x2]).unwrap();
         }
-        let options = Options { scheme, coulomb, min_speed, free_m2, max_jitter, covariance };
+        let options = Options { springs: SpringModel::Equal, scheme, coulomb, min_speed, free_m2, max_jitter, covariance };
         let finite = |e: &[Estimate]| e.iter().all(|e| e.value.is_finite() && e.std_error.is_finite());
         if let Ok(e) = identify_with(&rec, 1.3, 0.7, &options) {
-            prop_assert!(finite(&[e.k12, e.b1, e.gain, e.b2]), "{e:?}");
+            prop_assert!(finite(&[e.k12().unwrap(), e.b1, e.gain, e.b2]), "{e:?}");
             prop_assert!(e.m2_estimate.is_none_or(|m| finite(&[m]) && m.value > 0.0), "{e:?}");
         }
-        if let Ok(e) = identify_separate_springs_with(&rec, 1.3, 0.7, &options) {
-            prop_assert!(finite(&[e.k1, e.k2, e.b1, e.gain, e.b2]), "{e:?}");
+        if let Ok(e) = identify_with(&rec, 1.3, 0.7, &separate(options)) {
+            prop_assert!(finite(&[e.k1(), e.k2(), e.b1, e.gain, e.b2]), "{e:?}");
             prop_assert!(e.m2_estimate.is_none_or(|m| finite(&[m]) && m.value > 0.0), "{e:?}");
         }
     }
@@ -448,7 +454,7 @@ fn rig_identification(coulomb: bool) -> [f64; 7] {
         coulomb,
         ..Options::default()
     };
-    let mut estimates: Vec<SeparateSpringsEstimate> = Vec::new();
+    let mut estimates: Vec<MassSpringEstimate> = Vec::new();
     let pct = |e: &Estimate, want: f64| {
         format!(
             "{:+.2} ± {:.2} %",
@@ -458,7 +464,7 @@ fn rig_identification(coulomb: bool) -> [f64; 7] {
     };
     for (sim, rec) in rig_runs() {
         let t = sim.truth;
-        let e = identify_separate_springs_with(rec, t.m1, t.m2, &options).unwrap();
+        let e = identify_with(rec, t.m1, t.m2, &separate(options)).unwrap();
         let forces = e.coulomb.map_or(String::new(), |[f1, f2]| {
             format!(
                 ", F1 {}, F2 {}",
@@ -469,8 +475,8 @@ fn rig_identification(coulomb: bool) -> [f64; 7] {
         println!(
             "seed {} (coulomb {coulomb}): k1 {}, k2 {}, b1 {}, K {}, b2 {}{forces}; rows {} / {} of {}",
             sim.seed,
-            pct(&e.k1, t.k1),
-            pct(&e.k2, t.k2),
+            pct(&e.k1(), t.k1),
+            pct(&e.k2(), t.k2),
             pct(&e.b1, t.b1),
             pct(&e.gain, t.gain),
             pct(&e.b2, t.b2),
@@ -482,16 +488,16 @@ fn rig_identification(coulomb: bool) -> [f64; 7] {
     }
     let (sim, _) = &rig_runs()[0];
     let (t, f) = (sim.truth, sim.coulomb_friction);
-    let mean = |get: &dyn Fn(&SeparateSpringsEstimate) -> f64| {
+    let mean = |get: &dyn Fn(&MassSpringEstimate) -> f64| {
         Spread::of(&estimates.iter().map(get).collect::<Vec<_>>())
             .unwrap()
             .mean
     };
     let force =
-        |cart: usize| move |e: &SeparateSpringsEstimate| e.coulomb.map_or(0.0, |c| c[cart].value);
+        |cart: usize| move |e: &MassSpringEstimate| e.coulomb.map_or(0.0, |c| c[cart].value);
     [
-        mean(&|e| e.k1.value) / t.k1 - 1.0,
-        mean(&|e| e.k2.value) / t.k2 - 1.0,
+        mean(&|e| e.k1().value) / t.k1 - 1.0,
+        mean(&|e| e.k2().value) / t.k2 - 1.0,
         mean(&|e| e.b1.value) / t.b1 - 1.0,
         mean(&|e| e.gain.value) / t.gain - 1.0,
         mean(&|e| e.b2.value) / t.b2 - 1.0,
@@ -602,7 +608,7 @@ fn a_stalled_real_time_tick_leaves_a_gap_and_the_rest_identifies() {
         assert!(out.stats.skipped >= 2, "{}", out.stats);
         assert!(rec.sample_period().is_err());
 
-        let e = match identify_separate_springs_with(rec, truth.m1, truth.m2, &options) {
+        let e = match identify_with(rec, truth.m1, truth.m2, &separate(options)) {
             Ok(e) => e,
             // A busy machine makes the loop late by more than 5 % of a
             // period here and there: the recording is split at each, and
@@ -625,8 +631,8 @@ fn a_stalled_real_time_tick_leaves_a_gap_and_the_rest_identifies() {
         println!("timing tolerated: {:?}", e.timing);
         let [f1, f2] = e.coulomb.unwrap();
         for (name, got, want) in [
-            ("k1", e.k1.value, truth.k1),
-            ("k2", e.k2.value, truth.k2),
+            ("k1", e.k1().value, truth.k1),
+            ("k2", e.k2().value, truth.k2),
             ("b1", e.b1.value, truth.b1),
             ("K", e.gain.value, truth.gain),
             ("b2", e.b2.value, truth.b2),
@@ -654,8 +660,8 @@ fn a_stalled_real_time_tick_leaves_a_gap_and_the_rest_identifies() {
         // p99 lateness passes half a period, what is left after the splits
         // is too little to hold them, and that run counts as a busy one.
         let misses: Vec<String> = [
-            ("k1", e.k1.value, truth.k1),
-            ("k2", e.k2.value, truth.k2),
+            ("k1", e.k1().value, truth.k1),
+            ("k2", e.k2().value, truth.k2),
             ("K", e.gain.value, truth.gain),
         ]
         .iter()

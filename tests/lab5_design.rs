@@ -10,7 +10,7 @@ mod common;
 
 use common::lqi_design::{self, Design, Metrics, Spec};
 use common::run_on_rig;
-use ctrlab::lab::ident::{Options, Scheme, identify_separate_springs_with};
+use ctrlab::lab::ident::{Options, Scheme, SpringModel, identify_with};
 use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
 use ctrlab::signal::SquareWave;
 use std::sync::OnceLock;
@@ -23,18 +23,19 @@ const SETPOINT: f64 = 0.030;
 fn identified(sim: &SimulatedRig) -> (MassSpring, [f64; 2]) {
     let rec = common::open_loop(sim, &SquareWave::new(8.0, 0.2).unwrap(), 5.0);
     let options = Options {
+        springs: SpringModel::Separate,
         scheme: Scheme::Central,
         coulomb: true,
         ..Options::default()
     };
     let (m1, m2) = (sim.truth.m1, sim.truth.m2);
-    let e = identify_separate_springs_with(&rec, m1, m2, &options).unwrap();
+    let e = identify_with(&rec, m1, m2, &options).unwrap();
     let coulomb = e.coulomb.unwrap().map(|f| f.value);
     let model = MassSpring {
         m1,
         m2,
-        k1: e.k1.value,
-        k2: e.k2.value,
+        k1: e.k1().value,
+        k2: e.k2().value,
         b1: e.b1.value,
         b2: e.b2.value,
         gain: e.gain.value,

@@ -17,7 +17,7 @@ use common::open_loop;
 use ctrlab::Recording;
 use ctrlab::data::CsvOptions;
 use ctrlab::lab::SimulatedRig;
-use ctrlab::lab::ident::{Options, identify_separate_springs_with};
+use ctrlab::lab::ident::{Options, SpringModel, identify_with};
 use ctrlab::signal::SquareWave;
 
 /// The default rig's encoders: 8192 counts per 80 mm.
@@ -80,19 +80,20 @@ fn the_student_logs_load_and_identify_near_the_truth() {
         let rec =
             Recording::read_csv_with(dir().join(format!("group7_run{n}.csv")), &options).unwrap();
         assert_eq!(rec.len(), 2500); // 5 s at 2 ms
-        let est = identify_separate_springs_with(
+        let est = identify_with(
             &rec,
             1.3,
             0.7,
             &Options {
+                springs: SpringModel::Separate,
                 coulomb: true,
                 ..Options::DEFAULT
             },
         )
         .unwrap();
         let err = |got: f64, want: f64| (got / want - 1.0).abs();
-        assert!(err(est.k1.value, truth.k1) < 0.01, "{:?}", est.k1);
-        assert!(err(est.k2.value, truth.k2) < 0.01, "{:?}", est.k2);
+        assert!(err(est.k1().value, truth.k1) < 0.01, "{:?}", est.k1());
+        assert!(err(est.k2().value, truth.k2) < 0.01, "{:?}", est.k2());
         assert!(err(est.gain.value, truth.gain) < 0.01, "{:?}", est.gain);
         read += 1;
     }

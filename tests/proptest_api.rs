@@ -10,7 +10,7 @@
 use ctrlab::design::{StateFeedback, acker, dlqr, lqr};
 use ctrlab::discretize::expm;
 use ctrlab::ident::{LeastSquares, Rls};
-use ctrlab::lab::ident::{Scheme, Spread, average, identify, identify_separate_springs};
+use ctrlab::lab::ident::{Options, Scheme, Spread, SpringModel, average, identify, identify_with};
 use ctrlab::metrics::step_info_channel;
 use ctrlab::metrics::{Definition, step_info_mimo};
 use ctrlab::sim::{
@@ -348,11 +348,11 @@ proptest! {
         let Ok(rec) = Recording::from_columns(schema, t, vec![u[..n].to_vec(), x1.clone(), vec![0.0; n], x2[..n].to_vec(), vec![0.0; n]]) else { return Ok(()) };
         for scheme in [Scheme::Lab, Scheme::Central] {
             if let Ok(est) = identify(&rec, m1, m2, scheme) {
-                for e in [est.k12, est.b1, est.gain, est.b2] { prop_assert!(e.value.is_finite() && e.std_error.is_finite()); }
-                if let Ok(avg) = average(&[est.clone(), est]) { prop_assert!(avg.k12.std_dev.is_finite()); }
+                for e in [est.k12().unwrap(), est.b1, est.gain, est.b2] { prop_assert!(e.value.is_finite() && e.std_error.is_finite()); }
+                if let Ok(avg) = average(&[est.clone(), est]) { prop_assert!(avg.k12().unwrap().std_dev.is_finite()); }
             }
-            if let Ok(est) = identify_separate_springs(&rec, m1, m2, scheme) {
-                for e in [est.k1, est.k2, est.b1, est.gain, est.b2] { prop_assert!(e.value.is_finite() && e.std_error.is_finite()); }
+            if let Ok(est) = identify_with(&rec, m1, m2, &Options { springs: SpringModel::Separate, scheme, ..Options::DEFAULT }) {
+                for e in [est.k1(), est.k2(), est.b1, est.gain, est.b2] { prop_assert!(e.value.is_finite() && e.std_error.is_finite()); }
             }
         }
     }

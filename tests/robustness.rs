@@ -56,7 +56,7 @@ fn identify_on_a_csv_of_huge_positions_is_an_error_or_finite() {
     for scheme in [Scheme::Lab, Scheme::Central] {
         match identify(&rec, 1.3, 0.7, scheme) {
             Ok(est) => {
-                for e in [est.k12, est.b1, est.gain, est.b2] {
+                for e in [est.k12().unwrap(), est.b1, est.gain, est.b2] {
                     assert!(e.value.is_finite() && e.std_error.is_finite(), "{est:?}");
                 }
             }

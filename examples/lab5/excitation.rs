@@ -3,9 +3,7 @@
 //! voltage and length, each identified as the separate-springs model with
 //! Coulomb friction.
 
-use ctrlab::lab::ident::{
-    Options, Scheme, SeparateSpringsEstimate, identify_separate_springs_with,
-};
+use ctrlab::lab::ident::{MassSpringEstimate, Options, Scheme, SpringModel, identify_with};
 use ctrlab::nalgebra::vector;
 use ctrlab::signal::{Chirp, Multisine, Phases, Prbs, Signal, SquareWave, Sweep};
 use ctrlab::{OpenLoop, Recording};
@@ -73,6 +71,7 @@ pub fn section(
         "The same identification (separate springs, Coulomb friction, Central scheme) from four inputs of the same peak ({IDENT_VOLTS} V) and length ({IDENT_DURATION} s), {RUNS} runs each (recordings in `runs/excite_*.csv`). The square wave puts its power on a few odd harmonics of 2.5 Hz; the PRBS spreads it flat to 11 Hz; the multisine puts it exactly on 50 lines from 0.2 to 10 Hz; the chirp sweeps 0.2–10 Hz once, the same time per octave.\n"
     ));
     let options = Options {
+        springs: SpringModel::Separate,
         scheme: Scheme::Central,
         coulomb: true,
         ..Options::default()
@@ -84,7 +83,7 @@ pub fn section(
     let mut worst: Vec<(&str, f64)> = Vec::new();
     let mut fresh = None;
     for (i, (name, what, signal)) in inputs()?.into_iter().enumerate() {
-        let mut estimates: Vec<SeparateSpringsEstimate> = Vec::new();
+        let mut estimates: Vec<MassSpringEstimate> = Vec::new();
         let mut failure = None;
         let rms = {
             let u = signal.sample(
@@ -105,7 +104,7 @@ pub fn section(
             )?;
             match outcome {
                 Ok(out) => {
-                    match identify_separate_springs_with(&out.recording, M1, M2, &options) {
+                    match identify_with(&out.recording, M1, M2, &options) {
                         Ok(e) => estimates.push(e),
                         Err(e) => failure = Some(format!("not identified: {e}")),
                     }
@@ -128,12 +127,11 @@ pub fn section(
         }
         let n = estimates.len() as f64;
         let mean =
-            |f: &dyn Fn(&SeparateSpringsEstimate) -> f64| estimates.iter().map(f).sum::<f64>() / n;
-        let coulomb =
-            |e: &SeparateSpringsEstimate, c: usize| e.coulomb.map_or(f64::NAN, |f| f[c].value);
+            |f: &dyn Fn(&MassSpringEstimate) -> f64| estimates.iter().map(f).sum::<f64>() / n;
+        let coulomb = |e: &MassSpringEstimate, c: usize| e.coulomb.map_or(f64::NAN, |f| f[c].value);
         let cells: [(f64, Option<f64>); 7] = [
-            (mean(&|e| e.k1.value), truth.map(|t| t.k1)),
-            (mean(&|e| e.k2.value), truth.map(|t| t.k2)),
+            (mean(&|e| e.k1().value), truth.map(|t| t.k1)),
+            (mean(&|e| e.k2().value), truth.map(|t| t.k2)),
             (mean(&|e| e.gain.value), truth.map(|t| t.gain)),
             (mean(&|e| e.b1.value), truth.map(|t| t.b1)),
             (mean(&|e| e.b2.value), truth.map(|t| t.b2)),

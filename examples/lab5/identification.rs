@@ -7,8 +7,8 @@ use std::path::Path;
 use ctrlab::data::CsvOptions;
 use ctrlab::hw::LoopStats;
 use ctrlab::lab::ident::{
-    Estimate, MassSpringEstimate, Options, Scheme, SeparateSpringsAverage, SeparateSpringsEstimate,
-    Spread, average, average_separate_springs, identify, identify_separate_springs_with,
+    Estimate, MassSpringAverage, MassSpringEstimate, Options, Scheme, Spread, SpringModel, average,
+    identify, identify_with,
 };
 use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::vector;
@@ -25,6 +25,7 @@ use crate::rig::{
 /// The separate-springs identification: Central, with each cart's Coulomb
 /// friction.
 pub const SEPARATE: Options = Options {
+    springs: SpringModel::Separate,
     scheme: Scheme::Central,
     coulomb: true,
     ..Options::DEFAULT
@@ -54,14 +55,14 @@ pub struct Identification {
     pub lab: Vec<MassSpringEstimate>,
     pub central: Vec<MassSpringEstimate>,
     /// Separate springs with Coulomb friction (Central), one per run.
-    pub separate: Vec<SeparateSpringsEstimate>,
+    pub separate: Vec<MassSpringEstimate>,
     /// The runs, in order.
     pub runs: Vec<Run>,
     /// Lab and Central on one run of an equal-springs, frictionless truth
     /// (simulated rig only): the schemes' own bias, free of model error.
     pub equal_springs: Option<EqualSprings>,
     /// The separate-springs estimates averaged over the runs.
-    pub average: SeparateSpringsAverage,
+    pub average: MassSpringAverage,
     /// The identified model: the averages' linear part.
     pub model: MassSpring,
 }
@@ -176,22 +177,23 @@ pub fn identification(
         let context = |e: ctrlab::Error| format!("run {}: {e}", run.name);
         lab.push(identify(rec, M1, M2, Scheme::Lab).map_err(context)?);
         central.push(identify(rec, M1, M2, Scheme::Central).map_err(context)?);
-        separate.push(identify_separate_springs_with(rec, M1, M2, &options).map_err(context)?);
+        separate.push(identify_with(rec, M1, M2, &options).map_err(context)?);
     }
     let coulomb =
-        |e: &SeparateSpringsEstimate, cart: usize| e.coulomb.map_or(f64::NAN, |c| c[cart].value);
+        |e: &MassSpringEstimate, cart: usize| e.coulomb.map_or(f64::NAN, |c| c[cart].value);
+    // Lab and Central fit the lab's equal springs: their k1() is k12.
     let mut rows3 = Vec::new();
     let mut rows4 = Vec::new();
     for i in 0..lab.len() {
         let (l, c, s) = (&lab[i], &central[i], &separate[i]);
         rows3.push(vec![
             format!("{}", i + 1),
-            format!("{:.2}", l.k12.value),
+            format!("{:.2}", l.k1().value),
             format!("{:.3}", l.b1.value),
-            format!("{:.2}", c.k12.value),
+            format!("{:.2}", c.k1().value),
             format!("{:.3}", c.b1.value),
-            format!("{:.2}", s.k1.value),
-            format!("{:.2}", s.k2.value),
+            format!("{:.2}", s.k1().value),
+            format!("{:.2}", s.k2().value),
             format!("{:.3}", s.b1.value),
             format!("{:.3}", coulomb(s, 0)),
         ]);
@@ -207,16 +209,22 @@ pub fn identification(
         ]);
     }
     let (al, ac) = (average(&lab)?, average(&central)?);
-    let average = average_separate_springs(&separate)?;
+    let average = average(&separate)?;
     let [sf1, sf2] = average
         .coulomb
         .ok_or("the separate-springs fit has no Coulomb forces")?;
-    let (sk1, sk2, sb1, sg, sb2) = (average.k1, average.k2, average.b1, average.gain, average.b2);
+    let (sk1, sk2, sb1, sg, sb2) = (
+        average.k1(),
+        average.k2(),
+        average.b1,
+        average.gain,
+        average.b2,
+    );
     rows3.push(vec![
         "**mean ± sd**".into(),
-        pm(&al.k12, 2),
+        pm(&al.k1(), 2),
         pm(&al.b1, 3),
-        pm(&ac.k12, 2),
+        pm(&ac.k1(), 2),
         pm(&ac.b1, 3),
         pm(&sk1, 2),
         pm(&sk2, 2),
@@ -279,18 +287,18 @@ pub fn identification(
             ParamPanel {
                 name: "k1, k12 (N/m)".into(),
                 schemes: vec![
-                    ("Lab k12".into(), values(&|i| lab[i].k12.value)),
-                    ("Central k12".into(), values(&|i| central[i].k12.value)),
-                    ("separate k1".into(), values(&|i| separate[i].k1.value)),
+                    ("Lab k12".into(), values(&|i| lab[i].k1().value)),
+                    ("Central k12".into(), values(&|i| central[i].k1().value)),
+                    ("separate k1".into(), values(&|i| separate[i].k1().value)),
                 ],
                 truth: truth.map(|(t, _)| t.k1),
             },
             ParamPanel {
                 name: "k2 (N/m)".into(),
                 schemes: vec![
-                    ("Lab k12".into(), values(&|i| lab[i].k12.value)),
-                    ("Central k12".into(), values(&|i| central[i].k12.value)),
-                    ("separate k2".into(), values(&|i| separate[i].k2.value)),
+                    ("Lab k12".into(), values(&|i| lab[i].k1().value)),
+                    ("Central k12".into(), values(&|i| central[i].k1().value)),
+                    ("separate k2".into(), values(&|i| separate[i].k2().value)),
                 ],
                 truth: truth.map(|(t, _)| t.k2),
             },
@@ -380,13 +388,13 @@ pub fn identification(
 /// The separate-springs model's parameters with their uncertainty: the
 /// spread over the runs beside the runs' own standard errors.
 fn uncertainty(
-    separate: &[SeparateSpringsEstimate],
-    average: &SeparateSpringsAverage,
+    separate: &[MassSpringEstimate],
+    average: &MassSpringAverage,
     truth: Option<(MassSpring, [f64; 2])>,
     report: &mut Report,
 ) {
     report.heading(3, "The identified model and its uncertainty");
-    type Pick = fn(&SeparateSpringsEstimate) -> Option<Estimate>;
+    type Pick = fn(&MassSpringEstimate) -> Option<Estimate>;
     /// Name, estimate, spread over the runs, truth, decimals.
     type Row = (&'static str, Pick, Option<Spread>, Option<f64>, usize);
     let forces = average.coulomb.map(|[f1, f2]| (f1, f2));
@@ -394,15 +402,15 @@ fn uncertainty(
     let rows: [Row; 7] = [
         (
             "k1 (N/m)",
-            |e| Some(e.k1),
-            Some(average.k1),
+            |e| Some(e.k1()),
+            Some(average.k1()),
             truth.map(|(t, _)| t.k1),
             1,
         ),
         (
             "k2 (N/m)",
-            |e| Some(e.k2),
-            Some(average.k2),
+            |e| Some(e.k2()),
+            Some(average.k2()),
             truth.map(|(t, _)| t.k2),
             1,
         ),
@@ -537,11 +545,11 @@ pub fn equal_springs(
             report.add(&format!(
                 "One more run on a card whose springs are equal (k1 = k2 = {:.0} N/m) and without Coulomb friction, where the lab's model is exact, isolates the schemes' own bias: Lab k12 {}, b1 {}, K {}, b2 {}; Central k12 {}, b1 {}, K {}, b2 {}.\n",
                 truth.k1,
-                pct(l.k12.value, truth.k1),
+                pct(l.k1().value, truth.k1),
                 pct(l.b1.value, truth.b1),
                 pct(l.gain.value, truth.gain),
                 pct(l.b2.value, truth.b2),
-                pct(c.k12.value, truth.k1),
+                pct(c.k1().value, truth.k1),
                 pct(c.b1.value, truth.b1),
                 pct(c.gain.value, truth.gain),
                 pct(c.b2.value, truth.b2),

@@ -3,7 +3,7 @@
 //! `Ok` holds finite numbers.
 #![no_main]
 
-use ctrlab::lab::ident::{Scheme, identify, identify_separate_springs};
+use ctrlab::lab::ident::{Options, Scheme, SpringModel, identify, identify_with};
 use ctrlab::metrics::step_info_channel;
 use ctrlab::{Recording, StepInfoOptions};
 use libfuzzer_sys::fuzz_target;
@@ -17,7 +17,7 @@ fuzz_target!(|data: &[u8]| {
     for scheme in [Scheme::Lab, Scheme::Central] {
         for (m1, m2) in [(1.3, 0.7), (1300.0, 700.0)] {
             if let Ok(est) = identify(&rec, m1, m2, scheme) {
-                for e in [est.k12, est.b1, est.gain, est.b2] {
+                for e in [est.k1(), est.b1, est.gain, est.b2] {
                     assert!(e.value.is_finite() && e.std_error.is_finite(), "{est:?}");
                 }
                 assert!(
@@ -26,8 +26,13 @@ fuzz_target!(|data: &[u8]| {
                 let _ = est.warnings();
                 let _ = est.state_space();
             }
-            if let Ok(est) = identify_separate_springs(&rec, m1, m2, scheme) {
-                for e in [est.k1, est.k2, est.b1, est.gain, est.b2] {
+            let separate = Options {
+                springs: SpringModel::Separate,
+                scheme,
+                ..Options::DEFAULT
+            };
+            if let Ok(est) = identify_with(&rec, m1, m2, &separate) {
+                for e in [est.k1(), est.k2(), est.b1, est.gain, est.b2] {
                     assert!(e.value.is_finite() && e.std_error.is_finite(), "{est:?}");
                 }
             }

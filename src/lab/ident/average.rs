@@ -1,11 +1,19 @@
-//! The averages over repeated runs (Tables 3 and 4).
+//! The averages over repeated runs (Tables 3 and 4): one
+//! [`MassSpringAverage`] of whatever the runs identified.
 
-use super::{MassSpringEstimate, SeparateSpringsEstimate};
-use crate::error::Error;
+use std::fmt;
+
+use super::estimates::plus_minus;
+use super::{MassSpringEstimate, SpringModel, Springs};
+use crate::error::{Error, ErrorKind};
 use crate::kernels::reduce::pow2_floor;
+use crate::lab::{FrictionPlant, MassSpring};
 
 /// Mean and sample standard deviation (divisor `n − 1`) of one parameter
 /// over repeated runs.
+///
+/// Displays as `mean ± std_dev`, the formatter's precision applying to
+/// both.
 ///
 /// # Examples
 ///
@@ -13,6 +21,7 @@ use crate::kernels::reduce::pow2_floor;
 /// # use ctrlab::lab::ident::Spread;
 /// let s = Spread { mean: 950.0, std_dev: 4.0 };
 /// assert_eq!(s.mean, 950.0);
+/// assert_eq!(format!("{s:.1}"), "950.0 ± 4.0");
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spread {
@@ -22,36 +31,15 @@ pub struct Spread {
     pub std_dev: f64,
 }
 
-/// The averages of Tables 3 and 4: each parameter's mean and spread over
-/// repeated identification runs.
-///
-/// # Examples
-///
-/// ```
-/// # use ctrlab::{Recording, lab::ident::{average, identify, Scheme}};
-/// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
-/// let avg = average(&[est.clone(), est.clone()])?;
-/// assert_eq!((avg.runs, avg.k12.mean, avg.k12.std_dev), (2, est.k12.value, 0.0));
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MassSpringAverage {
-    /// Spring constant, N/m.
-    pub k12: Spread,
-    /// Friction of cart 1, N·s/m.
-    pub b1: Spread,
-    /// Motor gain, N per input unit.
-    pub gain: Spread,
-    /// Friction of cart 2, N·s/m.
-    pub b2: Spread,
-    /// Number of runs averaged.
-    pub runs: usize,
+impl fmt::Display for Spread {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        plus_minus(f, self.mean, self.std_dev)
+    }
 }
 
 impl Spread {
     /// Mean and sample standard deviation of `values` (e.g. one parameter of
-    /// [`SeparateSpringsEstimate`](super::SeparateSpringsEstimate) over several runs).
+    /// [`MassSpringEstimate`] over several runs).
     ///
     /// # Errors
     ///
@@ -107,86 +95,116 @@ fn spread(values: impl Iterator<Item = f64> + Clone, n: usize) -> Result<Spread,
     Ok(Spread { mean, std_dev })
 }
 
-/// Mean and sample standard deviation of each parameter over repeated runs
-/// (the "average" rows of Tables 3 and 4).
-///
-/// # Errors
-///
-/// [`Error::TooFewSamples`] for fewer than two runs (a sample standard
-/// deviation needs two); [`Error::Overflow`] for a spread beyond `f64::MAX`.
+/// The averages of Tables 3 and 4: each parameter's mean and spread over
+/// repeated identification runs ([`average`]), and the model of the
+/// means. The springs are those the runs identified: `k12` for the lab's
+/// equal springs, `k1` and `k2` for separate ones.
 ///
 /// # Examples
 ///
 /// ```
-/// # use ctrlab::{Error, lab::ident::average};
-/// assert!(matches!(average(&[]), Err(Error::TooFewSamples { needed: 2, got: 0, .. })));
-/// ```
-pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Error> {
-    let n = runs.len();
-    if n < 2 {
-        return Err(Error::TooFewSamples {
-            what: "averaging identification runs",
-            needed: 2,
-            got: n,
-        });
-    }
-    Ok(MassSpringAverage {
-        k12: spread(runs.iter().map(|r| r.k12.value), n)?,
-        b1: spread(runs.iter().map(|r| r.b1.value), n)?,
-        gain: spread(runs.iter().map(|r| r.gain.value), n)?,
-        b2: spread(runs.iter().map(|r| r.b2.value), n)?,
-        runs: n,
-    })
-}
-
-/// The averaged model of repeated separate-springs identifications
-/// ([`average_separate_springs`]): each parameter's mean and spread over
-/// the runs, and the model of the means.
-///
-/// # Examples
-///
-/// ```
-/// # use ctrlab::{Recording, lab::ident::{average_separate_springs, identify_separate_springs, Scheme}};
+/// # use ctrlab::{Recording, lab::ident::{average, identify, Scheme}};
 /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
-/// let avg = average_separate_springs(&[est.clone(), est.clone()])?;
+/// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+/// let avg = average(&[est.clone(), est.clone()])?;
+/// let k12 = avg.k12().unwrap();
+/// assert_eq!((avg.runs, k12.mean, k12.std_dev), (2, est.k12().unwrap().value, 0.0));
 /// assert_eq!(avg.plant(), est.plant());
-/// assert_eq!((avg.runs, avg.k2.std_dev, avg.coulomb), (2, 0.0, None));
-/// # Ok::<(), ctrlab::Error>(())
+/// assert_eq!(avg.coulomb, None);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SeparateSpringsAverage {
-    /// Spring between the wall and cart 1, N/m.
-    pub k1: Spread,
-    /// Spring between the carts, N/m.
-    pub k2: Spread,
+pub struct MassSpringAverage {
+    /// The springs, N/m, as the runs identified them.
+    pub springs: Springs<Spread>,
     /// Viscous friction of cart 1, N·s/m.
     pub b1: Spread,
     /// Motor gain `K`, N per input unit.
     pub gain: Spread,
     /// Viscous friction of cart 2, N·s/m.
     pub b2: Spread,
-    /// Coulomb friction force of cart 1 and cart 2, N, when every run
+    /// Coulomb friction force of cart 1 and cart 2, N, when the runs
     /// fitted it.
     pub coulomb: Option<[Spread; 2]>,
     /// Mass of cart 1, kg (the same in every run).
     pub m1: f64,
-    /// Mass of cart 2, kg: the one given (spread 0), or the fitted ones
-    /// ([`Options::free_m2`](super::Options::free_m2)).
+    /// Mass of cart 2, kg: the one given (the same in every run), or the
+    /// fitted ones ([`Options::free_m2`](super::Options::free_m2)). Given,
+    /// it is averaged like the others, so its mean and spread are the mass
+    /// and 0 to within rounding (three runs of 0.7 kg: 0.6999999999999998).
     pub m2: Spread,
     /// Number of runs averaged.
     pub runs: usize,
 }
 
-impl SeparateSpringsAverage {
-    /// The model of the means, as [`MassSpring`](crate::lab::MassSpring)
-    /// parameters (the linear part, for design).
-    pub fn plant(&self) -> crate::lab::MassSpring {
-        crate::lab::MassSpring {
+impl MassSpringAverage {
+    /// The spring between the wall and cart 1, N/m: `k12` for equal
+    /// springs ([`Springs::k1`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{Options, SpringModel, average, identify_with}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_with(&rec, 1.3, 0.7, &Options { springs: SpringModel::Separate, ..Options::DEFAULT })?;
+    /// assert_eq!(average(&[est.clone(), est.clone()])?.k1().mean, est.k1().value);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn k1(&self) -> Spread {
+        self.springs.k1()
+    }
+
+    /// The spring between the carts, N/m: `k12` for equal springs
+    /// ([`Springs::k2`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{Options, SpringModel, average, identify_with}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify_with(&rec, 1.3, 0.7, &Options { springs: SpringModel::Separate, ..Options::DEFAULT })?;
+    /// assert_eq!(average(&[est.clone(), est.clone()])?.k2().mean, est.k2().value);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn k2(&self) -> Spread {
+        self.springs.k2()
+    }
+
+    /// `k12`, N/m, when the runs identified equal springs; `None` for
+    /// separate ones ([`Springs::k12`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{Scheme, average, identify}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify(&rec, 1.3, 0.7, Scheme::Lab)?;
+    /// assert_eq!(average(&[est.clone(), est.clone()])?.k12().map(|k| k.std_dev), Some(0.0));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn k12(&self) -> Option<Spread> {
+        self.springs.k12()
+    }
+
+    /// The model of the means, as [`MassSpring`] parameters (the linear
+    /// part, for design; equal springs: `k1 = k2 = k12`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::{Recording, lab::ident::{Scheme, average, identify}};
+    /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+    /// let plant = average(&[est.clone(), est])?.plant();
+    /// assert_eq!(plant.k1, plant.k2);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn plant(&self) -> MassSpring {
+        MassSpring {
             m1: self.m1,
             m2: self.m2.mean,
-            k1: self.k1.mean,
-            k2: self.k2.mean,
+            k1: self.k1().mean,
+            k2: self.k2().mean,
             b1: self.b1.mean,
             b2: self.b2.mean,
             gain: self.gain.mean,
@@ -199,74 +217,252 @@ impl SeparateSpringsAverage {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Recording, lab::ident::{Options, average_separate_springs, identify_separate_springs_with}};
+    /// # use ctrlab::{Recording, lab::ident::{Options, SpringModel, average, identify_with}};
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-    /// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::DEFAULT })?;
-    /// let avg = average_separate_springs(&[est.clone(), est.clone()])?;
+    /// let options = Options { springs: SpringModel::Separate, coulomb: true, ..Options::DEFAULT };
+    /// let est = identify_with(&rec, 1.3, 0.7, &options)?;
+    /// let avg = average(&[est.clone(), est.clone()])?;
     /// assert_eq!(avg.friction_plant(), est.friction_plant());
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn friction_plant(&self) -> crate::lab::FrictionPlant {
+    pub fn friction_plant(&self) -> FrictionPlant {
         let forces = self
             .coulomb
             .map_or([0.0; 2], |c| c.map(|f| f.mean.max(0.0)));
-        crate::lab::FrictionPlant::new(self.plant(), forces)
+        FrictionPlant::new(self.plant(), forces)
     }
 }
 
-/// Averages repeated separate-springs identifications (one per run) into
-/// one model: each parameter's mean and sample standard deviation.
-///
-/// # Errors
-///
-/// [`Error::TooFewSamples`] for fewer than two runs;
-/// [`Error::InvalidParameter`] when the runs were identified with different
-/// `m1`, or some with Coulomb friction and some without (their parameters
-/// mean different things); [`Error::Overflow`] for a spread beyond
-/// `f64::MAX`.
+/// Why [`average`] did not average the runs: too few of them or a spread
+/// beyond `f64::MAX` (the numeric [`Error`]), or runs whose parameters
+/// mean different things ([`Mismatch`]).
 ///
 /// # Examples
 ///
 /// ```
-/// # use ctrlab::{Error, Recording, lab::ident::{Options, average_separate_springs, identify_separate_springs, identify_separate_springs_with, Scheme}};
-/// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let a = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
-/// let b = identify_separate_springs(&rec, 1.2, 0.7, Scheme::Central)?;
-/// assert!(matches!(average_separate_springs(&[a.clone(), b]), Err(Error::InvalidParameter { name: "m1", .. })));
-/// let friction = Options { coulomb: true, ..Options::DEFAULT };
-/// let c = identify_separate_springs_with(&rec, 1.3, 0.7, &friction)?;
-/// assert!(matches!(average_separate_springs(&[a, c]), Err(Error::InvalidParameter { name: "coulomb", .. })));
-/// # Ok::<(), ctrlab::Error>(())
+/// use ctrlab::{Error, ErrorKind, Recording};
+/// use ctrlab::lab::ident::{AverageError, Mismatch, Options, SpringModel, average, identify_with};
+///
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let equal = identify_with(&rec, 1.3, 0.7, &Options::DEFAULT)?;
+/// let separate = identify_with(&rec, 1.3, 0.7, &Options { springs: SpringModel::Separate, ..Options::DEFAULT })?;
+/// let err = average(&[equal.clone(), separate]).unwrap_err();
+/// assert_eq!(err, AverageError::Mismatch {
+///     run: 1,
+///     what: Mismatch::Springs { first: SpringModel::Equal, other: SpringModel::Separate },
+/// });
+/// assert_eq!(err.kind(), ErrorKind::InvalidInput);
+/// assert!(err.to_string().contains("spring models"));
+/// assert!(matches!(average(&[equal]), Err(AverageError::Data(Error::TooFewSamples { needed: 2, got: 1, .. }))));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn average_separate_springs(
-    runs: &[SeparateSpringsEstimate],
-) -> Result<SeparateSpringsAverage, Error> {
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum AverageError {
+    /// Fewer than two runs ([`Error::TooFewSamples`]), or a spread beyond
+    /// `f64::MAX` ([`Error::Overflow`]).
+    #[error(transparent)]
+    Data(#[from] Error),
+    /// Run `run` (from 0) was identified otherwise than run 0 in `what`.
+    #[error("run {run} cannot be averaged with run 0: {what}")]
+    Mismatch {
+        /// The first run that differs from run 0, counted from 0.
+        run: usize,
+        /// What differs.
+        what: Mismatch,
+    },
+}
+
+impl AverageError {
+    /// The category of the error: the numeric error's own, or
+    /// [`ErrorKind::InvalidInput`] for runs that do not match.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Error, ErrorKind, lab::ident::AverageError};
+    /// let e = AverageError::from(Error::Overflow { operation: "sample standard deviation" });
+    /// assert_eq!(e.kind(), ErrorKind::Numerical);
+    /// ```
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            AverageError::Data(e) => e.kind(),
+            AverageError::Mismatch { .. } => ErrorKind::InvalidInput,
+        }
+    }
+}
+
+/// What differs between two runs [`average`] will not mix
+/// ([`AverageError::Mismatch`]): `first` is run 0's, `other` the
+/// differing run's.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::Mismatch;
+/// let m = Mismatch::M1 { first: 1.3, other: 1.2 };
+/// assert_eq!(m.to_string(), "the masses of cart 1 differ (1.3 kg, 1.2 kg)");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Mismatch {
+    /// Equal springs in one run, separate in the other: `k12` is not
+    /// `k1`.
+    Springs {
+        /// Run 0's spring model.
+        first: SpringModel,
+        /// The other run's.
+        other: SpringModel,
+    },
+    /// The masses of cart 1 given, kg: every estimate scales with it.
+    M1 {
+        /// Run 0's.
+        first: f64,
+        /// The other run's.
+        other: f64,
+    },
+    /// The masses of cart 2 given, kg (both given, not fitted).
+    M2 {
+        /// Run 0's.
+        first: f64,
+        /// The other run's.
+        other: f64,
+    },
+    /// Cart 2's mass fitted ([`Options::free_m2`](super::Options::free_m2))
+    /// in one run and given in the other.
+    FreeM2 {
+        /// Whether run 0 fitted it.
+        first: bool,
+        /// Whether the other run did.
+        other: bool,
+    },
+    /// Coulomb friction fitted ([`Options::coulomb`](super::Options::coulomb))
+    /// in one run and not in the other: the viscous frictions then mean
+    /// different things.
+    Coulomb {
+        /// Whether run 0 fitted it.
+        first: bool,
+        /// Whether the other run did.
+        other: bool,
+    },
+}
+
+impl fmt::Display for Mismatch {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let fitted = |yes: bool| if yes { "fitted" } else { "not fitted" };
+        match *self {
+            Mismatch::Springs { first, other } => {
+                write!(f, "the spring models differ ({first:?}, {other:?})")
+            }
+            Mismatch::M1 { first, other } => {
+                write!(f, "the masses of cart 1 differ ({first} kg, {other} kg)")
+            }
+            Mismatch::M2 { first, other } => {
+                write!(f, "the masses of cart 2 differ ({first} kg, {other} kg)")
+            }
+            Mismatch::FreeM2 { first, other } => write!(
+                f,
+                "cart 2's mass is {} in one and {} in the other",
+                fitted(first),
+                fitted(other)
+            ),
+            Mismatch::Coulomb { first, other } => write!(
+                f,
+                "Coulomb friction is {} in one and {} in the other",
+                fitted(first),
+                fitted(other)
+            ),
+        }
+    }
+}
+
+/// The first thing `other` was identified with otherwise than `first`.
+fn mismatch(first: &MassSpringEstimate, other: &MassSpringEstimate) -> Option<Mismatch> {
+    let (a, b) = (first.springs.model(), other.springs.model());
+    if a != b {
+        return Some(Mismatch::Springs { first: a, other: b });
+    }
+    if first.m1 != other.m1 {
+        return Some(Mismatch::M1 {
+            first: first.m1,
+            other: other.m1,
+        });
+    }
+    let (a, b) = (first.m2_estimate.is_some(), other.m2_estimate.is_some());
+    if a != b {
+        return Some(Mismatch::FreeM2 { first: a, other: b });
+    }
+    if !a && first.m2 != other.m2 {
+        return Some(Mismatch::M2 {
+            first: first.m2,
+            other: other.m2,
+        });
+    }
+    let (a, b) = (first.coulomb.is_some(), other.coulomb.is_some());
+    (a != b).then_some(Mismatch::Coulomb { first: a, other: b })
+}
+
+/// Mean and sample standard deviation of each parameter over repeated runs
+/// (the "average" rows of Tables 3 and 4), of whatever the runs
+/// identified: the springs of their model, the Coulomb forces when fitted,
+/// cart 2's mass.
+///
+/// # Errors
+///
+/// [`AverageError::Mismatch`] when a run was identified with another
+/// spring model, another mass of cart 1, another given mass of cart 2, or
+/// with cart 2's mass or the Coulomb forces fitted where the first run did
+/// not (or the reverse): their parameters mean different things.
+/// [`AverageError::Data`] with [`Error::TooFewSamples`] for fewer than two
+/// runs (a sample standard deviation needs two), [`Error::Overflow`] for a
+/// spread beyond `f64::MAX`.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::{Error, Recording, lab::ident::{AverageError, Mismatch, Options, average, identify_with}};
+/// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// assert!(matches!(average(&[]), Err(AverageError::Data(Error::TooFewSamples { needed: 2, got: 0, .. }))));
+/// let a = identify_with(&rec, 1.3, 0.7, &Options::DEFAULT)?;
+/// let b = identify_with(&rec, 1.2, 0.7, &Options::DEFAULT)?;
+/// assert!(matches!(
+///     average(&[a.clone(), a.clone(), b]),
+///     Err(AverageError::Mismatch { run: 2, what: Mismatch::M1 { first: 1.3, other: 1.2 } })
+/// ));
+/// let c = identify_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::DEFAULT })?;
+/// assert!(matches!(
+///     average(&[a, c]),
+///     Err(AverageError::Mismatch { run: 1, what: Mismatch::Coulomb { first: false, other: true } })
+/// ));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, AverageError> {
     let n = runs.len();
     let Some(first) = runs.first().filter(|_| n >= 2) else {
         return Err(Error::TooFewSamples {
             what: "averaging identification runs",
             needed: 2,
             got: n,
-        });
+        }
+        .into());
     };
-    if let Some(other) = runs.iter().find(|r| r.m1 != first.m1) {
-        return Err(Error::InvalidParameter {
-            name: "m1",
-            value: other.m1,
-            reason: "the runs were identified with different masses of cart 1",
-        });
-    }
-    if runs
+    if let Some((run, what)) = runs
         .iter()
-        .any(|r| r.coulomb.is_some() != first.coulomb.is_some())
+        .enumerate()
+        .find_map(|(i, r)| Some((i, mismatch(first, r)?)))
     {
-        return Err(Error::InvalidParameter {
-            name: "coulomb",
-            value: runs.iter().filter(|r| r.coulomb.is_some()).count() as f64,
-            reason: "runs with and without Coulomb friction cannot be averaged",
-        });
+        return Err(AverageError::Mismatch { run, what });
     }
-    let of = |f: fn(&SeparateSpringsEstimate) -> f64| spread(runs.iter().map(f), n);
+    let of = |f: fn(&MassSpringEstimate) -> f64| spread(runs.iter().map(f), n);
+    let springs = match first.springs.model() {
+        SpringModel::Equal => Springs::Equal {
+            k12: of(|r| r.k1().value)?,
+        },
+        SpringModel::Separate => Springs::Separate {
+            k1: of(|r| r.k1().value)?,
+            k2: of(|r| r.k2().value)?,
+        },
+    };
     let coulomb = match first.coulomb {
         Some(_) => {
             let force = |cart: usize| {
@@ -280,9 +476,8 @@ pub fn average_separate_springs(
         }
         None => None,
     };
-    Ok(SeparateSpringsAverage {
-        k1: of(|r| r.k1.value)?,
-        k2: of(|r| r.k2.value)?,
+    Ok(MassSpringAverage {
+        springs,
         b1: of(|r| r.b1.value)?,
         gain: of(|r| r.gain.value)?,
         b2: of(|r| r.b2.value)?,

@@ -3,7 +3,7 @@
 
 use super::refine::check_forces;
 use super::simulation::{Run, SimulationModel};
-use super::{Options, Refined, identify_separate_springs_with, refine_with};
+use super::{Options, Refined, identify_with, refine_with};
 use crate::data::Recording;
 use crate::error::Error;
 use crate::signal::Rng;
@@ -113,7 +113,8 @@ impl RefinedStdErrors {
 /// on k1, 0.1 % on F2), which no standard error covers.
 ///
 /// `refined` must be the refinement of `rec` with `model`, started from
-/// the least squares with `identification` and the masses in
+/// the least squares with `identification` (its spring model included:
+/// equal springs, the default, or separate ones) and the masses in
 /// `refined.plant`. The work is `options.resamples` identifications and
 /// refinements (about 30 ms each for a 2500-sample run).
 ///
@@ -131,10 +132,10 @@ impl RefinedStdErrors {
 ///
 /// ```
 /// use ctrlab::Recording;
-/// use ctrlab::lab::ident::{Bootstrap, Options, SimulationModel, bootstrap, identify_separate_springs_with, refine};
+/// use ctrlab::lab::ident::{Bootstrap, Options, SimulationModel, SpringModel, bootstrap, identify_with, refine};
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let options = Options::default();
-/// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &options)?;
+/// let options = Options { springs: SpringModel::Separate, ..Options::default() };
+/// let est = identify_with(&rec, 1.3, 0.7, &options)?;
 /// let r = refine(&rec, &est)?;
 /// let resampling = Bootstrap { resamples: 4, ..Bootstrap::default() };
 /// let se = bootstrap(&rec, &options, &r, &SimulationModel::default(), &resampling)?;
@@ -202,7 +203,7 @@ pub fn bootstrap(
             .collect::<Result<Vec<_>, _>>()?;
         let resampled =
             Recording::from_columns(rec.schema().clone(), rec.time().to_vec(), columns)?;
-        let ls = identify_separate_springs_with(&resampled, plant.m1, plant.m2, identification)?;
+        let ls = identify_with(&resampled, plant.m1, plant.m2, identification)?;
         let r = refine_with(&resampled, &ls, model)?;
         evaluations += r.evaluations;
         for (i, v) in r.parameters().into_iter().enumerate() {

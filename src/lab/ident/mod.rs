@@ -9,6 +9,20 @@
 //! 2. cart 2, `m2 x2'' + b2 x2' + k2 (x2 − x1) = K u`, with `k2` from stage
 //!    1, gives the motor gain `K` and `b2`.
 //!
+//! # Springs
+//!
+//! The lab takes the two springs as equal, `k1 = k2 = k12` (equations
+//! (4)–(11)): that is the default ([`SpringModel::Equal`], stage 1 fits
+//! `[k12, b1]`). Separate springs ([`SpringModel::Separate`], stage 1
+//! fits `[k1, k2, b1]` from the same equation) are a case of the same
+//! estimate, not another pipeline: one [`identify_with`] whose
+//! [`Options::springs`] chooses, one [`MassSpringEstimate`] whose
+//! [`Springs`] say which were fitted (with [`k1`](MassSpringEstimate::k1)
+//! and [`k2`](MassSpringEstimate::k2) for either, `k12` for both when
+//! equal), one [`average`] of runs of either model (never mixed), and one
+//! [`refine`] from either (it works in `k1`, `k2`, starting equal springs
+//! at `k12` for both).
+//!
 //! Optionally ([`Options::coulomb`]) each equation gets a Coulomb friction
 //! term `F sign(v)`, fitted only over the rows where that cart clearly
 //! moves (see [`Options::min_speed`] for why).
@@ -53,14 +67,10 @@ mod regressors;
 mod simulation;
 mod timing;
 
-pub use average::{
-    MassSpringAverage, SeparateSpringsAverage, Spread, average, average_separate_springs,
-};
+pub use average::{AverageError, MassSpringAverage, Mismatch, Spread, average};
 pub use bootstrap::{Bootstrap, MAX_RESAMPLES, RefinedStdErrors, bootstrap};
-pub use estimates::{
-    Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, SeparateSpringsEstimate, Warning,
-};
-pub use options::{DEFAULT_MIN_SPEED, Options};
+pub use estimates::{Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, Springs, Warning};
+pub use options::{DEFAULT_MIN_SPEED, Options, SpringModel};
 pub use refine::{
     RESIDUAL_LAGS, Refined, ResidualTest, Validation, refine, refine_with, validate, validate_with,
 };
@@ -68,8 +78,7 @@ pub use simulation::SimulationModel;
 pub use timing::{DEFAULT_MAX_JITTER, GAP_RATIO, Timing};
 
 use self::regressors::{
-    CentralDifferences, Data, Differences, LabDifferences, Motion, Solver, motion, stage1_equal,
-    stage1_separate, stage2,
+    CentralDifferences, Data, Differences, LabDifferences, Motion, Solver, motion, stage1, stage2,
 };
 use crate::data::Recording;
 use crate::error::Error;
@@ -261,8 +270,9 @@ fn fitted_m2(free: bool, second: &LeastSquaresFit) -> Option<Estimate> {
 
 /// Identifies `k12 = k1 = k2`, `b1`, `K` and `b2` from a recording with
 /// known masses `m1`, `m2` (kg), by the lab's two-stage least squares:
-/// [`identify_with`] with the default [`Options`] and `scheme` (no Coulomb
-/// friction, 5 % jitter tolerated, split at gaps).
+/// [`identify_with`] with the default [`Options`] and `scheme` (the lab's
+/// equal springs, no Coulomb friction, 5 % jitter tolerated, split at
+/// gaps).
 ///
 /// # Errors
 ///
@@ -301,8 +311,11 @@ pub fn identify(
     identify_with(recording, m1, m2, &Options::with_scheme(scheme))
 }
 
-/// [`identify`] with [`Options`]: optionally each cart's Coulomb friction
-/// force, and another jitter tolerance.
+/// [`identify`] with [`Options`], the one identification pipeline: the
+/// lab's equal springs or separate ones ([`Options::springs`]; stage 1
+/// then fits `[k1, k2, b1]`, and stage 2 takes `k2`), optionally each
+/// cart's Coulomb friction force (a last column in each stage) and cart
+/// 2's effective mass, another jitter tolerance.
 ///
 /// # Errors
 ///
@@ -313,7 +326,7 @@ pub fn identify(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Recording, lab::ident::{Options, identify_with}};
+/// use ctrlab::{Recording, lab::ident::{Options, SpringModel, identify_with}};
 ///
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
 /// // The fixture's plant has no dry friction: the Coulomb forces come out
@@ -321,8 +334,14 @@ pub fn identify(
 /// let est = identify_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::default() })?;
 /// let [f1, f2] = est.coulomb.unwrap();
 /// assert!(f1.value.abs() < 0.1 && f2.value.abs() < 0.1, "{f1:?} {f2:?}");
-/// assert!((est.k12.value / 950.0 - 1.0).abs() < 0.005);
+/// assert!((est.k12().unwrap().value / 950.0 - 1.0).abs() < 0.005);
 /// assert!(est.first.rows < est.timing.rows); // rows at rest are left out
+///
+/// // Separate springs, with Coulomb friction: stage 1 fits [k1, k2, b1, F1].
+/// let options = Options { springs: SpringModel::Separate, coulomb: true, ..Options::default() };
+/// let est = identify_with(&rec, 1.3, 0.7, &options)?;
+/// assert_eq!((est.first.theta.len(), est.second.theta.len()), (4, 3));
+/// assert!((est.k2().value / 950.0 - 1.0).abs() < 0.01);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn identify_with(
@@ -332,12 +351,13 @@ pub fn identify_with(
     options: &Options,
 ) -> Result<MassSpringEstimate, Error> {
     match options.scheme {
-        Scheme::Lab => equal_springs::<LabDifferences>(recording, m1, m2, options),
-        Scheme::Central => equal_springs::<CentralDifferences>(recording, m1, m2, options),
+        Scheme::Lab => identify_by::<LabDifferences>(recording, m1, m2, options),
+        Scheme::Central => identify_by::<CentralDifferences>(recording, m1, m2, options),
     }
 }
 
-fn equal_springs<D: Differences>(
+/// [`identify_with`] with the differences of its scheme.
+fn identify_by<D: Differences>(
     recording: &Recording,
     m1: f64,
     m2: f64,
@@ -345,121 +365,33 @@ fn equal_springs<D: Differences>(
 ) -> Result<MassSpringEstimate, Error> {
     let (data, timing, dt) = prepare(recording, m1, m2, options)?;
     let fixed_m2 = (!options.free_m2).then_some(m2);
-    let motion = motions(&data, options, 3)?;
+    // Stage 1's parameters with the Coulomb column: the springs, b1, F1.
+    let model = options.springs;
+    let motion = motions(&data, options, model.parameters() + 2)?;
     let [cart1, cart2] = match &motion {
         Some([a, b]) => [Some(a), Some(b)],
         None => [None, None],
     };
     // Column-major [Φ | λ], the rows of every segment.
     let mut solver = Solver::new(options.covariance);
-    let first = stage1_equal::<D>(&data, m1, cart1, &mut solver)?;
-    let [k12, b1] = estimates::<2>(&first);
-    let second = stage2::<D>(&data, fixed_m2, (k12.value, 0), cart2, &mut solver)?;
+    let first = stage1::<D>(&data, m1, model, cart1, &mut solver)?;
+    let (springs, b1) = match model {
+        SpringModel::Equal => {
+            let [k12, b1] = estimates::<2>(&first);
+            (Springs::Equal { k12 }, b1)
+        }
+        SpringModel::Separate => {
+            let [k1, k2, b1] = estimates::<3>(&first);
+            (Springs::Separate { k1, k2 }, b1)
+        }
+    };
+    // Stage 2 takes the spring between the carts, stage 1's last spring.
+    let k2 = (springs.k2().value, model.parameters() - 1);
+    let second = stage2::<D>(&data, fixed_m2, k2, cart2, &mut solver)?;
     let [gain, b2] = estimates::<2>(&second);
     let m2_estimate = fitted_m2(options.free_m2, &second);
     Ok(MassSpringEstimate {
-        k12,
-        b1,
-        gain,
-        b2,
-        coulomb: coulomb_forces(options.coulomb, &first, &second),
-        m2_estimate,
-        m1,
-        m2: m2_estimate.map_or(m2, |e| e.value),
-        dt,
-        scheme: options.scheme,
-        timing,
-        first,
-        second,
-    })
-}
-
-/// Identifies unequal springs `k1`, `k2` with `b1` from cart 1's equation
-/// (three unknowns), then `K` and `b2` from cart 2's with that `k2`. Real
-/// springs are never exactly equal; this needs a run that moves the carts
-/// in both modes (a square wave does). [`identify_separate_springs_with`]
-/// with the default [`Options`] and `scheme`.
-///
-/// # Errors
-///
-/// As [`identify`].
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::{Recording, lab::ident::{identify_separate_springs, Scheme}};
-///
-/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
-/// assert!((est.k1.value / 950.0 - 1.0).abs() < 0.01);
-/// assert!((est.k2.value / 950.0 - 1.0).abs() < 0.01);
-/// assert_eq!(est.first.theta.len(), 3);
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-pub fn identify_separate_springs(
-    recording: &Recording,
-    m1: f64,
-    m2: f64,
-    scheme: Scheme,
-) -> Result<SeparateSpringsEstimate, Error> {
-    identify_separate_springs_with(recording, m1, m2, &Options::with_scheme(scheme))
-}
-
-/// [`identify_separate_springs`] with [`Options`]: optionally each cart's
-/// Coulomb friction force (stage 1 then fits `[k1, k2, b1, F1]`, stage 2
-/// `[K, b2, F2]`), and another jitter tolerance.
-///
-/// # Errors
-///
-/// As [`identify_with`].
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::{Recording, lab::ident::{Options, identify_separate_springs_with}};
-///
-/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let options = Options { coulomb: true, ..Options::default() };
-/// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &options)?;
-/// assert_eq!((est.first.theta.len(), est.second.theta.len()), (4, 3));
-/// assert!((est.k2.value / 950.0 - 1.0).abs() < 0.01);
-/// assert!(est.coulomb.unwrap()[1].value.abs() < 0.1); // frictionless fixture
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-pub fn identify_separate_springs_with(
-    recording: &Recording,
-    m1: f64,
-    m2: f64,
-    options: &Options,
-) -> Result<SeparateSpringsEstimate, Error> {
-    match options.scheme {
-        Scheme::Lab => separate_springs::<LabDifferences>(recording, m1, m2, options),
-        Scheme::Central => separate_springs::<CentralDifferences>(recording, m1, m2, options),
-    }
-}
-
-fn separate_springs<D: Differences>(
-    recording: &Recording,
-    m1: f64,
-    m2: f64,
-    options: &Options,
-) -> Result<SeparateSpringsEstimate, Error> {
-    let (data, timing, dt) = prepare(recording, m1, m2, options)?;
-    let fixed_m2 = (!options.free_m2).then_some(m2);
-    let motion = motions(&data, options, 4)?;
-    let [cart1, cart2] = match &motion {
-        Some([a, b]) => [Some(a), Some(b)],
-        None => [None, None],
-    };
-    let mut solver = Solver::new(options.covariance);
-    let first = stage1_separate::<D>(&data, m1, cart1, &mut solver)?;
-    let [k1, k2, b1] = estimates::<3>(&first);
-    let second = stage2::<D>(&data, fixed_m2, (k2.value, 1), cart2, &mut solver)?;
-    let [gain, b2] = estimates::<2>(&second);
-    let m2_estimate = fitted_m2(options.free_m2, &second);
-    Ok(SeparateSpringsEstimate {
-        k1,
-        k2,
+        springs,
         b1,
         gain,
         b2,

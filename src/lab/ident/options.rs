@@ -16,30 +16,69 @@ use crate::ident::Covariance;
 /// ```
 pub const DEFAULT_MIN_SPEED: f64 = 0.005;
 
-/// How [`identify_with`](super::identify_with) and
-/// [`identify_separate_springs_with`](super::identify_separate_springs_with)
-/// fit.
+/// Which springs the identification fits ([`Options::springs`]).
 ///
-/// The default is [`Scheme::Central`] without Coulomb friction, both
-/// masses as given, the [`DEFAULT_MIN_SPEED`] and [`DEFAULT_MAX_JITTER`],
-/// and Newey–West
-/// standard errors with the bandwidth chosen from the data: exactly
+/// The lab's model (LAB.md equations (4)–(11)) takes the two springs as
+/// equal, `k1 = k2 = k12`: stage 1 fits `[k12, b1]`. Real springs are never
+/// exactly equal; [`Separate`](Self::Separate) fits `[k1, k2, b1]` from the
+/// same equation of cart 1, which needs a run that moves the carts in both
+/// modes (the lab's square wave does). Either way the result is one
+/// [`MassSpringEstimate`](super::MassSpringEstimate), its
+/// [`Springs`](super::Springs) saying which.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{Options, SpringModel};
+/// assert_eq!(SpringModel::default(), SpringModel::Equal); // the lab's
+/// assert_eq!(Options::default().springs, SpringModel::Equal);
+/// ```
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum SpringModel {
+    /// `k1 = k2 = k12`, the lab's assumption (equations (6)–(11)).
+    #[default]
+    Equal,
+    /// `k1` (wall to cart 1) and `k2` (between the carts) apart.
+    Separate,
+}
+
+impl SpringModel {
+    /// How many spring constants stage 1 fits, first in its `θ`: 1
+    /// (`k12`) or 2 (`k1`, `k2`); the last of them is the spring between
+    /// the carts that stage 2 takes.
+    pub(super) fn parameters(self) -> usize {
+        match self {
+            SpringModel::Equal => 1,
+            SpringModel::Separate => 2,
+        }
+    }
+}
+
+/// How [`identify_with`](super::identify_with) fits.
+///
+/// The default is the lab's equal springs, [`Scheme::Central`] without
+/// Coulomb friction, both masses as given, the [`DEFAULT_MIN_SPEED`] and
+/// [`DEFAULT_MAX_JITTER`], and Newey–West standard errors with the
+/// bandwidth chosen from the data: exactly
 /// `identify(rec, m1, m2, Scheme::Central)`.
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::ident::Covariance;
-/// use ctrlab::lab::ident::{Options, Scheme};
+/// use ctrlab::lab::ident::{Options, Scheme, SpringModel};
 ///
-/// // The rig's carts have dry friction: fit it too.
-/// let options = Options { coulomb: true, ..Options::default() };
+/// // The rig's carts have dry friction and unequal springs: fit both.
+/// let options = Options { springs: SpringModel::Separate, coulomb: true, ..Options::default() };
 /// assert_eq!(options.scheme, Scheme::Central);
 /// assert_eq!((options.min_speed, options.max_jitter), (0.005, 0.05));
 /// assert_eq!(options.covariance, Covariance::NeweyWest { lags: None });
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
+    /// Equal springs (the lab's, the default) or separate ones: what the
+    /// estimate's [`springs`](super::MassSpringEstimate::springs) holds.
+    pub springs: SpringModel,
     /// How derivatives and the input are taken from the samples.
     pub scheme: Scheme,
     /// Fit a Coulomb friction force `F sign(v)` on each cart: a `sign(v1)`
@@ -160,6 +199,7 @@ impl Options {
     /// assert_eq!(Options { coulomb: false, ..FRICTION }, Options::default());
     /// ```
     pub const DEFAULT: Self = Self {
+        springs: SpringModel::Equal,
         scheme: Scheme::Central,
         coulomb: false,
         min_speed: DEFAULT_MIN_SPEED,
@@ -168,8 +208,8 @@ impl Options {
         covariance: Covariance::NeweyWest { lags: None },
     };
 
-    /// The options of [`identify`](super::identify) and [`identify_separate_springs`](super::identify_separate_springs): the
-    /// defaults with `scheme`.
+    /// The options of [`identify`](super::identify): the defaults (equal
+    /// springs) with `scheme`.
     pub(super) fn with_scheme(scheme: Scheme) -> Self {
         Self {
             scheme,

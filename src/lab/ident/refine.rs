@@ -11,7 +11,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::SeparateSpringsEstimate;
+use super::MassSpringEstimate;
 use super::simulation::{Run, SimulationModel};
 use crate::data::Recording;
 use crate::error::Error;
@@ -90,9 +90,10 @@ impl Refined {
     ///
     /// ```
     /// use ctrlab::Recording;
-    /// use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine};
+    /// use ctrlab::lab::ident::{Options, SpringModel, identify_with, refine};
     /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-    /// let r = refine(&rec, &identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?)?;
+    /// let options = Options { springs: SpringModel::Separate, ..Options::default() };
+    /// let r = refine(&rec, &identify_with(&rec, 1.3, 0.7, &options)?)?;
     /// assert_eq!(r.parameters()[4], r.plant.gain);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -183,9 +184,9 @@ fn correlation_test(a: &[f64], b: &[f64], first: usize) -> ResidualTest {
 ///
 /// ```
 /// use ctrlab::Recording;
-/// use ctrlab::lab::ident::{Options, identify_separate_springs_with, validate};
+/// use ctrlab::lab::ident::{Options, SpringModel, identify_with, validate};
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?;
+/// let est = identify_with(&rec, 1.3, 0.7, &Options { springs: SpringModel::Separate, ..Options::default() })?;
 /// let v = validate(&rec, &est.plant(), [0.0, 0.0])?;
 /// assert!(v.fit_percent[1] > 90.0);
 /// # Ok::<(), ctrlab::Error>(())
@@ -350,7 +351,8 @@ impl LeastSquaresProblem for Problem<'_> {
 /// Refines a least-squares estimate by output error: minimises the sum of
 /// both carts' squared simulation errors (m²) over
 /// `[k1, k2, b1, b2, K, F1, F2]` with the masses held, starting from
-/// `start` (its Coulomb forces, or 1 mN where it has none), by
+/// `start` (its Coulomb forces, or 1 mN where it has none; equal springs,
+/// the lab's model, start both `k1` and `k2` at `k12`), by
 /// Levenberg–Marquardt in the logarithms of the parameters (so they stay
 /// positive and the steps are relative). The simulation is that of
 /// [`validate`]: [`SimulationModel::default`], from rest at the first
@@ -390,14 +392,19 @@ impl LeastSquaresProblem for Problem<'_> {
 ///
 /// ```
 /// use ctrlab::Recording;
-/// use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine};
+/// use ctrlab::lab::ident::{Options, Scheme, SpringModel, identify, identify_with, refine, validate};
 /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
-/// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?;
+/// let est = identify_with(&rec, 1.3, 0.7, &Options { springs: SpringModel::Separate, ..Options::default() })?;
 /// let r = refine(&rec, &est)?;
 /// assert!(r.refined.fit_percent[1] >= r.start.fit_percent[1]);
+/// // From the lab's equal springs: k12 starts both k1 and k2.
+/// let equal = identify(&rec, 1.3, 0.7, Scheme::Central)?;
+/// let r = refine(&rec, &equal)?;
+/// assert_eq!((equal.plant().k1, equal.plant().k2), (equal.k12().unwrap().value, equal.k12().unwrap().value));
+/// assert_eq!(r.start, validate(&rec, &equal.plant(), [0.0; 2])?);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refined, Error> {
+pub fn refine(rec: &Recording, start: &MassSpringEstimate) -> Result<Refined, Error> {
     refine_with(rec, start, &SimulationModel::default())
 }
 
@@ -412,7 +419,7 @@ pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refine
 ///
 /// ```
 /// use ctrlab::lab::SimulatedRig;
-/// use ctrlab::lab::ident::{Options, identify_separate_springs_with, refine_with};
+/// use ctrlab::lab::ident::{Options, SpringModel, identify_with, refine_with};
 /// use ctrlab::signal::SquareWave;
 /// # use ctrlab::{OpenLoop, hw::{self, Clock, LoopConfig, VirtualClock}};
 /// # use nalgebra::vector;
@@ -426,8 +433,8 @@ pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refine
 /// # let rig = sim.rig(&Clock::Virtual(clock.clone()))?;
 /// # let rec = hw::run(rig, OpenLoop, |t| vector![wave.value(t)], &Clock::Virtual(clock), &config)
 /// #     .map_err(|e| e.error)?.recording;
-/// let options = Options { coulomb: true, ..Options::default() };
-/// let ls = identify_separate_springs_with(&rec, 1.3, 0.7, &options)?;
+/// let options = Options { springs: SpringModel::Separate, coulomb: true, ..Options::default() };
+/// let ls = identify_with(&rec, 1.3, 0.7, &options)?;
 /// let r = refine_with(&rec, &ls, &sim.simulation_model())?;
 /// assert!((r.plant.gain / sim.truth.gain - 1.0).abs() < 0.01);
 /// assert!((r.coulomb[1] / sim.coulomb_friction[1] - 1.0).abs() < 0.1);
@@ -435,7 +442,7 @@ pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refine
 /// ```
 pub fn refine_with(
     rec: &Recording,
-    start: &SeparateSpringsEstimate,
+    start: &MassSpringEstimate,
     model: &SimulationModel,
 ) -> Result<Refined, Error> {
     let plant = start.plant();

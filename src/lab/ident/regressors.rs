@@ -1,6 +1,7 @@
 //! The regressor columns of equations (6) and (9), per [`Scheme`](super::Scheme),
 //! built segment by segment, and the two least-squares stages.
 
+use super::SpringModel;
 use super::timing::Segment;
 use crate::error::Error;
 use crate::ident::{
@@ -409,56 +410,45 @@ fn push_cart1_friction_and_lambda<D: Differences>(
     });
 }
 
-/// Stage 1 with equal springs (equation (6)): `[k12, b1]`, then `F1` with
-/// the Coulomb column.
-pub(super) fn stage1_equal<D: Differences>(
+/// Stage 1 (equation (6)): the springs (`[k12]` equal, `[k1, k2]`
+/// separate), `b1`, then `F1` with the Coulomb column.
+pub(super) fn stage1<D: Differences>(
     data: &Data<'_>,
     m1: f64,
+    springs: SpringModel,
     coulomb: Option<&Motion>,
     solver: &mut Solver,
 ) -> Result<LeastSquaresFit, Error> {
     let buf = &mut solver.buf;
     let (x1, x2) = (data.x1, data.x2);
     let m = row_count(data, coulomb);
-    let p = 2 + usize::from(coulomb.is_some());
+    let p = springs.parameters() + 1 + usize::from(coulomb.is_some());
     buf.clear();
     buf.reserve(m * (p + 1));
-    column(buf, data, coulomb, |seg| {
-        let t2 = seg.dt * seg.dt;
-        let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
-        triples(x1)
-            .zip(triples(x2))
-            .map(move |(x1, x2)| t2 * (2.0 * D::pos(x1) - D::pos(x2)))
-    });
-    push_cart1_friction_and_lambda::<D>(data, m1, coulomb, buf);
-    solver.solve(data, coulomb, m, p, Stage::First)
-}
-
-/// Stage 1 with separate springs: `[k1, k2, b1]`, then `F1` with the
-/// Coulomb column.
-pub(super) fn stage1_separate<D: Differences>(
-    data: &Data<'_>,
-    m1: f64,
-    coulomb: Option<&Motion>,
-    solver: &mut Solver,
-) -> Result<LeastSquaresFit, Error> {
-    let buf = &mut solver.buf;
-    let (x1, x2) = (data.x1, data.x2);
-    let m = row_count(data, coulomb);
-    let p = 3 + usize::from(coulomb.is_some());
-    buf.clear();
-    buf.reserve(m * (p + 1));
-    column(buf, data, coulomb, |seg| {
-        let t2 = seg.dt * seg.dt;
-        triples(&x1[seg.start..seg.end]).map(move |x| t2 * D::pos(x))
-    });
-    column(buf, data, coulomb, |seg| {
-        let t2 = seg.dt * seg.dt;
-        let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
-        triples(x1)
-            .zip(triples(x2))
-            .map(move |(x1, x2)| t2 * (D::pos(x1) - D::pos(x2)))
-    });
+    match springs {
+        // `k12 T² [2x1(k) − x2(k)]`.
+        SpringModel::Equal => column(buf, data, coulomb, |seg| {
+            let t2 = seg.dt * seg.dt;
+            let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
+            triples(x1)
+                .zip(triples(x2))
+                .map(move |(x1, x2)| t2 * (2.0 * D::pos(x1) - D::pos(x2)))
+        }),
+        // `k1 T² x1(k) + k2 T² [x1(k) − x2(k)]`.
+        SpringModel::Separate => {
+            column(buf, data, coulomb, |seg| {
+                let t2 = seg.dt * seg.dt;
+                triples(&x1[seg.start..seg.end]).map(move |x| t2 * D::pos(x))
+            });
+            column(buf, data, coulomb, |seg| {
+                let t2 = seg.dt * seg.dt;
+                let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
+                triples(x1)
+                    .zip(triples(x2))
+                    .map(move |(x1, x2)| t2 * (D::pos(x1) - D::pos(x2)))
+            });
+        }
+    }
     push_cart1_friction_and_lambda::<D>(data, m1, coulomb, buf);
     solver.solve(data, coulomb, m, p, Stage::First)
 }
