@@ -175,7 +175,7 @@ fn panel(
 /// let path = std::env::temp_dir().join("ctrlab_bode_doc.svg");
 /// bode_svg(&path, "Two-cart plant", FrequencyUnit::Hertz, &[("force to x2", &b)])?;
 /// assert!(std::fs::read_to_string(&path).unwrap().contains("frequency (Hz)"));
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[doc(alias = "bodeplot")]
 pub fn bode_svg(
@@ -249,7 +249,7 @@ pub fn bode_svg(
 /// let path = std::env::temp_dir().join("ctrlab_nyquist_doc.svg");
 /// nyquist_svg(&path, "2/(s + 1)³", &[("L", &n)])?;
 /// assert!(std::fs::read_to_string(&path).unwrap().contains("<svg"));
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[doc(alias = "nyquistplot")]
 pub fn nyquist_svg(
