@@ -16,7 +16,9 @@
 //!   [`FrictionPlant`] inside the register-level card, in one call), with
 //!   its [`EncoderSensor`] for the sampled-data simulator;
 //! - the lab's recording layout, [`schema`]: input `u` (V), measurements
-//!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s).
+//!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s);
+//! - the lab's tables as data (the gains of Tables 2, 5 and 6, their
+//!   setpoints and groups of rows) and their computations, [`tables`].
 //!
 //! # Examples
 //!
@@ -55,6 +57,7 @@ mod probe;
 mod rig;
 mod sensor;
 mod simulated;
+pub mod tables;
 
 pub use calibration::Calibration;
 pub use config::RigConfig;
@@ -113,4 +116,21 @@ pub fn schema() -> Schema {
     )
     // Constant, valid names (the doctest above builds it): never fails.
     .expect("the lab's channel names are valid")
+}
+
+/// The recording's channel of `cart`'s position in [`schema`]: `x1` or
+/// `x2`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, position_channel, schema};
+/// assert_eq!(position_channel(Cart::Two), "x2");
+/// assert!(schema().position(position_channel(Cart::One)).is_some());
+/// ```
+pub fn position_channel(cart: Cart) -> &'static str {
+    match cart {
+        Cart::One => "x1",
+        Cart::Two => "x2",
+    }
 }
