@@ -17,8 +17,11 @@
 //!   its [`EncoderSensor`] for the sampled-data simulator;
 //! - the lab's recording layout, [`schema`]: input `u` (V), measurements
 //!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s);
+//! - how the lab's experiments are run (period, masses, identification
+//!   input), [`protocol`];
 //! - the lab's tables as data (the gains of Tables 2, 5 and 6, their
-//!   setpoints and groups of rows) and their computations, [`tables`].
+//!   setpoints and groups of rows) and their computations, [`tables`];
+//! - the LQI design to a spec on an identified model, [`lqi`].
 //!
 //! # Examples
 //!
@@ -52,8 +55,10 @@ mod config;
 mod file;
 mod gains;
 pub mod ident;
+pub mod lqi;
 mod plant;
 mod probe;
+pub mod protocol;
 mod rig;
 mod sensor;
 mod simulated;
