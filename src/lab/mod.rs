@@ -21,7 +21,12 @@
 //!   input), [`protocol`];
 //! - the lab's tables as data (the gains of Tables 2, 5 and 6, their
 //!   setpoints and groups of rows) and their computations, [`tables`];
-//! - the LQI design to a spec on an identified model, [`lqi`].
+//! - the LQI design to a spec on an identified model, [`lqi`];
+//! - the other sections of the lab's report as typed results:
+//!   [`excitation`] (which input identifies best), [`validation`] (the
+//!   models on a fresh run, refined) and [`frequency`] (the measured
+//!   response against the model); Tables 3 and 4 are
+//!   [`ident::summarize`].
 //!
 //! # Examples
 //!
@@ -52,7 +57,9 @@
 
 mod calibration;
 mod config;
+pub mod excitation;
 mod file;
+pub mod frequency;
 mod gains;
 pub mod ident;
 pub mod lqi;
@@ -63,6 +70,7 @@ mod rig;
 mod sensor;
 mod simulated;
 pub mod tables;
+pub mod validation;
 
 pub use calibration::Calibration;
 pub use config::RigConfig;
