@@ -1,12 +1,8 @@
 //! Helpers built on the two-cart lab (feature `lab`).
 
-/// LQI with a Kalman filter on the rig's positions, as lab5 designs it.
-#[path = "../../examples/common/lqi_design.rs"]
-pub mod lqi_design;
-
 use ctrlab::data::Recording;
 use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-use ctrlab::lab::SimulatedRig;
+use ctrlab::lab::{SimulatedRig, lqi};
 use ctrlab::signal::Signal;
 use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
 use nalgebra::vector;
@@ -22,7 +18,7 @@ pub fn simulate_on<C: Controller<4, 1, 1>>(
     setpoint: f64,
     duration: f64,
 ) -> Recording {
-    lqi_design::predict(sim, controller, setpoint, duration).unwrap()
+    lqi::predict(sim, controller, setpoint, duration).unwrap()
 }
 
 /// `controller` toward `setpoint` for `duration` seconds on `sim`'s rig
@@ -93,7 +89,7 @@ pub fn try_open_loop(
 
 /// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.
 pub fn position_model() -> StateSpace<4, 1, 2, Discrete> {
-    lqi_design::position_model(&MassSpring::nominal(), PERIOD).unwrap()
+    lqi::position_model(&MassSpring::nominal(), PERIOD).unwrap()
 }
 
 /// LQI on cart 2 (weights 1e7 on x2, 1e10 on its integral, 1 on u) with a
@@ -101,9 +97,9 @@ pub fn position_model() -> StateSpace<4, 1, 2, Discrete> {
 /// position read to a count of `metres_per_count`), back-calculation
 /// anti-windup past the drive's 24 mV step; it uses only `[x1, x2]` of the
 /// rig's `[x1, v1, x2, v2]`. The construction lab5's Design section uses.
-pub fn positions_lqi(metres_per_count: f64) -> lqi_design::PositionsLqi {
-    let q = lqi_design::weights(Cart::Two, 1e7);
-    lqi_design::positions_lqi(&position_model(), Cart::Two, &q, metres_per_count)
+pub fn positions_lqi(metres_per_count: f64) -> lqi::PositionsLqi {
+    let q = lqi::weights(Cart::Two, 1e7);
+    lqi::positions_lqi(&position_model(), Cart::Two, &q, metres_per_count)
         .unwrap()
         .controller
 }
