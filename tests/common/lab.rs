@@ -29,22 +29,32 @@ pub fn run_on_rig<C: Controller<4, 1, 1>>(
     setpoint: f64,
     duration: f64,
 ) -> Recording {
+    let out = try_run_on_rig(sim, controller, setpoint, duration).unwrap();
+    assert_eq!(out.stats.overruns, 0);
+    out.recording
+}
+
+/// [`run_on_rig`], returning the loop's error (a travel limit, say) with
+/// the recording up to it.
+pub fn try_run_on_rig<C: Controller<4, 1, 1>>(
+    sim: &SimulatedRig,
+    controller: C,
+    setpoint: f64,
+    duration: f64,
+) -> Result<hw::RunOutcome, Box<hw::RunError>> {
     let clock = VirtualClock::new();
     let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
     let config = LoopConfig {
         duration,
         ..LoopConfig::default()
     };
-    let out = hw::run(
+    hw::run(
         rig,
         controller,
         |_| vector![setpoint],
         &Clock::Virtual(clock),
         &config,
     )
-    .unwrap();
-    assert_eq!(out.stats.overruns, 0);
-    out.recording
 }
 
 /// The default simulated rig with plant `truth`, Coulomb friction
