@@ -5,7 +5,7 @@ use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
 use ctrlab::lab::{SimulatedRig, lqi};
 use ctrlab::signal::Signal;
 use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
-use nalgebra::vector;
+use nalgebra::{SVector, vector};
 
 /// The rig's sampling period, s.
 pub const PERIOD: f64 = 0.002;
@@ -42,19 +42,24 @@ pub fn try_run_on_rig<C: Controller<4, 1, 1>>(
     setpoint: f64,
     duration: f64,
 ) -> Result<hw::RunOutcome, Box<hw::RunError>> {
+    run_loop(sim, controller, |_| vector![setpoint], duration)
+}
+
+/// `controller` with `reference` for `duration` seconds on `sim`'s rig
+/// (card, driver, 2 ms loop) over a fresh virtual clock.
+fn run_loop<C: Controller<4, 1, 1>>(
+    sim: &SimulatedRig,
+    controller: C,
+    reference: impl FnMut(f64) -> SVector<f64, 1>,
+    duration: f64,
+) -> Result<hw::RunOutcome, Box<hw::RunError>> {
     let clock = VirtualClock::new();
     let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
     let config = LoopConfig {
         duration,
         ..LoopConfig::default()
     };
-    hw::run(
-        rig,
-        controller,
-        |_| vector![setpoint],
-        &Clock::Virtual(clock),
-        &config,
-    )
+    hw::run(rig, controller, reference, &Clock::Virtual(clock), &config)
 }
 
 /// The default simulated rig with plant `truth`, Coulomb friction
@@ -81,20 +86,7 @@ pub fn try_open_loop(
     input: &dyn Signal,
     duration: f64,
 ) -> Result<Recording, Box<hw::RunError>> {
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration,
-        ..LoopConfig::default()
-    };
-    hw::run(
-        rig,
-        ctrlab::OpenLoop,
-        |t| vector![input.value(t)],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .map(|out| out.recording)
+    run_loop(sim, ctrlab::OpenLoop, |t| vector![input.value(t)], duration).map(|out| out.recording)
 }
 
 /// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.

@@ -377,9 +377,8 @@ impl Report {
                 pct(f2, sim.coulomb_friction[1]),
             );
             let t = sim.truth;
-            let avg = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
-            let lab_k = avg(ident.summary.lab.iter().map(|e| e.gain.value).collect());
-            let cen_k = avg(ident.summary.central.iter().map(|e| e.gain.value).collect());
+            let lab_k = ident.summary.lab_average.gain.mean;
+            let cen_k = ident.summary.central_average.gain.mean;
             s += &format!(
                 " Against the simulated card's truth: k1 {}, k2 {}, b1 {}, b2 {}, K {}. The card's springs differ (k1 = {:.0}, k2 = {:.0} N/m) and its carts have Coulomb friction, so the lab's model is wrong for it whatever the differences: its K is off by {} (Lab) and {} (Central), while identifying k1, k2 and the friction separately recovers K within {}.",
                 pct(m.k1, t.k1),
