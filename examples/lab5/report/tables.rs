@@ -1,11 +1,11 @@
 //! Tables 1, 2, 5 and 6, and the answers on the effect of each gain.
 
+use ctrlab::StepInfo;
 use ctrlab::lab::protocol::STEP_DURATION;
 use ctrlab::lab::tables::{
-    GroupEffect, Halt, OvershootTrend, RigOutcome, SATURATED_OSCILLATION, TABLE1_DURATION, Table1,
-    Table2, kf_display, poles_display,
+    GroupEffect, Halt, OvershootTrend, RigOutcome, SATURATED_OSCILLATION, TABLE1_DURATION, TABLE2,
+    Table1, Table2, kf_display, poles_display,
 };
-use ctrlab::{Cart, StepInfo};
 
 use super::{Report, curve, timing_text};
 use crate::backend::Backend;
@@ -76,7 +76,7 @@ impl Report {
             2,
             &format!(
                 "Table 2: state feedback on cart {}, setpoint {} mm (simulation)",
-                Cart::Two.number(),
+                TABLE2.cart.number(),
                 t.setpoint_mm
             ),
         );
@@ -122,7 +122,8 @@ impl Report {
         self.lines(
             "table2.svg",
             &format!(
-                "Table 2: cart 2 position, setpoint {} mm (simulation)",
+                "Table 2: cart {} position, setpoint {} mm (simulation)",
+                TABLE2.cart.number(),
                 t.setpoint_mm
             ),
             ("t (s)", "x2 (mm)"),
