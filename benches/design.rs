@@ -6,11 +6,9 @@
 //! N = 20, 60, 100, and `care` on SciPy's CAREX 18 (N = 100). The same
 //! problems against SciPy in one run: `scripts/riccati_vs_scipy.py`.
 
-#[path = "../tests/common/mod.rs"]
-mod common;
-
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::design::{AntiWindup, IntegralFeedback, care, dlqe, dlqi, lqr, place};
+use ctrlab::lab::{lqi, protocol::PERIOD};
 use ctrlab::{Cart, Controller, DynStateSpace, MassSpring, StateSpace};
 use nalgebra::{Complex, DMatrix, SMatrix, matrix, vector};
 use std::hint::black_box;
@@ -18,7 +16,7 @@ use std::hint::black_box;
 fn benches(c: &mut Criterion) {
     // The tests' controller: LQI on cart 2, Kalman filter on both positions.
     let metres_per_count = 0.080 / 8192.0;
-    let model = common::position_model();
+    let model = lqi::position_model(&MassSpring::nominal(), PERIOD).unwrap();
     let tracked = model
         .with_output(matrix![0.0, 1.0] * model.c(), matrix![0.0])
         .unwrap();
@@ -35,7 +33,14 @@ fn benches(c: &mut Criterion) {
     c.bench_function(
         "observer + LQI update and applied (4 states, positions of 4 measurements)",
         |b| {
-            let mut ctrl = common::positions_lqi(metres_per_count);
+            let mut ctrl = lqi::positions_lqi(
+                &model,
+                Cart::Two,
+                &lqi::weights(Cart::Two, 1e7),
+                metres_per_count,
+            )
+            .unwrap()
+            .controller;
             let y = vector![0.0101, 0.0, 0.0297, 0.0];
             let setpoint = vector![0.030];
             b.iter(|| {

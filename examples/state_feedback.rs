@@ -21,12 +21,9 @@
 //! With the `plot` feature, one SVG per table (every stable row's response)
 //! is written to `target/state_feedback/`.
 
-#[path = "common/lab_tables.rs"]
-mod lab_tables;
-
+use ctrlab::lab::tables::{TABLE2, TABLE5, TABLE6, kf_display, poles_display};
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{Cart, Error, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
-use lab_tables::{fmt_kf, fmt_poles};
 use nalgebra::{Complex, SVector, vector};
 
 /// Grid of the responses, s.
@@ -65,21 +62,21 @@ fn tables() -> Vec<Table> {
             file: "table2.svg",
             cart: Cart::Two,
             setpoint_mm: 30.0,
-            rows: lab_tables::table2(),
+            rows: TABLE2.rows(),
         },
         Table {
             name: "Table 5: cart 2, setpoint 30 mm (nominal plant, gain 1)",
             file: "table5.svg",
             cart: Cart::Two,
             setpoint_mm: 30.0,
-            rows: lab_tables::table5(),
+            rows: TABLE5.rows(),
         },
         Table {
             name: "Table 6: cart 1, setpoint 15 mm (nominal plant, gain 1)",
             file: "table6.svg",
             cart: Cart::One,
             setpoint_mm: 15.0,
-            rows: lab_tables::table6(),
+            rows: TABLE6.rows(),
         },
     ]
 }
@@ -145,30 +142,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 } => {
                     println!(
                         "| {} | {} | {:.2} | {:.4} | {:.4} |",
-                        fmt_kf(kf),
-                        fmt_poles(&poles),
+                        kf_display(kf),
+                        poles_display(&poles),
                         info.overshoot,
                         info.settling_time,
                         info.steady_state_error.unwrap_or(f64::NAN),
                     );
                     longest_settling = longest_settling.max(info.settling_time);
-                    plotted.push((format!("Kf = {}", fmt_kf(kf)), t, y_mm));
+                    plotted.push((format!("Kf = {}", kf_display(kf)), t, y_mm));
                 }
                 Row::Unstable { poles } => {
                     let bad: Vec<Complex<f64>> =
                         poles.iter().copied().filter(|p| p.re >= 0.0).collect();
                     println!(
                         "| {} | {} | unstable: pole(s) {} in the right half-plane | | |",
-                        fmt_kf(kf),
-                        fmt_poles(&poles),
-                        fmt_poles(&bad)
+                        kf_display(kf),
+                        poles_display(&poles),
+                        poles_display(&bad)
                     );
                 }
                 Row::NotSettled { poles, horizon } => {
                     println!(
                         "| {} | {} | not settled within {horizon:.0} s | | |",
-                        fmt_kf(kf),
-                        fmt_poles(&poles)
+                        kf_display(kf),
+                        poles_display(&poles)
                     );
                 }
             }

@@ -8,11 +8,11 @@
 
 mod common;
 
-use common::lqi_design::{self, Design, Metrics, Spec};
 use common::run_on_rig;
-use ctrlab::lab::ident::{Options, Scheme, SpringModel, identify_with};
+use ctrlab::lab::ident::{SEPARATE_SPRINGS, identify_with};
+use ctrlab::lab::lqi::{self, Design, Metrics, Spec};
+use ctrlab::lab::protocol::{self, IDENT_DURATION};
 use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
-use ctrlab::signal::SquareWave;
 use std::sync::OnceLock;
 
 const SETPOINT: f64 = 0.030;
@@ -21,15 +21,10 @@ const SETPOINT: f64 = 0.030;
 /// identification runs (±8 V square wave, 0.2 s half period, 5 s) on
 /// `sim`, with the masses known.
 fn identified(sim: &SimulatedRig) -> (MassSpring, [f64; 2]) {
-    let rec = common::open_loop(sim, &SquareWave::new(8.0, 0.2).unwrap(), 5.0);
-    let options = Options {
-        springs: SpringModel::Separate,
-        scheme: Scheme::Central,
-        coulomb: true,
-        ..Options::default()
-    };
+    let wave = protocol::ident_square_wave().unwrap();
+    let rec = common::open_loop(sim, &wave, IDENT_DURATION);
     let (m1, m2) = (sim.truth.m1, sim.truth.m2);
-    let e = identify_with(&rec, m1, m2, &options).unwrap();
+    let e = identify_with(&rec, m1, m2, &SEPARATE_SPRINGS).unwrap();
     let coulomb = e.coulomb.unwrap().map(|f| f.value);
     let model = MassSpring {
         m1,
@@ -50,15 +45,16 @@ fn design() -> &'static Design {
     DESIGN.get_or_init(|| {
         let sim = SimulatedRig::default();
         let (model, coulomb) = identified(&sim);
-        let spec = Spec::new(Cart::Two, SETPOINT);
-        lqi_design::design(&model, coulomb, &sim, spec).unwrap()
+        let rig = lqi::predicted_rig(model, coulomb, &sim.calibration(), sim.period);
+        let spec = Spec::new(Cart::Two, SETPOINT, sim.supply_voltage);
+        lqi::design_search(&rig, spec).unwrap()
     })
 }
 
 /// The design's step on `sim`'s rig through `hw::run`, and its figures.
 fn run(sim: &SimulatedRig) -> Metrics {
     let design = design();
-    let rec = run_on_rig(sim, design.lqi.controller, SETPOINT, lqi_design::DURATION);
+    let rec = run_on_rig(sim, design.lqi.controller, SETPOINT, lqi::DURATION);
     let measured = Metrics::of(&rec, &design.spec, sim.metres_per_count()).unwrap();
     println!(
         "ρ = {:.3e} ({:?}); predicted {:?}, peak {:.2} V; measured {:?}, peak {:.2} V, {} samples at the limit",

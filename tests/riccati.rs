@@ -15,7 +15,6 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-#[path = "common/mod.rs"]
 mod common;
 
 use ctrlab::design::{care, dare};

@@ -7,5 +7,7 @@
 
 pub(crate) mod eigen;
 pub(crate) mod linalg;
+// The output-error refinement (`lab::ident::refine`) is its only user.
+#[cfg(feature = "lab")]
 pub(crate) mod lm;
 pub(crate) mod reduce;

@@ -16,7 +16,17 @@
 //!   [`FrictionPlant`] inside the register-level card, in one call), with
 //!   its [`EncoderSensor`] for the sampled-data simulator;
 //! - the lab's recording layout, [`schema`]: input `u` (V), measurements
-//!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s).
+//!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s);
+//! - how the lab's experiments are run (period, masses, identification
+//!   input), [`protocol`];
+//! - the lab's tables as data (the gains of Tables 2, 5 and 6, their
+//!   setpoints and groups of rows) and their computations, [`tables`];
+//! - the LQI design to a spec on an identified model, [`lqi`];
+//! - the other sections of the lab's report as typed results:
+//!   [`excitation`] (which input identifies best), [`validation`] (the
+//!   models on a fresh run, refined) and [`frequency`] (the measured
+//!   response against the model); Tables 3 and 4 are
+//!   [`ident::summarize`].
 //!
 //! # Examples
 //!
@@ -47,14 +57,20 @@
 
 mod calibration;
 mod config;
+pub mod excitation;
 mod file;
+pub mod frequency;
 mod gains;
 pub mod ident;
+pub mod lqi;
 mod plant;
 mod probe;
+pub mod protocol;
 mod rig;
 mod sensor;
 mod simulated;
+pub mod tables;
+pub mod validation;
 
 pub use calibration::Calibration;
 pub use config::RigConfig;
@@ -113,4 +129,21 @@ pub fn schema() -> Schema {
     )
     // Constant, valid names (the doctest above builds it): never fails.
     .expect("the lab's channel names are valid")
+}
+
+/// The recording's channel of `cart`'s position in [`schema`]: `x1` or
+/// `x2`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, position_channel, schema};
+/// assert_eq!(position_channel(Cart::Two), "x2");
+/// assert!(schema().position(position_channel(Cart::One)).is_some());
+/// ```
+pub fn position_channel(cart: Cart) -> &'static str {
+    match cart {
+        Cart::One => "x1",
+        Cart::Two => "x2",
+    }
 }

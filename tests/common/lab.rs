@@ -1,15 +1,11 @@
 //! Helpers built on the two-cart lab (feature `lab`).
 
-/// LQI with a Kalman filter on the rig's positions, as lab5 designs it.
-#[path = "../../examples/common/lqi_design.rs"]
-pub mod lqi_design;
-
 use ctrlab::data::Recording;
 use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-use ctrlab::lab::SimulatedRig;
+use ctrlab::lab::{SimulatedRig, lqi};
 use ctrlab::signal::Signal;
 use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
-use nalgebra::vector;
+use nalgebra::{SVector, vector};
 
 /// The rig's sampling period, s.
 pub const PERIOD: f64 = 0.002;
@@ -22,7 +18,7 @@ pub fn simulate_on<C: Controller<4, 1, 1>>(
     setpoint: f64,
     duration: f64,
 ) -> Recording {
-    lqi_design::predict(sim, controller, setpoint, duration).unwrap()
+    lqi::predict(sim, controller, setpoint, duration).unwrap()
 }
 
 /// `controller` toward `setpoint` for `duration` seconds on `sim`'s rig
@@ -33,22 +29,37 @@ pub fn run_on_rig<C: Controller<4, 1, 1>>(
     setpoint: f64,
     duration: f64,
 ) -> Recording {
+    let out = try_run_on_rig(sim, controller, setpoint, duration).unwrap();
+    assert_eq!(out.stats.overruns, 0);
+    out.recording
+}
+
+/// [`run_on_rig`], returning the loop's error (a travel limit, say) with
+/// the recording up to it.
+pub fn try_run_on_rig<C: Controller<4, 1, 1>>(
+    sim: &SimulatedRig,
+    controller: C,
+    setpoint: f64,
+    duration: f64,
+) -> Result<hw::RunOutcome, Box<hw::RunError>> {
+    run_loop(sim, controller, |_| vector![setpoint], duration)
+}
+
+/// `controller` with `reference` for `duration` seconds on `sim`'s rig
+/// (card, driver, 2 ms loop) over a fresh virtual clock.
+fn run_loop<C: Controller<4, 1, 1>>(
+    sim: &SimulatedRig,
+    controller: C,
+    reference: impl FnMut(f64) -> SVector<f64, 1>,
+    duration: f64,
+) -> Result<hw::RunOutcome, Box<hw::RunError>> {
     let clock = VirtualClock::new();
     let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
     let config = LoopConfig {
         duration,
         ..LoopConfig::default()
     };
-    let out = hw::run(
-        rig,
-        controller,
-        |_| vector![setpoint],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .unwrap();
-    assert_eq!(out.stats.overruns, 0);
-    out.recording
+    hw::run(rig, controller, reference, &Clock::Virtual(clock), &config)
 }
 
 /// The default simulated rig with plant `truth`, Coulomb friction
@@ -75,25 +86,12 @@ pub fn try_open_loop(
     input: &dyn Signal,
     duration: f64,
 ) -> Result<Recording, Box<hw::RunError>> {
-    let clock = VirtualClock::new();
-    let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
-    let config = LoopConfig {
-        duration,
-        ..LoopConfig::default()
-    };
-    hw::run(
-        rig,
-        ctrlab::OpenLoop,
-        |t| vector![input.value(t)],
-        &Clock::Virtual(clock),
-        &config,
-    )
-    .map(|out| out.recording)
+    run_loop(sim, ctrlab::OpenLoop, |t| vector![input.value(t)], duration).map(|out| out.recording)
 }
 
 /// The nominal plant's ZOH model at the rig's period, outputs `[x1, x2]`.
 pub fn position_model() -> StateSpace<4, 1, 2, Discrete> {
-    lqi_design::position_model(&MassSpring::nominal(), PERIOD).unwrap()
+    lqi::position_model(&MassSpring::nominal(), PERIOD).unwrap()
 }
 
 /// LQI on cart 2 (weights 1e7 on x2, 1e10 on its integral, 1 on u) with a
@@ -101,9 +99,9 @@ pub fn position_model() -> StateSpace<4, 1, 2, Discrete> {
 /// position read to a count of `metres_per_count`), back-calculation
 /// anti-windup past the drive's 24 mV step; it uses only `[x1, x2]` of the
 /// rig's `[x1, v1, x2, v2]`. The construction lab5's Design section uses.
-pub fn positions_lqi(metres_per_count: f64) -> lqi_design::PositionsLqi {
-    let q = lqi_design::weights(Cart::Two, 1e7);
-    lqi_design::positions_lqi(&position_model(), Cart::Two, &q, metres_per_count)
+pub fn positions_lqi(metres_per_count: f64) -> lqi::PositionsLqi {
+    let q = lqi::weights(Cart::Two, 1e7);
+    lqi::positions_lqi(&position_model(), Cart::Two, &q, metres_per_count)
         .unwrap()
         .controller
 }

@@ -65,6 +65,7 @@ mod options;
 mod refine;
 mod regressors;
 mod simulation;
+mod summary;
 mod timing;
 
 pub use average::{AverageError, MassSpringAverage, Mismatch, Spread, average};
@@ -75,6 +76,9 @@ pub use refine::{
     RESIDUAL_LAGS, Refined, ResidualTest, Validation, refine, refine_with, validate, validate_with,
 };
 pub use simulation::SimulationModel;
+pub use summary::{
+    EqualSprings, Parameter, SEPARATE_SPRINGS, Summary, SummaryError, Uncertainty, summarize,
+};
 pub use timing::{DEFAULT_MAX_JITTER, GAP_RATIO, Timing};
 
 use self::regressors::{

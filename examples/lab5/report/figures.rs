@@ -1,11 +1,8 @@
-//! lab5's figures (feature `plot`): the rig runs as small multiples, each
-//! run's position over its setpoint with the applied voltage beneath,
-//! predicted and measured runs overlaid the same way, and the
-//! identification estimates per run against their mean and the truth.
-//! Without the `plot` feature the report only names the figures.
-#![cfg_attr(not(feature = "plot"), allow(dead_code))]
+//! lab5's own figures: the rig runs as small multiples, each run's position
+//! over its setpoint with the applied voltage beneath, predicted and
+//! measured runs overlaid the same way, and the identification estimates
+//! per run against their mean and the truth.
 
-#[cfg(feature = "plot")]
 use plotters::prelude::*;
 
 /// One closed-loop rig run to draw.
@@ -40,7 +37,6 @@ pub struct ParamPanel {
 
 const WIDTH: u32 = 1200;
 /// Scheme colours: distinguishable for colour-blind readers (Okabe–Ito).
-#[cfg(feature = "plot")]
 const OKABE_ITO: [RGBColor; 4] = [
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
@@ -48,7 +44,6 @@ const OKABE_ITO: [RGBColor; 4] = [
     RGBColor(204, 121, 167),
 ];
 
-#[cfg(feature = "plot")]
 fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
@@ -69,7 +64,6 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 /// A grid of panels, one per run: position (mm) and the setpoint as a
 /// dashed line on top, the applied voltage (V) beneath. Small multiples
 /// keep 15 runs readable where one chart of 15 curves would not be.
-#[cfg(feature = "plot")]
 pub fn runs_svg(
     path: &std::path::Path,
     title: &str,
@@ -107,7 +101,6 @@ pub fn runs_svg(
 /// Panels side by side, each with its runs overlaid in the scheme's
 /// colours (position and voltage alike) and a legend: predicted against
 /// measured.
-#[cfg(feature = "plot")]
 pub fn compare_svg(
     path: &std::path::Path,
     title: &str,
@@ -145,7 +138,6 @@ pub fn compare_svg(
 }
 
 /// The longest run's end, s.
-#[cfg(feature = "plot")]
 fn t_end<'a>(runs: impl Iterator<Item = &'a RunCurve>) -> f64 {
     runs.filter_map(|r| r.t.last().copied())
         .fold(0.0, f64::max)
@@ -153,7 +145,6 @@ fn t_end<'a>(runs: impl Iterator<Item = &'a RunCurve>) -> f64 {
 }
 
 /// A run in a panel, with its legend entry and colours.
-#[cfg(feature = "plot")]
 struct Styled<'a> {
     run: &'a RunCurve,
     label: Option<&'a str>,
@@ -163,7 +154,6 @@ struct Styled<'a> {
 
 /// A panel's frame: caption, setpoint (mm), voltage scale (V), time axis
 /// (s) and the height of its position chart (px).
-#[cfg(feature = "plot")]
 struct Panel<'a> {
     caption: &'a str,
     setpoint_mm: f64,
@@ -174,7 +164,6 @@ struct Panel<'a> {
 
 /// One panel: the runs' positions over the dashed setpoint on top, their
 /// voltages beneath.
-#[cfg(feature = "plot")]
 fn run_panel(
     cell: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
     panel: &Panel<'_>,
@@ -256,7 +245,6 @@ fn run_panel(
 /// One panel per parameter: each run's estimate per scheme as points, their
 /// mean as a line in the scheme's colour, the truth as a black dashed line;
 /// the legend sits below the panels, outside the data.
-#[cfg(feature = "plot")]
 pub fn estimates_svg(
     path: &std::path::Path,
     title: &str,

@@ -1,0 +1,260 @@
+//! Where the rig sections run, through the full driver stack: the
+//! register-level simulated card (virtual or real time) or the real PC104
+//! card. One experiment at a time, each run's recording saved as CSV next
+//! to the report.
+
+use std::path::PathBuf;
+
+use ctrlab::hw::{
+    Clock, HwError, LoopConfig, LoopStats, RealTime, RunError, RunOutcome, StopSignal,
+    VirtualClock, run,
+};
+use ctrlab::lab::protocol::PERIOD;
+use ctrlab::lab::{Calibration, FrictionPlant, MassSpring, SimulatedRig};
+use ctrlab::nalgebra::SVector;
+use ctrlab::{Controller, Recording};
+
+use crate::cli::Args;
+
+/// Where the rig sections run, and how.
+pub struct Backend {
+    pub kind: BackendKind,
+    /// Real-time scheduling for the loop (`--rt-priority`).
+    pub realtime: Option<RealTime>,
+    /// Ctrl-C and SIGTERM stop the run in progress (the rig halts).
+    pub stop: StopSignal,
+    /// Where each run's CSV goes (`runs/` under it).
+    pub out: PathBuf,
+}
+
+pub enum BackendKind {
+    /// The register-level simulated card with `sim` inside (`--truth`),
+    /// virtual or real time.
+    Simulated {
+        sim: Box<SimulatedRig>,
+        real_time: bool,
+    },
+    /// The real PC104 card on a parallel port, with its card file's map
+    /// and calibration.
+    #[cfg(all(feature = "ppdev", target_os = "linux"))]
+    Card {
+        port: PathBuf,
+        config: ctrlab::lab::RigConfig,
+    },
+}
+
+/// The loop's timing over a section's runs (real-time runs only).
+pub struct LoopTiming {
+    /// The loop ran with SCHED_FIFO (`--rt-priority`).
+    pub fifo: bool,
+    /// Worst 99th percentile of the tick's lateness, s.
+    pub lateness_p99: f64,
+    /// Worst lateness, s.
+    pub lateness_max: f64,
+    /// Overruns, summed over the runs.
+    pub overruns: usize,
+    /// Skipped ticks, summed.
+    pub skipped: usize,
+    /// Longest interval between samples, s.
+    pub max_interval: f64,
+}
+
+impl Backend {
+    /// The backend the arguments ask for: the simulated rig (its truth file
+    /// read and checked) or, after printing what it will do and checking
+    /// the card's ID, the real card. Then Ctrl-C halts the rig.
+    pub fn new(args: &Args) -> Result<Self, Box<dyn std::error::Error>> {
+        let realtime = args.rt_priority.map(|priority| RealTime {
+            priority,
+            ..RealTime::default()
+        });
+        // First the backend: before Ctrl-C is caught, so that it still ends
+        // the process during the real card's countdown, before anything is
+        // driven.
+        let kind = kind(args)?;
+        // Then Ctrl-C halts the rig and ends the run with its recording,
+        // instead of killing the process with the motor at its last duty.
+        let stop = StopSignal::on_interrupt()?;
+        Ok(Self {
+            kind,
+            realtime,
+            stop,
+            out: args.out.clone(),
+        })
+    }
+
+    /// The simulated rig, when there is one.
+    pub fn sim(&self) -> Option<&SimulatedRig> {
+        match &self.kind {
+            BackendKind::Simulated { sim, .. } => Some(sim),
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { .. } => None,
+        }
+    }
+
+    /// The plant behind a simulated rig, when there is one.
+    pub fn truth(&self) -> Option<MassSpring> {
+        self.sim().map(|s| s.truth)
+    }
+
+    /// The plant and Coulomb friction behind a simulated rig.
+    pub fn friction_truth(&self) -> Option<FrictionPlant> {
+        self.sim().map(SimulatedRig::plant)
+    }
+
+    /// The card's calibration: the simulated card's, or the real card's
+    /// from its card file (its encoders, drive full scale, travel limits).
+    pub fn calibration(&self) -> Calibration {
+        match &self.kind {
+            BackendKind::Simulated { sim, .. } => sim.calibration(),
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { config, .. } => config.calibration,
+        }
+    }
+
+    pub fn real_time(&self) -> bool {
+        match &self.kind {
+            BackendKind::Simulated { real_time, .. } => *real_time,
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { .. } => true,
+        }
+    }
+
+    /// The same backend on another simulated card (the equal-springs run).
+    pub fn with_sim(&self, sim: SimulatedRig) -> Self {
+        Self {
+            kind: BackendKind::Simulated {
+                sim: Box::new(sim),
+                real_time: self.real_time(),
+            },
+            realtime: self.realtime,
+            stop: self.stop.clone(),
+            out: self.out.clone(),
+        }
+    }
+
+    /// One experiment from rest: `controller` against the rig for
+    /// `duration` s with reference `reference(t)`, its recording saved as
+    /// `runs/{name}.csv`. The outer error is a set-up failure (or Ctrl-C),
+    /// the inner one the run's own (with its recording).
+    pub fn experiment(
+        &self,
+        name: &str,
+        seed: u64,
+        controller: impl Controller<4, 1, 1>,
+        reference: impl FnMut(f64) -> SVector<f64, 1>,
+        duration: f64,
+    ) -> Result<Result<RunOutcome, Box<RunError>>, Box<dyn std::error::Error>> {
+        let loop_config = LoopConfig {
+            duration,
+            realtime: self.realtime,
+            stop: Some(self.stop.clone()),
+            ..LoopConfig::default()
+        };
+        let outcome = match &self.kind {
+            BackendKind::Simulated { sim, real_time } => {
+                let sim = SimulatedRig {
+                    seed,
+                    period: PERIOD,
+                    ..(**sim).clone()
+                };
+                let clock = if *real_time {
+                    Clock::RealTime
+                } else {
+                    Clock::Virtual(VirtualClock::new())
+                };
+                let rig = sim.rig(&clock)?;
+                run(rig, controller, reference, &clock, &loop_config)
+            }
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { port, config } => {
+                let _ = seed; // the real rig has its own noise
+                // Let the carts come to rest, then make it the zero position.
+                std::thread::sleep(std::time::Duration::from_secs(3));
+                let rig = crate::card::rig(port, config, PERIOD)?;
+                run(rig, controller, reference, &Clock::RealTime, &loop_config)
+            }
+        };
+        let recording = match &outcome {
+            Ok(out) => &out.recording,
+            Err(e) => &e.recording,
+        };
+        let path = self.save(name, recording)?;
+        if let Err(e) = &outcome
+            && let HwError::Interrupted { .. } = e.error
+        {
+            return Err(format!("{e}; the run's recording is in {}", path.display()).into());
+        }
+        Ok(outcome)
+    }
+
+    /// Saves `recording` as `runs/{name}.csv`; returns the path.
+    pub fn save(
+        &self,
+        name: &str,
+        recording: &Recording,
+    ) -> Result<PathBuf, Box<dyn std::error::Error>> {
+        let dir = self.out.join("runs");
+        std::fs::create_dir_all(&dir)?;
+        let path = dir.join(format!("{name}.csv"));
+        recording.write_csv(&path)?;
+        Ok(path)
+    }
+
+    /// The loop's timing over `stats`, for real-time runs.
+    pub fn timing(&self, stats: &[LoopStats]) -> Option<LoopTiming> {
+        if !self.real_time() || stats.is_empty() {
+            return None;
+        }
+        let worst = |f: fn(&LoopStats) -> f64| stats.iter().map(f).fold(0.0, f64::max);
+        Some(LoopTiming {
+            fifo: self.realtime.is_some(),
+            lateness_p99: worst(|s| s.lateness_p99),
+            lateness_max: worst(|s| s.lateness_max),
+            overruns: stats.iter().map(|s| s.overruns).sum(),
+            skipped: stats.iter().map(|s| s.skipped).sum(),
+            max_interval: worst(|s| s.max_interval),
+        })
+    }
+}
+
+fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
+    match &args.port {
+        None => {
+            let sim = match &args.truth {
+                Some(path) => SimulatedRig::read_toml(path)?,
+                None => SimulatedRig::default(),
+            };
+            sim.validate()?;
+            Ok(BackendKind::Simulated {
+                sim: Box::new(sim),
+                real_time: args.real_time,
+            })
+        }
+        #[cfg(all(feature = "ppdev", target_os = "linux"))]
+        Some(port) => {
+            let (file, config) = crate::card::load(port, args.card.as_deref())?;
+            println!(
+                "{}",
+                crate::card::plan(port, file, &config, ctrlab::lab::protocol::IDENT_VOLTS)
+            );
+            let id = crate::card::check_id(port, &config)?;
+            println!(
+                "The card answers {id:#04x} at register {:#04x}, as the card file says.\n\
+                 Keep a hand on the emergency stop. Starting in 10 s (Ctrl-C to abort).",
+                config.map.id
+            );
+            std::thread::sleep(std::time::Duration::from_secs(10));
+            Ok(BackendKind::Card {
+                port: port.clone(),
+                config,
+            })
+        }
+        #[cfg(not(all(feature = "ppdev", target_os = "linux")))]
+        Some(_) => Err(
+            "--port needs the `ppdev` feature on Linux: cargo run --release \
+                        --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml"
+                .into(),
+        ),
+    }
+}

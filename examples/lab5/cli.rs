@@ -1,0 +1,96 @@
+//! lab5's command line: every argument parsed and checked before anything
+//! runs (clap prints the error, naming the argument, and exits with 2).
+
+use std::path::PathBuf;
+
+use clap::Parser;
+
+/// The whole of Lab 5 (state feedback control of the two-cart rig): every
+/// table, the identification, validation, frequency response and design,
+/// written to DIR/report.md with its figures and every run's recording.
+///
+/// Without --logs it runs on the built-in simulated rig (or --truth FILE,
+/// or the real card with --port and --card). With --logs it works offline
+/// on a student's recorded runs.
+#[derive(Debug, Parser)]
+#[command(
+    name = "lab5",
+    after_help = "Examples:
+  cargo run --release --example lab5
+  cargo run --release --example lab5 -- --out my_report
+  cargo run --release --example lab5 -- --truth truth.toml
+  cargo run --release --example lab5 -- --logs my_runs --metres-per-count 0.000009765625
+  cargo run --release --example lab5 -- --real-time --rt-priority 80
+  cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml"
+)]
+pub struct Args {
+    /// Where report.md, the SVGs and runs/*.csv go (created if missing)
+    #[arg(long, value_name = "DIR", default_value = "target/lab5", value_parser = out_dir)]
+    pub out: PathBuf,
+    /// The simulated rig from a TOML file (see ctrlab::lab::SimulatedRig)
+    #[arg(long, value_name = "FILE", value_parser = existing_file, conflicts_with = "port")]
+    pub truth: Option<PathBuf>,
+    /// Run the rig sections on the wall clock instead of virtual time
+    #[arg(long)]
+    pub real_time: bool,
+    /// Run the loop with SCHED_FIFO priority N, memory locked (Linux)
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(i32).range(1..=99))]
+    pub rt_priority: Option<i32>,
+    /// Run the rig sections on the real PC104 card on this parallel port
+    /// (feature `ppdev`); needs --card
+    #[arg(long, value_name = "PATH")]
+    pub port: Option<PathBuf>,
+    /// The real card's register map and calibration (ctrlab::lab::RigConfig),
+    /// written by the probe
+    #[arg(long, value_name = "FILE", value_parser = existing_file, requires = "port")]
+    pub card: Option<PathBuf>,
+    /// Offline: identify from every *.csv in DIR (two or more identification
+    /// runs: columns t, u, x1, x2 with units, e.g. t_s;u_V;x1_mm;x2_mm)
+    #[arg(
+        long,
+        value_name = "DIR",
+        value_parser = existing_dir,
+        conflicts_with_all = ["truth", "real_time", "rt_priority", "port", "card"]
+    )]
+    pub logs: Option<PathBuf>,
+    /// With --logs: the encoders' calibration, m per count, for positions
+    /// logged in counts
+    #[arg(long, value_name = "M", value_parser = positive_metres, requires = "logs")]
+    pub metres_per_count: Option<f64>,
+}
+
+/// `--out`: a directory, or a path that does not exist yet.
+fn out_dir(s: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(s);
+    if path.exists() && !path.is_dir() {
+        return Err(format!("`{s}` exists and is not a directory"));
+    }
+    Ok(path)
+}
+
+/// A file that exists.
+fn existing_file(s: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(s);
+    if !path.is_file() {
+        return Err(format!("`{s}` is not a readable file"));
+    }
+    Ok(path)
+}
+
+/// A directory that exists.
+fn existing_dir(s: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(s);
+    if !path.is_dir() {
+        return Err(format!("`{s}` is not a directory"));
+    }
+    Ok(path)
+}
+
+/// A length per count: finite and positive, m.
+fn positive_metres(s: &str) -> Result<f64, String> {
+    let m: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if !(m.is_finite() && m > 0.0) {
+        return Err(format!("`{s}` must be a finite length > 0, m"));
+    }
+    Ok(m)
+}

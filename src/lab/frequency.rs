@@ -1,0 +1,258 @@
+//! The rig's measured frequency response against the identified model:
+//! a periodic multisine run, its empirical transfer-function estimate
+//! (ETFE, one point per line) and Blackman–Tukey smoothing from the drive
+//! voltage to cart 2's position, the identified model's Bode plot, the
+//! identified model with its Coulomb friction simulated on the same input
+//! and estimated the same way, and the two modes located on each.
+//!
+//! # Examples
+//!
+//! ```
+//! use ctrlab::lab::{MassSpring, frequency};
+//! let modes = frequency::modes_hz(&MassSpring::nominal())?;
+//! assert_eq!(modes.len(), 2);
+//! // k1 = k2 = 1000 N/m, m1 = 1.3 kg, m2 = 0.7 kg: 3.31 and 8.01 Hz.
+//! assert!((modes[0] - 3.31).abs() < 0.05 && (modes[1] - 8.01).abs() < 0.05);
+//! let ms = frequency::multisine(8.0)?;
+//! assert_eq!(ms.harmonics().len(), 75);
+//! # Ok::<(), ctrlab::Error>(())
+//! ```
+
+use std::ops::RangeInclusive;
+
+use nalgebra::{SVector, vector};
+
+use super::{Cart, MassSpring, SimulatedRig};
+use crate::data::Recording;
+use crate::design::OpenLoop;
+use crate::error::Error;
+use crate::freq::{Bode, bode, logspace};
+use crate::ident::{FrequencyEstimate, etfe, spa};
+use crate::signal::{Multisine, Phases, Signal};
+use crate::sim::run_sampled;
+
+/// One period of the multisine, s: lines every 0.2 Hz.
+pub const MS_PERIOD: f64 = 5.0;
+/// Harmonics of `1 / MS_PERIOD`: 0.2 to 15 Hz, past both modes.
+pub const LINES: RangeInclusive<u32> = 1..=75;
+/// Periods run; the first lets the transient die out (the slowest mode
+/// decays in about a second) and is left out of the estimate.
+pub const PERIODS: usize = 3;
+/// The smoothed estimate's lag window, s.
+pub const SPA_WINDOW: f64 = 2.5;
+/// Points of the smoothed estimate and the Bode plots, log-spaced from 0.2
+/// to 15 Hz.
+pub const GRID_POINTS: usize = 400;
+
+/// The multisine of [`LINES`] with Schroeder phases, scaled to `volts`
+/// peak.
+///
+/// # Errors
+///
+/// [`Error::InvalidParameter`] for a non-positive or non-finite `volts`.
+pub fn multisine(volts: f64) -> Result<Multisine, Error> {
+    let unit = Multisine::new(1.0, MS_PERIOD, LINES, Phases::Schroeder)?;
+    Multisine::new(volts / unit.peak(), MS_PERIOD, LINES, Phases::Schroeder)
+}
+
+/// The run's length, s: [`PERIODS`] periods.
+pub const DURATION: f64 = MS_PERIOD * PERIODS as f64;
+
+/// The natural frequencies of `model`'s two complex pole pairs, Hz,
+/// ascending.
+///
+/// # Errors
+///
+/// An invalid model.
+pub fn modes_hz(model: &MassSpring) -> Result<Vec<f64>, Error> {
+    let mut hz: Vec<f64> = model
+        .state_space(Cart::Two)?
+        .damping()?
+        .iter()
+        .filter(|d| d.pole.im > 0.0)
+        .map(|d| d.natural_frequency / std::f64::consts::TAU)
+        .collect();
+    hz.sort_by(f64::total_cmp);
+    Ok(hz)
+}
+
+/// The frequencies (Hz) of the `count` largest local maxima of `|G|`,
+/// ascending.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::ident::FrequencyEstimate;
+/// use nalgebra::Complex;
+/// let tau = std::f64::consts::TAU;
+/// let g = FrequencyEstimate {
+///     omega: [1.0, 2.0, 3.0, 4.0, 5.0].map(|f| f * tau).to_vec(),
+///     response: [1.0, 3.0, 1.0, 2.0, 1.0].map(|m| Complex::new(m, 0.0)).to_vec(),
+/// };
+/// assert_eq!(ctrlab::lab::frequency::peaks_hz(&g, 2), [2.0, 4.0]);
+/// ```
+pub fn peaks_hz(g: &FrequencyEstimate, count: usize) -> Vec<f64> {
+    let m = g.magnitude();
+    let hz = g.frequency_hz();
+    let mut peaks: Vec<(f64, f64)> = (1..m.len().saturating_sub(1))
+        .filter(|&i| m[i] > m[i - 1] && m[i] >= m[i + 1])
+        .map(|i| (m[i], hz[i]))
+        .collect();
+    peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut out: Vec<f64> = peaks.iter().take(count).map(|p| p.1).collect();
+    out.sort_by(f64::total_cmp);
+    out
+}
+
+/// The ETFE on the multisine's lines (bins above them hold only the
+/// drive's quantisation) and the smoothed estimate on `w` (rad/s), from u
+/// (V) to x2 (m) over the periods after the first, sampled every `period`
+/// s.
+///
+/// # Errors
+///
+/// A recording without `u` or `x2`, or too short for the window.
+pub fn estimates(
+    rec: &Recording,
+    w: &[f64],
+    period: f64,
+) -> Result<(FrequencyEstimate, FrequencyEstimate), Error> {
+    let skip = (MS_PERIOD / period).round() as usize;
+    let (u, x2) = (rec.channel("u")?, rec.channel("x2")?);
+    if u.len() <= skip {
+        return Err(Error::TooFewSamples {
+            what: "multisine run after its first period",
+            needed: skip + 1,
+            got: u.len(),
+        });
+    }
+    let (u, y) = (&u[skip..], &x2[skip..]);
+    let mut raw = etfe(u, y, period)?;
+    let top = f64::from(*LINES.end()) / MS_PERIOD * std::f64::consts::TAU * (1.0 + 1e-9);
+    let keep = raw.omega.iter().take_while(|w| **w <= top).count();
+    raw.omega.truncate(keep);
+    raw.response.truncate(keep);
+    let smooth = spa(u, y, period, Some((SPA_WINDOW / period) as usize), w)?;
+    Ok((raw, smooth))
+}
+
+/// Median relative distance between two magnitude curves on one grid.
+fn median_gap(a: &[f64], b: &[f64]) -> f64 {
+    let mut rel: Vec<f64> = a.iter().zip(b).map(|(a, b)| (a / b - 1.0).abs()).collect();
+    rel.sort_by(f64::total_cmp);
+    rel.get(rel.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// One mode located four ways, Hz (`None` where not found).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    /// The identified linear model's natural frequency.
+    pub model_hz: Option<f64>,
+    /// The gain peak of the identified model with friction, simulated.
+    pub simulated_hz: Option<f64>,
+    /// The gain peak of the measured (smoothed) response.
+    pub measured_hz: Option<f64>,
+    /// The truth's natural frequency (a simulated rig).
+    pub truth_hz: Option<f64>,
+}
+
+/// The measured response against the identified model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrequencyResponse {
+    /// The grid of the smoothed estimates and Bode plots, rad/s.
+    pub omega: Vec<f64>,
+    /// The ETFE on the multisine's lines, m/V.
+    pub measured: FrequencyEstimate,
+    /// Its Blackman–Tukey smoothing on [`omega`](Self::omega), m/V.
+    pub smoothed: FrequencyEstimate,
+    /// The identified model with friction, simulated and smoothed the same
+    /// way, m/V.
+    pub simulated: FrequencyEstimate,
+    /// The identified model's linear part.
+    pub model: Bode,
+    /// The truth's linear part (a simulated rig).
+    pub truth: Option<Bode>,
+    /// The first (carts in phase) and second (in opposition) mode.
+    pub modes: [Mode; 2],
+    /// Median relative distance of the measured magnitude from the linear
+    /// model's (a fraction).
+    pub gap_linear: f64,
+    /// The same from the model with friction, simulated.
+    pub gap_friction: f64,
+}
+
+/// The response of `measured`, a run of `multisine` for [`DURATION`] s,
+/// against `rig`: the identified plant and Coulomb friction as the
+/// prediction knows the rig
+/// ([`lqi::predicted_rig`](super::lqi::predicted_rig)), simulated on the
+/// same input through the same drive; `truth` is a simulated card's plant.
+/// Work: one simulation of the run and three spectral estimates on
+/// [`GRID_POINTS`] frequencies.
+///
+/// # Errors
+///
+/// A recording without `u` or `x2` or too short, an invalid model.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::OpenLoop;
+/// use ctrlab::lab::{Calibration, SimulatedRig, frequency, lqi};
+/// use ctrlab::signal::Signal;
+/// use nalgebra::vector;
+/// let sim = SimulatedRig::default();
+/// let rig = lqi::predicted_rig(sim.truth, sim.coulomb_friction, &sim.calibration(), sim.period);
+/// let ms = frequency::multisine(8.0)?;
+/// // The model's own run as the measurement: both peaks where the model's are.
+/// let rec = ctrlab::run_sampled(rig.plant(), rig.sensor(), OpenLoop, |t| vector![ms.value(t)],
+///                               vector![0.0, 0.0, 0.0, 0.0], &rig.sampled_config(frequency::DURATION))?;
+/// let r = frequency::frequency_response(&rec, &rig, Some(&sim.truth), &ms)?;
+/// assert_eq!(r.modes[0].measured_hz, r.modes[0].simulated_hz);
+/// assert!(r.gap_friction < 1e-9);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn frequency_response(
+    measured: &Recording,
+    rig: &SimulatedRig,
+    truth: Option<&MassSpring>,
+    multisine: &Multisine,
+) -> Result<FrequencyResponse, Error> {
+    let tau = std::f64::consts::TAU;
+    let omega = logspace((0.2 * tau).log10(), (15.0 * tau).log10(), GRID_POINTS)?;
+    let (raw, smoothed) = estimates(measured, &omega, rig.period)?;
+    let simulated = run_sampled(
+        rig.plant(),
+        rig.sensor(),
+        OpenLoop,
+        |t| vector![multisine.value(t)],
+        SVector::zeros(),
+        &rig.sampled_config(DURATION),
+    )?;
+    let (_, simulated) = estimates(&simulated, &omega, rig.period)?;
+    let model = bode(&rig.truth.state_space(Cart::Two)?, &omega)?;
+    let truth_bode = truth
+        .map(|t| bode(&t.state_space(Cart::Two)?, &omega))
+        .transpose()?;
+    let model_modes = modes_hz(&rig.truth)?;
+    let measured_peaks = peaks_hz(&smoothed, 2);
+    let simulated_peaks = peaks_hz(&simulated, 2);
+    let truth_modes = truth.map(modes_hz).transpose()?;
+    let modes = [0, 1].map(|i| Mode {
+        model_hz: model_modes.get(i).copied(),
+        simulated_hz: simulated_peaks.get(i).copied(),
+        measured_hz: measured_peaks.get(i).copied(),
+        truth_hz: truth_modes.as_ref().and_then(|t| t.get(i).copied()),
+    });
+    let magnitude = smoothed.magnitude();
+    Ok(FrequencyResponse {
+        gap_linear: median_gap(&magnitude, &model.magnitude),
+        gap_friction: median_gap(&magnitude, &simulated.magnitude()),
+        omega,
+        measured: raw,
+        smoothed,
+        simulated,
+        model,
+        truth: truth_bode,
+        modes,
+    })
+}

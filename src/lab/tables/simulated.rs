@@ -1,0 +1,194 @@
+//! Tables 1 and 2: the nominal model in simulation.
+
+use nalgebra::{Complex, SVector, vector};
+
+use super::TABLE2;
+use crate::design::StateFeedback;
+use crate::error::Error;
+use crate::lab::{Cart, MassSpring};
+use crate::metrics::{StepInfo, StepInfoOptions, step_info};
+use crate::sim::{Solver, simulate, time_grid};
+
+/// Table 1's forces, N.
+pub const FORCES: [f64; 5] = [10.0, 20.0, 30.0, 40.0, 50.0];
+/// How long Table 1 simulates each force, s: the nominal model's slowest
+/// pole decays at 3.70 /s, so what is left after 10 s is e^−37.
+pub const TABLE1_DURATION: f64 = 10.0;
+/// Table 1's time step, s.
+pub const TABLE1_STEP: f64 = 0.002;
+/// Table 2's simulated time, s.
+pub const TABLE2_DURATION: f64 = 3.0;
+/// Table 2's time step, s: the python-control reference's grid.
+pub const TABLE2_STEP: f64 = 0.0005;
+
+/// One row of Table 1: a constant force on cart 2 from rest, the simulated
+/// final positions beside the static deflection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Table1Row {
+    /// The force on cart 2, N.
+    pub force: f64,
+    /// Cart 1's simulated final position, mm.
+    pub x1_mm: f64,
+    /// Cart 1's static deflection `F / k1`, mm.
+    pub x1_static_mm: f64,
+    /// Cart 2's simulated final position, mm.
+    pub x2_mm: f64,
+    /// Cart 2's static deflection `F / k1 + F / k2`, mm.
+    pub x2_static_mm: f64,
+}
+
+/// Table 1: open loop on the nominal model, one row per force of
+/// [`FORCES`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table1 {
+    /// The rows, by force.
+    pub rows: Vec<Table1Row>,
+}
+
+/// Table 1 on [`MassSpring::nominal`]: each force of [`FORCES`] on cart 2
+/// from rest, exact ZOH simulation for [`TABLE1_DURATION`] at
+/// [`TABLE1_STEP`]; five simulations of 5000 steps.
+///
+/// # Errors
+///
+/// Only as the simulation can fail (it does not on the nominal model).
+///
+/// # Examples
+///
+/// ```
+/// let t = ctrlab::lab::tables::table1()?;
+/// // F = 10 N: cart 1 at 10 mm, cart 2 at 20 mm.
+/// assert!((t.rows[0].x1_mm - 10.0).abs() < 1e-3 && (t.rows[0].x2_mm - 20.0).abs() < 1e-3);
+/// assert!(t.rows.iter().all(|r| (r.x2_mm - r.x2_static_mm).abs() < 1e-6));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn table1() -> Result<Table1, Error> {
+    let plant = MassSpring::nominal();
+    let sys = plant.state_space(Cart::Two)?;
+    let t = time_grid(TABLE1_DURATION, TABLE1_STEP)?;
+    let mut rows = Vec::with_capacity(FORCES.len());
+    for force in FORCES {
+        let r = simulate(&sys, &t, SVector::zeros(), |_| vector![force], Solver::Zoh)?;
+        let x = r.x.last().copied().unwrap_or_default();
+        let (s1, s2) = plant.static_deflection(force)?;
+        rows.push(Table1Row {
+            force,
+            x1_mm: x[0] * 1e3,
+            x1_static_mm: s1 * 1e3,
+            x2_mm: x[2] * 1e3,
+            x2_static_mm: s2 * 1e3,
+        });
+    }
+    Ok(Table1 { rows })
+}
+
+/// A simulated step of Table 2: its metrics and the response.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulatedStep {
+    /// Step metrics of cart 2's position in mm against the setpoint (the
+    /// final value the closed loop's DC gain; crossings interpolated).
+    pub info: StepInfo,
+    /// Time, s.
+    pub t: Vec<f64>,
+    /// Cart 2's position, mm.
+    pub y_mm: Vec<f64>,
+}
+
+/// One row of Table 2.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table2Row {
+    /// The lab's gains, per mm.
+    pub kf: [f64; 4],
+    /// The continuous closed loop's poles, 1/s.
+    pub poles: [Complex<f64>; 4],
+    /// The step, or `None` when the closed loop is unstable (no metrics of
+    /// a diverging signal).
+    pub step: Option<SimulatedStep>,
+}
+
+/// Table 2: state feedback `u = Kf (G r − x_mm)` on the nominal model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table2 {
+    /// The setpoint, mm.
+    pub setpoint_mm: f64,
+    /// The rows of [`TABLE2`], in order.
+    pub rows: Vec<Table2Row>,
+}
+
+impl Table2 {
+    /// The row with gains `kf`, if the table has it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// let t = ctrlab::lab::tables::table2()?;
+    /// let row = t.row([0.0, 0.0, 10.0, 0.1]).expect("a row of Table 2");
+    /// // python-control: 5.03 % overshoot.
+    /// assert!((row.step.as_ref().unwrap().info.overshoot - 5.03).abs() < 0.05);
+    /// assert!(t.row([1.0, 0.0, 0.0, 0.0]).is_none());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn row(&self, kf: [f64; 4]) -> Option<&Table2Row> {
+        self.rows.iter().find(|r| r.kf == kf)
+    }
+}
+
+/// Table 2 on [`MassSpring::nominal`] (force input, K = 1): each row of
+/// [`TABLE2`] as a continuous closed loop, simulated exactly (ZOH) for
+/// [`TABLE2_DURATION`] on a [`TABLE2_STEP`] grid toward the setpoint; six
+/// simulations of 6000 steps at most.
+///
+/// # Errors
+///
+/// As the closed loop's analysis and the step metrics can fail (a stable
+/// row that does not settle in the simulated time: [`Error::NotSettled`];
+/// none does).
+///
+/// # Examples
+///
+/// ```
+/// let t = ctrlab::lab::tables::table2()?;
+/// assert_eq!(t.rows.len(), 6);
+/// // Kf3 = 0.1 → 10 shrinks the steady-state error.
+/// let sse = |i: usize| t.rows[i].step.as_ref().unwrap().info.steady_state_error.unwrap();
+/// assert!(sse(2).abs() < sse(0).abs());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn table2() -> Result<Table2, Error> {
+    let plant = MassSpring::nominal().state_space(TABLE2.cart)?;
+    let setpoint_mm = TABLE2.setpoint_mm;
+    let mut rows = Vec::new();
+    for kf in TABLE2.rows() {
+        let cl = StateFeedback::from_lab_gains(kf, TABLE2.cart)?.closed_loop(&plant)?;
+        let poles = cl.poles()?;
+        if !cl.is_stable()? {
+            rows.push(Table2Row {
+                kf,
+                poles,
+                step: None,
+            });
+            continue;
+        }
+        let t = time_grid(TABLE2_DURATION, TABLE2_STEP)?;
+        let r = simulate(
+            &cl,
+            &t,
+            SVector::zeros(),
+            |_| vector![setpoint_mm / 1e3],
+            Solver::Zoh,
+        )?;
+        let y_mm: Vec<f64> = r.y.iter().map(|y| y[0] * 1e3).collect();
+        let options = StepInfoOptions {
+            final_value: Some(cl.dc_gain()?[(0, 0)] * setpoint_mm),
+            reference: Some(setpoint_mm),
+            ..Default::default()
+        };
+        let info = step_info(&r.t, &y_mm, &options)?;
+        rows.push(Table2Row {
+            kf,
+            poles,
+            step: Some(SimulatedStep { info, t: r.t, y_mm }),
+        });
+    }
+    Ok(Table2 { setpoint_mm, rows })
+}
