@@ -365,7 +365,7 @@ impl EqualSprings {
     /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let truth = MassSpring { k1: 950.0, k2: 950.0, ..MassSpring::nominal() };
     /// let e = EqualSprings::identify(&rec, truth, 1.3, 0.7)?;
-    /// assert!((e.central.k12.value / 950.0 - 1.0).abs() < 0.01);
+    /// assert!((e.central.k1().value / 950.0 - 1.0).abs() < 0.01);
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn identify(rec: &Recording, truth: MassSpring, m1: f64, m2: f64) -> Result<Self, Error> {
