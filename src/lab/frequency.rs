@@ -20,7 +20,7 @@
 
 use std::ops::RangeInclusive;
 
-use nalgebra::{SVector, vector};
+use crate::nalgebra::{SVector, vector};
 
 use super::{Cart, MassSpring, SimulatedRig};
 use crate::data::Recording;

@@ -37,7 +37,7 @@ mod compare;
 mod search;
 mod spec;
 
-use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
+use crate::nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 
 use crate::data::Recording;
 use crate::design::{

@@ -1,6 +1,6 @@
 //! Tables 1 and 2: the nominal model in simulation.
 
-use nalgebra::{Complex, SVector, vector};
+use crate::nalgebra::{Complex, SVector, vector};
 
 use super::TABLE2;
 use crate::design::StateFeedback;
