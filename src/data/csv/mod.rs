@@ -5,6 +5,8 @@
 
 mod header;
 mod lines;
+#[cfg(test)]
+mod old;
 mod options;
 mod read;
 mod value;
