@@ -1,5 +1,8 @@
-//! Writing a [`Recording`] as CSV.
+//! Writing a [`Recording`] as CSV, through `csv-core`'s writer (which
+//! quotes a field only where needed: never, for the headers and numbers a
+//! recording has).
 
+use std::fmt::Write as _;
 use std::io::Write;
 use std::path::Path;
 
@@ -74,17 +77,15 @@ impl Recording {
         let path = path.as_ref();
         let file = std::fs::File::create(path)
             .map_err(|e| Error::io(format!("creating {}", path.display()), &e))?;
-        let mut w = std::io::BufWriter::new(file);
-        self.to_writer(&mut w).map_err(|e| match e {
+        // `to_writer` buffers: the file gets large writes.
+        self.to_writer(file).map_err(|e| match e {
             Error::Io { kind, message, .. } => Error::Io {
                 context: format!("writing {}", path.display()),
                 kind,
                 message,
             },
             other => other,
-        })?;
-        w.flush()
-            .map_err(|e| Error::io(format!("writing {}", path.display()), &e))
+        })
     }
 
     /// Writes the recording as CSV in SI units: header `t_s` and one column
@@ -118,22 +119,101 @@ impl Recording {
     pub fn to_writer(&self, writer: impl Write) -> Result<(), Error> {
         self.check_values()?;
         self.check_round_trip()?;
-        let io = |e: csv::Error| match e.into_kind() {
-            csv::ErrorKind::Io(e) => Error::io("writing CSV", &e),
-            other => Error::io("writing CSV", &std::io::Error::other(format!("{other:?}"))),
-        };
-        let mut w = csv::Writer::from_writer(writer);
-        let header: Vec<String> = std::iter::once("t_s".to_string())
-            .chain(self.schema.channels().map(header_of))
-            .collect();
-        w.write_record(&header).map_err(io)?;
-        let mut fields: Vec<String> = Vec::with_capacity(header.len());
-        for k in 0..self.len() {
-            fields.clear();
-            fields.push(format!("{:?}", self.t[k]));
-            fields.extend(self.columns.iter().map(|c| format!("{:?}", c[k])));
-            w.write_record(&fields).map_err(io)?;
+        let io = |e: std::io::Error| Error::io("writing CSV", &e);
+        let mut out = Output::new(writer);
+        out.field(b"t_s").map_err(io)?;
+        for channel in self.schema.channels() {
+            out.delimiter().map_err(io)?;
+            out.field(header_of(channel).as_bytes()).map_err(io)?;
         }
-        w.flush().map_err(|e| Error::io("writing CSV", &e))
+        out.terminator().map_err(io)?;
+        // Each value in Rust's shortest round-trip form (`{:?}`: `2.0`,
+        // `0.001`, `1e-7`), written into one reused string.
+        let mut number = String::new();
+        for k in 0..self.len() {
+            for (i, v) in std::iter::once(self.t[k])
+                .chain(self.columns.iter().map(|c| c[k]))
+                .enumerate()
+            {
+                if i > 0 {
+                    out.delimiter().map_err(io)?;
+                }
+                number.clear();
+                write!(number, "{v:?}").unwrap_or_default();
+                out.field(number.as_bytes()).map_err(io)?;
+            }
+            out.terminator().map_err(io)?;
+        }
+        out.flush().map_err(io)
+    }
+}
+
+/// `csv-core`'s writer on an [`io::Write`](Write), through a buffer.
+struct Output<W> {
+    core: csv_core::Writer,
+    buf: Vec<u8>,
+    /// How much of `buf` is written.
+    len: usize,
+    writer: W,
+}
+
+impl<W: Write> Output<W> {
+    fn new(writer: W) -> Self {
+        Self {
+            core: csv_core::WriterBuilder::new().build(),
+            buf: vec![0; 64 * 1024],
+            len: 0,
+            writer,
+        }
+    }
+
+    /// Writes what the buffer holds.
+    fn flush_buf(&mut self) -> std::io::Result<()> {
+        self.writer.write_all(&self.buf[..self.len])?;
+        self.len = 0;
+        Ok(())
+    }
+
+    /// Writes a field, quoted if it needs to be.
+    fn field(&mut self, mut input: &[u8]) -> std::io::Result<()> {
+        loop {
+            let (res, nin, nout) = self.core.field(input, &mut self.buf[self.len..]);
+            input = &input[nin..];
+            self.len += nout;
+            match res {
+                csv_core::WriteResult::InputEmpty => return Ok(()),
+                csv_core::WriteResult::OutputFull => self.flush_buf()?,
+            }
+        }
+    }
+
+    /// Ends a field.
+    fn delimiter(&mut self) -> std::io::Result<()> {
+        loop {
+            let (res, nout) = self.core.delimiter(&mut self.buf[self.len..]);
+            self.len += nout;
+            match res {
+                csv_core::WriteResult::InputEmpty => return Ok(()),
+                csv_core::WriteResult::OutputFull => self.flush_buf()?,
+            }
+        }
+    }
+
+    /// Ends a record (`\n`).
+    fn terminator(&mut self) -> std::io::Result<()> {
+        loop {
+            let (res, nout) = self.core.terminator(&mut self.buf[self.len..]);
+            self.len += nout;
+            match res {
+                csv_core::WriteResult::InputEmpty => return Ok(()),
+                csv_core::WriteResult::OutputFull => self.flush_buf()?,
+            }
+        }
+    }
+
+    /// Writes what is buffered and flushes the writer.
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.flush_buf()?;
+        self.writer.flush()
     }
 }

@@ -334,6 +334,24 @@ mod tests {
         Ok(())
     }
 
+    /// The writer as it was: the `csv` crate, a `format!` a value.
+    fn old_to_writer(rec: &Recording) -> Vec<u8> {
+        use super::super::header::header_of;
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let header: Vec<String> = std::iter::once("t_s".to_string())
+            .chain(rec.schema.channels().map(header_of))
+            .collect();
+        w.write_record(&header).unwrap();
+        let mut fields: Vec<String> = Vec::with_capacity(header.len());
+        for k in 0..rec.len() {
+            fields.clear();
+            fields.push(format!("{:?}", rec.t[k]));
+            fields.extend(rec.columns.iter().map(|c| format!("{:?}", c[k])));
+            w.write_record(&fields).unwrap();
+        }
+        w.into_inner().unwrap()
+    }
+
     fn options(counts: bool) -> CsvOptions {
         CsvOptions {
             metres_per_count: counts.then_some(1.0 / 102_400.0),
@@ -430,6 +448,29 @@ mod tests {
                 }
             }
             same(&bytes, &CsvOptions::default())?;
+        }
+
+        #[test]
+        fn recordings_are_written_as_the_old_writer_wrote_them(
+            n in 0usize..300,
+            values in prop::collection::vec(prop_oneof![any::<f64>().prop_filter("finite", |v| v.is_finite()), Just(-0.0), Just(1e-300), -1e3f64..1e3], 6),
+            schema in prop::sample::select(vec![0usize, 1, 2]),
+        ) {
+            use crate::data::Channel;
+            let schema = match schema {
+                0 => crate::lab::schema(),
+                1 => Schema::numbered(2, 3),
+                _ => Schema::new(vec![Channel::new("u", "V")], vec![Channel::new("x 1", "deg"), Channel::new("w", "rad/s"), Channel::new("#y", "")]).unwrap(),
+            };
+            let mut rec = Recording::with_capacity(schema.clone(), n);
+            let m = schema.inputs().len();
+            for k in 0..n {
+                let v: Vec<f64> = (0..schema.len()).map(|i| values[(i * 7 + k) % 6] * if k % 2 == 0 { 1.0 } else { -0.5 }).collect();
+                rec.push(k as f64 * 0.002, &v[..m], &v[m..]).unwrap();
+            }
+            let mut new = Vec::new();
+            rec.to_writer(&mut new).unwrap();
+            prop_assert_eq!(String::from_utf8(new).unwrap(), String::from_utf8(old_to_writer(&rec)).unwrap());
         }
 
         #[test]
