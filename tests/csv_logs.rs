@@ -3,7 +3,7 @@
 //! file's own line with what was found there, and any text read without a
 //! panic.
 
-use ctrlab::data::CsvOptions;
+use ctrlab::data::{CsvError, CsvOptions};
 use ctrlab::{Error, Recording};
 use proptest::prelude::*;
 
@@ -58,19 +58,19 @@ fn lab_channels(u_unit: &str) -> Vec<(String, String)> {
         .collect()
 }
 
-/// The `Error::Csv` of reading `file` with `options`.
+/// The `CsvError::Line` of reading `file` with `options`.
 fn csv_err(file: &str, options: &CsvOptions) -> (u64, String) {
     match Recording::read_csv_with(path(file), options) {
-        Err(Error::Csv { line, reason }) => (line, reason),
-        other => panic!("{file}: expected Error::Csv, got {other:?}"),
+        Err(CsvError::Line { line, reason }) => (line, reason),
+        other => panic!("{file}: expected CsvError::Line, got {other:?}"),
     }
 }
 
-/// The `Error::Csv` of reading `text`.
+/// The `CsvError::Line` of reading `text`.
 fn text_err(text: &str) -> (u64, String) {
     match Recording::from_reader(text.as_bytes()) {
-        Err(Error::Csv { line, reason }) => (line, reason),
-        other => panic!("expected Error::Csv, got {other:?}"),
+        Err(CsvError::Line { line, reason }) => (line, reason),
+        other => panic!("expected CsvError::Line, got {other:?}"),
     }
 }
 
@@ -148,7 +148,7 @@ fn counts_without_a_calibration_name_the_option() {
     // The old entry point is the default options.
     assert!(matches!(
         Recording::read_csv(path("counts.csv")),
-        Err(Error::Csv { line: 1, .. })
+        Err(CsvError::Line { line: 1, .. })
     ));
     // A calibration that cannot be one.
     for bad in [0.0, -1e-5, f64::NAN, f64::INFINITY] {
@@ -158,9 +158,11 @@ fn counts_without_a_calibration_name_the_option() {
         assert!(
             matches!(
                 Recording::read_csv_with(path("counts.csv"), &options),
-                Err(Error::InvalidParameter {
-                    name: "metres_per_count",
-                    ..
+                Err(CsvError::Options {
+                    source: Error::InvalidParameter {
+                        name: "metres_per_count",
+                        ..
+                    }
                 })
             ),
             "{bad}"
@@ -365,11 +367,13 @@ fn the_writer_refuses_names_that_would_read_back_in_lower_case() {
     let mut rec = Recording::new(schema);
     rec.push(0.0, &[1.0], &[0.0]).unwrap();
     match rec.to_writer(Vec::new()) {
-        Err(Error::Channel { name, reason }) => {
+        Err(CsvError::Recording {
+            source: Error::Channel { name, reason },
+        }) => {
             assert_eq!(name, "X1");
             assert!(reason.contains("lower case"), "{reason}");
         }
-        other => panic!("expected Error::Channel, got {other:?}"),
+        other => panic!("expected CsvError::Recording, got {other:?}"),
     }
 }
 
@@ -390,8 +394,11 @@ fn a_failing_reader_is_an_io_error() {
     }
     for text in [&b""[..], b"# c\n", b"t_s,u\n0,1\n"] {
         match Recording::from_reader(Failing(text)) {
-            Err(Error::Io { message, .. }) => assert!(message.contains("USB"), "{message}"),
-            other => panic!("expected Error::Io, got {other:?}"),
+            Err(CsvError::Io { context, source }) => {
+                assert!(source.to_string().contains("USB"), "{source}");
+                assert!(context.starts_with("reading"), "{context}");
+            }
+            other => panic!("expected CsvError::Io, got {other:?}"),
         }
     }
 }
@@ -407,7 +414,7 @@ fn line_count(text: &str) -> u64 {
 
 /// What any reading must give: a recording of finite values, at least two
 /// rows, time increasing; or an error on a line of the text.
-fn check_outcome(text: &str, result: Result<Recording, Error>) -> Result<(), TestCaseError> {
+fn check_outcome(text: &str, result: Result<Recording, CsvError>) -> Result<(), TestCaseError> {
     match result {
         Ok(rec) => {
             prop_assert!(rec.len() >= 2);
@@ -417,7 +424,7 @@ fn check_outcome(text: &str, result: Result<Recording, Error>) -> Result<(), Tes
                 prop_assert!(rec.channel(&c.name).unwrap().iter().all(|v| v.is_finite()));
             }
         }
-        Err(Error::Csv { line, .. }) => {
+        Err(CsvError::Line { line, .. }) => {
             prop_assert!(
                 line >= 1 && line <= line_count(text),
                 "line {} of {:?}",
@@ -539,11 +546,11 @@ proptest! {
         let line = 1 + marked.iter().position(|(bad, _)| *bad).unwrap() as u64;
         let broken: Vec<String> = marked.iter().map(|(bad, l)| if *bad { format!("{l}q") } else { l.clone() }).collect();
         match Recording::from_reader(broken.join("\n").as_bytes()) {
-            Err(Error::Csv { line: got, reason }) => {
+            Err(CsvError::Line { line: got, reason }) => {
                 prop_assert_eq!(got, line, "{}", reason);
                 prop_assert!(reason.contains("q`"), "{}", reason);
             }
-            other => prop_assert!(false, "expected Error::Csv, got {:?}", other),
+            other => prop_assert!(false, "expected CsvError::Line, got {:?}", other),
         }
     }
 }

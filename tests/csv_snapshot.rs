@@ -15,7 +15,7 @@
 //! Rewrite it only for a change meant to alter what a file reads as:
 //! `CTRLAB_UPDATE_CSV_SNAPSHOT=1 cargo test --release --test csv_snapshot`.
 
-use ctrlab::data::CsvOptions;
+use ctrlab::data::{CsvError, CsvOptions};
 use ctrlab::{Error, Recording};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -48,7 +48,7 @@ impl Fnv {
 
 /// One line of the snapshot: the recording's shape and the hash of every
 /// value's bits, or the error's line and message.
-fn outcome(result: Result<Recording, Error>) -> String {
+fn outcome(result: Result<Recording, CsvError>) -> String {
     match result {
         Ok(rec) => {
             let mut h = Fnv::new();
@@ -72,8 +72,10 @@ fn outcome(result: Result<Recording, Error>) -> String {
                 h.0
             )
         }
-        Err(Error::Csv { line, reason }) => format!("line {line}: {reason:?}"),
-        Err(Error::InvalidParameter { name, .. }) => format!("options: {name}"),
+        Err(CsvError::Line { line, reason }) => format!("line {line}: {reason:?}"),
+        Err(CsvError::Options {
+            source: Error::InvalidParameter { name, .. },
+        }) => format!("options: {name}"),
         Err(e) => format!("other: {e:?}"),
     }
 }

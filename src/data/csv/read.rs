@@ -12,9 +12,8 @@ use csv_core::ReadRecordResult;
 use super::header::{Scale, parse_header};
 use super::lines::{Kind, Line, Lines, separator, without_break};
 use super::value::{self, BadValue};
-use super::{CsvOptions, csv_error, is_input_name};
+use super::{CsvError, CsvOptions, csv_error, is_input_name};
 use crate::data::{Channel, Recording, Schema};
-use crate::error::Error;
 
 /// Where one channel is read from, and how its values become SI.
 struct Slot<'a> {
@@ -200,20 +199,20 @@ impl Recording {
     ///
     /// # Errors
     ///
-    /// [`Error::Io`] (with the path) when the file cannot be opened, and the
-    /// errors of [`from_reader`](Self::from_reader).
+    /// [`CsvError::Io`] (with the path) when the file cannot be opened or
+    /// read, and the errors of [`from_reader`](Self::from_reader).
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Error, Recording};
+    /// # use ctrlab::{Recording, data::CsvError};
     /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv");
     /// let rec = Recording::read_csv(path)?;
     /// assert_eq!(rec.len(), 2500);
-    /// assert!(matches!(Recording::read_csv("no/such/file.csv"), Err(Error::Io { .. })));
-    /// # Ok::<(), ctrlab::Error>(())
+    /// assert!(matches!(Recording::read_csv("no/such/file.csv"), Err(CsvError::Io { .. })));
+    /// # Ok::<(), CsvError>(())
     /// ```
-    pub fn read_csv(path: impl AsRef<Path>) -> Result<Self, Error> {
+    pub fn read_csv(path: impl AsRef<Path>) -> Result<Self, CsvError> {
         Self::read_csv_with(path, &CsvOptions::default())
     }
 
@@ -223,34 +222,28 @@ impl Recording {
     ///
     /// # Errors
     ///
-    /// [`Error::Io`] (with the path) when the file cannot be opened or
-    /// read, and the errors of [`from_reader_with`](Self::from_reader_with).
+    /// [`CsvError::Io`] (with the path, and near which line when reading)
+    /// when the file cannot be opened or read, and the errors of
+    /// [`from_reader_with`](Self::from_reader_with).
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Error, Recording, data::CsvOptions};
+    /// # use ctrlab::{Recording, data::{CsvError, CsvOptions}};
     /// let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/logs/counts.csv");
     /// let options = CsvOptions { metres_per_count: Some(1.0 / 102_400.0) };
     /// let rec = Recording::read_csv_with(path, &options)?;
     /// assert_eq!(rec.schema().measurements()[0].unit, "m"); // counts read as metres
-    /// assert!(matches!(Recording::read_csv(path), Err(Error::Csv { .. }))); // no calibration
-    /// # Ok::<(), ctrlab::Error>(())
+    /// assert!(matches!(Recording::read_csv(path), Err(CsvError::Line { line: 1, .. }))); // no calibration
+    /// # Ok::<(), CsvError>(())
     /// ```
-    pub fn read_csv_with(path: impl AsRef<Path>, options: &CsvOptions) -> Result<Self, Error> {
+    pub fn read_csv_with(path: impl AsRef<Path>, options: &CsvOptions) -> Result<Self, CsvError> {
         let path = path.as_ref();
         let file = std::fs::File::open(path)
-            .map_err(|e| Error::io(format!("opening {}", path.display()), &e))?;
+            .map_err(|e| CsvError::io(format!("opening {}", path.display()), e))?;
         // The file's length sizes the columns once (0 for a pipe: unknown).
         let size = file.metadata().ok().map(|m| m.len()).filter(|&n| n > 0);
-        read(file, options, size).map_err(|e| match e {
-            Error::Io { kind, message, .. } => Error::Io {
-                context: format!("reading {}", path.display()),
-                kind,
-                message,
-            },
-            other => other,
-        })
+        read(file, options, size, Some(path))
     }
 
     /// Reads a recording from CSV text with the default [`CsvOptions`]: any
@@ -264,7 +257,7 @@ impl Recording {
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Error, Recording};
+    /// # use ctrlab::{Recording, data::CsvError};
     /// let text = "t_s,u,x1_mm,x2_mm\n\
     ///             0.000,2,0,0\n0.002,2,0,0.05\n0.004,2,0.01,0.2\n";
     /// let rec = Recording::from_reader(text.as_bytes())?;
@@ -274,10 +267,10 @@ impl Recording {
     ///
     /// let bad = text.replace("0.01,0.2", "0.01,oops");
     /// let err = Recording::from_reader(bad.as_bytes()).unwrap_err();
-    /// assert!(matches!(err, Error::Csv { line: 4, .. }));
-    /// # Ok::<(), ctrlab::Error>(())
+    /// assert!(matches!(err, CsvError::Line { line: 4, .. }));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn from_reader(reader: impl Read) -> Result<Self, Error> {
+    pub fn from_reader(reader: impl Read) -> Result<Self, CsvError> {
         Self::from_reader_with(reader, &CsvOptions::default())
     }
 
@@ -332,22 +325,23 @@ impl Recording {
     ///
     /// # Errors
     ///
-    /// [`Error::InvalidParameter`] for a `metres_per_count` that is not
-    /// finite and positive. [`Error::Csv`] with the file's line and what was
-    /// found there: for no header line, and on the header line (shown as
-    /// found) for a missing or duplicated time column, two columns for one
-    /// channel, or a column in counts without
-    /// [`CsvOptions::metres_per_count`]; for a row with the wrong number of
-    /// fields (found and expected, and the row); for a value that is not a
-    /// finite number or holds a thousands separator (the value); for a time
-    /// that does not increase (or an interval that overflows); for fewer
-    /// than two rows; for bytes the CSV parser rejects (invalid UTF-8).
-    /// [`Error::Io`] for a failing reader.
+    /// [`CsvError::Options`] for a `metres_per_count` that is not finite and
+    /// positive. [`CsvError::Line`] with the file's line and what was found
+    /// there: for no header line, and on the header line (shown as found)
+    /// for a missing or duplicated time column, two columns for one
+    /// channel, a column in counts without
+    /// [`CsvOptions::metres_per_count`], or a header that is not UTF-8; for
+    /// a row with the wrong number of fields (found and expected, and the
+    /// row); for a value that is not a finite number, holds a thousands
+    /// separator or is not UTF-8 (the value); for a time that does not
+    /// increase (or an interval that overflows); for fewer than two rows.
+    /// [`CsvError::Io`] for a failing reader (near which line), the
+    /// reader's error as its source.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Error, Recording, data::CsvOptions};
+    /// use ctrlab::{Recording, data::{CsvError, CsvOptions}};
     ///
     /// // Excel in a German locale, with the logger's own comments.
     /// let log = "# lab 5, group 3\n\
@@ -363,22 +357,37 @@ impl Recording {
     /// // A thousands separator, on the file's line 5.
     /// let bad = log.replace("0,125", "1.000,125");
     /// match Recording::from_reader_with(bad.as_bytes(), &CsvOptions::default()) {
-    ///     Err(Error::Csv { line, reason }) => {
+    ///     Err(CsvError::Line { line, reason }) => {
     ///         assert_eq!(line, 5);
     ///         assert!(reason.contains("`1.000,125`"), "{reason}");
     ///     }
     ///     other => panic!("{other:?}"),
     /// }
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn from_reader_with(reader: impl Read, options: &CsvOptions) -> Result<Self, Error> {
-        read(reader, options, None)
+    pub fn from_reader_with(reader: impl Read, options: &CsvOptions) -> Result<Self, CsvError> {
+        read(reader, options, None, None)
+    }
+}
+
+/// What an I/O error while reading was doing: reading the header or near
+/// which line, of the file at `path` when there is one.
+fn reading(path: Option<&Path>, header: bool, line: u64) -> String {
+    match (path, header) {
+        (None, true) => "reading the CSV header".to_string(),
+        (None, false) => format!("reading CSV (near line {line})"),
+        (Some(path), _) => format!("reading {} (near line {line})", path.display()),
     }
 }
 
 /// Reads a recording from `reader` (of `size` bytes when known, to size
-/// the columns once).
-fn read<R: Read>(reader: R, options: &CsvOptions, size: Option<u64>) -> Result<Recording, Error> {
+/// the columns once; the file at `path` when there is one, for errors).
+fn read<R: Read>(
+    reader: R,
+    options: &CsvOptions,
+    size: Option<u64>,
+    path: Option<&Path>,
+) -> Result<Recording, CsvError> {
     options.check()?;
     let mut lines = Lines::new(reader);
     let header = loop {
@@ -398,7 +407,7 @@ fn read<R: Read>(reader: R, options: &CsvOptions, size: Option<u64>) -> Result<R
                     )
                 });
             }
-            Err(e) => return Err(Error::io("reading the CSV header", &e)),
+            Err(e) => return Err(CsvError::io(reading(path, true, lines.line() + 1), e)),
         }
     };
     let header_line = header.number;
@@ -415,10 +424,7 @@ fn read<R: Read>(reader: R, options: &CsvOptions, size: Option<u64>) -> Result<R
     };
     let mut records = Records::new(lines, separator);
     let io = |records: &Records<R>, e: std::io::Error| {
-        Error::io(
-            format!("reading CSV (near line {})", records.lines.line() + 1),
-            &e,
-        )
+        CsvError::io(reading(path, false, records.lines.line() + 1), e)
     };
     match records.next(Some(header)) {
         Ok(Some(_)) => {}

@@ -13,7 +13,7 @@ pub(super) enum BadValue {
 }
 
 impl BadValue {
-    /// The reason of an [`Error::Csv`](crate::Error::Csv) for field `text`
+    /// The reason of a [`CsvError::Line`](super::CsvError::Line) for field `text`
     /// of column `column`.
     pub(super) fn describe(self, column: &str, text: &str, decimal_comma: bool) -> String {
         match self {

@@ -7,7 +7,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::header::{Scale, header_of, parse_header};
-use super::is_input_name;
+use super::{CsvError, is_input_name};
 use crate::data::Recording;
 use crate::error::Error;
 
@@ -55,7 +55,7 @@ impl Recording {
     ///
     /// # Errors
     ///
-    /// [`Error::Io`] (with the path) when the file cannot be created or
+    /// [`CsvError::Io`] (with the path) when the file cannot be created or
     /// written; the errors of [`to_writer`](Self::to_writer).
     ///
     /// # Examples
@@ -71,21 +71,18 @@ impl Recording {
     /// rec.write_csv(&path)?;
     /// assert_eq!(Recording::read_csv(&path)?, rec);
     /// # std::fs::remove_file(&path).ok();
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn write_csv(&self, path: impl AsRef<Path>) -> Result<(), Error> {
+    pub fn write_csv(&self, path: impl AsRef<Path>) -> Result<(), CsvError> {
         let path = path.as_ref();
+        // Checked before the file is created, so a refused recording leaves
+        // no file behind (or an old one as it was).
+        self.check_csv()?;
         let file = std::fs::File::create(path)
-            .map_err(|e| Error::io(format!("creating {}", path.display()), &e))?;
-        // `to_writer` buffers: the file gets large writes.
-        self.to_writer(file).map_err(|e| match e {
-            Error::Io { kind, message, .. } => Error::Io {
-                context: format!("writing {}", path.display()),
-                kind,
-                message,
-            },
-            other => other,
-        })
+            .map_err(|e| CsvError::io(format!("creating {}", path.display()), e))?;
+        // `write` buffers: the file gets large writes.
+        self.write(file)
+            .map_err(|e| CsvError::io(format!("writing {}", path.display()), e))
     }
 
     /// Writes the recording as CSV in SI units: header `t_s` and one column
@@ -96,13 +93,14 @@ impl Recording {
     ///
     /// # Errors
     ///
-    /// [`Error::InvalidRecording`] for a non-finite value (the reader would
-    /// refuse it); [`Error::Channel`] for a channel whose header would not
-    /// read back as itself (a unit outside [`KNOWN_UNITS`](crate::data::KNOWN_UNITS) that is not SI
+    /// [`CsvError::Recording`] holding [`Error::InvalidRecording`] for a
+    /// non-finite value (the reader would refuse it), or [`Error::Channel`]
+    /// for a channel whose header would not read back as itself (a unit
+    /// outside [`KNOWN_UNITS`](crate::data::KNOWN_UNITS) that is not SI
     /// such as `mm`, a name ending in a unit, a name `t` or `time`, or an
     /// input not named `u…` / a measurement named `u…`), so that every
-    /// file written reads back identical; [`Error::Io`] when the writer
-    /// fails.
+    /// file written reads back identical; nothing is written then.
+    /// [`CsvError::Io`] when the writer fails.
     ///
     /// # Examples
     ///
@@ -114,19 +112,30 @@ impl Recording {
     /// let mut out = Vec::new();
     /// rec.to_writer(&mut out)?;
     /// assert_eq!(String::from_utf8(out).unwrap(), "t_s,u_V,x1_m,v1_m_s\n0.0,2.0,0.001,0.0025\n");
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn to_writer(&self, writer: impl Write) -> Result<(), Error> {
-        self.check_values()?;
-        self.check_round_trip()?;
-        let io = |e: std::io::Error| Error::io("writing CSV", &e);
+    pub fn to_writer(&self, writer: impl Write) -> Result<(), CsvError> {
+        self.check_csv()?;
+        self.write(writer)
+            .map_err(|e| CsvError::io("writing CSV", e))
+    }
+
+    /// Checks the recording can be written as CSV and read back identical.
+    fn check_csv(&self) -> Result<(), CsvError> {
+        self.check_values()
+            .and_then(|()| self.check_round_trip())
+            .map_err(|source| CsvError::Recording { source })
+    }
+
+    /// Writes the recording, checked, as CSV.
+    fn write(&self, writer: impl Write) -> std::io::Result<()> {
         let mut out = Output::new(writer);
-        out.field(b"t_s").map_err(io)?;
+        out.field(b"t_s")?;
         for channel in self.schema.channels() {
-            out.delimiter().map_err(io)?;
-            out.field(header_of(channel).as_bytes()).map_err(io)?;
+            out.delimiter()?;
+            out.field(header_of(channel).as_bytes())?;
         }
-        out.terminator().map_err(io)?;
+        out.terminator()?;
         // Each value in Rust's shortest round-trip form (`{:?}`: `2.0`,
         // `0.001`, `1e-7`), written into one reused string.
         let mut number = String::new();
@@ -136,15 +145,15 @@ impl Recording {
                 .enumerate()
             {
                 if i > 0 {
-                    out.delimiter().map_err(io)?;
+                    out.delimiter()?;
                 }
                 number.clear();
                 write!(number, "{v:?}").unwrap_or_default();
-                out.field(number.as_bytes()).map_err(io)?;
+                out.field(number.as_bytes())?;
             }
-            out.terminator().map_err(io)?;
+            out.terminator()?;
         }
-        out.flush().map_err(io)
+        out.flush()
     }
 }
 

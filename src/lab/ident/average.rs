@@ -33,7 +33,7 @@ pub struct Spread {
 /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
 /// let avg = average(&[est.clone(), est.clone()])?;
 /// assert_eq!((avg.runs, avg.k12.mean, avg.k12.std_dev), (2, est.k12.value, 0.0));
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MassSpringAverage {
@@ -152,7 +152,7 @@ pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Error> 
 /// let avg = average_separate_springs(&[est.clone(), est.clone()])?;
 /// assert_eq!(avg.plant(), est.plant());
 /// assert_eq!((avg.runs, avg.k2.std_dev, avg.coulomb), (2, 0.0, None));
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SeparateSpringsAverage {
@@ -204,7 +204,7 @@ impl SeparateSpringsAverage {
     /// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options { coulomb: true, ..Options::DEFAULT })?;
     /// let avg = average_separate_springs(&[est.clone(), est.clone()])?;
     /// assert_eq!(avg.friction_plant(), est.friction_plant());
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn friction_plant(&self) -> crate::lab::FrictionPlant {
         let forces = self
@@ -236,7 +236,7 @@ impl SeparateSpringsAverage {
 /// let friction = Options { coulomb: true, ..Options::DEFAULT };
 /// let c = identify_separate_springs_with(&rec, 1.3, 0.7, &friction)?;
 /// assert!(matches!(average_separate_springs(&[a, c]), Err(Error::InvalidParameter { name: "coulomb", .. })));
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn average_separate_springs(
     runs: &[SeparateSpringsEstimate],

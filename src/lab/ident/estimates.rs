@@ -52,7 +52,7 @@ impl Estimate {
 /// assert!((est.k12.value - 950.0).abs() < 0.003 * 950.0);
 /// let sys = est.state_space()?; // the identified model, output cart 2
 /// assert!((sys.b()[(3, 0)] - est.gain.value / 0.7).abs() < 1e-12);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct MassSpringEstimate {
@@ -103,7 +103,7 @@ impl MassSpringEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// assert!(identify(&rec, 1.3, 0.7, Scheme::Lab)?.warnings().is_empty());
     /// assert_eq!(identify(&rec, 1300.0, 700.0, Scheme::Lab)?.warnings().len(), 2);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn warnings(&self) -> Vec<Warning> {
         mass_warnings(self.m1, self.m2)
@@ -118,7 +118,7 @@ impl MassSpringEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let p = identify(&rec, 1.3, 0.7, Scheme::Lab)?.plant();
     /// assert_eq!(p.k1, p.k2);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn plant(&self) -> MassSpring {
         MassSpring {
@@ -147,7 +147,7 @@ impl MassSpringEstimate {
     /// let model = est.friction_plant();
     /// assert_eq!(model.truth(), est.plant());
     /// assert_eq!(model.friction()[1], est.coulomb.unwrap()[1].value.max(0.0));
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn friction_plant(&self) -> FrictionPlant {
         FrictionPlant::new(self.plant(), coulomb_forces(self.coulomb))
@@ -169,7 +169,7 @@ impl MassSpringEstimate {
     /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
     /// let a = *est.state_space()?.a();
     /// assert_eq!(a[(1, 0)], -2.0 * est.k12.value / 1.3);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.plant().state_space(Cart::Two)
@@ -187,7 +187,7 @@ impl MassSpringEstimate {
 /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
 /// // The fixture's springs are equal: both estimates find 950 N/m.
 /// assert!((est.k1.value / est.k2.value - 1.0).abs() < 0.01);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeparateSpringsEstimate {
@@ -239,7 +239,7 @@ impl SeparateSpringsEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// assert!(identify_separate_springs(&rec, 1.3, 0.7, Scheme::Lab)?.warnings().is_empty());
     /// assert_eq!(identify_separate_springs(&rec, 1300.0, 700.0, Scheme::Lab)?.warnings().len(), 2);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn warnings(&self) -> Vec<Warning> {
         mass_warnings(self.m1, self.m2)
@@ -254,7 +254,7 @@ impl SeparateSpringsEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
     /// assert_eq!(est.plant().k2, est.k2.value);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn plant(&self) -> MassSpring {
         MassSpring {
@@ -283,7 +283,7 @@ impl SeparateSpringsEstimate {
     /// let model = est.friction_plant();
     /// assert_eq!(model.truth(), est.plant());
     /// assert_eq!(model.friction()[1], est.coulomb.unwrap()[1].value.max(0.0));
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn friction_plant(&self) -> FrictionPlant {
         FrictionPlant::new(self.plant(), coulomb_forces(self.coulomb))
@@ -302,7 +302,7 @@ impl SeparateSpringsEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let est = identify_separate_springs(&rec, 1.3, 0.7, Scheme::Central)?;
     /// assert_eq!(est.state_space()?.a()[(3, 0)], est.k2.value / 0.7);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.plant().state_space(Cart::Two)
@@ -342,7 +342,7 @@ pub const PLAUSIBLE_MASS_KG: (f64, f64) = (0.01, 100.0);
 /// let w = &est.warnings()[0];
 /// assert_eq!((w.parameter, w.value), ("m1", 1300.0));
 /// assert!(w.to_string().contains("grams"));
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Warning {

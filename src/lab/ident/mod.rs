@@ -290,7 +290,7 @@ fn fitted_m2(free: bool, second: &LeastSquaresFit) -> Option<Estimate> {
 /// assert!((lab.gain.value / 8.5 - 1.0).abs() > 0.01);
 /// assert!((central.gain.value / 8.5 - 1.0).abs() < 0.003);
 /// assert_eq!(central.coulomb, None);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn identify(
     recording: &Recording,
@@ -323,7 +323,7 @@ pub fn identify(
 /// assert!(f1.value.abs() < 0.1 && f2.value.abs() < 0.1, "{f1:?} {f2:?}");
 /// assert!((est.k12.value / 950.0 - 1.0).abs() < 0.005);
 /// assert!(est.first.rows < est.timing.rows); // rows at rest are left out
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn identify_with(
     recording: &Recording,
@@ -394,7 +394,7 @@ fn equal_springs<D: Differences>(
 /// assert!((est.k1.value / 950.0 - 1.0).abs() < 0.01);
 /// assert!((est.k2.value / 950.0 - 1.0).abs() < 0.01);
 /// assert_eq!(est.first.theta.len(), 3);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn identify_separate_springs(
     recording: &Recording,
@@ -424,7 +424,7 @@ pub fn identify_separate_springs(
 /// assert_eq!((est.first.theta.len(), est.second.theta.len()), (4, 3));
 /// assert!((est.k2.value / 950.0 - 1.0).abs() < 0.01);
 /// assert!(est.coulomb.unwrap()[1].value.abs() < 0.1); // frictionless fixture
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn identify_separate_springs_with(
     recording: &Recording,

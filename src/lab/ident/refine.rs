@@ -96,7 +96,7 @@ impl Refined {
     /// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// let r = refine(&rec, &identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?)?;
     /// assert_eq!(r.parameters()[4], r.plant.gain);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn parameters(&self) -> [f64; 7] {
         let p = &self.plant;
@@ -190,7 +190,7 @@ fn correlation_test(a: &[f64], b: &[f64], first: usize) -> ResidualTest {
 /// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?;
 /// let v = validate(&rec, &est.plant(), [0.0, 0.0])?;
 /// assert!(v.fit_percent[1] > 90.0);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn validate(
     rec: &Recording,
@@ -219,7 +219,7 @@ pub fn validate(
 /// let model = SimulationModel { input_delay: 0.15e-3, ..SimulationModel::default() };
 /// let v = validate_with(&rec, &sim.truth, [0.0; 2], &model)?;
 /// assert!(v.fit_percent[1].is_finite());
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn validate_with(
     rec: &Recording,
@@ -403,7 +403,7 @@ impl LeastSquaresProblem<f64, na::Dyn, na::Dyn> for Problem<'_> {
 /// let est = identify_separate_springs_with(&rec, 1.3, 0.7, &Options::default())?;
 /// let r = refine(&rec, &est)?;
 /// assert!(r.refined.fit_percent[1] >= r.start.fit_percent[1]);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn refine(rec: &Recording, start: &SeparateSpringsEstimate) -> Result<Refined, Error> {
     refine_with(rec, start, &SimulationModel::default())

@@ -62,7 +62,9 @@ pub(super) fn from_reader_with(
     reader: impl Read,
     options: &CsvOptions,
 ) -> Result<Recording, Error> {
-    options.check()?;
+    if let Err(crate::data::CsvError::Options { source }) = options.check() {
+        return Err(source);
+    }
     let mut lines = BufReader::new(Uncommented::new(BufReader::new(reader)));
     let header =
         HeaderLine::read(&mut lines).map_err(|e| Error::io("reading the CSV header", &e))?;
@@ -281,6 +283,7 @@ pub(super) fn from_reader_with(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::data::CsvError;
     use proptest::prelude::*;
 
     /// Whether the reader built on `csv-core` reads `bytes` as the old one:
@@ -307,7 +310,7 @@ mod tests {
                     line: la,
                     reason: ra,
                 }),
-                Err(Error::Csv {
+                Err(CsvError::Line {
                     line: lb,
                     reason: rb,
                 }),
@@ -324,10 +327,14 @@ mod tests {
                     prop_assert_eq!(ra, rb, "in {:?}", String::from_utf8_lossy(bytes));
                 }
             }
-            _ => prop_assert_eq!(
-                format!("{old:?}"),
-                format!("{new:?}"),
-                "in {:?}",
+            (Err(a @ Error::InvalidParameter { .. }), Err(CsvError::Options { source: b })) => {
+                prop_assert_eq!(a, b);
+            }
+            _ => prop_assert!(
+                false,
+                "{:?} / {:?} in {:?}",
+                old,
+                new,
                 String::from_utf8_lossy(bytes)
             ),
         }
