@@ -404,8 +404,8 @@ fn a_failing_reader_is_an_io_error() {
 }
 
 /// How many lines `text` has, counting `\n`, `\r\n` and `\r` as line breaks.
-fn line_count(text: &str) -> u64 {
-    let b = text.as_bytes();
+fn line_count(text: &[u8]) -> u64 {
+    let b = text;
     let breaks = (0..b.len())
         .filter(|&i| b[i] == b'\n' || (b[i] == b'\r' && b.get(i + 1) != Some(&b'\n')))
         .count();
@@ -414,7 +414,7 @@ fn line_count(text: &str) -> u64 {
 
 /// What any reading must give: a recording of finite values, at least two
 /// rows, time increasing; or an error on a line of the text.
-fn check_outcome(text: &str, result: Result<Recording, CsvError>) -> Result<(), TestCaseError> {
+fn check_outcome(text: &[u8], result: Result<Recording, CsvError>) -> Result<(), TestCaseError> {
     match result {
         Ok(rec) => {
             prop_assert!(rec.len() >= 2);
@@ -474,7 +474,7 @@ proptest! {
     #[test]
     fn any_text_reads_or_fails_on_one_of_its_lines(text in any::<String>(), counts: bool) {
         let options = if counts { calibrated() } else { CsvOptions::default() };
-        check_outcome(&text, Recording::from_reader_with(text.as_bytes(), &options))?;
+        check_outcome(text.as_bytes(), Recording::from_reader_with(text.as_bytes(), &options))?;
     }
 
     #[test]
@@ -512,7 +512,7 @@ proptest! {
         }
         let text = lines.join(breaks);
         let options = if counts { calibrated() } else { CsvOptions::default() };
-        check_outcome(&text, Recording::from_reader_with(text.as_bytes(), &options))?;
+        check_outcome(text.as_bytes(), Recording::from_reader_with(text.as_bytes(), &options))?;
     }
 
     #[test]
@@ -552,5 +552,109 @@ proptest! {
             }
             other => prop_assert!(false, "expected CsvError::Line, got {:?}", other),
         }
+    }
+}
+
+/// Hands out at most `.1` bytes a read, as a pipe or a slow device might.
+struct Trickle<'a>(&'a [u8], usize);
+
+impl std::io::Read for Trickle<'_> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.0.len().min(out.len()).min(self.1);
+        out[..n].copy_from_slice(&self.0[..n]);
+        self.0 = &self.0[n..];
+        Ok(n)
+    }
+}
+
+/// The fuzz target's seeds (`fuzz/seeds/csv_identify`) and the logs here.
+fn seeds() -> Vec<Vec<u8>> {
+    let mut files: Vec<_> = ["fuzz/seeds/csv_identify", "tests/data/logs"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(format!("{}/{d}", env!("CARGO_MANIFEST_DIR"))).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "csv" || e == "tsv"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 4 + 15, "{files:?}");
+    files.iter().map(|p| std::fs::read(p).unwrap()).collect()
+}
+
+#[test]
+fn the_fuzz_seeds_read_or_fail_on_one_of_their_lines() {
+    for seed in seeds() {
+        for options in [CsvOptions::default(), calibrated()] {
+            check_outcome(&seed, Recording::from_reader_with(&seed[..], &options)).unwrap();
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1024, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_bytes_read_or_fail_on_one_of_their_lines(
+        bytes in prop::collection::vec(
+            prop_oneof![any::<u8>(), prop::sample::select(b"t_s,u;\t\n\r\"#% 0123456789.e-".to_vec())],
+            0..2000,
+        ),
+        counts: bool,
+    ) {
+        let options = if counts { calibrated() } else { CsvOptions::default() };
+        check_outcome(&bytes, Recording::from_reader_with(&bytes[..], &options))?;
+    }
+
+    #[test]
+    fn mutated_logs_read_or_fail_on_one_of_their_lines(
+        seed in any::<prop::sample::Index>(),
+        edits in prop::collection::vec(
+            (any::<prop::sample::Index>(), any::<u8>(), prop::sample::select(b"\n\r\",;\t#% \xff\xc3e-.0".to_vec()), 0u8..5),
+            1..8,
+        ),
+        counts: bool,
+    ) {
+        let seeds = seeds();
+        let mut bytes = seeds[seed.index(seeds.len())].clone();
+        for (at, any, special, op) in edits {
+            let at = at.index(bytes.len() + 1);
+            match op {
+                0 if at < bytes.len() => bytes[at] = special,
+                1 if at < bytes.len() => bytes[at] = any,
+                2 if at < bytes.len() => {
+                    bytes.remove(at);
+                }
+                // A line repeated (a time that does not increase) or the
+                // end cut off (a logger that stopped mid-line).
+                3 => {
+                    let start = bytes[..at].iter().rposition(|&b| b == b'\n').map_or(0, |k| k + 1);
+                    let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |k| at + k + 1);
+                    let line = bytes[start..end].to_vec();
+                    bytes.splice(start..start, line);
+                }
+                4 => bytes.truncate(at),
+                _ => bytes.insert(at, special),
+            }
+        }
+        let options = if counts { calibrated() } else { CsvOptions::default() };
+        check_outcome(&bytes, Recording::from_reader_with(&bytes[..], &options))?;
+    }
+
+    #[test]
+    fn a_log_read_in_pieces_reads_as_in_one(
+        seed in any::<prop::sample::Index>(),
+        edits in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"\n\r\",;#% \xef\xbb\xbf".to_vec())), 0..4),
+        chunk in 1usize..40,
+    ) {
+        // The reader takes what each read gives: a line, a `\r\n` or a
+        // byte-order mark split across reads reads as whole.
+        let seeds = seeds();
+        let mut bytes = seeds[seed.index(seeds.len())].clone();
+        for (at, b) in edits {
+            let at = at.index(bytes.len() + 1);
+            bytes.insert(at, b);
+        }
+        let whole = Recording::from_reader_with(&bytes[..], &calibrated());
+        let pieces = Recording::from_reader_with(Trickle(&bytes, chunk), &calibrated());
+        prop_assert_eq!(format!("{whole:?}"), format!("{pieces:?}"));
     }
 }
