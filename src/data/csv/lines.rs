@@ -34,6 +34,8 @@ pub(super) struct Line {
     /// The file's one-based line number.
     pub(super) number: u64,
     pub(super) kind: Kind,
+    /// Whether `range` ends with a line break.
+    pub(super) has_break: bool,
 }
 
 /// What a line is, from its bytes without the line break.
@@ -160,6 +162,7 @@ impl<R: Read> Lines<R> {
                     range: self.pos..at + 1,
                     number: self.line + 1,
                     kind: kind(&self.buf[self.pos..at]),
+                    has_break: true,
                 };
                 self.after_cr = self.buf[at] == b'\r';
                 self.pos = at + 1;
@@ -175,6 +178,7 @@ impl<R: Read> Lines<R> {
                     range: self.pos..self.end,
                     number: self.line + 1,
                     kind: kind(&self.buf[self.pos..self.end]),
+                    has_break: false,
                 };
                 self.pos = self.end;
                 self.line += 1;

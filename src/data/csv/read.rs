@@ -1,8 +1,10 @@
 //! Reading a [`Recording`] from CSV: one pass over the bytes. The lines of
 //! the log ([`Lines`]) are told apart as they come, comment and blank lines
 //! skipped; content lines go to `csv-core`'s tokenizer, which splits them
-//! into fields (quotes included); each field is trimmed and parsed from its
-//! bytes, and only the header is read as text.
+//! into fields (quotes included), except a row without a quote, split at
+//! the separator in place as the tokenizer would; each field is trimmed and
+//! parsed from its bytes (one UTF-8 check a row), and only the header is
+//! read as text.
 
 use std::io::Read;
 use std::path::Path;
@@ -31,16 +33,22 @@ struct Slot<'a> {
 /// quoted field holds a line break; comment and blank lines are skipped
 /// wherever they are, so the tokenizer sees what the reader before the
 /// port to `csv-core` gave the `csv` crate: content lines, each ending in a
-/// line break.
+/// line break. A row without a quote (the usual row) is split at the
+/// separator in place ([`split`]): the same fields, a tenth fewer
+/// instructions a row, no copy.
 struct Records<R> {
     lines: Lines<R>,
     core: csv_core::Reader,
-    /// The current record's fields, back to back, and where each ends.
+    separator: u8,
+    /// The tokenizer's output: fields back to back, and where each ends.
     fields: Vec<u8>,
     ends: Vec<usize>,
-    /// The number of fields of the current record, and of its bytes.
-    len: usize,
+    /// The current record: where its bytes are (`None`: the first `out`
+    /// bytes of `fields`; else a line, in `lines`), and where each of its
+    /// fields is in them.
+    line: Option<std::ops::Range<usize>>,
     out: usize,
+    bounds: Vec<(usize, usize)>,
 }
 
 impl<R: Read> Records<R> {
@@ -48,10 +56,12 @@ impl<R: Read> Records<R> {
         Self {
             lines,
             core: csv_core::ReaderBuilder::new().delimiter(separator).build(),
+            separator,
             fields: vec![0; 1024],
             ends: vec![0; 64],
-            len: 0,
+            line: None,
             out: 0,
+            bounds: Vec::new(),
         }
     }
 
@@ -69,6 +79,7 @@ impl<R: Read> Records<R> {
     /// line already read); returns the file's line it starts on, or `None`
     /// at the end.
     fn next(&mut self, mut first: Option<Line>) -> std::io::Result<Option<u64>> {
+        let at_header = first.is_some();
         let (mut out, mut end) = (0, 0);
         let mut start = None;
         loop {
@@ -85,7 +96,7 @@ impl<R: Read> Records<R> {
                     end += n;
                     match res {
                         ReadRecordResult::Record => {
-                            (self.len, self.out) = (end, out);
+                            self.tokenized(end, out);
                             return Ok(Some(start.unwrap_or(self.lines.line())));
                         }
                         ReadRecordResult::OutputEndsFull => grow(&mut self.ends),
@@ -94,6 +105,17 @@ impl<R: Read> Records<R> {
                     }
                 }
             };
+            if start.is_none() && !at_header {
+                let range = line.range.start..line.range.end - usize::from(line.has_break);
+                if split(
+                    self.lines.bytes(range.clone()),
+                    self.separator,
+                    &mut self.bounds,
+                ) {
+                    self.line = Some(range);
+                    return Ok(Some(line.number));
+                }
+            }
             start.get_or_insert(line.number);
             let bytes = self.lines.bytes(line.range);
             let mut input = bytes;
@@ -109,7 +131,7 @@ impl<R: Read> Records<R> {
                     ReadRecordResult::OutputFull => grow(&mut self.fields),
                     ReadRecordResult::OutputEndsFull => grow(&mut self.ends),
                     ReadRecordResult::Record => {
-                        (self.len, self.out) = (end, out);
+                        self.tokenized(end, out);
                         return Ok(Some(start.unwrap_or(line.number)));
                     }
                     ReadRecordResult::End => return Ok(None),
@@ -124,37 +146,77 @@ impl<R: Read> Records<R> {
         }
     }
 
+    /// Takes the record the tokenizer wrote: `len` fields in `out` bytes.
+    fn tokenized(&mut self, len: usize, out: usize) {
+        self.bounds.clear();
+        let mut from = 0;
+        for &end in &self.ends[..len] {
+            self.bounds.push((from, end));
+            from = end;
+        }
+        self.line = None;
+        self.out = out;
+    }
+
     /// The number of fields of the current record.
     fn len(&self) -> usize {
-        self.len
+        self.bounds.len()
+    }
+
+    /// The current record's bytes.
+    #[inline(always)]
+    fn bytes(&self) -> &[u8] {
+        match &self.line {
+            Some(range) => self.lines.bytes(range.clone()),
+            None => &self.fields[..self.out],
+        }
     }
 
     /// Where field `i` of the current record is in its bytes.
     #[inline(always)]
     fn bounds(&self, i: usize) -> std::ops::Range<usize> {
-        let start = if i == 0 { 0 } else { self.ends[i - 1] };
-        start..self.ends[i]
+        let (start, end) = self.bounds[i];
+        start..end
     }
 
     /// Field `i` of the current record, as found (quotes removed).
     fn field(&self, i: usize) -> &[u8] {
-        &self.fields[self.bounds(i)]
+        &self.bytes()[self.bounds(i)]
     }
 
-    /// The current record's bytes (its fields back to back) as text, when
-    /// they are UTF-8.
+    /// The current record's bytes as text, when they are UTF-8.
     #[inline(always)]
     fn text(&self) -> Option<&str> {
-        std::str::from_utf8(&self.fields[..self.out]).ok()
+        std::str::from_utf8(self.bytes()).ok()
     }
 
     /// The current record's fields as found, joined by `separator`.
     fn joined(&self, separator: u8) -> String {
-        let fields: Vec<String> = (0..self.len)
+        let fields: Vec<String> = (0..self.len())
             .map(|i| String::from_utf8_lossy(self.field(i)).into_owned())
             .collect();
         fields.join(&(separator as char).to_string())
     }
+}
+
+/// Splits a line (without its line break) at `separator` into `bounds`,
+/// unless it holds a quote: then returns false, and the tokenizer reads it.
+/// Without a quote, and a content line holds no line break, the tokenizer
+/// would find exactly these fields; this is the same split in one pass
+/// over the line, without copying it.
+fn split(line: &[u8], separator: u8, bounds: &mut Vec<(usize, usize)>) -> bool {
+    bounds.clear();
+    let mut from = 0;
+    for (at, &b) in line.iter().enumerate() {
+        if b == separator {
+            bounds.push((from, at));
+            from = at + 1;
+        } else if b == b'"' {
+            return false;
+        }
+    }
+    bounds.push((from, line.len()));
+    true
 }
 
 /// Doubles a buffer of the tokenizer's output.
@@ -708,6 +770,44 @@ mod tests {
         let capacity = rec.capacity();
         assert!(capacity >= rows && capacity < rows + rows / 4, "{capacity}");
         assert_eq!(rec, Recording::from_reader(text.as_bytes()).unwrap());
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn a_line_without_quotes_splits_as_the_tokenizer_splits_it(
+            line in proptest::collection::vec(proptest::prop_oneof![
+                proptest::sample::select(b",;\t 0.e-x#%\xff".to_vec()),
+                proptest::prelude::any::<u8>(),
+            ], 1..60),
+            separator in proptest::sample::select(b",;\t".to_vec()),
+        ) {
+            let line: Vec<u8> = line.into_iter().filter(|b| !b"\"\r\n".contains(b)).collect();
+            let mut bounds = Vec::new();
+            proptest::prop_assert!(split(&line, separator, &mut bounds));
+            let split: Vec<&[u8]> = bounds.iter().map(|&(a, b)| &line[a..b]).collect();
+            // The tokenizer, given the line and its line break.
+            let mut core = csv_core::ReaderBuilder::new().delimiter(separator).build();
+            let (mut out, mut ends) = (vec![0; 256], vec![0; 128]);
+            let input = [&line[..], b"\n"].concat();
+            let (res, nin, _, n) = core.read_record(&input, &mut out, &mut ends);
+            if line.is_empty() {
+                return Ok(()); // an empty line is no record (a content line is never empty)
+            }
+            proptest::prop_assert_eq!(res, ReadRecordResult::Record);
+            proptest::prop_assert_eq!(nin, input.len());
+            let mut from = 0;
+            let tokenized: Vec<&[u8]> = ends[..n].iter().map(|&end| { let f = &out[from..end]; from = end; f }).collect();
+            proptest::prop_assert_eq!(split, tokenized);
+        }
+    }
+
+    #[test]
+    fn a_line_with_a_quote_goes_to_the_tokenizer() {
+        let mut bounds = Vec::new();
+        assert!(!split(b"0,\"1,5\"", b',', &mut bounds));
+        assert!(!split(b"0,1\"", b',', &mut bounds));
+        assert!(split(b"0;1,5", b';', &mut bounds));
+        assert_eq!(bounds, [(0, 1), (2, 5)]);
     }
 
     #[test]

@@ -556,14 +556,16 @@ mod tests {
         let path = std::env::temp_dir().join(format!("ctrlab_timing_{}.csv", std::process::id()));
         std::fs::write(&path, &log).unwrap();
         let options = CsvOptions::default();
-        // Under `perf stat` or valgrind: one reader only, once, on one log.
+        // Under `perf stat` or valgrind: one reader only, on one log,
+        // `CTRLAB_TIMING_N` times (once).
         if let Ok(only) = std::env::var("CTRLAB_TIMING_ONLY") {
             let text = if only.ends_with("excel") {
                 &excel
             } else {
                 &log
             };
-            for _ in 0..usize::from(only != "none") {
+            let n: usize = std::env::var("CTRLAB_TIMING_N").map_or(1, |n| n.parse().unwrap());
+            for _ in 0..n * usize::from(only != "none") {
                 let rec = if only.starts_with("old") {
                     from_reader_with(text.as_bytes(), &options).unwrap()
                 } else {
