@@ -7,8 +7,6 @@
 mod error;
 mod header;
 mod lines;
-#[cfg(test)]
-mod old;
 mod options;
 mod read;
 mod value;
