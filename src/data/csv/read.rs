@@ -242,6 +242,89 @@ fn field_text(raw: &[u8]) -> Option<&str> {
     std::str::from_utf8(raw).ok().map(trim)
 }
 
+/// Reads the values of the current row (of the right width, on line
+/// `line`) into `cols`, one per slot, in SI.
+fn read_row<R: Read>(
+    records: &Records<R>,
+    slots: &[Slot],
+    cols: &mut [Vec<f64>],
+    decimal_comma: bool,
+    scratch: &mut String,
+    line: u64,
+) -> Result<(), CsvError> {
+    // One check that the row is text; a field cut out of it at characters
+    // is then text too (a number always is).
+    let row = records.text();
+    for (slot, col) in slots.iter().zip(cols.iter_mut()) {
+        let cut = match row {
+            Some(row) => row.get(records.bounds(slot.index)),
+            None => None,
+        };
+        let text = match cut {
+            Some(text) => trim(text),
+            None => match field_text(records.field(slot.index)) {
+                Some(text) => text,
+                None => return Err(not_text(line, slot, records.field(slot.index))),
+            },
+        };
+        let value = match value::parse(text, decimal_comma, scratch) {
+            Ok(value) => value,
+            Err(why) => return Err(not_a_number(line, slot, text, why, decimal_comma)),
+        };
+        // As `value / divisor * factor`: dividing or multiplying by 1
+        // changes no bit.
+        let value = if slot.divisor == 1.0 {
+            value
+        } else {
+            value / slot.divisor
+        };
+        let value = if slot.factor == 1.0 {
+            value
+        } else {
+            value * slot.factor
+        };
+        if !value.is_finite() {
+            return Err(not_finite(line, slot, text));
+        }
+        col.push(value);
+    }
+    Ok(())
+}
+
+/// A field whose bytes are not UTF-8.
+#[cold]
+fn not_text(line: u64, slot: &Slot, raw: &[u8]) -> CsvError {
+    csv_error(
+        line,
+        format!(
+            "column {}: `{}` is not a number (not even UTF-8 text)",
+            slot.name,
+            String::from_utf8_lossy(raw).trim()
+        ),
+    )
+}
+
+/// A field that is not a number.
+#[cold]
+fn not_a_number(
+    line: u64,
+    slot: &Slot,
+    text: &str,
+    why: BadValue,
+    decimal_comma: bool,
+) -> CsvError {
+    csv_error(line, why.describe(slot.name, text, decimal_comma))
+}
+
+/// A number that is not finite (as written, or once in SI).
+#[cold]
+fn not_finite(line: u64, slot: &Slot, text: &str) -> CsvError {
+    csv_error(
+        line,
+        format!("column {}: `{text}` is not a finite number", slot.name),
+    )
+}
+
 /// How many rows a file of `size` bytes holds, from the first `rows` rows
 /// in `bytes` bytes: an estimate a little high, to size the columns once.
 /// Each row of `width` fields needs at least `2 width - 1` bytes.
@@ -621,52 +704,14 @@ fn read<R: Read>(
                 ),
             ));
         }
-        // One check that the row is text; a field cut out of it at
-        // characters is then text too (a number always is).
-        let row = records.text();
-        for (slot, col) in slots.iter().zip(cols.iter_mut()) {
-            let at = records.bounds(slot.index);
-            let cut = match row {
-                Some(row) => row.get(at),
-                None => None,
-            };
-            let text = match cut {
-                Some(text) => Some(trim(text)),
-                None => field_text(records.field(slot.index)),
-            };
-            let Some(text) = text else {
-                let raw = records.field(slot.index);
-                return Err(csv_error(
-                    last,
-                    format!(
-                        "column {}: `{}` is not a number (not even UTF-8 text)",
-                        slot.name,
-                        String::from_utf8_lossy(raw).trim()
-                    ),
-                ));
-            };
-            let bad = |why: BadValue| csv_error(last, why.describe(slot.name, text, decimal_comma));
-            let value = value::parse(text, decimal_comma, &mut scratch).map_err(bad)?;
-            // As `value / divisor * factor`: dividing or multiplying by 1
-            // changes no bit.
-            let value = if slot.divisor == 1.0 {
-                value
-            } else {
-                value / slot.divisor
-            };
-            let value = if slot.factor == 1.0 {
-                value
-            } else {
-                value * slot.factor
-            };
-            if !value.is_finite() {
-                return Err(csv_error(
-                    last,
-                    format!("column {}: `{text}` is not a finite number", slot.name),
-                ));
-            }
-            col.push(value);
-        }
+        read_row(
+            &records,
+            &slots,
+            &mut cols,
+            decimal_comma,
+            &mut scratch,
+            last,
+        )?;
         // Increasing, but not necessarily uniform: a rig's recording has its
         // actual sampling instants, jitter and gaps included, and must read
         // back; `sample_period` and identification judge the timing.
