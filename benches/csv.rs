@@ -1,7 +1,8 @@
 //! Reading a lab log: 1e6 rows of `t, u, x1, x2` (a 2 ms log of 33 min)
-//! through `Recording::from_reader` (target < 1 s in release), and the same
-//! log as Excel writes it in a German locale (`;`, decimal commas, `\r\n`)
-//! with a comment line every 1000 rows.
+//! through `Recording::from_reader` (target < 1 s in release), the same log
+//! as a file through `Recording::read_csv` (which sizes the columns from the
+//! file's length), and the log as Excel writes it in a German locale (`;`,
+//! decimal commas, `\r\n`) with a comment line every 1000 rows.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::Recording;
@@ -32,6 +33,14 @@ fn benches(c: &mut Criterion) {
     group.bench_function("from_reader, 1e6 rows t,u,x1,x2 (comma)", |b| {
         b.iter(|| Recording::from_reader(black_box(log.as_bytes())).unwrap())
     });
+    // The same log as a file (31 MB, written once into the temporary
+    // directory, removed at the end).
+    let path = std::env::temp_dir().join(format!("ctrlab_bench_{}.csv", std::process::id()));
+    std::fs::write(&path, &log).unwrap();
+    group.bench_function("read_csv, 1e6 rows t,u,x1,x2 (comma), a file", |b| {
+        b.iter(|| Recording::read_csv(black_box(&path)).unwrap())
+    });
+    std::fs::remove_file(&path).unwrap();
     let excel: String = log
         .replace(',', ";")
         .replace('.', ",")

@@ -104,7 +104,7 @@ fn print_estimate(out: &mut String, name: &str, e: &MassSpringEstimate) {
 
 /// Identifies and formats the report (written to a `String`, so a closed
 /// pipe cannot interrupt it half way).
-fn run(args: &Args) -> Result<String, ctrlab::Error> {
+fn run(args: &Args) -> Result<String, Box<dyn std::error::Error>> {
     let rec = Recording::read_csv(&args.path)?;
     let mut out = String::new();
     let w = &mut out;

@@ -3,7 +3,7 @@
 //! file's own line with what was found there, and any text read without a
 //! panic.
 
-use ctrlab::data::CsvOptions;
+use ctrlab::data::{CsvError, CsvOptions};
 use ctrlab::{Error, Recording};
 use proptest::prelude::*;
 
@@ -58,19 +58,19 @@ fn lab_channels(u_unit: &str) -> Vec<(String, String)> {
         .collect()
 }
 
-/// The `Error::Csv` of reading `file` with `options`.
+/// The `CsvError::Line` of reading `file` with `options`.
 fn csv_err(file: &str, options: &CsvOptions) -> (u64, String) {
     match Recording::read_csv_with(path(file), options) {
-        Err(Error::Csv { line, reason }) => (line, reason),
-        other => panic!("{file}: expected Error::Csv, got {other:?}"),
+        Err(CsvError::Line { line, reason }) => (line, reason),
+        other => panic!("{file}: expected CsvError::Line, got {other:?}"),
     }
 }
 
-/// The `Error::Csv` of reading `text`.
+/// The `CsvError::Line` of reading `text`.
 fn text_err(text: &str) -> (u64, String) {
     match Recording::from_reader(text.as_bytes()) {
-        Err(Error::Csv { line, reason }) => (line, reason),
-        other => panic!("expected Error::Csv, got {other:?}"),
+        Err(CsvError::Line { line, reason }) => (line, reason),
+        other => panic!("expected CsvError::Line, got {other:?}"),
     }
 }
 
@@ -148,7 +148,7 @@ fn counts_without_a_calibration_name_the_option() {
     // The old entry point is the default options.
     assert!(matches!(
         Recording::read_csv(path("counts.csv")),
-        Err(Error::Csv { line: 1, .. })
+        Err(CsvError::Line { line: 1, .. })
     ));
     // A calibration that cannot be one.
     for bad in [0.0, -1e-5, f64::NAN, f64::INFINITY] {
@@ -158,9 +158,11 @@ fn counts_without_a_calibration_name_the_option() {
         assert!(
             matches!(
                 Recording::read_csv_with(path("counts.csv"), &options),
-                Err(Error::InvalidParameter {
-                    name: "metres_per_count",
-                    ..
+                Err(CsvError::Options {
+                    source: Error::InvalidParameter {
+                        name: "metres_per_count",
+                        ..
+                    }
                 })
             ),
             "{bad}"
@@ -365,11 +367,13 @@ fn the_writer_refuses_names_that_would_read_back_in_lower_case() {
     let mut rec = Recording::new(schema);
     rec.push(0.0, &[1.0], &[0.0]).unwrap();
     match rec.to_writer(Vec::new()) {
-        Err(Error::Channel { name, reason }) => {
+        Err(CsvError::Recording {
+            source: Error::Channel { name, reason },
+        }) => {
             assert_eq!(name, "X1");
             assert!(reason.contains("lower case"), "{reason}");
         }
-        other => panic!("expected Error::Channel, got {other:?}"),
+        other => panic!("expected CsvError::Recording, got {other:?}"),
     }
 }
 
@@ -390,15 +394,18 @@ fn a_failing_reader_is_an_io_error() {
     }
     for text in [&b""[..], b"# c\n", b"t_s,u\n0,1\n"] {
         match Recording::from_reader(Failing(text)) {
-            Err(Error::Io { message, .. }) => assert!(message.contains("USB"), "{message}"),
-            other => panic!("expected Error::Io, got {other:?}"),
+            Err(CsvError::Io { context, source }) => {
+                assert!(source.to_string().contains("USB"), "{source}");
+                assert!(context.starts_with("reading"), "{context}");
+            }
+            other => panic!("expected CsvError::Io, got {other:?}"),
         }
     }
 }
 
 /// How many lines `text` has, counting `\n`, `\r\n` and `\r` as line breaks.
-fn line_count(text: &str) -> u64 {
-    let b = text.as_bytes();
+fn line_count(text: &[u8]) -> u64 {
+    let b = text;
     let breaks = (0..b.len())
         .filter(|&i| b[i] == b'\n' || (b[i] == b'\r' && b.get(i + 1) != Some(&b'\n')))
         .count();
@@ -407,7 +414,7 @@ fn line_count(text: &str) -> u64 {
 
 /// What any reading must give: a recording of finite values, at least two
 /// rows, time increasing; or an error on a line of the text.
-fn check_outcome(text: &str, result: Result<Recording, Error>) -> Result<(), TestCaseError> {
+fn check_outcome(text: &[u8], result: Result<Recording, CsvError>) -> Result<(), TestCaseError> {
     match result {
         Ok(rec) => {
             prop_assert!(rec.len() >= 2);
@@ -417,7 +424,7 @@ fn check_outcome(text: &str, result: Result<Recording, Error>) -> Result<(), Tes
                 prop_assert!(rec.channel(&c.name).unwrap().iter().all(|v| v.is_finite()));
             }
         }
-        Err(Error::Csv { line, .. }) => {
+        Err(CsvError::Line { line, .. }) => {
             prop_assert!(
                 line >= 1 && line <= line_count(text),
                 "line {} of {:?}",
@@ -467,7 +474,7 @@ proptest! {
     #[test]
     fn any_text_reads_or_fails_on_one_of_its_lines(text in any::<String>(), counts: bool) {
         let options = if counts { calibrated() } else { CsvOptions::default() };
-        check_outcome(&text, Recording::from_reader_with(text.as_bytes(), &options))?;
+        check_outcome(text.as_bytes(), Recording::from_reader_with(text.as_bytes(), &options))?;
     }
 
     #[test]
@@ -505,7 +512,7 @@ proptest! {
         }
         let text = lines.join(breaks);
         let options = if counts { calibrated() } else { CsvOptions::default() };
-        check_outcome(&text, Recording::from_reader_with(text.as_bytes(), &options))?;
+        check_outcome(text.as_bytes(), Recording::from_reader_with(text.as_bytes(), &options))?;
     }
 
     #[test]
@@ -539,11 +546,115 @@ proptest! {
         let line = 1 + marked.iter().position(|(bad, _)| *bad).unwrap() as u64;
         let broken: Vec<String> = marked.iter().map(|(bad, l)| if *bad { format!("{l}q") } else { l.clone() }).collect();
         match Recording::from_reader(broken.join("\n").as_bytes()) {
-            Err(Error::Csv { line: got, reason }) => {
+            Err(CsvError::Line { line: got, reason }) => {
                 prop_assert_eq!(got, line, "{}", reason);
                 prop_assert!(reason.contains("q`"), "{}", reason);
             }
-            other => prop_assert!(false, "expected Error::Csv, got {:?}", other),
+            other => prop_assert!(false, "expected CsvError::Line, got {:?}", other),
         }
+    }
+}
+
+/// Hands out at most `.1` bytes a read, as a pipe or a slow device might.
+struct Trickle<'a>(&'a [u8], usize);
+
+impl std::io::Read for Trickle<'_> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.0.len().min(out.len()).min(self.1);
+        out[..n].copy_from_slice(&self.0[..n]);
+        self.0 = &self.0[n..];
+        Ok(n)
+    }
+}
+
+/// The fuzz target's seeds (`fuzz/seeds/csv_identify`) and the logs here.
+fn seeds() -> Vec<Vec<u8>> {
+    let mut files: Vec<_> = ["fuzz/seeds/csv_identify", "tests/data/logs"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(format!("{}/{d}", env!("CARGO_MANIFEST_DIR"))).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "csv" || e == "tsv"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 4 + 15, "{files:?}");
+    files.iter().map(|p| std::fs::read(p).unwrap()).collect()
+}
+
+#[test]
+fn the_fuzz_seeds_read_or_fail_on_one_of_their_lines() {
+    for seed in seeds() {
+        for options in [CsvOptions::default(), calibrated()] {
+            check_outcome(&seed, Recording::from_reader_with(&seed[..], &options)).unwrap();
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1024, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_bytes_read_or_fail_on_one_of_their_lines(
+        bytes in prop::collection::vec(
+            prop_oneof![any::<u8>(), prop::sample::select(b"t_s,u;\t\n\r\"#% 0123456789.e-".to_vec())],
+            0..2000,
+        ),
+        counts: bool,
+    ) {
+        let options = if counts { calibrated() } else { CsvOptions::default() };
+        check_outcome(&bytes, Recording::from_reader_with(&bytes[..], &options))?;
+    }
+
+    #[test]
+    fn mutated_logs_read_or_fail_on_one_of_their_lines(
+        seed in any::<prop::sample::Index>(),
+        edits in prop::collection::vec(
+            (any::<prop::sample::Index>(), any::<u8>(), prop::sample::select(b"\n\r\",;\t#% \xff\xc3e-.0".to_vec()), 0u8..5),
+            1..8,
+        ),
+        counts: bool,
+    ) {
+        let seeds = seeds();
+        let mut bytes = seeds[seed.index(seeds.len())].clone();
+        for (at, any, special, op) in edits {
+            let at = at.index(bytes.len() + 1);
+            match op {
+                0 if at < bytes.len() => bytes[at] = special,
+                1 if at < bytes.len() => bytes[at] = any,
+                2 if at < bytes.len() => {
+                    bytes.remove(at);
+                }
+                // A line repeated (a time that does not increase) or the
+                // end cut off (a logger that stopped mid-line).
+                3 => {
+                    let start = bytes[..at].iter().rposition(|&b| b == b'\n').map_or(0, |k| k + 1);
+                    let end = bytes[at..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |k| at + k + 1);
+                    let line = bytes[start..end].to_vec();
+                    bytes.splice(start..start, line);
+                }
+                4 => bytes.truncate(at),
+                _ => bytes.insert(at, special),
+            }
+        }
+        let options = if counts { calibrated() } else { CsvOptions::default() };
+        check_outcome(&bytes, Recording::from_reader_with(&bytes[..], &options))?;
+    }
+
+    #[test]
+    fn a_log_read_in_pieces_reads_as_in_one(
+        seed in any::<prop::sample::Index>(),
+        edits in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(b"\n\r\",;#% \xef\xbb\xbf".to_vec())), 0..4),
+        chunk in 1usize..40,
+    ) {
+        // The reader takes what each read gives: a line, a `\r\n` or a
+        // byte-order mark split across reads reads as whole.
+        let seeds = seeds();
+        let mut bytes = seeds[seed.index(seeds.len())].clone();
+        for (at, b) in edits {
+            let at = at.index(bytes.len() + 1);
+            bytes.insert(at, b);
+        }
+        let whole = Recording::from_reader_with(&bytes[..], &calibrated());
+        let pieces = Recording::from_reader_with(Trickle(&bytes, chunk), &calibrated());
+        prop_assert_eq!(format!("{whole:?}"), format!("{pieces:?}"));
     }
 }

@@ -4,7 +4,7 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::data::{Channel, Schema};
+use ctrlab::data::{Channel, CsvError, CsvErrorKind, Schema};
 use ctrlab::lab::ident::{MIN_SAMPLES, Scheme, identify};
 use ctrlab::{Error, Recording};
 use proptest::prelude::*;
@@ -21,8 +21,8 @@ const GOOD: &str = "t_s,u,x1_mm,x2_mm
 
 fn csv_err(text: &str) -> (u64, String) {
     match Recording::from_reader(text.as_bytes()) {
-        Err(Error::Csv { line, reason }) => (line, reason),
-        other => panic!("expected Error::Csv, got {other:?}"),
+        Err(CsvError::Line { line, reason }) => (line, reason),
+        other => panic!("expected CsvError::Line, got {other:?}"),
     }
 }
 
@@ -264,7 +264,7 @@ fn each_malformed_input_names_its_line() {
     bytes[at] = 0xff;
     assert!(matches!(
         Recording::from_reader(&bytes[..]),
-        Err(Error::Csv { line: 3, .. })
+        Err(CsvError::Line { line: 3, .. })
     ));
 }
 
@@ -366,9 +366,30 @@ fn the_generic_reader_accepts_what_the_lab_identification_refuses() {
 #[test]
 fn missing_file_is_an_io_error_with_the_path() {
     match Recording::read_csv("/no/such/dir/log.csv") {
-        Err(Error::Io { context, kind, .. }) => {
+        Err(e @ CsvError::Io { .. }) => {
+            assert_eq!(e.kind(), CsvErrorKind::Io);
+            assert!(e.to_string().contains("/no/such/dir/log.csv"), "{e}");
+            // The io::Error itself, as the source.
+            let source = std::error::Error::source(&e).unwrap();
+            let io = source.downcast_ref::<std::io::Error>().unwrap();
+            assert_eq!(io.kind(), std::io::ErrorKind::NotFound);
+            let CsvError::Io { context, source } = e else {
+                unreachable!()
+            };
             assert!(context.contains("/no/such/dir/log.csv"));
-            assert_eq!(kind, std::io::ErrorKind::NotFound);
+            assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
+        }
+        other => panic!("expected Io, got {other:?}"),
+    }
+    // Writing into a directory that is not there.
+    let rec = read(GOOD);
+    match rec.write_csv("/no/such/dir/log.csv") {
+        Err(CsvError::Io { context, source }) => {
+            assert!(
+                context.contains("creating /no/such/dir/log.csv"),
+                "{context}"
+            );
+            assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
         }
         other => panic!("expected Io, got {other:?}"),
     }
@@ -392,19 +413,33 @@ fn file_round_trip_and_writer_refusals() {
     nan.channel_mut("u").unwrap()[2] = f64::NAN;
     assert!(matches!(
         nan.to_writer(Vec::new()),
-        Err(Error::InvalidRecording { index: 2, .. })
+        Err(CsvError::Recording {
+            source: Error::InvalidRecording { index: 2, .. }
+        })
     ));
     let path = std::env::temp_dir().join(format!("ctrlab_nan_{}.csv", std::process::id()));
-    assert!(matches!(
-        nan.write_csv(&path),
-        Err(Error::InvalidRecording { index: 2, .. })
-    ));
-    std::fs::remove_file(&path).ok();
+    let err = nan.write_csv(&path).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            CsvError::Recording {
+                source: Error::InvalidRecording { index: 2, .. }
+            }
+        ),
+        "{err:?}"
+    );
+    assert_eq!(err.kind(), CsvErrorKind::Recording);
+    // The message keeps the numeric error's.
+    assert!(err.to_string().contains("u = NaN"), "{err}");
+    // Refused before the file is created.
+    assert!(!path.exists());
     let mut late = read(GOOD);
     late.time_mut()[4] = f64::INFINITY;
     assert!(matches!(
         late.to_writer(Vec::new()),
-        Err(Error::InvalidRecording { index: 4, .. })
+        Err(CsvError::Recording {
+            source: Error::InvalidRecording { index: 4, .. }
+        })
     ));
 }
 
@@ -578,7 +613,7 @@ proptest! {
     fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..512)) {
         // Any outcome is fine except a panic; an error must name a line.
         if let Err(e) = Recording::from_reader(&bytes[..]) {
-            let ok = matches!(e, Error::Csv { line, .. } if line >= 1);
+            let ok = matches!(e, CsvError::Line { line, .. } if line >= 1);
             prop_assert!(ok, "unexpected error {:?}", e);
         }
     }
@@ -596,7 +631,7 @@ proptest! {
             text.push('\n');
         }
         if let Err(e) = Recording::from_reader(text.as_bytes()) {
-            let ok = matches!(e, Error::Csv { line, .. } if line >= 1);
+            let ok = matches!(e, CsvError::Line { line, .. } if line >= 1);
             prop_assert!(ok, "unexpected error {:?}", e);
         }
     }
@@ -613,6 +648,6 @@ fn a_time_column_whose_span_overflows_is_refused() {
     }
     assert!(matches!(
         Recording::from_reader(text.as_bytes()),
-        Err(Error::Csv { line: 4, .. })
+        Err(CsvError::Line { line: 4, .. })
     ));
 }

@@ -5,6 +5,7 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
+use ctrlab::data::CsvError;
 use ctrlab::design::{acker, lqr};
 use ctrlab::discretize::expm;
 use ctrlab::hw::{Clock, HwErrorKind, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
@@ -596,9 +597,9 @@ fn csv_errors_show_what_they_found() {
     assert!(err.to_string().contains("time_ms_x,u,x1_m"), "{err}");
     // A header after blank lines is reported on its own line.
     let err = Recording::from_reader("\n\nx,u\n0,1\n1,1\n".as_bytes()).unwrap_err();
-    assert!(matches!(err, Error::Csv { line: 3, .. }), "{err}");
+    assert!(matches!(err, CsvError::Line { line: 3, .. }), "{err}");
     let err = Recording::from_reader("\n\nt_s,u\n0,1\n0,1\n".as_bytes()).unwrap_err();
-    assert!(matches!(err, Error::Csv { line: 5, .. }), "{err}");
+    assert!(matches!(err, CsvError::Line { line: 5, .. }), "{err}");
 }
 
 #[test]

@@ -9,7 +9,8 @@
 //! schema, [`lab::schema`](crate::lab::schema). It reads and writes CSV with
 //! the unit in each header, and reads the logs students have: `;` or tab
 //! separators, decimal commas, comment lines, any case, raw encoder counts
-//! (see [`Recording::from_reader_with`]).
+//! (see [`Recording::from_reader_with`]); what goes wrong doing so is a
+//! [`CsvError`].
 //!
 //! # Examples
 //!
@@ -25,7 +26,7 @@
 //! let mut out = Vec::new();
 //! rec.to_writer(&mut out)?; // SI, the unit in each header
 //! assert!(String::from_utf8(out).unwrap().starts_with("t_s,u_V,x_m\n"));
-//! # Ok::<(), ctrlab::Error>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 mod csv;
@@ -34,7 +35,7 @@ use nalgebra::SVector;
 
 use crate::error::Error;
 
-pub use self::csv::{CsvOptions, KNOWN_UNITS};
+pub use self::csv::{CsvError, CsvErrorKind, CsvOptions, KNOWN_UNITS};
 
 /// Largest accepted deviation of one sampling interval from the mean
 /// interval, as a fraction of the mean (1 %), when a recording is checked

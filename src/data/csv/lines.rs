@@ -1,240 +1,216 @@
-//! The lines of a log before the CSV parser sees them: a UTF-8 byte-order
-//! mark, line breaks (`\n`, `\r\n` or `\r`), comment lines (`#` or `%`) and
-//! blank lines, the header line and the separator it shows.
+//! The lines of a log, read once: a UTF-8 byte-order mark, line breaks
+//! (`\n`, `\r\n` or `\r`), comment lines (`#` or `%`) and blank lines, and
+//! the separator the header line shows.
 //!
-//! The parser sees content lines only, each ending in `\n`; [`Uncommented`]
-//! remembers the lines it dropped, so an error names the file's own line.
+//! [`Lines`] hands out the file's lines in place, in its own buffer, each
+//! with its number and what it is; the reader feeds the content lines to the
+//! CSV tokenizer and skips the others, so a line number is the file's own.
 
-use std::io::{self, BufRead, Read};
-
-/// Where [`Uncommented`] is within a line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum State {
-    /// At the start of a line, holding its leading whitespace until it
-    /// shows whether the line is blank, a comment or content.
-    LineStart,
-    /// In a content line: bytes pass through.
-    Content,
-    /// In a comment line: bytes are dropped up to its line break.
-    Comment,
-}
-
-/// `inner` with its comment lines (first byte other than space or tab `#`
-/// or `%`) and blank lines (spaces and tabs only) dropped, every line break
-/// written `\n`, and a UTF-8 byte-order mark at its start dropped. Content
-/// lines pass otherwise unchanged, leading whitespace included (in a
-/// tab-separated file a leading tab is an empty first field).
-pub(super) struct Uncommented<R> {
-    inner: R,
-    state: State,
-    /// The last line break was a `\r`: a `\n` right after it is the same
-    /// line break.
-    after_cr: bool,
-    /// Leading whitespace of the current line, and how much of it has been
-    /// passed on.
-    pending: Vec<u8>,
-    flushed: usize,
-    started: bool,
-    /// The one-based number of the output line being written.
-    out_line: u64,
-    /// Lines dropped: `(output line, lines dropped before it in all)`, one
-    /// entry per output line that follows dropped lines, in order.
-    dropped: Vec<(u64, u64)>,
-}
+use std::io::{self, Read};
+use std::ops::Range;
 
 const BOM: &[u8] = b"\xef\xbb\xbf";
 
-impl<R: BufRead> Uncommented<R> {
+/// How much is read from the source at a time.
+const CHUNK: usize = 64 * 1024;
+
+/// What a line of a log is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Kind {
+    /// Spaces and tabs only, or nothing: skipped.
+    Blank,
+    /// Its first byte other than space or tab is `#` or `%`: skipped.
+    Comment,
+    /// Anything else: the header or a row (or part of a quoted field).
+    Content,
+}
+
+/// One line of a log, in [`Lines::bytes`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct Line {
+    /// Where it is, with its line break (`\n` or `\r`; not the `\n` of a
+    /// `\r\n`) if it has one: the last line of a file may have none.
+    pub(super) range: Range<usize>,
+    /// The file's one-based line number.
+    pub(super) number: u64,
+    pub(super) kind: Kind,
+    /// Whether `range` ends with a line break.
+    pub(super) has_break: bool,
+}
+
+/// What a line is, from its bytes without the line break.
+fn kind(line: &[u8]) -> Kind {
+    match line.iter().find(|&&b| b != b' ' && b != b'\t') {
+        None => Kind::Blank,
+        Some(b'#' | b'%') => Kind::Comment,
+        Some(_) => Kind::Content,
+    }
+}
+
+/// The lines of `inner`, split at `\n`, `\r\n` or `\r`, a UTF-8 byte-order
+/// mark at its start dropped. A last line without a line break is a line if
+/// it holds anything.
+pub(super) struct Lines<R> {
+    inner: R,
+    buf: Vec<u8>,
+    /// The first byte not handed out yet, and the end of what was read.
+    pos: usize,
+    end: usize,
+    /// Bytes dropped from the front of `buf` so far.
+    dropped: u64,
+    eof: bool,
+    /// The last line break was a `\r`: a `\n` right after it belongs to it.
+    after_cr: bool,
+    started: bool,
+    /// The number of the last line handed out.
+    line: u64,
+}
+
+impl<R: Read> Lines<R> {
     pub(super) fn new(inner: R) -> Self {
+        Self::with_capacity(inner, CHUNK)
+    }
+
+    /// As [`new`](Self::new), reading `capacity` bytes at a time (at least
+    /// 4); the buffer grows for a longer line.
+    pub(super) fn with_capacity(inner: R, capacity: usize) -> Self {
         Self {
             inner,
-            state: State::LineStart,
+            buf: vec![0; capacity.max(4)],
+            pos: 0,
+            end: 0,
+            dropped: 0,
+            eof: false,
             after_cr: false,
-            pending: Vec::new(),
-            flushed: 0,
             started: false,
-            out_line: 1,
-            dropped: Vec::new(),
+            line: 0,
         }
     }
-}
 
-impl<R> Uncommented<R> {
-    /// The file's one-based line number of output line `line`.
-    pub(super) fn file_line(&self, line: u64) -> u64 {
-        let k = self.dropped.partition_point(|&(at, _)| at <= line);
-        line + k.checked_sub(1).map_or(0, |k| self.dropped[k].1)
+    /// The bytes of a [`Line`] just handed out (valid until the next call
+    /// to [`next`](Self::next)).
+    pub(super) fn bytes(&self, range: Range<usize>) -> &[u8] {
+        &self.buf[range]
     }
 
-    /// How many lines were dropped in all.
-    pub(super) fn dropped_lines(&self) -> u64 {
-        self.dropped.last().map_or(0, |d| d.1)
+    /// The number of the last line handed out (0 before the first).
+    pub(super) fn line(&self) -> u64 {
+        self.line
     }
-}
 
-/// Counts one more dropped line before output line `out_line` in
-/// [`Uncommented::dropped`].
-fn drop_line(dropped: &mut Vec<(u64, u64)>, out_line: u64) {
-    match dropped.last_mut() {
-        Some(last) if last.0 == out_line => last.1 += 1,
-        Some(&mut (_, total)) => dropped.push((out_line, total + 1)),
-        None => dropped.push((out_line, 1)),
+    /// How many bytes of the source have been handed out or skipped.
+    pub(super) fn consumed(&self) -> u64 {
+        self.dropped + self.pos as u64
     }
-}
 
-/// Copies what fits of `pending[*flushed..]` to `out`; returns the count.
-fn flush(pending: &[u8], flushed: &mut usize, out: &mut [u8]) -> usize {
-    let n = (pending.len() - *flushed).min(out.len());
-    out[..n].copy_from_slice(&pending[*flushed..*flushed + n]);
-    *flushed += n;
-    n
-}
-
-/// Where the first line break (`\n` or `\r`) in `bytes` is.
-fn line_break(bytes: &[u8]) -> Option<usize> {
-    bytes.iter().position(|&b| b == b'\n' || b == b'\r')
-}
-
-impl<R: BufRead> Read for Uncommented<R> {
-    fn read(&mut self, out: &mut [u8]) -> io::Result<usize> {
-        if !self.started {
-            self.started = true;
-            if self.inner.fill_buf()?.starts_with(BOM) {
-                self.inner.consume(BOM.len());
-            }
+    /// Moves what is not handed out yet to the front of the buffer, growing
+    /// it when full, and reads more after it. At the end of the source sets
+    /// `eof`.
+    fn refill(&mut self) -> io::Result<()> {
+        if self.pos > 0 {
+            self.buf.copy_within(self.pos..self.end, 0);
+            self.dropped += self.pos as u64;
+            self.end -= self.pos;
+            self.pos = 0;
         }
-        let mut w = 0;
-        if self.state == State::Content && self.flushed < self.pending.len() {
-            // A content line's leading whitespace that a full `out` cut short.
-            w = flush(&self.pending, &mut self.flushed, out);
-            if self.flushed < self.pending.len() {
-                return Ok(w);
-            }
-            self.pending.clear();
+        if self.end == self.buf.len() {
+            self.buf.resize(2 * self.buf.len(), 0);
         }
         loop {
-            let buf = self.inner.fill_buf()?;
-            if buf.is_empty() {
-                // The end. A last line without a line break that was blank
-                // or a comment is dropped too.
-                if self.state == State::Comment
-                    || (self.state == State::LineStart && !self.pending.is_empty())
-                {
-                    self.state = State::LineStart;
-                    self.pending.clear();
-                    drop_line(&mut self.dropped, self.out_line);
+            match self.inner.read(&mut self.buf[self.end..]) {
+                Ok(0) => {
+                    self.eof = true;
+                    return Ok(());
                 }
-                return Ok(w);
-            }
-            let mut i = 0;
-            while i < buf.len() && w < out.len() {
-                let b = buf[i];
-                if std::mem::take(&mut self.after_cr) && b == b'\n' {
-                    // The `\n` of a `\r\n`, already counted.
-                    i += 1;
-                    continue;
+                Ok(n) => {
+                    self.end += n;
+                    return Ok(());
                 }
-                match self.state {
-                    State::Content => {
-                        let rest = &buf[i..];
-                        let end = line_break(rest);
-                        let n = end.unwrap_or(rest.len()).min(out.len() - w);
-                        out[w..w + n].copy_from_slice(&rest[..n]);
-                        w += n;
-                        i += n;
-                        if end == Some(n) && w < out.len() {
-                            self.after_cr = rest[n] == b'\r';
-                            out[w] = b'\n';
-                            w += 1;
-                            i += 1;
-                            self.out_line += 1;
-                            self.state = State::LineStart;
-                        }
-                    }
-                    State::Comment => match line_break(&buf[i..]) {
-                        Some(p) => {
-                            i += p;
-                            self.after_cr = buf[i] == b'\r';
-                            i += 1;
-                            self.state = State::LineStart;
-                            drop_line(&mut self.dropped, self.out_line);
-                        }
-                        None => i = buf.len(),
-                    },
-                    State::LineStart => match b {
-                        b' ' | b'\t' => {
-                            self.pending.push(b);
-                            i += 1;
-                        }
-                        b'\n' | b'\r' => {
-                            self.after_cr = b == b'\r';
-                            self.pending.clear();
-                            drop_line(&mut self.dropped, self.out_line);
-                            i += 1;
-                        }
-                        b'#' | b'%' => {
-                            self.pending.clear();
-                            self.state = State::Comment;
-                            i += 1;
-                        }
-                        _ => {
-                            self.state = State::Content;
-                            self.flushed = 0;
-                            w += flush(&self.pending, &mut self.flushed, &mut out[w..]);
-                            if self.flushed < self.pending.len() {
-                                break;
-                            }
-                            self.pending.clear();
-                        }
-                    },
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// The next line, or `None` at the end.
+    pub(super) fn next(&mut self) -> io::Result<Option<Line>> {
+        if !self.started {
+            while self.end - self.pos < BOM.len() && !self.eof {
+                self.refill()?;
+            }
+            self.started = true;
+            if self.buf[self.pos..self.end].starts_with(BOM) {
+                self.pos += BOM.len();
+            }
+        }
+        if self.after_cr {
+            if self.pos == self.end && !self.eof {
+                self.refill()?;
+            }
+            self.after_cr = false;
+            if self.pos < self.end && self.buf[self.pos] == b'\n' {
+                self.pos += 1;
+            }
+        }
+        // Searched so far, from `pos`: a long line is searched once.
+        let mut searched = 0;
+        loop {
+            let from = self.pos + searched;
+            if let Some(k) = memchr::memchr2(b'\n', b'\r', &self.buf[from..self.end]) {
+                let at = from + k;
+                let line = Line {
+                    range: self.pos..at + 1,
+                    number: self.line + 1,
+                    kind: kind(&self.buf[self.pos..at]),
+                    has_break: true,
+                };
+                self.after_cr = self.buf[at] == b'\r';
+                self.pos = at + 1;
+                self.line += 1;
+                return Ok(Some(line));
+            }
+            searched = self.end - self.pos;
+            if self.eof {
+                if self.pos == self.end {
+                    return Ok(None);
                 }
+                let line = Line {
+                    range: self.pos..self.end,
+                    number: self.line + 1,
+                    kind: kind(&self.buf[self.pos..self.end]),
+                    has_break: false,
+                };
+                self.pos = self.end;
+                self.line += 1;
+                return Ok(Some(line));
             }
-            self.inner.consume(i);
-            // Only what this read could take without waiting for more input
-            // (a comment that filled the whole buffer gave nothing yet).
-            if w > 0 {
-                return Ok(w);
-            }
+            self.refill()?;
         }
     }
 }
 
-/// The header line of a log, as read from an [`Uncommented`] stream.
-pub(super) struct HeaderLine {
-    /// The line as read, with its `\n`. The CSV parser reads it again.
-    pub(super) bytes: Vec<u8>,
+/// A line without its line break.
+pub(super) fn without_break(line: &[u8]) -> &[u8] {
+    match line {
+        [rest @ .., b'\n' | b'\r'] => rest,
+        _ => line,
+    }
 }
 
-impl HeaderLine {
-    /// Reads the first line of `lines`: the header, the comment and blank
-    /// lines before it being dropped. `None` when there is none.
-    pub(super) fn read(lines: &mut impl BufRead) -> io::Result<Option<Self>> {
-        let mut bytes = Vec::new();
-        Ok((lines.read_until(b'\n', &mut bytes)? > 0).then_some(Self { bytes }))
-    }
-
-    /// The header line as found, without its line break.
-    pub(super) fn text(&self) -> &[u8] {
-        self.bytes.strip_suffix(b"\n").unwrap_or(&self.bytes)
-    }
-
-    /// The separator the header line shows: a tab if it holds one, else `;`
-    /// if it holds one, else `,`. A header holding a comma is
-    /// comma-separated whatever else it holds: a name or unit cannot hold a
-    /// comma, so no `;` or tab header has one, and a comma header with
-    /// fields padded by tabs reads as it did before the reader knew other
-    /// separators.
-    pub(super) fn separator(&self) -> u8 {
-        let header = self.text();
-        if header.contains(&b',') {
-            b','
-        } else if header.contains(&b'\t') {
-            b'\t'
-        } else if header.contains(&b';') {
-            b';'
-        } else {
-            b','
-        }
+/// The separator a header line (without its line break) shows: a tab if it
+/// holds one, else `;` if it holds one, else `,`. A header holding a comma
+/// is comma-separated whatever else it holds: a name or unit cannot hold a
+/// comma, so no `;` or tab header has one, and a comma header with fields
+/// padded by tabs reads as it did before the reader knew other separators.
+pub(super) fn separator(header: &[u8]) -> u8 {
+    if header.contains(&b',') {
+        b','
+    } else if header.contains(&b'\t') {
+        b'\t'
+    } else if header.contains(&b';') {
+        b';'
+    } else {
+        b','
     }
 }
 
@@ -242,66 +218,100 @@ impl HeaderLine {
 mod tests {
     use super::*;
 
-    /// `text` through [`Uncommented`], read `chunk` bytes at a time from a
-    /// reader that hands out `fill` bytes at a time; and the filter.
-    fn filtered(text: &[u8], fill: usize, chunk: usize) -> (Vec<u8>, Uncommented<impl BufRead>) {
-        let inner = io::BufReader::with_capacity(fill, text);
-        let mut f = Uncommented::new(inner);
+    /// A reader that hands out at most `n` bytes a read.
+    struct Trickle<'a>(&'a [u8], usize);
+
+    impl Read for Trickle<'_> {
+        fn read(&mut self, out: &mut [u8]) -> io::Result<usize> {
+            let n = self.0.len().min(out.len()).min(self.1);
+            out[..n].copy_from_slice(&self.0[..n]);
+            self.0 = &self.0[n..];
+            Ok(n)
+        }
+    }
+
+    /// Every line of `text` as (number, kind, bytes), reading `fill` bytes
+    /// at a time into a buffer of `capacity`.
+    fn lines(text: &[u8], fill: usize, capacity: usize) -> Vec<(u64, Kind, String)> {
+        let mut lines = Lines::with_capacity(Trickle(text, fill), capacity);
         let mut out = Vec::new();
-        let mut buf = vec![0; chunk];
-        loop {
-            let n = f.read(&mut buf).unwrap();
-            if n == 0 {
-                return (out, f);
-            }
-            out.extend_from_slice(&buf[..n]);
+        while let Some(line) = lines.next().unwrap() {
+            let bytes = lines.bytes(line.range);
+            out.push((
+                line.number,
+                line.kind,
+                String::from_utf8_lossy(bytes).into_owned(),
+            ));
+            assert_eq!(lines.line(), line.number);
         }
+        assert_eq!(lines.consumed(), text.len() as u64);
+        out
     }
 
     #[test]
-    fn comments_and_blank_lines_are_dropped_and_counted() {
+    fn comments_and_blank_lines_are_told_from_content_and_counted() {
+        use Kind::{Blank, Comment, Content};
         let text = b"\xef\xbb\xbf# lab 5\r\n% group 3\n\n  \t\r\nt_s,u\r\n  # late\n0,1\r\r\n\t1,2\n  3,4 # not a comment\n%";
-        let want = "t_s,u\n0,1\n\t1,2\n  3,4 # not a comment\n";
-        for fill in [3, 4, 5, 7, 64] {
-            for chunk in [1, 2, 7, 64] {
-                let (out, f) = filtered(text, fill, chunk);
+        let want = vec![
+            (1, Comment, "# lab 5\r".to_string()),
+            (2, Comment, "% group 3\n".into()),
+            (3, Blank, "\n".into()),
+            (4, Blank, "  \t\r".into()),
+            (5, Content, "t_s,u\r".into()),
+            (6, Comment, "  # late\n".into()),
+            (7, Content, "0,1\r".into()),
+            (8, Blank, "\r".into()),
+            (9, Content, "\t1,2\n".into()),
+            (10, Content, "  3,4 # not a comment\n".into()),
+            (11, Comment, "%".into()),
+        ];
+        for fill in [1, 2, 3, 5, 7, 64] {
+            for capacity in [4, 5, 8, 64] {
                 assert_eq!(
-                    String::from_utf8_lossy(&out),
+                    lines(text, fill, capacity),
                     want,
-                    "fill {fill}, chunk {chunk}"
+                    "fill {fill}, capacity {capacity}"
                 );
-                // Output lines 1-4 are the file's lines 5, 7, 9 and 10
-                // (line 8 is the empty line of `\r\r\n`); 11 is dropped.
-                let lines: Vec<u64> = (1..=4).map(|k| f.file_line(k)).collect();
-                assert_eq!(lines, [5, 7, 9, 10], "fill {fill}, chunk {chunk}");
-                assert_eq!(f.dropped_lines(), 7);
             }
         }
-        // Content without a final line break, and a final blank line.
-        assert_eq!(filtered(b"a\n  ", 64, 64).0, b"a\n");
-        assert_eq!(filtered(b"a\n b", 64, 64).0, b"a\n b");
-        // Old Mac line breaks.
-        let (out, f) = filtered(b"a\r\rb\rc", 64, 64);
-        assert_eq!(
-            (out.as_slice(), f.file_line(2), f.file_line(3)),
-            (&b"a\nb\nc"[..], 3, 4)
-        );
+        // A last line without a line break; a final line break ends the
+        // last line, it does not start an empty one.
+        let kinds = |t: &[u8]| -> Vec<Kind> { lines(t, 64, 64).iter().map(|l| l.1).collect() };
+        assert_eq!(kinds(b"a\n  "), [Content, Blank]);
+        assert_eq!(kinds(b"a\n b"), [Content, Content]);
+        assert_eq!(kinds(b"a\n"), [Content]);
+        assert_eq!(kinds(b""), []);
+        assert_eq!(kinds(b"\xef\xbb\xbf"), []);
+        assert_eq!(kinds(b"\n"), [Blank]);
+        // Old Mac line breaks, and a `\r\n` split across reads.
+        let got = lines(b"a\r\rb\rc", 64, 64);
+        assert_eq!(got.iter().map(|l| l.0).collect::<Vec<_>>(), [1, 2, 3, 4]);
+        assert_eq!(lines(b"a\r\nb", 2, 4)[1], (2, Content, "b".into()));
+        // Only one byte-order mark is dropped, and only at the start.
+        assert_eq!(lines(b"\xef\xbb\xbf\xef\xbb\xbfx", 1, 4)[0].2, "\u{feff}x");
+        assert_eq!(lines(b"x\n\xef\xbb\xbf", 1, 4)[1].2, "\u{feff}");
     }
 
     #[test]
-    fn the_header_line_and_its_separator() {
-        let read = |text: &[u8]| {
-            let mut lines = io::BufReader::new(Uncommented::new(text));
-            HeaderLine::read(&mut lines).unwrap()
-        };
-        let h = read(b"# c\n\nt_s;u\r\n0;1\n").unwrap();
-        assert_eq!((h.text(), h.separator()), (&b"t_s;u"[..], b';'));
-        assert_eq!(h.bytes, b"t_s;u\n");
-        assert_eq!(read(b"t [s]\tu [V]\n").unwrap().separator(), b'\t');
-        assert_eq!(read(b"t;s\tu\n").unwrap().separator(), b'\t');
-        assert_eq!(read(b"t_s\t,u;x\n").unwrap().separator(), b',');
-        assert_eq!(read(b"t_s").unwrap().separator(), b',');
-        assert!(read(b"# only\n\n%\n").is_none());
-        assert!(read(b"").is_none());
+    fn long_lines_grow_the_buffer() {
+        let long = "x".repeat(1000);
+        let text = format!("{long}\n{long}\r\n# {long}\n");
+        let got = lines(text.as_bytes(), 7, 4);
+        assert_eq!(got.len(), 3);
+        assert_eq!(got[0].2, format!("{long}\n"));
+        assert_eq!(got[1].2, format!("{long}\r"));
+        assert_eq!(got[2].1, Kind::Comment);
+    }
+
+    #[test]
+    fn the_separator_a_header_shows() {
+        assert_eq!(separator(b"t_s;u"), b';');
+        assert_eq!(separator(b"t [s]\tu [V]"), b'\t');
+        assert_eq!(separator(b"t;s\tu"), b'\t');
+        assert_eq!(separator(b"t_s\t,u;x"), b',');
+        assert_eq!(separator(b"t_s"), b',');
+        assert_eq!(without_break(b"t_s;u\r"), b"t_s;u");
+        assert_eq!(without_break(b"t_s;u\n"), b"t_s;u");
+        assert_eq!(without_break(b"t_s;u"), b"t_s;u");
     }
 }

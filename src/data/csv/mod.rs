@@ -1,8 +1,10 @@
 //! CSV reading and writing of [`Recording`](super::Recording)s: the lines
 //! of a log ([`lines`]: comments, blank lines, the separator), a header
 //! and its units ([`header`]), one field's number ([`value`]), the options
-//! ([`options`]), the reader ([`read`]) and the writer ([`write`]).
+//! ([`options`]), the reader ([`read`]) and the writer ([`write`]), and what
+//! goes wrong ([`error`]).
 
+mod error;
 mod header;
 mod lines;
 mod options;
@@ -10,9 +12,8 @@ mod read;
 mod value;
 mod write;
 
+pub use self::error::{CsvError, CsvErrorKind};
 pub use self::options::CsvOptions;
-
-use crate::error::Error;
 
 /// The units the CSV reader recognises as a header suffix, with the SI unit
 /// they stand for and how many of them make one SI unit:
@@ -51,8 +52,9 @@ pub(super) fn is_input_name(name: &str) -> bool {
         .is_some_and(|rest| rest.chars().all(|c| c.is_ascii_digit()))
 }
 
-pub(super) fn csv_error(line: u64, reason: impl Into<String>) -> Error {
-    Error::Csv {
+/// A [`CsvError::Line`]: what is wrong on the file's line `line`.
+pub(super) fn csv_error(line: u64, reason: impl Into<String>) -> CsvError {
+    CsvError::Line {
         line,
         reason: reason.into(),
     }

@@ -1,5 +1,6 @@
 //! [`CsvOptions`]: what the reader needs to know that a log does not say.
 
+use super::CsvError;
 use crate::error::Error;
 
 /// What the CSV reader needs to know that a log does not say about itself:
@@ -23,26 +24,28 @@ use crate::error::Error;
 ///
 /// // Without the calibration a column in counts is refused.
 /// assert!(Recording::from_reader_with(log.as_bytes(), &CsvOptions::default()).is_err());
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct CsvOptions {
     /// Metres per encoder count, m (finite and positive): a column whose
     /// unit is `counts` (`x1_counts`, `x1 [counts]`, `x1 [cnt]`) is read as
     /// the channel in `m`, each value times this. `None` (the default): a
-    /// column in counts is an [`Error::Csv`] on the header line.
+    /// column in counts is a [`CsvError::Line`] on the header line.
     pub metres_per_count: Option<f64>,
 }
 
 impl CsvOptions {
-    /// Checks every field: [`Error::InvalidParameter`] naming the first bad
-    /// one.
-    pub(super) fn check(&self) -> Result<(), Error> {
+    /// Checks every field: [`CsvError::Options`] holding the
+    /// [`Error::InvalidParameter`] that names the first bad one.
+    pub(super) fn check(&self) -> Result<(), CsvError> {
         match self.metres_per_count {
-            Some(m) if !(m.is_finite() && m > 0.0) => Err(Error::InvalidParameter {
-                name: "metres_per_count",
-                value: m,
-                reason: "must be finite and positive (m per encoder count)",
+            Some(m) if !(m.is_finite() && m > 0.0) => Err(CsvError::Options {
+                source: Error::InvalidParameter {
+                    name: "metres_per_count",
+                    value: m,
+                    reason: "must be finite and positive (m per encoder count)",
+                },
             }),
             _ => Ok(()),
         }

@@ -13,7 +13,7 @@ pub(super) enum BadValue {
 }
 
 impl BadValue {
-    /// The reason of an [`Error::Csv`](crate::Error::Csv) for field `text`
+    /// The reason of a [`CsvError::Line`](super::CsvError::Line) for field `text`
     /// of column `column`.
     pub(super) fn describe(self, column: &str, text: &str, decimal_comma: bool) -> String {
         match self {
@@ -87,6 +87,18 @@ mod tests {
             Err(BadValue::NotANumber)
         );
         assert_eq!(parse("é,5", true, &mut s), Err(BadValue::NotANumber));
+        // Any length: as with a point.
+        let digits = "1234567890".repeat(5);
+        for n in 0..=40 {
+            let comma = format!("-{},{}e-3", &digits[..n], &digits[n..40]);
+            let point = comma.replace(',', ".");
+            let want = point.parse::<f64>().unwrap();
+            assert_eq!(
+                parse(&comma, true, &mut s).map(f64::to_bits),
+                Ok(want.to_bits()),
+                "{comma}"
+            );
+        }
         let why = BadValue::Thousands.describe("x1", "1.234,5", true);
         assert!(
             why.contains("`1.234,5`") && why.contains("thousands"),

@@ -140,7 +140,7 @@ impl RefinedStdErrors {
 /// let resampling = Bootstrap { resamples: 4, ..Bootstrap::default() };
 /// let se = bootstrap(&rec, &options, &r, &SimulationModel::default(), &resampling)?;
 /// assert!(se.gain > 0.0 && se.gain < 0.01 * r.plant.gain);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn bootstrap(
     rec: &Recording,

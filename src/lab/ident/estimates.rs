@@ -83,7 +83,7 @@ pub(super) fn plus_minus(f: &mut fmt::Formatter<'_>, value: f64, error: f64) -> 
 /// assert_eq!(est.springs.model(), SpringModel::Separate);
 /// assert_eq!(est.springs.k12(), None);
 /// assert_eq!(format!("{:.1}", est.springs), "k1 = 950.0 ± 0.1 N/m, k2 = 950.0 ± 0.1 N/m");
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Springs<T = Estimate> {
@@ -201,7 +201,7 @@ impl<T: fmt::Display> fmt::Display for Springs<T> {
 /// assert_eq!((est.k1(), est.k2()), (k12, k12));
 /// let sys = est.state_space()?; // the identified model, output cart 2
 /// assert!((sys.b()[(3, 0)] - est.gain.value / 0.7).abs() < 1e-12);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct MassSpringEstimate {
@@ -255,7 +255,7 @@ impl MassSpringEstimate {
     /// let est = identify_with(&rec, 1.3, 0.7, &options)?;
     /// assert_eq!(est.k1().value, est.first.theta[0]);
     /// assert!((est.k1().value / 950.0 - 1.0).abs() < 0.01);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn k1(&self) -> Estimate {
         self.springs.k1()
@@ -273,7 +273,7 @@ impl MassSpringEstimate {
     /// let est = identify_with(&rec, 1.3, 0.7, &options)?;
     /// assert_eq!(est.k2().value, est.first.theta[1]);
     /// assert!((est.k2().value / 950.0 - 1.0).abs() < 0.01);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn k2(&self) -> Estimate {
         self.springs.k2()
@@ -292,7 +292,7 @@ impl MassSpringEstimate {
     /// assert_eq!(equal.k12().map(|k| k.value), Some(equal.first.theta[0]));
     /// let options = Options { springs: SpringModel::Separate, ..Options::default() };
     /// assert_eq!(identify_with(&rec, 1.3, 0.7, &options)?.k12(), None);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn k12(&self) -> Option<Estimate> {
         self.springs.k12()
@@ -309,7 +309,7 @@ impl MassSpringEstimate {
     /// # let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
     /// assert!(identify(&rec, 1.3, 0.7, Scheme::Lab)?.warnings().is_empty());
     /// assert_eq!(identify(&rec, 1300.0, 700.0, Scheme::Lab)?.warnings().len(), 2);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn warnings(&self) -> Vec<Warning> {
         mass_warnings(self.m1, self.m2)
@@ -328,7 +328,7 @@ impl MassSpringEstimate {
     /// let options = Options { springs: SpringModel::Separate, ..Options::default() };
     /// let est = identify_with(&rec, 1.3, 0.7, &options)?;
     /// assert_eq!((est.plant().k1, est.plant().k2), (est.k1().value, est.k2().value));
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn plant(&self) -> MassSpring {
         MassSpring {
@@ -357,7 +357,7 @@ impl MassSpringEstimate {
     /// let model = est.friction_plant();
     /// assert_eq!(model.truth(), est.plant());
     /// assert_eq!(model.friction()[1], est.coulomb.unwrap()[1].value.max(0.0));
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn friction_plant(&self) -> FrictionPlant {
         FrictionPlant::new(self.plant(), coulomb_forces(self.coulomb))
@@ -379,7 +379,7 @@ impl MassSpringEstimate {
     /// let est = identify(&rec, 1.3, 0.7, Scheme::Central)?;
     /// let a = *est.state_space()?.a();
     /// assert_eq!(a[(1, 0)], -2.0 * est.k12().unwrap().value / 1.3);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn state_space(&self) -> Result<StateSpace<4, 1, 1, Continuous>, Error> {
         self.plant().state_space(Cart::Two)
@@ -419,7 +419,7 @@ pub const PLAUSIBLE_MASS_KG: (f64, f64) = (0.01, 100.0);
 /// let w = &est.warnings()[0];
 /// assert_eq!((w.parameter, w.value), ("m1", 1300.0));
 /// assert!(w.to_string().contains("grams"));
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Warning {

@@ -304,7 +304,7 @@ fn fitted_m2(free: bool, second: &LeastSquaresFit) -> Option<Estimate> {
 /// assert!((lab.gain.value / 8.5 - 1.0).abs() > 0.01);
 /// assert!((central.gain.value / 8.5 - 1.0).abs() < 0.003);
 /// assert_eq!(central.coulomb, None);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn identify(
     recording: &Recording,
@@ -346,7 +346,7 @@ pub fn identify(
 /// let est = identify_with(&rec, 1.3, 0.7, &options)?;
 /// assert_eq!((est.first.theta.len(), est.second.theta.len()), (4, 3));
 /// assert!((est.k2().value / 950.0 - 1.0).abs() < 0.01);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn identify_with(
     recording: &Recording,

@@ -95,7 +95,7 @@ impl Refined {
     /// let options = Options { springs: SpringModel::Separate, ..Options::default() };
     /// let r = refine(&rec, &identify_with(&rec, 1.3, 0.7, &options)?)?;
     /// assert_eq!(r.parameters()[4], r.plant.gain);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn parameters(&self) -> [f64; 7] {
         let p = &self.plant;
@@ -189,7 +189,7 @@ fn correlation_test(a: &[f64], b: &[f64], first: usize) -> ResidualTest {
 /// let est = identify_with(&rec, 1.3, 0.7, &Options { springs: SpringModel::Separate, ..Options::default() })?;
 /// let v = validate(&rec, &est.plant(), [0.0, 0.0])?;
 /// assert!(v.fit_percent[1] > 90.0);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn validate(
     rec: &Recording,
@@ -218,7 +218,7 @@ pub fn validate(
 /// let model = SimulationModel { input_delay: 0.15e-3, ..SimulationModel::default() };
 /// let v = validate_with(&rec, &sim.truth, [0.0; 2], &model)?;
 /// assert!(v.fit_percent[1].is_finite());
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn validate_with(
     rec: &Recording,
@@ -402,7 +402,7 @@ impl LeastSquaresProblem for Problem<'_> {
 /// let r = refine(&rec, &equal)?;
 /// assert_eq!((equal.plant().k1, equal.plant().k2), (equal.k12().unwrap().value, equal.k12().unwrap().value));
 /// assert_eq!(r.start, validate(&rec, &equal.plant(), [0.0; 2])?);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn refine(rec: &Recording, start: &MassSpringEstimate) -> Result<Refined, Error> {
     refine_with(rec, start, &SimulationModel::default())

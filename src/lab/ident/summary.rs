@@ -366,7 +366,7 @@ impl EqualSprings {
     /// let truth = MassSpring { k1: 950.0, k2: 950.0, ..MassSpring::nominal() };
     /// let e = EqualSprings::identify(&rec, truth, 1.3, 0.7)?;
     /// assert!((e.central.k1().value / 950.0 - 1.0).abs() < 0.01);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn identify(rec: &Recording, truth: MassSpring, m1: f64, m2: f64) -> Result<Self, Error> {
         Ok(Self {

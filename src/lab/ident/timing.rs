@@ -29,7 +29,7 @@ use crate::kernels::reduce::max_step_deviation;
 /// assert_eq!((est.timing.gaps, est.timing.segments), (1, 2));
 /// assert!((est.timing.longest_gap - 2.0 * 0.002).abs() < 1e-12);
 /// assert!(2.0 > GAP_RATIO && 1.05 < GAP_RATIO); // a gap, and jitter
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub const GAP_RATIO: f64 = 1.5;
 
@@ -76,7 +76,7 @@ const FAST_PATH_JITTER: f64 = 0.2;
 /// // A uniformly sampled recording: one segment, every row, no gap.
 /// assert_eq!((timing.segments, timing.rows, timing.gaps), (1, rec.len() - 2, 0));
 /// assert!(timing.max_jitter < 1e-9);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Timing {
