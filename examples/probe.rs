@@ -123,7 +123,7 @@ impl<P> Operator<P> for Console {
 }
 
 /// The time of one register read (an address and a data cycle), µs.
-fn cycle_time<P: EppPort>(port: &mut P) -> Result<f64, ctrlab::hw::HwError> {
+fn cycle_time<P: EppPort>(port: &mut P) -> Result<f64, ctrlab::hw::PortError> {
     let start = Instant::now();
     for _ in 0..1000 {
         port.read_register(0)?;

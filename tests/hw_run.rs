@@ -13,7 +13,8 @@
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
-    Clock, EppPort, HwError, HwErrorKind, LoopConfig, Pc104, Rig, SimulatedCard, VirtualClock, run,
+    Clock, EppPort, LoopConfig, LoopFault, LoopFaultKind, Pc104, PortErrorKind, Rig, RigError,
+    SimulatedCard, VirtualClock, run,
 };
 use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
 use ctrlab::signal::{Signal, SquareWave};
@@ -228,7 +229,7 @@ fn a_travel_limit_breach_halts_and_keeps_the_recording() {
         &config(5.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::TravelLimit);
+    assert_eq!(err.error.kind(), LoopFaultKind::TravelLimit);
     assert!(
         err.last_measurement.is_none(),
         "the breach is found in the read"
@@ -267,7 +268,7 @@ fn a_non_finite_command_halts_the_same_way() {
         &config(1.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::InvalidCommand);
+    assert_eq!(err.error.kind(), PortErrorKind::InvalidCommand);
     assert_eq!(err.recording.len(), 10);
     assert!(
         err.last_measurement.is_some(),
@@ -293,7 +294,7 @@ fn a_dead_port_leaves_the_motor_to_the_watchdog() {
         &config(1.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Timeout);
+    assert_eq!(err.error.kind(), PortErrorKind::Timeout);
     assert_eq!(err.recording.len(), 50);
     assert_eq!(
         rig.card().port().inner().pwm_duty(0),
@@ -329,13 +330,13 @@ fn overruns_stop_the_loop_safely() {
         ..LoopConfig::default()
     };
     let err = run(&mut rig, Slow, |_| vector![0.0], &Clock::RealTime, &cfg).unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Timing);
+    assert_eq!(err.error.kind(), LoopFaultKind::Timing);
     // Each 3 ms tick overruns and makes the loop skip the deadline it
     // overran: two faults a tick, so three faults end it in the second.
     assert!(
         matches!(
             err.error,
-            ctrlab::hw::HwError::TimingFaults { faults: 3, .. }
+            RigError::Fault(LoopFault::TimingFaults { faults: 3, .. })
         ),
         "{}",
         err.error
@@ -482,13 +483,13 @@ impl Controller<4, 1, 1> for DesignedFor {
 /// period of its own any more, it takes the rig's.
 struct ClaimsPeriod<R>(R, f64);
 impl<R: Rig<1, 4>> Rig<1, 4> for ClaimsPeriod<R> {
-    fn read(&mut self) -> Result<SVector<f64, 4>, HwError> {
+    fn read(&mut self) -> Result<SVector<f64, 4>, RigError> {
         self.0.read()
     }
-    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HwError> {
+    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, RigError> {
         self.0.apply(u)
     }
-    fn halt(&mut self) -> Result<(), HwError> {
+    fn halt(&mut self) -> Result<(), RigError> {
         self.0.halt()
     }
     fn period(&self) -> f64 {
@@ -515,7 +516,7 @@ fn a_loop_at_another_period_than_the_rig_is_refused() {
     .unwrap_err();
     assert!(matches!(
         err.error,
-        ctrlab::hw::HwError::InvalidConfig { name: "period", .. }
+        RigError::Config(ref e) if e.key() == "period"
     ));
     assert!(err.recording.is_empty());
     assert_eq!(rig.card().port().pwm_duty(0), 0);
@@ -589,7 +590,7 @@ fn bad_loop_settings_are_refused_before_anything_runs() {
         )
         .unwrap_err();
         match err.error {
-            ctrlab::hw::HwError::InvalidConfig { name: got, .. } => assert_eq!(got, name),
+            RigError::Config(e) => assert_eq!(e.key(), name),
             other => panic!("{name}: {other}"),
         }
         assert!(err.recording.is_empty());
@@ -602,7 +603,7 @@ fn bad_loop_settings_are_refused_before_anything_runs() {
             ..Default::default()
         };
         match bad.rig(&Clock::Virtual(VirtualClock::new())) {
-            Err(ctrlab::hw::HwError::InvalidConfig { name, .. }) => assert_eq!(name, "period"),
+            Err(RigError::Config(e)) => assert_eq!(e.key(), "period"),
             other => panic!("period {period}: {other:?}"),
         }
     }
@@ -619,7 +620,7 @@ proptest! {
         let mut rig = rig(port, &clock);
         let result = run(&mut rig, OpenLoop, |_| vector![3.0], &Clock::Virtual(clock), &config(0.1));
         let err = result.expect_err("cycle k is inside the 50-tick run");
-        prop_assert_eq!(err.error.kind(), HwErrorKind::Timeout);
+        prop_assert_eq!(err.error.kind(), PortErrorKind::Timeout);
         let tick = k / CYCLES_PER_TICK;
         prop_assert_eq!(err.recording.len(), tick);
         // Cut in the read (first 18 cycles) there is no state of that tick;

@@ -14,8 +14,8 @@
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
-    Clock, CycleKind, EppPort, HwError, HwErrorKind, Pc104, Rig, SIMULATED_CARD_ID, SimulatedCard,
-    VirtualClock,
+    Clock, CycleKind, EppPort, LoopFault, Pc104, PortError, PortErrorKind, Rig, RigError,
+    SIMULATED_CARD_ID, SimulatedCard, VirtualClock,
 };
 use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
 use ctrlab::{Cart, MassSpring, Method};
@@ -57,7 +57,7 @@ fn card_id_and_probe() {
         SIMULATED_CARD_ID
     );
     let err = pc104.probe_id(0x3c).unwrap_err();
-    assert_eq!(err.kind(), HwErrorKind::NotPresent);
+    assert_eq!(err.kind(), PortErrorKind::NotPresent);
     assert!(err.to_string().contains("0xa5"), "{err}");
     // An unmapped address reads an open bus.
     assert_eq!(pc104.port_mut().read_register(0x99).unwrap(), 0xff);
@@ -378,7 +378,7 @@ fn invalid_configurations_are_refused() {
                 encoder_channels: [1, 1],
                 ..default.clone()
             },
-            "encoder_channels",
+            "encoder_channels[1]",
         ),
         (
             SimulatedRig {
@@ -399,8 +399,8 @@ fn invalid_configurations_are_refused() {
         ),
     ] {
         match bad.card(&Clock::RealTime) {
-            Err(HwError::InvalidConfig { name: got, .. }) => assert_eq!(got, name),
-            other => panic!("expected InvalidConfig for {name}, got {other:?}"),
+            Err(e) => assert_eq!(e.key(), name),
+            Ok(_) => panic!("expected {name} refused"),
         }
     }
 }
@@ -543,7 +543,7 @@ fn non_finite_voltage_halts_the_rig() {
         rig.apply_voltage(10.0).unwrap();
         assert_eq!(rig.card().port().pwm_duty(0), 417); // 10 V / 24 mV
         let err = rig.apply_voltage(bad).unwrap_err();
-        assert_eq!(err.kind(), HwErrorKind::InvalidCommand, "{bad}");
+        assert_eq!(err.kind(), PortErrorKind::InvalidCommand, "{bad}");
         assert_eq!(rig.card().port().pwm_duty(0), 0, "{bad}");
     }
 }
@@ -568,11 +568,11 @@ fn travel_limit_breach_halts_the_rig() {
     }
     match err {
         // Axis 2 is cart 2.
-        Some(HwError::TravelLimit {
+        Some(RigError::Fault(LoopFault::TravelLimit {
             axis: 2,
             position,
             limit,
-        }) => {
+        })) => {
             assert_eq!(limit, 0.05);
             // Found at the first sample past it: within one period at the
             // largest speed the rig accepts (any faster is a bus fault).
@@ -647,10 +647,10 @@ fn a_dead_port_surfaces_as_an_error_from_the_rig() {
     let err = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap_err();
     assert!(matches!(
         err,
-        HwError::Timeout {
+        RigError::Port(PortError::Timeout {
             cycle: CycleKind::AddressWrite,
             register: Some(0x00)
-        }
+        })
     ));
     // Dead after the probe (cycles 0–1): cycle 2 is the latch's address write.
     let (_clock, card) = sim(SimulatedRig::default());
@@ -659,10 +659,10 @@ fn a_dead_port_surfaces_as_an_error_from_the_rig() {
     let err = rig.read_state().unwrap_err();
     assert!(matches!(
         err,
-        HwError::Timeout {
+        RigError::Port(PortError::Timeout {
             cycle: CycleKind::AddressWrite,
             register: Some(0x01)
-        }
+        })
     ));
 }
 
@@ -691,7 +691,7 @@ fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
             .read_state()
             .and_then(|_| rig.apply_voltage(3.0).map(drop));
         let err = result.expect_err("the injected fault surfaces");
-        assert_eq!(err.kind(), HwErrorKind::Timeout, "cycle {k}");
+        assert_eq!(err.kind(), PortErrorKind::Timeout, "cycle {k}");
         // Cut in the read (k < 18) the new command is never sent; cut in the
         // PWM write (even after its low byte, k = 20, 21) the card keeps the
         // previous duty whole: only the high byte applies a duty.

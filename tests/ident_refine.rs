@@ -10,7 +10,7 @@
 mod common;
 
 use common::{friction_rig, open_loop, try_open_loop};
-use ctrlab::hw::HwErrorKind;
+use ctrlab::hw::LoopFaultKind;
 use ctrlab::lab::ident::{
     Bootstrap, Options, Refined, SeparateSpringsEstimate, SimulationModel, bootstrap,
     identify_separate_springs_with, refine_with, validate, validate_with,
@@ -28,7 +28,7 @@ fn square_run(sim: &SimulatedRig) -> Recording {
     let mut volts = volts(sim);
     loop {
         match try_open_loop(sim, &SquareWave::new(volts, 0.2).unwrap(), 5.0) {
-            Err(e) if e.error.kind() == HwErrorKind::TravelLimit && volts > 1.0 => volts *= 0.9,
+            Err(e) if e.error.kind() == LoopFaultKind::TravelLimit && volts > 1.0 => volts *= 0.9,
             run => return run.unwrap(),
         }
     }

@@ -221,16 +221,16 @@ fn a_bad_value_names_its_key_and_line() {
         ("map.latch_bit", "0x00", "refused"),
         ("map.clear_bit", "0x01", "refused"),
         ("map.watchdog_bit", "0x03", "refused"),
-        ("map.pwm_low", "[0x10, 0x12, 0x01, 0x16]", "refused"),
-        ("map.pwm_high", "[0x11, 0x13, 0x15, 0x10]", "refused"),
-        ("map.encoder", "[0x20, 0x24, 0x28, 0xfd]", "refused"),
+        ("map.pwm_low[2]", "[0x10, 0x12, 0x01, 0x16]", "refused"),
+        ("map.pwm_high[3]", "[0x11, 0x13, 0x15, 0x10]", "refused"),
+        ("map.encoder[3]", "[0x20, 0x24, 0x28, 0xfd]", "refused"),
         // Calibration::validate.
         ("calibration.metres_per_count", "0.0", "refused"),
-        ("calibration.sign", "[1.0, 0.5]", "refused"),
+        ("calibration.sign[1]", "[1.0, 0.5]", "refused"),
         ("calibration.volts_full_scale", "-24.0", "refused"),
         ("calibration.pwm_channel", "4", "refused"),
-        ("calibration.encoder_channels", "[1, 1]", "refused"),
-        ("calibration.travel_limits", "[0.05, -0.05]", "refused"),
+        ("calibration.encoder_channels[1]", "[1, 1]", "refused"),
+        ("calibration.travel_limits[1]", "[0.05, -0.05]", "refused"),
         ("calibration.card_id", "0xff", "refused"),
         ("calibration.watchdog_timeout", "0.0", "refused"),
         ("calibration.max_speed", "nan", "refused"),
@@ -238,8 +238,10 @@ fn a_bad_value_names_its_key_and_line() {
         ("calibration.stall_time", "-inf", "refused"),
         ("calibration.stall_counts", "0", "refused"),
     ] {
-        let bad = with_value(&text, key, value);
-        let name = key.split_once('.').unwrap().1;
+        // An array's element is named by its index.
+        let written = key.split('[').next().unwrap();
+        let bad = with_value(&text, written, value);
+        let name = written.split_once('.').unwrap().1;
         let line = bad
             .lines()
             .position(|l| l.starts_with(&format!("{name} = ")))

@@ -14,7 +14,7 @@ mod common;
 use common::{last, run_on_rig, saturated, simulate_on};
 use ctrlab::data::Recording;
 use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqe, dlqi};
-use ctrlab::hw::{self, Clock, HwErrorKind, LoopConfig, VirtualClock};
+use ctrlab::hw::{self, Clock, ConfigErrorKind, LoopConfig, VirtualClock};
 use ctrlab::lab::{self, SimulatedRig};
 use ctrlab::sim::run_sampled;
 use ctrlab::{Cart, Controller, Error, MassSpring, Method, StateFeedback, StateSpace};
@@ -387,7 +387,7 @@ fn a_controller_designed_for_another_period_is_refused_by_both_loops() {
         &config,
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::InvalidConfig);
+    assert_eq!(err.error.kind(), ConfigErrorKind::Conflict);
     assert!(err.recording.is_empty());
     // Nothing ran: no time passed and the drive is off.
     assert_eq!(clock.now_nanos(), 0);

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use ctrlab::hw::{
-    Clock, HwError, LoopConfig, LoopStats, RealTime, RunError, RunOutcome, StopSignal,
+    Clock, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome, StopSignal,
     VirtualClock, run,
 };
 use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
@@ -165,7 +165,7 @@ impl Backend {
         std::fs::create_dir_all(&dir)?;
         recording.write_csv(dir.join(format!("{name}.csv")))?;
         if let Err(e) = &outcome
-            && let HwError::Interrupted { .. } = e.error
+            && let RigError::Fault(LoopFault::Interrupted { .. }) = e.error
         {
             return Err(format!(
                 "{e}; the run's recording is in {}",
@@ -381,11 +381,11 @@ pub fn rig_table(
             Err(e) => {
                 stats.push(e.stats.clone());
                 let why = match &e.error {
-                    HwError::TravelLimit {
+                    RigError::Fault(LoopFault::TravelLimit {
                         axis,
                         position,
                         limit,
-                    } => format!(
+                    }) => format!(
                         "cart {axis} at {:.1} mm beyond the ±{:.0} mm travel limit",
                         position * 1e3,
                         limit * 1e3

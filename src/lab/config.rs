@@ -8,7 +8,7 @@ use std::path::Path;
 
 use super::{Calibration, file};
 use crate::error::Error;
-use crate::hw::{HwError, RegisterMap};
+use crate::hw::{ConfigError, RegisterMap};
 
 /// A rig's card file (`card.toml`): where the card's registers are and how
 /// the rig's counts and volts map to SI.
@@ -194,22 +194,6 @@ fn lookup(section: &str, name: &str) -> Option<&'static Field> {
     })
 }
 
-/// A validator's error with its field's name made the file's dotted key.
-fn qualify(section: &str, error: HwError) -> HwError {
-    match error {
-        HwError::InvalidConfig {
-            name,
-            value,
-            reason,
-        } => HwError::InvalidConfig {
-            name: lookup(section, name).map_or(name, |f| f.key),
-            value,
-            reason,
-        },
-        other => other,
-    }
-}
-
 /// The one-based line of dotted `key` in `text` (a `key = …` line under its
 /// `[section]` header), if written that way.
 fn line_of(text: &str, key: &str) -> Option<usize> {
@@ -264,36 +248,26 @@ impl RigConfig {
     /// let bad = good.to_toml().replace("travel_limits = [0.05, 0.05]", "travel_limits = [0.05, -0.05]");
     /// match RigConfig::from_toml(&bad) {
     ///     Err(Error::Toml { key, line: Some(_), .. }) => {
-    ///         assert_eq!(key.as_deref(), Some("calibration.travel_limits"))
+    ///         assert_eq!(key.as_deref(), Some("calibration.travel_limits[1]"))
     ///     }
     ///     other => panic!("{other:?}"),
     /// }
     /// ```
     pub fn from_toml(text: &str) -> Result<Self, Error> {
         let config: Self = file::parse(text)?;
-        config.validate().map_err(|e| match e {
-            HwError::InvalidConfig {
-                name,
-                value,
-                reason,
-            } => {
-                let shown = match FIELDS.iter().find(|f| f.key == name) {
-                    Some(f) if f.hex && (0.0..=255.0).contains(&value) => {
-                        format!("{:#04x}", value as u8)
-                    }
-                    _ => value.to_string(),
-                };
-                Error::Toml {
-                    line: line_of(text, name),
-                    key: Some(name.to_owned()),
-                    message: format!("{shown} is refused: {reason}"),
+        config.validate().map_err(|e| {
+            let key = e.key().split('[').next().unwrap_or_default();
+            let shown = match FIELDS.iter().find(|f| f.key == key) {
+                Some(f) if f.hex && (0.0..=255.0).contains(&e.value()) => {
+                    format!("{:#04x}", e.value() as u8)
                 }
+                _ => e.value().to_string(),
+            };
+            Error::Toml {
+                line: line_of(text, key),
+                key: Some(e.key().to_owned()),
+                message: format!("{shown} is refused: {}", e.reason()),
             }
-            other => Error::Toml {
-                line: None,
-                key: None,
-                message: other.to_string(),
-            },
         })?;
         Ok(config)
     }
@@ -392,24 +366,24 @@ impl RigConfig {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] whose name is the file's dotted key
-    /// (`map.encoder`, `calibration.travel_limits`).
+    /// [`ConfigError`] whose key is the file's dotted key (`map.encoder[3]`,
+    /// `calibration.travel_limits[1]`).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::{HwError, RegisterMap}, lab::{Calibration, RigConfig}};
+    /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
     /// let config = RigConfig {
     ///     map: RegisterMap { encoder: [0x20, 0x24, 0x28, 0xfe], ..RegisterMap::default() },
     ///     calibration: Calibration::default(),
     /// };
-    /// assert!(matches!(config.validate(), Err(HwError::InvalidConfig { name: "map.encoder", .. })));
+    /// assert_eq!(config.validate().unwrap_err().key(), "map.encoder[3]");
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        self.map.validate().map_err(|e| qualify("map", e))?;
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.map.validate().map_err(|e| e.in_table("map"))?;
         self.calibration
             .validate()
-            .map_err(|e| qualify("calibration", e))
+            .map_err(|e| e.in_table("calibration"))
     }
 }
 

@@ -7,8 +7,8 @@ use nalgebra::SVector;
 use super::{Calibration, EncoderSensor, MassSpring, MassSpringRig, schema};
 use crate::error::Error;
 use crate::hw::{
-    Clock, ENCODER_CHANNELS, HwError, MAX_DUTY, Pc104, RegisterMap, SIMULATED_CARD_ID,
-    SimulatedCard, SimulatedCardConfig,
+    Clock, ConfigError, ENCODER_CHANNELS, MAX_DUTY, Pc104, RegisterMap, RigError,
+    SIMULATED_CARD_ID, SimulatedCard, SimulatedCardConfig,
 };
 use crate::model::Dynamics;
 use crate::sim::SampledConfig;
@@ -326,7 +326,7 @@ impl Dynamics<4, 1> for FrictionPlant {
 /// rig.apply_voltage(10.0)?;
 /// clock.advance(5.0)?;
 /// assert!((rig.read_state()?[2] - 0.020).abs() < 1e-4); // 10 N: 20 mm
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -592,8 +592,8 @@ impl SimulatedRig {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field (of the truth
-    /// or the card).
+    /// [`ConfigError`] naming the first bad field (of the truth or the
+    /// card).
     ///
     /// # Examples
     ///
@@ -601,9 +601,9 @@ impl SimulatedRig {
     /// use ctrlab::{hw::{Clock, Pc104, SIMULATED_CARD_ID}, lab::SimulatedRig};
     /// let card = SimulatedRig::default().card(&Clock::RealTime)?;
     /// assert_eq!(Pc104::new(card).read_id()?, SIMULATED_CARD_ID);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn card(&self, clock: &Clock) -> Result<SimulatedCard<FrictionPlant, 4>, HwError> {
+    pub fn card(&self, clock: &Clock) -> Result<SimulatedCard<FrictionPlant, 4>, ConfigError> {
         self.validate()?;
         SimulatedCard::new(self.plant(), self.card_config(), clock.clone())
     }
@@ -621,12 +621,12 @@ impl SimulatedRig {
     /// use ctrlab::{hw::{Clock, Rig}, lab::SimulatedRig};
     /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(Rig::period(&rig), 0.002);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn rig(
         &self,
         clock: &Clock,
-    ) -> Result<MassSpringRig<SimulatedCard<FrictionPlant, 4>>, HwError> {
+    ) -> Result<MassSpringRig<SimulatedCard<FrictionPlant, 4>>, RigError> {
         MassSpringRig::with_clock(
             Pc104::new(self.card(clock)?),
             self.calibration(),
@@ -713,31 +713,23 @@ impl SimulatedRig {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
+    /// [`ConfigError`] naming the first bad field.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::HwError, lab::SimulatedRig};
+    /// use ctrlab::lab::SimulatedRig;
     /// let bad = SimulatedRig { coulomb_friction: [-1.0, 0.0], ..Default::default() };
-    /// assert!(matches!(bad.validate(), Err(HwError::InvalidConfig { name: "coulomb_friction", .. })));
+    /// assert_eq!(bad.validate().unwrap_err().key(), "coulomb_friction");
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         self.truth.validate().map_err(|e| match e {
             crate::Error::InvalidParameter {
                 name,
                 value,
                 reason,
-            } => HwError::InvalidConfig {
-                name,
-                value,
-                reason,
-            },
-            _ => HwError::InvalidConfig {
-                name: "truth",
-                value: f64::NAN,
-                reason: "invalid plant parameters",
-            },
+            } => ConfigError::invalid(name, value, reason),
+            _ => ConfigError::invalid("truth", f64::NAN, "invalid plant parameters"),
         })?;
         for (name, forces) in [
             ("coulomb_friction", self.coulomb_friction),
@@ -745,11 +737,15 @@ impl SimulatedRig {
         ] {
             for f in forces {
                 if !(f.is_finite() && f >= 0.0) {
-                    return Err(HwError::invalid_config(name, f, "must be finite and ≥ 0"));
+                    return Err(ConfigError::invalid(name, f, "must be finite and ≥ 0"));
                 }
             }
         }
-        super::calibration::check_encoder_channels(self.encoder_channels)?;
+        Calibration {
+            encoder_channels: self.encoder_channels,
+            ..Calibration::default()
+        }
+        .validate()?;
         self.card_config().validate()
     }
 }
