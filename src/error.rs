@@ -243,23 +243,6 @@ pub enum Error {
         /// What is wrong; for a missing channel, the channels there are.
         reason: String,
     },
-    /// A TOML file (a simulated rig's truth, a rig's register map and
-    /// calibration) does not parse, holds an unknown field or a value of the
-    /// wrong type, or (where fields are required) lacks one.
-    #[error(
-        "TOML{}{}: {message}",
-        line.map(|l| format!(" line {l}")).unwrap_or_default(),
-        key.as_ref().map(|k| format!(", key `{k}`")).unwrap_or_default()
-    )]
-    Toml {
-        /// One-based line of the fault, when the parser knows it.
-        line: Option<usize>,
-        /// The dotted key of the field at fault (`calibration.card_id`,
-        /// `map.encoder[2]`), when the fault is in a field.
-        key: Option<String>,
-        /// The parser's message.
-        message: String,
-    },
     /// An index is past the end of what it indexes (an output channel of a
     /// response, …).
     #[error("{what} index {index} is out of range: there are {len}")]

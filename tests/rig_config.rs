@@ -5,9 +5,8 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::Error;
 use ctrlab::hw::RegisterMap;
-use ctrlab::lab::{Calibration, RigConfig};
+use ctrlab::lab::{Calibration, FileError, FileErrorKind, RigConfig};
 
 fn lab() -> RigConfig {
     RigConfig {
@@ -101,12 +100,7 @@ fn without(text: &str, key: &str) -> String {
 /// The key a refused file names, with the whole error for the message.
 fn refused_key(text: &str) -> (Option<String>, String) {
     match RigConfig::from_toml(text) {
-        Err(e @ Error::Toml { .. }) => {
-            let Error::Toml { ref key, .. } = e else {
-                unreachable!()
-            };
-            (key.clone(), e.to_string())
-        }
+        Err(e) => (e.key().map(str::to_owned), e.to_string()),
         other => panic!("expected a TOML error, got {other:?} for\n{text}"),
     }
 }
@@ -161,9 +155,12 @@ fn the_file_has_every_field_of_both_structs() {
 fn a_value_of_the_wrong_type_names_its_key() {
     let text = unusual().to_toml();
     for key in keys(&text) {
-        let (named, message) = refused_key(&with_value(&text, &key, "\"oops\""));
+        let bad = with_value(&text, &key, "\"oops\"");
+        let (named, message) = refused_key(&bad);
         assert_eq!(named.as_deref(), Some(key.as_str()), "{message}");
         assert!(message.contains(&key), "{message}");
+        let kind = RigConfig::from_toml(&bad).unwrap_err().kind();
+        assert_eq!(kind, FileErrorKind::WrongType, "{message}");
     }
 }
 
@@ -171,9 +168,12 @@ fn a_value_of_the_wrong_type_names_its_key() {
 fn a_missing_key_is_refused_and_named() {
     let text = unusual().to_toml();
     for key in keys(&text) {
-        let (named, message) = refused_key(&without(&text, &key));
+        let bad = without(&text, &key);
+        let (named, message) = refused_key(&bad);
         assert_eq!(named.as_deref(), Some(key.as_str()), "{message}");
         assert!(message.contains("missing"), "{message}");
+        let kind = RigConfig::from_toml(&bad).unwrap_err().kind();
+        assert_eq!(kind, FileErrorKind::MissingKey, "{message}");
     }
     for table in ["map", "calibration"] {
         let text = lab().to_toml();
@@ -196,6 +196,8 @@ fn an_unknown_key_is_refused_and_named() {
         let bad = text.replace(&header, &format!("{header}{typo} = 1\n"));
         let (named, message) = refused_key(&bad);
         assert_eq!(named, Some(format!("{section}.{typo}")), "{message}");
+        let kind = RigConfig::from_toml(&bad).unwrap_err().kind();
+        assert_eq!(kind, FileErrorKind::UnknownKey, "{message}");
         let line = bad.lines().position(|l| l.starts_with(typo)).unwrap() + 1;
         assert!(
             message.starts_with(&format!("TOML line {line},")),
@@ -216,7 +218,8 @@ fn a_bad_value_names_its_key_and_line() {
         ("map.latch_bit", "0x100", "expected u8"),
         ("calibration.pwm_channel", "-1", "expected usize"),
         ("calibration.card_id", "300", "expected u8"),
-        // RegisterMap::validate: a clash names the later of the two.
+        // RegisterMap::validate: a clash names the later of the two (an
+        // array's element, by its index).
         ("map.control", "0x00", "refused"),
         ("map.latch_bit", "0x00", "refused"),
         ("map.clear_bit", "0x01", "refused"),
@@ -238,7 +241,6 @@ fn a_bad_value_names_its_key_and_line() {
         ("calibration.stall_time", "-inf", "refused"),
         ("calibration.stall_counts", "0", "refused"),
     ] {
-        // An array's element is named by its index.
         let written = key.split('[').next().unwrap();
         let bad = with_value(&text, written, value);
         let name = written.split_once('.').unwrap().1;
@@ -247,14 +249,17 @@ fn a_bad_value_names_its_key_and_line() {
             .position(|l| l.starts_with(&format!("{name} = ")))
             .map(|i| i + 1);
         match RigConfig::from_toml(&bad) {
-            Err(Error::Toml {
-                key: Some(named),
-                line: got,
-                message,
-            }) => {
-                assert_eq!(named, key, "{message}");
-                assert_eq!(got, line, "{key}: {message}");
+            Err(e) => {
+                let message = e.to_string();
+                assert_eq!(e.key(), Some(key), "{message}");
+                assert_eq!(e.line(), line, "{key}: {message}");
                 assert!(message.contains(says), "{key}: {message}");
+                let kind = if says == "refused" {
+                    FileErrorKind::Invalid
+                } else {
+                    FileErrorKind::WrongType
+                };
+                assert_eq!(e.kind(), kind, "{key}: {message}");
             }
             other => panic!("expected {key} refused, got {other:?}"),
         }
@@ -293,10 +298,10 @@ fn a_syntax_error_quotes_its_line() {
         .to_toml()
         .replace("stall_counts = 3", "stall_counts = = 3");
     match RigConfig::from_toml(&text) {
-        Err(Error::Toml {
+        Err(FileError::Syntax {
             line: Some(line),
-            key: None,
             message,
+            ..
         }) => {
             assert_eq!(
                 text.lines().nth(line - 1).map(str::trim_start),
@@ -320,7 +325,7 @@ fn write_refuses_an_invalid_config_and_writes_nothing() {
     let mut bad = lab();
     bad.calibration.card_id = 0x00;
     match bad.write_toml(&path) {
-        Err(Error::Toml { key, .. }) => assert_eq!(key.as_deref(), Some("calibration.card_id")),
+        Err(e) => assert_eq!(e.key(), Some("calibration.card_id")),
         other => panic!("{other:?}"),
     }
     assert!(!path.exists());
@@ -330,8 +335,26 @@ fn write_refuses_an_invalid_config_and_writes_nothing() {
     // Into a directory that does not exist: an I/O error with the path.
     let nowhere = dir.join("no/such/dir/card.toml");
     match lab().write_toml(&nowhere) {
-        Err(Error::Io { context, .. }) => assert!(context.contains("card.toml"), "{context}"),
+        Err(e @ FileError::Io { .. }) => {
+            assert_eq!(e.path(), Some(nowhere.as_path()));
+            assert!(e.to_string().starts_with("writing "), "{e}");
+            assert!(e.to_string().contains("card.toml"), "{e}");
+        }
         other => panic!("{other:?}"),
     }
+    // Reading: the path, and a parse error in the file says it too.
+    let err = RigConfig::read_toml(&nowhere).unwrap_err();
+    assert_eq!(err.kind(), FileErrorKind::Io);
+    std::fs::write(&path, "[map]\nid = 0x00 0x01\n").unwrap();
+    let err = RigConfig::read_toml(&path).unwrap_err();
+    assert_eq!(
+        (err.kind(), err.path(), err.line()),
+        (FileErrorKind::Syntax, Some(path.as_path()), Some(2))
+    );
+    assert!(
+        err.to_string()
+            .starts_with(&format!("{}: TOML line 2", path.display())),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

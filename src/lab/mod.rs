@@ -11,7 +11,8 @@
 //!   [`ident`];
 //! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`]
 //!   (a real card's register map and calibration come from its card file,
-//!   [`RigConfig`]),
+//!   [`RigConfig`]; a file's faults are a [`FileError`] that says the
+//!   path, the line and the key),
 //!   and in simulation [`SimulatedRig`] (the plant with stick–slip
 //!   [`FrictionPlant`] inside the register-level card, in one call), with
 //!   its [`EncoderSensor`] for the sampled-data simulator;
@@ -58,6 +59,7 @@ mod simulated;
 
 pub use calibration::Calibration;
 pub use config::RigConfig;
+pub use file::{FileError, FileErrorKind};
 pub use gains::LabGains;
 pub use plant::{Cart, MassSpring};
 pub use probe::SimulatedOperator;

@@ -4,8 +4,8 @@
 
 use nalgebra::SVector;
 
+use super::file::{self, FileError};
 use super::{Calibration, EncoderSensor, MassSpring, MassSpringRig, schema};
-use crate::error::Error;
 use crate::hw::{
     Clock, ConfigError, ENCODER_CHANNELS, MAX_DUTY, Pc104, RegisterMap, RigError,
     SIMULATED_CARD_ID, SimulatedCard, SimulatedCardConfig,
@@ -308,7 +308,7 @@ impl Dynamics<4, 1> for FrictionPlant {
 /// assert_eq!((rig.truth.gain, rig.coulomb_friction[1]), (1.2, 1.5));
 /// assert_eq!(rig.travel_limits, [0.05, 0.05]); // a default
 /// assert!(SimulatedRig::from_toml("gian = 1.2").is_err()); // a typo is refused
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), ctrlab::lab::FileError>(())
 /// ```
 ///
 /// # Examples
@@ -457,7 +457,7 @@ impl SimulatedRig {
     ///
     /// # Errors
     ///
-    /// [`Error::Toml`] with the line, the dotted key at fault (an unknown
+    /// [`FileError`] with the line, the dotted key at fault (an unknown
     /// field, a value of the wrong type) and the parser's message. The values
     /// themselves are checked when the rig is built
     /// ([`validate`](Self::validate)).
@@ -469,27 +469,27 @@ impl SimulatedRig {
     /// assert_eq!(SimulatedRig::from_toml("")?, SimulatedRig::default());
     /// let err = SimulatedRig::from_toml("[truth]\nm1 = \"heavy\"").unwrap_err();
     /// assert!(err.to_string().contains("key `truth.m1`"), "{err}");
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), ctrlab::lab::FileError>(())
     /// ```
-    pub fn from_toml(text: &str) -> Result<Self, Error> {
-        super::file::parse(text)
+    pub fn from_toml(text: &str) -> Result<Self, FileError> {
+        file::parse(text)
     }
 
     /// The simulated rig in `path` ([`from_toml`](Self::from_toml)).
     ///
     /// # Errors
     ///
-    /// [`Error::Io`] with the path, and the errors of
-    /// [`from_toml`](Self::from_toml).
+    /// [`FileError`] with the path: [`FileError::Io`] when it cannot be
+    /// read, and the errors of [`from_toml`](Self::from_toml).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Error, lab::SimulatedRig};
-    /// assert!(matches!(SimulatedRig::read_toml("no/such/truth.toml"), Err(Error::Io { .. })));
+    /// use ctrlab::lab::{FileError, SimulatedRig};
+    /// assert!(matches!(SimulatedRig::read_toml("no/such/truth.toml"), Err(FileError::Io { .. })));
     /// ```
-    pub fn read_toml(path: impl AsRef<std::path::Path>) -> Result<Self, Error> {
-        Self::from_toml(&super::file::read(path.as_ref())?)
+    pub fn read_toml(path: impl AsRef<std::path::Path>) -> Result<Self, FileError> {
+        file::read_with(path.as_ref(), Self::from_toml)
     }
 
     /// The rig as TOML text, every field written; reads back equal.
@@ -500,7 +500,7 @@ impl SimulatedRig {
     /// use ctrlab::lab::SimulatedRig;
     /// let rig = SimulatedRig::default();
     /// assert_eq!(SimulatedRig::from_toml(&rig.to_toml())?, rig);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), ctrlab::lab::FileError>(())
     /// ```
     pub fn to_toml(&self) -> String {
         // Plain numbers, arrays and tables: serialisation cannot fail.
