@@ -5,7 +5,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::hw::{Clock, SimulatedCard, VirtualClock};
-use ctrlab::lab::{FrictionPlant, MassSpringRig, SimulatedRig};
+use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
 use ctrlab::{Cart, Controller, StateFeedback};
 use nalgebra::vector;
 use std::hint::black_box;
@@ -15,8 +15,11 @@ use std::hint::black_box;
 /// loop's own work.
 fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard<FrictionPlant, 4>> {
     SimulatedRig {
-        watchdog_timeout: None,
         initial_state: [0.001, 0.0, 0.002, 0.0],
+        calibration: Calibration {
+            watchdog_timeout: None,
+            ..Calibration::default()
+        },
         ..Default::default()
     }
     .rig(&Clock::Virtual(clock.clone()))

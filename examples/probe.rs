@@ -179,10 +179,10 @@ fn simulated() -> Result<ProbeReport, String> {
     for line in &hand.transcript {
         println!("{line}");
     }
-    if report.map != rig.map {
+    if report.map != rig.card.map {
         return Err(format!(
             "the probe found {:?}, not the simulated card's map {:?}",
-            report.map, rig.map
+            report.map, rig.card.map
         ));
     }
     println!("the probe rediscovered the simulated card's register map exactly");

@@ -317,7 +317,7 @@ fn friction_band() -> f64 {
     let truth = sim.truth;
     let compliance = 1.0 / truth.k1 + 1.0 / truth.k2;
     let loop_gain = compliance * truth.gain * 10_000.0;
-    sim.stiction[1] * compliance / (1.0 + loop_gain) + 3.0 * sim.metres_per_count()
+    sim.friction.stiction[1] * compliance / (1.0 + loop_gain) + 3.0 * sim.metres_per_count()
 }
 
 #[test]

@@ -14,7 +14,7 @@ use common::{
 };
 use ctrlab::data::Recording;
 use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqi};
-use ctrlab::lab::SimulatedRig;
+use ctrlab::lab::{Friction, SimulatedRig};
 use ctrlab::sim::run_sampled;
 use ctrlab::{Cart, Controller, MassSpring, StateFeedback};
 use nalgebra::{SMatrix, SVector, matrix, vector};
@@ -98,7 +98,7 @@ fn observer_lqi_on_positions_reaches_the_setpoint_within_a_count_despite_frictio
     let sim = SimulatedRig {
         // Coulomb friction only (breakaway at the same force), no delay
         // or noise: what this controller was designed against.
-        coulomb_friction: [1.0, 2.0],
+        friction: Friction::coulomb([1.0, 2.0]),
         ..SimulatedRig::ideal(MassSpring::nominal())
     };
     let count = sim.metres_per_count();
@@ -154,7 +154,7 @@ fn with_time_the_integrator_unsticks_the_cart_onto_the_setpoints_count() {
     let sim = SimulatedRig {
         // Coulomb friction only (breakaway at the same force), no delay
         // or noise: what this controller was designed against.
-        coulomb_friction: [1.0, 2.0],
+        friction: Friction::coulomb([1.0, 2.0]),
         ..SimulatedRig::ideal(MassSpring::nominal())
     };
     let rec = simulate_on(&sim, positions_lqi(sim.metres_per_count()), SETPOINT, 6.0);

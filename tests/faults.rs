@@ -41,13 +41,7 @@ type LoggedRig = MassSpringRig<RecordingPort<Card>>;
 /// and checks timed on `clock`.
 fn logged_rig(sim: &SimulatedRig, clock: &Clock) -> LoggedRig {
     let port = RecordingPort::new(sim.card(clock).unwrap());
-    MassSpringRig::with_clock(
-        Pc104::new(port),
-        sim.calibration(),
-        sim.period,
-        clock.clone(),
-    )
-    .unwrap()
+    MassSpringRig::with_clock(Pc104::new(port), sim.calibration, sim.period, clock.clone()).unwrap()
 }
 
 /// The realistic rig on a fresh virtual clock.
@@ -87,7 +81,7 @@ fn pwm_writes(log: &[Cycle]) -> Vec<(u8, u8)> {
 fn assert_drive_off(rig: &mut LoggedRig, clock: &Clock) {
     let writes = pwm_writes(rig.card().port().log());
     assert_eq!(writes.last(), Some(&(0, 0)), "the halt is the last write");
-    let delay = SimulatedRig::default().pwm_delay;
+    let delay = SimulatedRig::default().card.pwm_delay;
     match clock {
         Clock::Virtual(c) => c.advance(delay).unwrap(),
         // Well past the delay, well before the 100 ms watchdog.
@@ -371,7 +365,7 @@ fn run_with_flipped_bit(
     };
     let mut rig = MassSpringRig::with_clock(
         Pc104::new(RecordingPort::new(port)),
-        sim.calibration(),
+        sim.calibration,
         PERIOD,
         virtual_clock.clone(),
     )
@@ -430,7 +424,9 @@ fn a_flipped_counter_bit_is_a_bus_fault_not_a_measurement() {
     // The drive is off: the halt was the last write, and the card applies it.
     let writes = pwm_writes(rig.card().port().log());
     assert_eq!(writes.last(), Some(&(0, 0)));
-    clock.advance(SimulatedRig::default().pwm_delay).unwrap();
+    clock
+        .advance(SimulatedRig::default().card.pwm_delay)
+        .unwrap();
     let card = &mut rig.card_mut().port_mut().inner_mut().inner;
     card.sync().unwrap();
     assert_eq!(card.pwm_duty(0), 0);
@@ -497,7 +493,10 @@ fn another_card_is_refused() {
     );
     // A simulated card with another ID, against the lab's calibration.
     let other = SimulatedRig {
-        card_id: 0x5a,
+        calibration: Calibration {
+            card_id: 0x5a,
+            ..Calibration::default()
+        },
         ..SimulatedRig::default()
     };
     let card = other.card(&Clock::Virtual(VirtualClock::new())).unwrap();
@@ -520,7 +519,7 @@ fn a_motor_that_does_not_respond_is_detected_and_halted() {
         },
         ..SimulatedRig::default()
     };
-    let cal = dead.calibration();
+    let cal = dead.calibration;
     let (clock, mut rig) = virtual_rig(&dead);
     // 12 V (duty 500 exactly), well above the 6 V the check watches.
     let err = run(

@@ -16,7 +16,7 @@ use ctrlab::hw::{
     Clock, EppPort, LoopConfig, LoopFault, LoopFaultKind, Pc104, PortErrorKind, Rig, RigError,
     SimulatedCard, VirtualClock, run,
 };
-use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
+use ctrlab::lab::{Calibration, CardSettings, FrictionPlant, MassSpringRig, SimulatedRig};
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::{
     Cart, Controller, MassSpring, Method, OpenLoop, StateFeedback, StepInfoOptions, step_info,
@@ -110,21 +110,24 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
     let supply = 400.0;
     let clock = VirtualClock::new();
     let sim = SimulatedRig {
-        supply_voltage: supply,
+        calibration: Calibration {
+            volts_full_scale: supply,
+            ..Calibration::default()
+        },
         ..SimulatedRig::ideal(truth)
     };
     let gains = [0.0, 0.0, 10.0, 0.1];
     let ctrl = StateFeedback::from_lab_gains(gains, Cart::Two).unwrap();
     let setpoint = 0.030;
     // The simulated rig's calibration has the card's supply as full scale.
-    assert_eq!(sim.calibration().volts_full_scale, supply);
+    assert_eq!(sim.calibration.volts_full_scale, supply);
     // 300 N on cart 2 drives it past the 2 m/s that the lab's 24 V motor
     // can reach (the rig would call that a bus fault): this unphysical drive
     // needs a looser plausibility limit, well above the run's peak speed
     // (printed: 2.007 m/s, at the 5th sample).
     let calibration = Calibration {
         max_speed: 10.0,
-        ..sim.calibration()
+        ..sim.calibration
     };
     let virtual_clock = Clock::Virtual(clock.clone());
     let card = Pc104::new(sim.card(&virtual_clock).unwrap());
@@ -180,8 +183,11 @@ fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
     // check watches.
     let make = || {
         let (clock, rig) = sim_rig(SimulatedRig {
-            encoder_noise: 0.5,
-            seed: 7,
+            card: CardSettings {
+                encoder_noise: 0.5,
+                seed: 7,
+                ..CardSettings::default()
+            },
             ..Default::default()
         });
         let square = SquareWave::new(5.0, 0.2).unwrap();
@@ -244,7 +250,9 @@ fn a_travel_limit_breach_halts_and_keeps_the_recording() {
             .all(|x| x.abs() <= 0.05)
     );
     // The halt was written; the drive takes it the PWM delay later.
-    clock.advance(SimulatedRig::default().pwm_delay).unwrap();
+    clock
+        .advance(SimulatedRig::default().card.pwm_delay)
+        .unwrap();
     rig.card_mut().port_mut().sync().unwrap();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }

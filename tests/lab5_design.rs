@@ -11,7 +11,7 @@ mod common;
 use common::lqi_design::{self, Design, Metrics, Spec};
 use common::run_on_rig;
 use ctrlab::lab::ident::{Options, Scheme, identify_separate_springs_with};
-use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, Cart, Friction, MassSpring, SimulatedRig};
 use ctrlab::signal::SquareWave;
 use std::sync::OnceLock;
 
@@ -75,7 +75,11 @@ fn run(sim: &SimulatedRig) -> Metrics {
 #[test]
 fn cart_2_on_the_simulated_rig_meets_overshoot_settling_and_drive_and_rests_within_3_counts() {
     let sim = SimulatedRig {
-        seed: 202, // lab5's run of this design
+        // lab5's run of this design
+        card: CardSettings {
+            seed: 202,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     };
     let rig = run(&sim);
@@ -114,8 +118,14 @@ fn cart_2_meets_the_whole_spec_on_a_rig_with_only_what_the_prediction_models() {
     // identification error.
     let defaults = SimulatedRig::default();
     let sim = SimulatedRig {
-        stiction: defaults.coulomb_friction,
-        encoder_noise: 0.0,
+        friction: Friction {
+            stiction: defaults.friction.coulomb,
+            ..defaults.friction
+        },
+        card: CardSettings {
+            encoder_noise: 0.0,
+            ..defaults.card
+        },
         ..defaults
     };
     let rig = run(&sim);

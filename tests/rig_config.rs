@@ -1,12 +1,18 @@
-//! The card file (`lab::RigConfig`): round trip, and every way a field can
-//! be wrong (wrong type, missing, unknown, refused value) named by its
-//! dotted key.
+//! The lab's TOML files. The card file (`lab::RigConfig`): round trip, and
+//! every way a field can be wrong (wrong type, missing, unknown, refused
+//! value) named by its dotted key. The simulated rig's truth file
+//! (`lab::SimulatedRig`): defaults, unknown keys, round trip, and a bad
+//! value giving the same error from the file as from code, including what
+//! used to fail later under a name the file does not have.
 
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::hw::RegisterMap;
-use ctrlab::lab::{Calibration, FileError, FileErrorKind, RigConfig};
+use ctrlab::MassSpring;
+use ctrlab::hw::{Clock, RegisterMap};
+use ctrlab::lab::{
+    Calibration, CardSettings, FileError, FileErrorKind, Friction, RigConfig, SimulatedRig,
+};
 
 fn lab() -> RigConfig {
     RigConfig {
@@ -357,4 +363,339 @@ fn write_refuses_an_invalid_config_and_writes_nothing() {
         "{err}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+// ---- truth files: the same bad value, the same error from file and code --------
+
+/// A bad value of a simulated rig's truth file and the same value set in
+/// code: `from_toml` refuses the file with `FileError::Invalid` holding the
+/// very error `validate` gives the rig, named by the file's key, at the
+/// line the key is written on.
+fn same_error(file: &str, code: &SimulatedRig, key: &str) {
+    let from_code = code.validate().unwrap_err();
+    assert_eq!(from_code.key(), key, "{from_code}");
+    match SimulatedRig::from_toml(file) {
+        Err(FileError::Invalid { error, line, .. }) => {
+            // Debug, so that a NaN value compares equal to itself.
+            assert_eq!(format!("{error:?}"), format!("{from_code:?}"), "{file}");
+            let written = key.split('[').next().unwrap().rsplit('.').next().unwrap();
+            let at = file
+                .lines()
+                .position(|l| l.trim_start().starts_with(&format!("{written} =")))
+                .map(|i| i + 1);
+            assert_eq!(line, at, "{file}");
+        }
+        other => panic!("expected {key} refused, got {other:?} for\n{file}"),
+    }
+    // The card and the rig refuse it with the same error.
+    assert_eq!(
+        format!("{:?}", code.card(&Clock::RealTime).unwrap_err()),
+        format!("{from_code:?}")
+    );
+}
+
+#[test]
+fn a_bad_truth_value_gives_the_same_error_from_a_file_and_from_code() {
+    let d = SimulatedRig::default();
+    let cases: Vec<(&str, SimulatedRig, &str)> = vec![
+        (
+            "[truth]\nm2 = 0.0",
+            SimulatedRig {
+                truth: MassSpring { m2: 0.0, ..d.truth },
+                ..d.clone()
+            },
+            "truth.m2",
+        ),
+        (
+            "[friction]\ncoulomb = [1.0, -2.0]",
+            SimulatedRig {
+                friction: Friction {
+                    coulomb: [1.0, -2.0],
+                    ..d.friction
+                },
+                ..d.clone()
+            },
+            "friction.coulomb[1]",
+        ),
+        (
+            "[friction]\nstiction = [nan, 2.4]",
+            SimulatedRig {
+                friction: Friction {
+                    stiction: [f64::NAN, 2.4],
+                    ..d.friction
+                },
+                ..d.clone()
+            },
+            "friction.stiction[0]",
+        ),
+        (
+            "[card]\nencoder_noise = -0.5",
+            SimulatedRig {
+                card: CardSettings {
+                    encoder_noise: -0.5,
+                    ..d.card
+                },
+                ..d.clone()
+            },
+            "card.encoder_noise",
+        ),
+        (
+            "[card]\nmax_substep = 0.0",
+            SimulatedRig {
+                card: CardSettings {
+                    max_substep: 0.0,
+                    ..d.card
+                },
+                ..d.clone()
+            },
+            "card.max_substep",
+        ),
+        (
+            "[card.map]\nencoder = [0x20, 0x24, 0x28, 0xfd]",
+            SimulatedRig {
+                card: CardSettings {
+                    map: RegisterMap {
+                        encoder: [0x20, 0x24, 0x28, 0xfd],
+                        ..d.card.map
+                    },
+                    ..d.card
+                },
+                ..d.clone()
+            },
+            "card.map.encoder[3]",
+        ),
+        (
+            "[calibration]\ntravel_limits = [0.05, -0.05]",
+            SimulatedRig {
+                calibration: Calibration {
+                    travel_limits: [0.05, -0.05],
+                    ..d.calibration
+                },
+                ..d.clone()
+            },
+            "calibration.travel_limits[1]",
+        ),
+        (
+            "[calibration]\nwatchdog_timeout = nan",
+            SimulatedRig {
+                calibration: Calibration {
+                    watchdog_timeout: Some(f64::NAN),
+                    ..d.calibration
+                },
+                ..d.clone()
+            },
+            "calibration.watchdog_timeout",
+        ),
+        (
+            "[calibration]\nencoder_channels = [1, 1]",
+            SimulatedRig {
+                calibration: Calibration {
+                    encoder_channels: [1, 1],
+                    ..d.calibration
+                },
+                ..d.clone()
+            },
+            "calibration.encoder_channels[1]",
+        ),
+        (
+            "period = 0.0",
+            SimulatedRig {
+                period: 0.0,
+                ..d.clone()
+            },
+            "period",
+        ),
+        (
+            "initial_state = [0.0, 0.0, inf, 0.0]",
+            SimulatedRig {
+                initial_state: [0.0, 0.0, f64::INFINITY, 0.0],
+                ..d.clone()
+            },
+            "initial_state[2]",
+        ),
+    ];
+    for (file, code, key) in &cases {
+        same_error(file, code, key);
+    }
+}
+
+#[test]
+fn what_would_fail_later_under_another_name_is_refused_under_the_files_key() {
+    let d = SimulatedRig::default();
+    // A Coulomb force so small that the stiction over it overflows: it
+    // validated, and failed later as the simulation model's
+    // `stiction_ratio = inf`.
+    let tiny = SimulatedRig {
+        friction: Friction {
+            coulomb: [5e-324, 2.0],
+            ..d.friction
+        },
+        ..d.clone()
+    };
+    let later = tiny.simulation_model().validate().unwrap_err();
+    assert!(later.to_string().contains("stiction_ratio"), "{later}");
+    same_error(
+        "[friction]\ncoulomb = [5e-324, 2.0]",
+        &tiny,
+        "friction.coulomb[0]",
+    );
+    // A resolution whose travel per revolution overflows on the card
+    // (the old `travel_per_revolution = 1e300` over
+    // `counts_per_revolution = 1e-300`, which failed later as
+    // `metres_per_count = inf`): named by the file's one resolution key.
+    let coarse = SimulatedRig {
+        calibration: Calibration {
+            metres_per_count: 1e306,
+            ..d.calibration
+        },
+        ..d.clone()
+    };
+    same_error(
+        "[calibration]\nmetres_per_count = 1e306",
+        &coarse,
+        "calibration.metres_per_count",
+    );
+    // A resolution too fine for the card's 32-bit counters.
+    let fine = SimulatedRig {
+        calibration: Calibration {
+            metres_per_count: 1e-300,
+            ..d.calibration
+        },
+        ..d.clone()
+    };
+    same_error(
+        "[calibration]\nmetres_per_count = 1e-300",
+        &fine,
+        "calibration.metres_per_count",
+    );
+    // A watchdog shorter than two periods: the loop refused it later as
+    // `max_gap`.
+    let quick = SimulatedRig {
+        calibration: Calibration {
+            watchdog_timeout: Some(0.003),
+            ..d.calibration
+        },
+        ..d.clone()
+    };
+    same_error(
+        "[calibration]\nwatchdog_timeout = 0.003",
+        &quick,
+        "calibration.watchdog_timeout",
+    );
+    // A PWM delay of a period or more: the sampled-data simulation refused
+    // it later as `input_delay`.
+    let slow = SimulatedRig {
+        card: CardSettings {
+            pwm_delay: 0.002,
+            ..d.card
+        },
+        ..d.clone()
+    };
+    assert!(slow.sampled_config(1.0).validate().is_err());
+    same_error("[card]\npwm_delay = 0.002", &slow, "card.pwm_delay");
+    // A period below the loop's 1 µs: refused later by `hw::run`.
+    let fast = SimulatedRig {
+        period: 1e-7,
+        ..d.clone()
+    };
+    same_error("period = 1e-7", &fast, "period");
+    // A mass so small that an acceleration overflows: the card diverged
+    // at its first step.
+    let light = SimulatedRig {
+        truth: MassSpring {
+            m1: 1e-320,
+            ..d.truth
+        },
+        ..d.clone()
+    };
+    same_error("[truth]\nm1 = 1e-320", &light, "truth.m1");
+    // A cart starting beyond its travel limit: the first sample halted the
+    // rig.
+    let outside = SimulatedRig {
+        initial_state: [0.0, 0.0, 0.06, 0.0],
+        ..d.clone()
+    };
+    same_error(
+        "initial_state = [0.0, 0.0, 0.06, 0.0]",
+        &outside,
+        "initial_state[2]",
+    );
+    // Encoders counting down: the simulated card counts up.
+    let reversed = SimulatedRig {
+        calibration: Calibration {
+            sign: [1.0, -1.0],
+            ..d.calibration
+        },
+        ..d.clone()
+    };
+    same_error(
+        "[calibration]\nsign = [1.0, -1.0]",
+        &reversed,
+        "calibration.sign[1]",
+    );
+}
+
+#[test]
+fn a_truth_file_keeps_defaults_refuses_unknown_keys_and_round_trips() {
+    // Left out: the default; a table given in part keeps the rest.
+    let rig = SimulatedRig::from_toml("[truth]\ngain = 1.5\n[card]\nseed = 9").unwrap();
+    assert_eq!(rig.truth.gain, 1.5);
+    assert_eq!(rig.truth.m1, SimulatedRig::default_truth().m1);
+    assert_eq!(rig.card.seed, 9);
+    assert_eq!(
+        rig.card.encoder_noise,
+        CardSettings::default().encoder_noise
+    );
+    assert_eq!(rig.calibration, Calibration::default());
+    // Unknown keys, by their dotted key and line, the old flat layout's
+    // among them.
+    for (text, key, line) in [
+        ("[truth]\ngian = 1.2", "truth.gian", 2),
+        ("coulomb_friction = [1.0, 2.0]", "coulomb_friction", 1),
+        (
+            "[card]\ntravel_per_revolution = 1e300",
+            "card.travel_per_revolution",
+            2,
+        ),
+        ("[card.map]\nencoders = 1", "card.map.encoders", 2),
+    ] {
+        let err = SimulatedRig::from_toml(text).unwrap_err();
+        assert_eq!(err.kind(), FileErrorKind::UnknownKey, "{err}");
+        assert_eq!((err.key(), err.line()), (Some(key), Some(line)), "{err}");
+    }
+    // Every key written reads back equal, for a rig unlike the default in
+    // every part.
+    let unusual = SimulatedRig {
+        period: 0.001,
+        initial_state: [0.001, 0.0, -0.002, 0.01],
+        truth: MassSpring::nominal(),
+        friction: Friction::coulomb([0.3, 0.6]),
+        card: CardSettings {
+            encoder_noise: 0.1,
+            seed: 3,
+            pwm_delay: 0.0001,
+            max_substep: 0.0001,
+            map: RegisterMap {
+                encoder: [0x40, 0x44, 0x48, 0x4c],
+                ..RegisterMap::default()
+            },
+        },
+        calibration: Calibration {
+            travel_limits: [0.04, 0.045],
+            watchdog_timeout: None,
+            card_id: 0x3c,
+            ..Calibration::default()
+        },
+    };
+    let text = unusual.to_toml();
+    assert_eq!(SimulatedRig::from_toml(&text).unwrap(), unusual, "{text}");
+    for table in [
+        "[truth]",
+        "[friction]",
+        "[card]",
+        "[card.map]",
+        "[calibration]",
+    ] {
+        assert!(text.contains(table), "{table} missing from\n{text}");
+    }
 }

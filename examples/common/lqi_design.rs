@@ -9,7 +9,7 @@
 use ctrlab::design::{
     AntiWindup, EstimatorForm, Observer, ObserverController, SelectOutputs, dlqe, dlqi,
 };
-use ctrlab::lab::{self, Cart, MassSpring, SimulatedRig};
+use ctrlab::lab::{self, CardSettings, Cart, Friction, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::{SMatrix, SVector, matrix, vector};
 use ctrlab::sim::run_sampled;
 use ctrlab::{Discrete, Error, Method, Recording, StateSpace, StepInfoOptions, step_info};
@@ -98,10 +98,12 @@ pub fn predicted_rig(
 ) -> SimulatedRig {
     SimulatedRig {
         truth: model,
-        coulomb_friction: coulomb,
-        stiction: coulomb,
-        pwm_delay: DRIVE_DELAY,
-        encoder_noise: 0.0,
+        friction: Friction::coulomb(coulomb),
+        card: CardSettings {
+            pwm_delay: DRIVE_DELAY,
+            encoder_noise: 0.0,
+            ..calibration.card
+        },
         ..calibration.clone()
     }
 }

@@ -75,7 +75,7 @@ pub fn section(
         lqi_design::rho_grid().last().unwrap_or(f64::NAN),
         coulomb[0],
         coulomb[1],
-        calibration.supply_voltage,
+        calibration.calibration.volts_full_scale,
         calibration.sampled_config(DURATION).input_quantisation[0] * 1e3,
         DRIVE_DELAY * 1e3
     ));
@@ -116,7 +116,7 @@ pub fn section(
         });
     }
     table(report, &cases, count);
-    figure(report, &cases, calibration.supply_voltage)?;
+    figure(report, &cases, calibration.calibration.volts_full_scale)?;
     differences(report, backend, ident, &cases, count);
     Ok(())
 }
@@ -125,7 +125,10 @@ pub fn section(
 /// cart 2's travel, against the larger alternative, on the identified
 /// model.
 fn setpoint_reason(model: &MassSpring, coulomb: [f64; 2], rig: &SimulatedRig) -> String {
-    let (supply, travel) = (rig.supply_voltage, rig.travel_limits[1]);
+    let (supply, travel) = (
+        rig.calibration.volts_full_scale,
+        rig.calibration.travel_limits[1],
+    );
     // At rest cart 1 at r needs the force k1 r, passed through k2: cart 2
     // sits at r (1 + k1 / k2); friction adds up to F1 + F2 either way.
     let hold = |r: f64| (model.k1 * r / model.gain, r * (1.0 + model.k1 / model.k2));
@@ -402,13 +405,13 @@ fn friction_reason(backend: &Backend, coulomb: [f64; 2], cart: Cart) -> String {
             "the prediction's cart {} breaks away at the identified Coulomb force, {:.2} N; the card's at {:.2} N ({} over its {:.2} N Coulomb force), a stiction the identification cannot see (it uses only rows where the carts move), and the card adds σ = {} count of encoder noise the prediction has none of",
             cart.number(),
             coulomb[i],
-            sim.stiction[i].max(sim.coulomb_friction[i]),
+            sim.friction.stiction[i].max(sim.friction.coulomb[i]),
             pct(
-                sim.stiction[i].max(sim.coulomb_friction[i]),
-                sim.coulomb_friction[i]
+                sim.friction.stiction[i].max(sim.friction.coulomb[i]),
+                sim.friction.coulomb[i]
             ),
-            sim.coulomb_friction[i],
-            sim.encoder_noise
+            sim.friction.coulomb[i],
+            sim.card.encoder_noise
         ),
         None => format!(
             "the prediction's cart {} breaks away at the identified Coulomb force, {:.2} N, and a real cart's breakaway force is higher (stiction), which identification from moving rows cannot see",
@@ -513,7 +516,7 @@ fn walk(c: &Case, ident: &Identification, backend: &Backend, err: f64, count: f6
     let rate = kz * err.abs() * count;
     let breakaway = |i: usize| {
         backend.sim().map_or(ident.coulomb()[i], |sim| {
-            sim.stiction[i].max(sim.coulomb_friction[i])
+            sim.friction.stiction[i].max(sim.friction.coulomb[i])
         })
     };
     let (band, which) = match c.design.spec.cart {
@@ -562,21 +565,21 @@ fn transient_reasons(backend: &Backend, ident: &Identification) -> String {
             off.join(", ")
         ));
     }
-    if (sim.pwm_delay - DRIVE_DELAY).abs() > 1e-6 {
+    if (sim.card.pwm_delay - DRIVE_DELAY).abs() > 1e-6 {
         reasons.push(format!(
             "the card's {:.2} ms PWM delay where the prediction assumed the data sheet's {:.2} ms",
-            sim.pwm_delay * 1e3,
+            sim.card.pwm_delay * 1e3,
             DRIVE_DELAY * 1e3
         ));
     }
-    let stiction = (0..2).any(|i| sim.stiction[i] > sim.coulomb_friction[i]);
+    let stiction = (0..2).any(|i| sim.friction.stiction[i] > sim.friction.coulomb[i]);
     if stiction {
         reasons.push("breakaway (stiction) the prediction does not have".into());
     }
-    if sim.encoder_noise > 0.0 {
+    if sim.card.encoder_noise > 0.0 {
         reasons.push(format!(
             "σ = {} count of encoder noise the prediction does not have",
-            sim.encoder_noise
+            sim.card.encoder_noise
         ));
     }
     let worst = params

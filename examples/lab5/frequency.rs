@@ -4,7 +4,7 @@
 
 use ctrlab::freq::{bode, logspace};
 use ctrlab::ident::{FrequencyEstimate, etfe, spa};
-use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, Cart, Friction, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::{SVector, vector};
 use ctrlab::signal::{Multisine, Phases, Signal};
 use ctrlab::sim::run_sampled;
@@ -117,13 +117,16 @@ pub fn section(
     // The identified model with its Coulomb friction, driven by the same
     // multisine through the same drive (delay, quantisation), noise-free.
     let coulomb = ident.coulomb();
+    let rig = backend.sim().cloned().unwrap_or_default();
     let model_rig = SimulatedRig {
         truth: ident.model,
-        coulomb_friction: coulomb,
-        stiction: coulomb,
-        encoder_noise: 0.0,
         period: PERIOD,
-        ..backend.sim().cloned().unwrap_or_default()
+        friction: Friction::coulomb(coulomb),
+        card: CardSettings {
+            encoder_noise: 0.0,
+            ..rig.card
+        },
+        ..rig
     };
     let simulated = run_sampled(
         model_rig.plant(),

@@ -10,7 +10,7 @@ use ctrlab::lab::ident::{
     Estimate, MassSpringEstimate, Options, Scheme, SeparateSpringsAverage, SeparateSpringsEstimate,
     Spread, average, average_separate_springs, identify, identify_separate_springs_with,
 };
-use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
+use ctrlab::lab::{Cart, Friction, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::vector;
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::{OpenLoop, Recording};
@@ -509,8 +509,10 @@ pub fn equal_springs(
             let run_backend = Backend {
                 kind: BackendKind::Simulated {
                     sim: Box::new(SimulatedRig {
-                        coulomb_friction: [0.0; 2],
-                        stiction: [0.0; 2],
+                        friction: Friction {
+                            coulomb: [0.0; 2],
+                            stiction: [0.0; 2],
+                        },
                         ..sim.clone()
                     }),
                     real_time: backend.real_time(),

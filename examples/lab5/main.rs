@@ -397,10 +397,10 @@ fn answer_model(report: &mut Report, backend: Option<&Backend>, ident: &Identifi
     if let Some(sim) = backend.and_then(Backend::sim) {
         s += &format!(
             " The card's Coulomb friction is {} N and {} N: identified {} and {}.",
-            sim.coulomb_friction[0],
-            sim.coulomb_friction[1],
-            pct(f1, sim.coulomb_friction[0]),
-            pct(f2, sim.coulomb_friction[1]),
+            sim.friction.coulomb[0],
+            sim.friction.coulomb[1],
+            pct(f1, sim.friction.coulomb[0]),
+            pct(f2, sim.friction.coulomb[1]),
         );
     }
     if let Some(t) = backend.and_then(Backend::truth) {

@@ -8,7 +8,7 @@ use ctrlab::hw::{
     Clock, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome, StopSignal,
     VirtualClock, run,
 };
-use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, Cart, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::{SVector, vector};
 use ctrlab::{Controller, Error, Recording, StateFeedback, StepInfo, StepInfoOptions, step_info};
 
@@ -73,12 +73,12 @@ impl Backend {
                     t.b1,
                     t.b2,
                     t.gain,
-                    sim.coulomb_friction[0],
-                    sim.coulomb_friction[1],
-                    sim.stiction[0],
-                    sim.stiction[1],
-                    sim.pwm_delay * 1e3,
-                    sim.encoder_noise
+                    sim.friction.coulomb[0],
+                    sim.friction.coulomb[1],
+                    sim.friction.stiction[0],
+                    sim.friction.stiction[1],
+                    sim.card.pwm_delay * 1e3,
+                    sim.card.encoder_noise
                 )
             }
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
@@ -102,7 +102,7 @@ impl Backend {
 
     /// The simulated card's Coulomb forces (cart 1, cart 2), N.
     pub fn coulomb_truth(&self) -> Option<[f64; 2]> {
-        self.sim().map(|s| s.coulomb_friction)
+        self.sim().map(|s| s.friction.coulomb)
     }
 
     pub fn real_time(&self) -> bool {
@@ -135,9 +135,9 @@ impl Backend {
         let outcome = match &self.kind {
             BackendKind::Simulated { sim, real_time } => {
                 let sim = SimulatedRig {
-                    seed,
                     truth: truth.unwrap_or(sim.truth),
                     period: PERIOD,
+                    card: CardSettings { seed, ..sim.card },
                     ..(**sim).clone()
                 };
                 let clock = if *real_time {

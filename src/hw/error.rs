@@ -405,6 +405,15 @@ impl ConfigError {
         *key = format!("{table}.{key}");
         self
     }
+
+    /// The same error under another key (a value derived from a
+    /// configuration's field, reported under that field's key).
+    #[must_use]
+    pub(crate) fn with_key(mut self, new: String) -> Self {
+        let (ConfigError::Invalid { key, .. } | ConfigError::Conflict { key, .. }) = &mut self;
+        *key = new;
+        self
+    }
 }
 
 /// Checks that `value` is finite and > 0 (the validators' most common rule).

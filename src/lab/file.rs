@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 use crate::hw::ConfigError;
@@ -283,6 +284,33 @@ impl FileError {
 pub(super) fn parse<T: DeserializeOwned>(text: &str) -> Result<T, FileError> {
     let deserializer = toml::Deserializer::parse(text).map_err(|e| syntax(text, &e))?;
     serde_path_to_error::deserialize(deserializer).map_err(|e| field_error(text, &e, span_line))
+}
+
+/// `T` from TOML `text` laid over `defaults`: every key the text leaves out
+/// keeps its default value (a table the text gives in part keeps the
+/// default of the keys it lacks), a key the text adds is refused, as is a
+/// value of the wrong type, by its dotted key and line.
+pub(super) fn parse_over<T: Serialize + DeserializeOwned>(
+    text: &str,
+    defaults: &T,
+) -> Result<T, FileError> {
+    let given: toml::Table = toml::from_str(text).map_err(|e| syntax(text, &e))?;
+    // Plain numbers, arrays and tables: the defaults always serialise.
+    let mut merged = toml::Table::try_from(defaults).unwrap_or_default();
+    lay_over(&mut merged, given);
+    serde_path_to_error::deserialize(merged).map_err(|e| field_error(text, &e, |_, _| None))
+}
+
+/// `given` over `base`, table by table.
+fn lay_over(base: &mut toml::Table, given: toml::Table) {
+    for (key, value) in given {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(base)), toml::Value::Table(given)) => lay_over(base, given),
+            (_, value) => {
+                base.insert(key, value);
+            }
+        }
+    }
 }
 
 /// The line of a parse error's span.

@@ -14,7 +14,8 @@
 //!   [`RigConfig`]; a file's faults are a [`FileError`] that says the
 //!   path, the line and the key),
 //!   and in simulation [`SimulatedRig`] (the plant with stick–slip
-//!   [`FrictionPlant`] inside the register-level card, in one call), with
+//!   [`FrictionPlant`] inside the register-level card, in one call), made
+//!   of its truth, [`Friction`], [`CardSettings`] and [`Calibration`], with
 //!   its [`EncoderSensor`] for the sampled-data simulator;
 //! - the lab's recording layout, [`schema`]: input `u` (V), measurements
 //!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s).
@@ -65,7 +66,7 @@ pub use plant::{Cart, MassSpring};
 pub use probe::SimulatedOperator;
 pub use rig::MassSpringRig;
 pub use sensor::EncoderSensor;
-pub use simulated::{FrictionPlant, SimulatedRig};
+pub use simulated::{CardSettings, Friction, FrictionPlant, SimulatedRig};
 
 use nalgebra::SMatrix;
 

@@ -129,7 +129,7 @@ impl<P: EppPort> MassSpringRig<P> {
     /// use ctrlab::lab::{MassSpringRig, SimulatedRig};
     /// let sim = SimulatedRig::default();
     /// let clock = Clock::Virtual(VirtualClock::new());
-    /// let rig = MassSpringRig::with_clock(Pc104::new(sim.card(&clock)?), sim.calibration(), 0.002, clock)?;
+    /// let rig = MassSpringRig::with_clock(Pc104::new(sim.card(&clock)?), sim.calibration, 0.002, clock)?;
     /// assert_eq!(rig.calibration().card_id, 0xa5);
     /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```

@@ -6,7 +6,7 @@ pub mod lqi_design;
 
 use ctrlab::data::Recording;
 use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-use ctrlab::lab::SimulatedRig;
+use ctrlab::lab::{CardSettings, Friction, SimulatedRig};
 use ctrlab::signal::Signal;
 use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
 use nalgebra::vector;
@@ -56,9 +56,14 @@ pub fn run_on_rig<C: Controller<4, 1, 1>>(
 pub fn friction_rig(truth: MassSpring, friction: [f64; 2], seed: u64) -> SimulatedRig {
     SimulatedRig {
         truth,
-        coulomb_friction: friction,
-        stiction: friction.map(|f| 1.2 * f),
-        seed,
+        friction: Friction {
+            coulomb: friction,
+            stiction: friction.map(|f| 1.2 * f),
+        },
+        card: CardSettings {
+            seed,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     }
 }

@@ -200,7 +200,7 @@ pub struct ProbeReport {
 /// let hand = SimulatedOperator::new(clock, [true, true]);
 /// let mut probe = Probe::new(card, hand, ProbeOptions::default())?;
 /// let report = probe.run()?;
-/// assert_eq!(report.map, rig.map);
+/// assert_eq!(report.map, rig.card.map);
 /// assert_eq!(report.watchdog_timeout, Some(0.1));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
