@@ -5,8 +5,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::hw::{Clock, SimulatedCard, VirtualClock};
-use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
-use ctrlab::{Cart, Controller, StateFeedback};
+use ctrlab::lab::{Calibration, FrictionPlant, LabGains, MassSpringRig, SimulatedRig};
+use ctrlab::{Cart, Controller};
 use nalgebra::vector;
 use std::hint::black_box;
 
@@ -28,7 +28,9 @@ fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard<FrictionPlant, 4>> {
 
 fn benches(c: &mut Criterion) {
     // The lab's gain [0 0 10 0.1] per mm on cart 2, setpoint 30 mm.
-    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let mut ctrl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
 
     c.bench_function("loop iteration, simulated card, clock held", |b| {
         let clock = VirtualClock::new();

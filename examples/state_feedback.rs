@@ -24,8 +24,9 @@
 #[path = "common/lab_tables.rs"]
 mod lab_tables;
 
+use ctrlab::lab::LabGains;
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Cart, Error, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Cart, Error, MassSpring, StepInfo, StepInfoOptions, step_info};
 use lab_tables::{fmt_kf, fmt_poles};
 use nalgebra::{Complex, SVector, vector};
 
@@ -87,7 +88,9 @@ fn tables() -> Vec<Table> {
 /// Simulates one row and measures it.
 fn run_row(plant: &MassSpring, table: &Table, kf: [f64; 4]) -> Result<Row, Error> {
     let sys = plant.state_space(table.cart)?;
-    let cl = StateFeedback::from_lab_gains(kf, table.cart)?.closed_loop(&sys)?;
+    let cl = LabGains::new(kf, table.cart)
+        .state_feedback()?
+        .closed_loop(&sys)?;
     let poles = cl.poles()?;
     if !cl.is_stable()? {
         return Ok(Row::Unstable { poles });

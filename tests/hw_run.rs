@@ -16,11 +16,11 @@ use ctrlab::hw::{
     Clock, EppPort, LoopConfig, LoopFault, LoopFaultKind, Pc104, PortErrorKind, Rig, RigError,
     SimulatedCard, VirtualClock, run,
 };
-use ctrlab::lab::{Calibration, CardSettings, FrictionPlant, MassSpringRig, SimulatedRig};
-use ctrlab::signal::{Signal, SquareWave};
-use ctrlab::{
-    Cart, Controller, MassSpring, Method, OpenLoop, StateFeedback, StepInfoOptions, step_info,
+use ctrlab::lab::{
+    Calibration, CardSettings, FrictionPlant, LabGains, MassSpringRig, SimulatedRig,
 };
+use ctrlab::signal::{Signal, SquareWave};
+use ctrlab::{Cart, Controller, MassSpring, Method, OpenLoop, StepInfoOptions, step_info};
 use nalgebra::{SVector, vector};
 use proptest::prelude::*;
 
@@ -117,7 +117,7 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
         ..SimulatedRig::ideal(truth)
     };
     let gains = [0.0, 0.0, 10.0, 0.1];
-    let ctrl = StateFeedback::from_lab_gains(gains, Cart::Two).unwrap();
+    let ctrl = LabGains::new(gains, Cart::Two).state_feedback().unwrap();
     let setpoint = 0.030;
     // The simulated rig's calibration has the card's supply as full scale.
     assert_eq!(sim.calibration.volts_full_scale, supply);

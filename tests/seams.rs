@@ -15,7 +15,7 @@ use common::{last, run_on_rig, saturated, simulate_on};
 use ctrlab::data::Recording;
 use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqe, dlqi};
 use ctrlab::hw::{self, Clock, ConfigErrorKind, LoopConfig, VirtualClock};
-use ctrlab::lab::{self, CardSettings, Friction, SimulatedRig};
+use ctrlab::lab::{self, CardSettings, Friction, LabGains, SimulatedRig};
 use ctrlab::sim::run_sampled;
 use ctrlab::{Cart, Controller, Error, MassSpring, Method, StateFeedback, StateSpace};
 use nalgebra::{SMatrix, SVector, matrix, vector};
@@ -99,7 +99,9 @@ fn assert_agree(sim: &SimulatedRig, simulated: &Recording, measured: &Recording)
 
 /// The lab's Table 2 row on cart 2: `Kf = [0 0 10 0.1]` per mm.
 fn lab_law() -> StateFeedback<4, 1> {
-    StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap()
+    LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap()
 }
 
 #[test]

@@ -8,9 +8,9 @@ use ctrlab::hw::{
     Clock, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome, StopSignal,
     VirtualClock, run,
 };
-use ctrlab::lab::{CardSettings, Cart, MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, Cart, LabGains, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::{SVector, vector};
-use ctrlab::{Controller, Error, Recording, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Controller, Error, Recording, StepInfo, StepInfoOptions, step_info};
 
 use crate::figures::RunCurve;
 use crate::lab_tables::{self, fmt_kf, fmt_poles};
@@ -338,7 +338,7 @@ pub fn rig_table(
     let mut results = Vec::new();
     let mut stats = Vec::new();
     for (i, kf) in table.rows.iter().enumerate() {
-        let ctrl = StateFeedback::from_lab_gains(*kf, table.cart)?;
+        let ctrl = LabGains::new(*kf, table.cart).state_feedback()?;
         let poles = fmt_poles(&ctrl.closed_loop(&sys)?.poles()?);
         let radius = ctrl
             .closed_loop(&sampled)?

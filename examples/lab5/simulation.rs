@@ -1,7 +1,8 @@
 //! Tables 1 and 2: the nominal model in simulation.
 
+use ctrlab::lab::LabGains;
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Cart, Error, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Cart, Error, MassSpring, StepInfo, StepInfoOptions, step_info};
 use nalgebra::{SVector, vector};
 
 use crate::lab_tables::{self, fmt_kf, fmt_poles};
@@ -73,7 +74,9 @@ pub fn table2(report: &mut Report) -> Result<Vec<Measured>, Error> {
     let mut curves = Vec::new();
     let mut measured = Vec::new();
     for kf in lab_tables::table2() {
-        let cl = StateFeedback::from_lab_gains(kf, Cart::Two)?.closed_loop(&plant)?;
+        let cl = LabGains::new(kf, Cart::Two)
+            .state_feedback()?
+            .closed_loop(&plant)?;
         let poles = cl.poles()?;
         if !cl.is_stable()? {
             rows.push(vec![

@@ -267,14 +267,13 @@ const SPIN: Duration = Duration::from_micros(200);
 ///
 /// ```
 /// use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
-/// use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
-/// use ctrlab::StateFeedback;
+/// use ctrlab::lab::{Cart, LabGains, MassSpring, SimulatedRig};
 /// use nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
 /// let mut rig = SimulatedRig::ideal(MassSpring::nominal())
 ///     .rig(&Clock::Virtual(clock.clone()))?;
-/// let controller = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
+/// let controller = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?;
 /// let loop_config = LoopConfig { duration: 1.0, ..LoopConfig::default() };
 ///
 /// let out = run(&mut rig, controller, |_t| vector![0.030], &Clock::Virtual(clock), &loop_config)?;

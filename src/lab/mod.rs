@@ -4,9 +4,8 @@
 //!
 //! - the plant: [`MassSpring`] (equations (1)–(3), (14)) and [`Cart`];
 //! - the lab's per-millimetre gains,
-//!   [`StateFeedback::from_lab_gains`](crate::StateFeedback::from_lab_gains),
-//!   and back, [`StateFeedback::to_lab_gains`](crate::StateFeedback::to_lab_gains)
-//!   into [`LabGains`];
+//!   [`LabGains`] (Kf in V/mm and V/(mm/s), and the setpoint's column
+//!   `G`), to an SI [`StateFeedback`](crate::StateFeedback) and back;
 //! - the identification of equations (4)–(11) from a recording, in
 //!   [`ident`];
 //! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`]
@@ -28,12 +27,12 @@
 //!
 //! ```
 //! use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-//! use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
-//! use ctrlab::{StateFeedback, sim::run_sampled};
+//! use ctrlab::lab::{Cart, LabGains, MassSpring, SimulatedRig};
+//! use ctrlab::sim::run_sampled;
 //! use nalgebra::vector;
 //!
 //! let sim = SimulatedRig::ideal(MassSpring::nominal());
-//! let law = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
+//! let law = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?;
 //! let simulated = run_sampled(sim.plant(), sim.sensor(), law, |_| vector![0.030],
 //!                             vector![0.0, 0.0, 0.0, 0.0], &sim.sampled_config(1.0))?;
 //!
