@@ -5,8 +5,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::hw::{Clock, SimulatedCard, VirtualClock};
-use ctrlab::lab::{FrictionPlant, MassSpringRig, SimulatedRig};
-use ctrlab::{Cart, Controller, StateFeedback};
+use ctrlab::lab::{Calibration, FrictionPlant, LabGains, MassSpringRig, SimulatedRig};
+use ctrlab::{Cart, Controller};
 use nalgebra::vector;
 use std::hint::black_box;
 
@@ -15,8 +15,11 @@ use std::hint::black_box;
 /// loop's own work.
 fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard<FrictionPlant, 4>> {
     SimulatedRig {
-        watchdog_timeout: None,
         initial_state: [0.001, 0.0, 0.002, 0.0],
+        calibration: Calibration {
+            watchdog_timeout: None,
+            ..Calibration::default()
+        },
         ..Default::default()
     }
     .rig(&Clock::Virtual(clock.clone()))
@@ -25,7 +28,9 @@ fn rig(clock: &VirtualClock) -> MassSpringRig<SimulatedCard<FrictionPlant, 4>> {
 
 fn benches(c: &mut Criterion) {
     // The lab's gain [0 0 10 0.1] per mm on cart 2, setpoint 30 mm.
-    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let mut ctrl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
 
     c.bench_function("loop iteration, simulated card, clock held", |b| {
         let clock = VirtualClock::new();

@@ -3,10 +3,9 @@
 //! `acker` and `dlqr` on the lab's 4-state plant.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use ctrlab::lab::LabGains;
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{
-    Cart, Discretization, MassSpring, StateFeedback, StepInfoOptions, acker, dlqr, step_info,
-};
+use ctrlab::{Cart, Discretization, MassSpring, StepInfoOptions, acker, dlqr, step_info};
 use nalgebra::{Complex, SMatrix, SVector, matrix, vector};
 use std::hint::black_box;
 
@@ -14,7 +13,8 @@ fn benches(c: &mut Criterion) {
     let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
 
     // Table 2, row [0 0 10 0.1]: 5000 samples at 0.5 ms (2.5 s).
-    let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)
+    let cl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
         .unwrap()
         .closed_loop(&plant)
         .unwrap();

@@ -16,8 +16,8 @@
 //! millisecond outliers under load. The numbers say how much of the 2 ms
 //! period is left on a given PC.
 
-use ctrlab::StateFeedback;
 use ctrlab::hw::{Clock, LoopConfig, RealTime, run};
+use ctrlab::lab::LabGains;
 use ctrlab::lab::{Cart, SimulatedRig};
 use ctrlab::nalgebra::vector;
 
@@ -54,7 +54,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
-    let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.05], Cart::Two)?;
+    let ctrl = LabGains::new([0.0, 0.0, 10.0, 0.05], Cart::Two).state_feedback()?;
     let config = LoopConfig {
         duration: seconds,
         realtime,

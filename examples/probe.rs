@@ -123,7 +123,7 @@ impl<P> Operator<P> for Console {
 }
 
 /// The time of one register read (an address and a data cycle), µs.
-fn cycle_time<P: EppPort>(port: &mut P) -> Result<f64, ctrlab::hw::HwError> {
+fn cycle_time<P: EppPort>(port: &mut P) -> Result<f64, ctrlab::hw::PortError> {
     let start = Instant::now();
     for _ in 0..1000 {
         port.read_register(0)?;
@@ -179,10 +179,10 @@ fn simulated() -> Result<ProbeReport, String> {
     for line in &hand.transcript {
         println!("{line}");
     }
-    if report.map != rig.map {
+    if report.map != rig.card.map {
         return Err(format!(
             "the probe found {:?}, not the simulated card's map {:?}",
-            report.map, rig.map
+            report.map, rig.card.map
         ));
     }
     println!("the probe rediscovered the simulated card's register map exactly");

@@ -21,9 +21,10 @@
 //! With the `plot` feature, one SVG per table (every stable row's response)
 //! is written to `target/state_feedback/`.
 
+use ctrlab::lab::LabGains;
 use ctrlab::lab::tables::{TABLE2, TABLE5, TABLE6, kf_display, poles_display};
 use ctrlab::sim::{Solver, simulate, time_grid};
-use ctrlab::{Cart, Error, MassSpring, StateFeedback, StepInfo, StepInfoOptions, step_info};
+use ctrlab::{Cart, Error, MassSpring, StepInfo, StepInfoOptions, step_info};
 use nalgebra::{Complex, SVector, vector};
 
 /// Grid of the responses, s.
@@ -84,7 +85,9 @@ fn tables() -> Vec<Table> {
 /// Simulates one row and measures it.
 fn run_row(plant: &MassSpring, table: &Table, kf: [f64; 4]) -> Result<Row, Error> {
     let sys = plant.state_space(table.cart)?;
-    let cl = StateFeedback::from_lab_gains(kf, table.cart)?.closed_loop(&sys)?;
+    let cl = LabGains::new(kf, table.cart)
+        .state_feedback()?
+        .closed_loop(&sys)?;
     let poles = cl.poles()?;
     if !cl.is_stable()? {
         return Ok(Row::Unstable { poles });

@@ -181,19 +181,6 @@ pub enum Error {
         /// Iterations spent.
         iterations: usize,
     },
-    /// A CSV recording is malformed: a missing or unit-less time column, a
-    /// column in encoder counts without a calibration, a row of the wrong
-    /// width, a value that is not a finite number (or holds a thousands
-    /// separator), a time column that does not increase, too few rows, or
-    /// bytes the CSV parser rejects.
-    #[error("CSV line {line}: {reason}")]
-    Csv {
-        /// One-based line number in the file, comment and blank lines
-        /// counted (a header after two comment lines is line 3).
-        line: u64,
-        /// What is wrong on that line, with the offending value.
-        reason: String,
-    },
     /// A least-squares regressor does not determine every parameter: its
     /// column-equilibrated condition number exceeds the solver's limit
     /// (typically a run with no excitation, or two collinear regressors).
@@ -235,23 +222,6 @@ pub enum Error {
         /// What is wrong; for a missing channel, the channels there are.
         reason: String,
     },
-    /// A TOML file (a simulated rig's truth, a rig's register map and
-    /// calibration) does not parse, holds an unknown field or a value of the
-    /// wrong type, or (where fields are required) lacks one.
-    #[error(
-        "TOML{}{}: {message}",
-        line.map(|l| format!(" line {l}")).unwrap_or_default(),
-        key.as_ref().map(|k| format!(", key `{k}`")).unwrap_or_default()
-    )]
-    Toml {
-        /// One-based line of the fault, when the parser knows it.
-        line: Option<usize>,
-        /// The dotted key of the field at fault (`calibration.card_id`,
-        /// `map.encoder[2]`), when the fault is in a field.
-        key: Option<String>,
-        /// The parser's message.
-        message: String,
-    },
     /// An index is past the end of what it indexes (an output channel of a
     /// response, …).
     #[error("{what} index {index} is out of range: there are {len}")]
@@ -291,17 +261,6 @@ pub enum Error {
         /// What is wrong with it.
         reason: &'static str,
     },
-    /// Reading or writing a file failed. Holds the error kind and message
-    /// rather than `std::io::Error` so that `Error` stays `Clone + PartialEq`.
-    #[error("{context}: {message}")]
-    Io {
-        /// What was being done, with the path (`"reading log.csv"`).
-        context: String,
-        /// The I/O error's kind.
-        kind: std::io::ErrorKind,
-        /// The I/O error's message.
-        message: String,
-    },
 }
 
 /// The category of an [`Error`], for callers that branch on what happened
@@ -331,9 +290,6 @@ pub enum ErrorKind {
     /// The model lacks a property the operation needs: stability,
     /// controllability, observability, or a response that settles.
     System,
-    /// Reading or writing a file (being moved to the error types of the
-    /// modules that do I/O).
-    Io,
 }
 
 impl Error {
@@ -368,7 +324,6 @@ impl Error {
             | Error::Unstable { .. }
             | Error::Uncontrollable { .. }
             | Error::Unobservable { .. } => ErrorKind::System,
-            Error::Csv { .. } | Error::Toml { .. } | Error::Io { .. } => ErrorKind::Io,
         }
     }
 }
@@ -457,17 +412,6 @@ impl std::fmt::Display for Short {
         };
         // Fall back to the value itself where the scaling over- or underflows.
         write!(f, "{}", if rounded.is_finite() { rounded } else { v })
-    }
-}
-
-impl Error {
-    /// An [`Error::Io`] from an I/O error and what was being done.
-    pub(crate) fn io(context: impl Into<String>, err: &std::io::Error) -> Self {
-        Error::Io {
-            context: context.into(),
-            kind: err.kind(),
-            message: err.to_string(),
-        }
     }
 }
 

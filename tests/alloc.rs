@@ -176,8 +176,11 @@ fn step_info_allocates_nothing() {
 
 #[test]
 fn state_feedback_update_allocates_nothing() {
-    use ctrlab::{Controller, StateFeedback};
-    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    use ctrlab::Controller;
+    use ctrlab::lab::LabGains;
+    let mut ctrl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
     let d = MassSpring::nominal()
         .state_space(Cart::Two)
         .unwrap()
@@ -317,21 +320,22 @@ fn friction_band() -> f64 {
     let truth = sim.truth;
     let compliance = 1.0 / truth.k1 + 1.0 / truth.k2;
     let loop_gain = compliance * truth.gain * 10_000.0;
-    sim.stiction[1] * compliance / (1.0 + loop_gain) + 3.0 * sim.metres_per_count()
+    sim.friction.stiction[1] * compliance / (1.0 + loop_gain) + 3.0 * sim.metres_per_count()
 }
 
 #[test]
 fn hw_run_on_the_simulated_rig_allocates_nothing_per_tick() {
-    use ctrlab::StateFeedback;
     use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
-    use ctrlab::lab::SimulatedRig;
+    use ctrlab::lab::{LabGains, SimulatedRig};
     let clock = VirtualClock::new();
     let virtual_clock = Clock::Virtual(clock.clone());
     // The realistic rig: friction, stiction, PWM delay, encoder noise; the
     // loop's checks (timing faults, gaps, the rig's bus-fault and stall
     // checks) all run.
     let mut rig = SimulatedRig::default().rig(&virtual_clock).unwrap();
-    let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let ctrl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
     let mut counted = |ticks: usize| {
         let config = LoopConfig {
             duration: ticks as f64 * 0.002,
@@ -367,12 +371,13 @@ fn hw_run_on_the_simulated_rig_allocates_nothing_per_tick() {
 
 #[test]
 fn run_sampled_allocates_nothing_per_sample() {
-    use ctrlab::StateFeedback;
-    use ctrlab::lab::SimulatedRig;
+    use ctrlab::lab::{LabGains, SimulatedRig};
     use ctrlab::sim::run_sampled;
     // The realistic rig: friction, stiction, the input delay, noise.
     let sim = SimulatedRig::default();
-    let ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let ctrl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
     let counted = |samples: usize| {
         let config = sim.sampled_config(samples as f64 * 0.002);
         let (plant, sensor) = (sim.plant(), sim.sensor());

@@ -7,6 +7,7 @@
 
 mod common;
 
+use ctrlab::lab::LabGains;
 use ctrlab::{
     Cart, Controller, Discretization, Error, MassSpring, StateFeedback, StateSpace, acker, dlqr,
     lqr,
@@ -25,18 +26,22 @@ fn fixture_poles(row: &serde_json::Value) -> Vec<Complex<f64>> {
 
 #[test]
 fn lab_gains_are_converted_to_si_once() {
-    let c = StateFeedback::from_lab_gains([1.0, 0.005, 10.0, 0.1], Cart::Two).unwrap();
+    let c = LabGains::new([1.0, 0.005, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
     assert_eq!(*c.gain(), matrix![1000.0, 5.0, 10_000.0, 100.0]);
     // N = K G: G selects cart 2's position.
     assert_eq!(*c.reference_gain(), vector![10_000.0]);
-    let c1 = StateFeedback::from_lab_gains([1.0, 0.005, 10.0, 0.1], Cart::One).unwrap();
+    let c1 = LabGains::new([1.0, 0.005, 10.0, 0.1], Cart::One)
+        .state_feedback()
+        .unwrap();
     assert_eq!(*c1.reference_gain(), vector![1000.0]);
 }
 
 #[test]
 fn lab_law_in_si_equals_the_lab_law_in_millimetres() {
     let kf = [0.7, 0.003, 4.0, 0.2];
-    let mut c = StateFeedback::from_lab_gains(kf, Cart::Two).unwrap();
+    let mut c = LabGains::new(kf, Cart::Two).state_feedback().unwrap();
     let x_m = vector![0.004, -0.02, 0.011, 0.05];
     let r_m = 0.030;
     // u = Kf (G r_mm − x_mm), evaluated in millimetres by hand.
@@ -50,7 +55,9 @@ fn lab_law_in_si_equals_the_lab_law_in_millimetres() {
 
 #[test]
 fn non_finite_lab_gain_is_an_error() {
-    let err = StateFeedback::from_lab_gains([0.0, f64::NAN, 1.0, 0.0], Cart::Two).unwrap_err();
+    let err = LabGains::new([0.0, f64::NAN, 1.0, 0.0], Cart::Two)
+        .state_feedback()
+        .unwrap_err();
     assert!(matches!(
         err,
         Error::NonFinite {
@@ -78,7 +85,9 @@ fn closed_loop_poles_match_the_fixture_rows() {
             _ => Cart::Two,
         };
         let plant = MassSpring::nominal().state_space(output).unwrap();
-        let c = StateFeedback::from_lab_gains([kf[0], kf[1], kf[2], kf[3]], output).unwrap();
+        let c = LabGains::new([kf[0], kf[1], kf[2], kf[3]], output)
+            .state_feedback()
+            .unwrap();
         let cl = c.closed_loop(&plant).unwrap();
         let got = cl.poles().unwrap();
         let want = fixture_poles(row);
@@ -100,7 +109,8 @@ fn closed_loop_of_the_lab_law_has_the_lab_steady_state() {
     // x2 = r·K3/(K3 + k_series) with k_series = 500 N/m; for Kf3 = 0.1/mm
     // (100 N/m) that is r/6.
     let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
-    let cl = StateFeedback::from_lab_gains([0.0, 0.0, 0.1, 0.0], Cart::Two)
+    let cl = LabGains::new([0.0, 0.0, 0.1, 0.0], Cart::Two)
+        .state_feedback()
         .unwrap()
         .closed_loop(&plant)
         .unwrap();

@@ -14,9 +14,9 @@ use common::{
 };
 use ctrlab::data::Recording;
 use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqi};
-use ctrlab::lab::SimulatedRig;
+use ctrlab::lab::{Friction, LabGains, SimulatedRig};
 use ctrlab::sim::run_sampled;
-use ctrlab::{Cart, Controller, MassSpring, StateFeedback};
+use ctrlab::{Cart, Controller, MassSpring};
 use nalgebra::{SMatrix, SVector, matrix, vector};
 
 const SETPOINT: f64 = 0.030;
@@ -98,12 +98,14 @@ fn observer_lqi_on_positions_reaches_the_setpoint_within_a_count_despite_frictio
     let sim = SimulatedRig {
         // Coulomb friction only (breakaway at the same force), no delay
         // or noise: what this controller was designed against.
-        coulomb_friction: [1.0, 2.0],
+        friction: Friction::coulomb([1.0, 2.0]),
         ..SimulatedRig::ideal(MassSpring::nominal())
     };
     let count = sim.metres_per_count();
     let duration = 3.0;
-    let lab_law = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let lab_law = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
     for (path, ours, theirs) in [
         (
             "run_sampled",
@@ -154,7 +156,7 @@ fn with_time_the_integrator_unsticks_the_cart_onto_the_setpoints_count() {
     let sim = SimulatedRig {
         // Coulomb friction only (breakaway at the same force), no delay
         // or noise: what this controller was designed against.
-        coulomb_friction: [1.0, 2.0],
+        friction: Friction::coulomb([1.0, 2.0]),
         ..SimulatedRig::ideal(MassSpring::nominal())
     };
     let rec = simulate_on(&sim, positions_lqi(sim.metres_per_count()), SETPOINT, 6.0);

@@ -7,8 +7,9 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::design::{StateFeedback, acker, place, place_observer};
+use ctrlab::design::{acker, place, place_observer};
 use ctrlab::discretize::{expm, expm_dyn};
+use ctrlab::lab::LabGains;
 use ctrlab::sim::{Solver, impulse_response, initial_response, simulate, step_response, time_grid};
 use ctrlab::{
     Cart, Continuous, Discrete, Discretization, DynStateSpace, Error, MassSpring, StateSpace,
@@ -45,7 +46,8 @@ const ROUNDING: f64 = 1e-13;
 
 #[test]
 fn analysis_agrees_with_the_fixed_size_model() {
-    let closed = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)
+    let closed = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
         .unwrap()
         .closed_loop(&plant())
         .unwrap();
@@ -231,7 +233,8 @@ fn responses_agree_with_the_fixed_size_functions() {
 #[test]
 fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     let fixed = plant();
-    let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)
+    let cl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
         .unwrap()
         .closed_loop(&fixed)
         .unwrap();

@@ -23,8 +23,8 @@ use std::time::Duration;
 
 use ctrlab::hw::testing::{Cycle, RecordingPort, RegisterFile};
 use ctrlab::hw::{
-    Clock, EppPort, HwError, HwErrorKind, LoopConfig, Pc104, RunError, RunOutcome, SimulatedCard,
-    StopSignal, VirtualClock, run,
+    Clock, EppPort, LoopConfig, LoopFault, LoopFaultKind, Pc104, PortError, PortErrorKind,
+    RigError, RunError, RunOutcome, SimulatedCard, StopSignal, VirtualClock, run,
 };
 use ctrlab::lab::{Calibration, FrictionPlant, MassSpring, MassSpringRig, SimulatedRig};
 use ctrlab::{Controller, OpenLoop};
@@ -41,13 +41,7 @@ type LoggedRig = MassSpringRig<RecordingPort<Card>>;
 /// and checks timed on `clock`.
 fn logged_rig(sim: &SimulatedRig, clock: &Clock) -> LoggedRig {
     let port = RecordingPort::new(sim.card(clock).unwrap());
-    MassSpringRig::with_clock(
-        Pc104::new(port),
-        sim.calibration(),
-        sim.period,
-        clock.clone(),
-    )
-    .unwrap()
+    MassSpringRig::with_clock(Pc104::new(port), sim.calibration, sim.period, clock.clone()).unwrap()
 }
 
 /// The realistic rig on a fresh virtual clock.
@@ -87,7 +81,7 @@ fn pwm_writes(log: &[Cycle]) -> Vec<(u8, u8)> {
 fn assert_drive_off(rig: &mut LoggedRig, clock: &Clock) {
     let writes = pwm_writes(rig.card().port().log());
     assert_eq!(writes.last(), Some(&(0, 0)), "the halt is the last write");
-    let delay = SimulatedRig::default().pwm_delay;
+    let delay = SimulatedRig::default().card.pwm_delay;
     match clock {
         Clock::Virtual(c) => c.advance(delay).unwrap(),
         // Well past the delay, well before the 100 ms watchdog.
@@ -173,9 +167,9 @@ fn a_panicking_controller_halts_the_rig_and_keeps_the_recording() {
         &config(1.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Panic);
+    assert_eq!(err.error.kind(), LoopFaultKind::Panic);
     match &err.error {
-        HwError::Panicked { what, message, at } => {
+        RigError::Fault(LoopFault::Panicked { what, message, at }) => {
             assert_eq!(*what, "controller");
             assert_eq!(message, "gain table index out of range");
             assert!((at - 24.0 * PERIOD).abs() < 1e-12, "{at}");
@@ -213,9 +207,9 @@ fn a_panicking_reference_halts_the_rig_and_keeps_the_recording() {
         &config(1.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Panic);
+    assert_eq!(err.error.kind(), LoopFaultKind::Panic);
     match &err.error {
-        HwError::Panicked { what, message, at } => {
+        RigError::Fault(LoopFault::Panicked { what, message, at }) => {
             assert_eq!(*what, "reference");
             assert_eq!(message, "no setpoint defined after 0.050 s");
             assert!((at - 0.05).abs() < 1e-12, "{at}");
@@ -262,21 +256,21 @@ fn a_controller_stalled_for_300_ms_is_a_gap_and_its_stale_command_never_reaches_
         // Disturbed: the machine held the loop past the 50 ms limit before
         // the stall (ten samples are taken before it).
         match err.error {
-            HwError::Gap {
+            RigError::Fault(LoopFault::Gap {
                 what: "the controller",
                 ..
-            } if err.recording.len() == 10 => Ok((rig, err)),
+            }) if err.recording.len() == 10 => Ok((rig, err)),
             ref other => Err(format!("{other} after {} samples", err.recording.len())),
         }
     });
-    assert_eq!(err.error.kind(), HwErrorKind::Timing);
+    assert_eq!(err.error.kind(), LoopFaultKind::Timing);
     match &err.error {
-        HwError::Gap {
+        RigError::Fault(LoopFault::Gap {
             what,
             gap,
             limit,
             at,
-        } => {
+        }) => {
             assert_eq!(*what, "the controller");
             assert!(*gap >= 0.3, "{gap}");
             // Half the card's 100 ms watchdog timeout, by default.
@@ -297,7 +291,7 @@ fn a_controller_stalled_for_300_ms_is_a_gap_and_its_stale_command_never_reaches_
     // after its deadline, 18 ms, and before the stalled tick).
     assert_eq!(err.recording.len(), 10);
     let last = *err.recording.time().last().unwrap();
-    let HwError::Gap { at, .. } = err.error else {
+    let RigError::Fault(LoopFault::Gap { at, .. }) = err.error else {
         unreachable!()
     };
     assert!(last >= 9.0 * PERIOD && last < at, "{last} vs {at}");
@@ -329,11 +323,11 @@ struct FlipBit<P> {
 }
 
 impl<P: EppPort> EppPort for FlipBit<P> {
-    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         self.selected = Some(address);
         self.inner.write_address(address)
     }
-    fn read_data(&mut self) -> Result<u8, HwError> {
+    fn read_data(&mut self) -> Result<u8, PortError> {
         let mut value = self.inner.read_data()?;
         if self.selected == Some(self.address) {
             if self.reads == self.nth {
@@ -343,7 +337,7 @@ impl<P: EppPort> EppPort for FlipBit<P> {
         }
         Ok(value)
     }
-    fn write_data(&mut self, value: u8) -> Result<(), HwError> {
+    fn write_data(&mut self, value: u8) -> Result<(), PortError> {
         self.inner.write_data(value)
     }
 }
@@ -371,7 +365,7 @@ fn run_with_flipped_bit(
     };
     let mut rig = MassSpringRig::with_clock(
         Pc104::new(RecordingPort::new(port)),
-        sim.calibration(),
+        sim.calibration,
         PERIOD,
         virtual_clock.clone(),
     )
@@ -392,15 +386,15 @@ fn a_flipped_counter_bit_is_a_bus_fault_not_a_measurement() {
     // counts, 20 mm in 2 ms, 10 m/s: five times what the carts can do.
     let (clock, mut rig, result) = run_with_flipped_bit(30, 0x08);
     let err = result.unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::BusFault);
+    assert_eq!(err.error.kind(), LoopFaultKind::BusFault);
     match err.error {
-        HwError::BusFault {
+        RigError::Fault(LoopFault::BusFault {
             channel,
             counts,
             interval,
             speed,
             limit,
-        } => {
+        }) => {
             assert_eq!(channel, 1, "cart 2's encoder");
             // ±2048 plus a few counts of true motion and noise in 2 ms.
             assert!((counts.abs() - 2048).abs() < 50, "{counts}");
@@ -430,7 +424,9 @@ fn a_flipped_counter_bit_is_a_bus_fault_not_a_measurement() {
     // The drive is off: the halt was the last write, and the card applies it.
     let writes = pwm_writes(rig.card().port().log());
     assert_eq!(writes.last(), Some(&(0, 0)));
-    clock.advance(SimulatedRig::default().pwm_delay).unwrap();
+    clock
+        .advance(SimulatedRig::default().card.pwm_delay)
+        .unwrap();
     let card = &mut rig.card_mut().port_mut().inner_mut().inner;
     card.sync().unwrap();
     assert_eq!(card.pwm_duty(0), 0);
@@ -458,7 +454,7 @@ fn an_open_bus_is_no_card_and_nothing_is_written() {
         let mut port = RecordingPort::new(registers);
         let err =
             MassSpringRig::new(Pc104::new(&mut port), Calibration::default(), PERIOD).unwrap_err();
-        assert_eq!(err.kind(), HwErrorKind::NotPresent, "{open:#04x}");
+        assert_eq!(err.kind(), PortErrorKind::NotPresent, "{open:#04x}");
         let text = err.to_string();
         assert!(
             text.contains(&format!("reads {open:#04x}"))
@@ -485,7 +481,7 @@ fn another_card_is_refused() {
     let mut port = RecordingPort::new(registers);
     let err =
         MassSpringRig::new(Pc104::new(&mut port), Calibration::default(), PERIOD).unwrap_err();
-    assert_eq!(err.kind(), HwErrorKind::NotPresent);
+    assert_eq!(err.kind(), PortErrorKind::NotPresent);
     assert!(
         err.to_string().contains("another card answers")
             && err.to_string().contains("reads 0x3c, expected 0xa5"),
@@ -497,12 +493,15 @@ fn another_card_is_refused() {
     );
     // A simulated card with another ID, against the lab's calibration.
     let other = SimulatedRig {
-        card_id: 0x5a,
+        calibration: Calibration {
+            card_id: 0x5a,
+            ..Calibration::default()
+        },
         ..SimulatedRig::default()
     };
     let card = other.card(&Clock::Virtual(VirtualClock::new())).unwrap();
     let err = MassSpringRig::new(Pc104::new(card), Calibration::default(), PERIOD).unwrap_err();
-    assert_eq!(err.kind(), HwErrorKind::NotPresent);
+    assert_eq!(err.kind(), PortErrorKind::NotPresent);
     assert!(err.to_string().contains("reads 0x5a"), "{err}");
     // Built as one, the simulated rig's calibration expects its own card.
     assert!(other.rig(&Clock::Virtual(VirtualClock::new())).is_ok());
@@ -520,7 +519,7 @@ fn a_motor_that_does_not_respond_is_detected_and_halted() {
         },
         ..SimulatedRig::default()
     };
-    let cal = dead.calibration();
+    let cal = dead.calibration;
     let (clock, mut rig) = virtual_rig(&dead);
     // 12 V (duty 500 exactly), well above the 6 V the check watches.
     let err = run(
@@ -531,13 +530,13 @@ fn a_motor_that_does_not_respond_is_detected_and_halted() {
         &config(2.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::NotResponding);
+    assert_eq!(err.error.kind(), LoopFaultKind::NotResponding);
     match err.error {
-        HwError::NotResponding {
+        RigError::Fault(LoopFault::NotResponding {
             volts,
             seconds,
             counts,
-        } => {
+        }) => {
             assert_eq!(volts, 12.0);
             assert_eq!(counts, cal.stall_counts);
             assert!((seconds - cal.stall_time).abs() < 1e-9, "{seconds}");
@@ -590,14 +589,14 @@ fn too_many_overruns_stop_the_run() {
         ..LoopConfig::default()
     };
     let err = run(&mut rig, Slow, |_| vector![0.0], &clock, &cfg).unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Timing);
+    assert_eq!(err.error.kind(), LoopFaultKind::Timing);
     let at = match err.error {
-        HwError::TimingFaults {
+        RigError::Fault(LoopFault::TimingFaults {
             faults,
             window,
             period,
             at,
-        } => {
+        }) => {
             assert_eq!((faults, window, period), (3, 0.5, PERIOD));
             at
         }
@@ -732,9 +731,11 @@ fn a_stop_request_halts_the_rig_and_keeps_the_recording() {
 /// Stopped at the tick after the request made in tick 50 (t = 0.1 s):
 /// ticks 0–50 recorded, nothing read in tick 51.
 fn assert_interrupted(err: &RunError) {
-    assert_eq!(err.error.kind(), HwErrorKind::Interrupted);
+    assert_eq!(err.error.kind(), LoopFaultKind::Interrupted);
     match err.error {
-        HwError::Interrupted { at } => assert!((at - 51.0 * PERIOD).abs() < 1e-12, "{at}"),
+        RigError::Fault(LoopFault::Interrupted { at }) => {
+            assert!((at - 51.0 * PERIOD).abs() < 1e-12, "{at}")
+        }
         ref other => panic!("expected Interrupted, got {other:?}"),
     }
     assert!(

@@ -145,8 +145,8 @@ fn the_precomputed_plant_integrates_as_the_plant_that_rebuilt_its_coefficients()
     let cases: [(_, _, _, &dyn Signal, _); 6] = [
         // The default rig's friction: the carts stick at each reversal.
         (
-            rig.coulomb_friction,
-            rig.stiction,
+            rig.friction.coulomb,
+            rig.friction.stiction,
             at_rest,
             &square,
             "reversals",

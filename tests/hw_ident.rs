@@ -12,8 +12,8 @@
 
 use ctrlab::OpenLoop;
 use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
-use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{MassSpringEstimate, Options, Spread, SpringModel, identify_with};
+use ctrlab::lab::{CardSettings, SimulatedRig};
 use ctrlab::signal::{Signal, SquareWave};
 use nalgebra::vector;
 
@@ -35,8 +35,11 @@ fn five_simulated_runs_recover_the_truth_within_one_percent() {
     for seed in 1..=5 {
         let clock = VirtualClock::new();
         let rig = SimulatedRig {
-            encoder_noise: 0.5,
-            seed,
+            card: CardSettings {
+                encoder_noise: 0.5,
+                seed,
+                ..CardSettings::ideal()
+            },
             ..SimulatedRig::ideal(truth)
         }
         .rig(&Clock::Virtual(clock.clone()))

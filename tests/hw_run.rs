@@ -13,14 +13,14 @@
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
-    Clock, EppPort, HwError, HwErrorKind, LoopConfig, Pc104, Rig, SimulatedCard, VirtualClock, run,
+    Clock, EppPort, LoopConfig, LoopFault, LoopFaultKind, Pc104, PortErrorKind, Rig, RigError,
+    SimulatedCard, VirtualClock, run,
 };
-use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
+use ctrlab::lab::{
+    Calibration, CardSettings, FrictionPlant, LabGains, MassSpringRig, SimulatedRig,
+};
 use ctrlab::signal::{Signal, SquareWave};
-use ctrlab::{
-    Cart, Controller, Discretization, MassSpring, OpenLoop, StateFeedback, StepInfoOptions,
-    step_info,
-};
+use ctrlab::{Cart, Controller, Discretization, MassSpring, OpenLoop, StepInfoOptions, step_info};
 use nalgebra::{SVector, vector};
 use proptest::prelude::*;
 
@@ -110,21 +110,24 @@ fn table2_row_through_the_full_stack_matches_the_simulation() {
     let supply = 400.0;
     let clock = VirtualClock::new();
     let sim = SimulatedRig {
-        supply_voltage: supply,
+        calibration: Calibration {
+            volts_full_scale: supply,
+            ..Calibration::default()
+        },
         ..SimulatedRig::ideal(truth)
     };
     let gains = [0.0, 0.0, 10.0, 0.1];
-    let ctrl = StateFeedback::from_lab_gains(gains, Cart::Two).unwrap();
+    let ctrl = LabGains::new(gains, Cart::Two).state_feedback().unwrap();
     let setpoint = 0.030;
     // The simulated rig's calibration has the card's supply as full scale.
-    assert_eq!(sim.calibration().volts_full_scale, supply);
+    assert_eq!(sim.calibration.volts_full_scale, supply);
     // 300 N on cart 2 drives it past the 2 m/s that the lab's 24 V motor
     // can reach (the rig would call that a bus fault): this unphysical drive
     // needs a looser plausibility limit, well above the run's peak speed
     // (printed: 2.007 m/s, at the 5th sample).
     let calibration = Calibration {
         max_speed: 10.0,
-        ..sim.calibration()
+        ..sim.calibration
     };
     let virtual_clock = Clock::Virtual(clock.clone());
     let card = Pc104::new(sim.card(&virtual_clock).unwrap());
@@ -180,8 +183,11 @@ fn a_virtual_run_is_reproducible_and_records_the_applied_voltage() {
     // check watches.
     let make = || {
         let (clock, rig) = sim_rig(SimulatedRig {
-            encoder_noise: 0.5,
-            seed: 7,
+            card: CardSettings {
+                encoder_noise: 0.5,
+                seed: 7,
+                ..CardSettings::default()
+            },
             ..Default::default()
         });
         let square = SquareWave::new(5.0, 0.2).unwrap();
@@ -229,7 +235,7 @@ fn a_travel_limit_breach_halts_and_keeps_the_recording() {
         &config(5.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::TravelLimit);
+    assert_eq!(err.error.kind(), LoopFaultKind::TravelLimit);
     assert!(
         err.last_measurement.is_none(),
         "the breach is found in the read"
@@ -244,7 +250,9 @@ fn a_travel_limit_breach_halts_and_keeps_the_recording() {
             .all(|x| x.abs() <= 0.05)
     );
     // The halt was written; the drive takes it the PWM delay later.
-    clock.advance(SimulatedRig::default().pwm_delay).unwrap();
+    clock
+        .advance(SimulatedRig::default().card.pwm_delay)
+        .unwrap();
     rig.card_mut().port_mut().sync().unwrap();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
@@ -268,7 +276,7 @@ fn a_non_finite_command_halts_the_same_way() {
         &config(1.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::InvalidCommand);
+    assert_eq!(err.error.kind(), PortErrorKind::InvalidCommand);
     assert_eq!(err.recording.len(), 10);
     assert!(
         err.last_measurement.is_some(),
@@ -294,7 +302,7 @@ fn a_dead_port_leaves_the_motor_to_the_watchdog() {
         &config(1.0),
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Timeout);
+    assert_eq!(err.error.kind(), PortErrorKind::Timeout);
     assert_eq!(err.recording.len(), 50);
     assert_eq!(
         rig.card().port().inner().pwm_duty(0),
@@ -330,13 +338,13 @@ fn overruns_stop_the_loop_safely() {
         ..LoopConfig::default()
     };
     let err = run(&mut rig, Slow, |_| vector![0.0], &Clock::RealTime, &cfg).unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::Timing);
+    assert_eq!(err.error.kind(), LoopFaultKind::Timing);
     // Each 3 ms tick overruns and makes the loop skip the deadline it
     // overran: two faults a tick, so three faults end it in the second.
     assert!(
         matches!(
             err.error,
-            ctrlab::hw::HwError::TimingFaults { faults: 3, .. }
+            RigError::Fault(LoopFault::TimingFaults { faults: 3, .. })
         ),
         "{}",
         err.error
@@ -483,13 +491,13 @@ impl Controller<4, 1, 1> for DesignedFor {
 /// period of its own any more, it takes the rig's.
 struct ClaimsPeriod<R>(R, f64);
 impl<R: Rig<1, 4>> Rig<1, 4> for ClaimsPeriod<R> {
-    fn read(&mut self) -> Result<SVector<f64, 4>, HwError> {
+    fn read(&mut self) -> Result<SVector<f64, 4>, RigError> {
         self.0.read()
     }
-    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HwError> {
+    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, RigError> {
         self.0.apply(u)
     }
-    fn halt(&mut self) -> Result<(), HwError> {
+    fn halt(&mut self) -> Result<(), RigError> {
         self.0.halt()
     }
     fn period(&self) -> f64 {
@@ -516,7 +524,7 @@ fn a_loop_at_another_period_than_the_rig_is_refused() {
     .unwrap_err();
     assert!(matches!(
         err.error,
-        ctrlab::hw::HwError::InvalidConfig { name: "period", .. }
+        RigError::Config(ref e) if e.key() == "period"
     ));
     assert!(err.recording.is_empty());
     assert_eq!(rig.card().port().pwm_duty(0), 0);
@@ -590,7 +598,7 @@ fn bad_loop_settings_are_refused_before_anything_runs() {
         )
         .unwrap_err();
         match err.error {
-            ctrlab::hw::HwError::InvalidConfig { name: got, .. } => assert_eq!(got, name),
+            RigError::Config(e) => assert_eq!(e.key(), name),
             other => panic!("{name}: {other}"),
         }
         assert!(err.recording.is_empty());
@@ -603,7 +611,7 @@ fn bad_loop_settings_are_refused_before_anything_runs() {
             ..Default::default()
         };
         match bad.rig(&Clock::Virtual(VirtualClock::new())) {
-            Err(ctrlab::hw::HwError::InvalidConfig { name, .. }) => assert_eq!(name, "period"),
+            Err(RigError::Config(e)) => assert_eq!(e.key(), "period"),
             other => panic!("period {period}: {other:?}"),
         }
     }
@@ -620,7 +628,7 @@ proptest! {
         let mut rig = rig(port, &clock);
         let result = run(&mut rig, OpenLoop, |_| vector![3.0], &Clock::Virtual(clock), &config(0.1));
         let err = result.expect_err("cycle k is inside the 50-tick run");
-        prop_assert_eq!(err.error.kind(), HwErrorKind::Timeout);
+        prop_assert_eq!(err.error.kind(), PortErrorKind::Timeout);
         let tick = k / CYCLES_PER_TICK;
         prop_assert_eq!(err.recording.len(), tick);
         // Cut in the read (first 18 cycles) there is no state of that tick;

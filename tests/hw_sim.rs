@@ -14,10 +14,12 @@
 
 use ctrlab::hw::testing::RecordingPort;
 use ctrlab::hw::{
-    Clock, CycleKind, EppPort, HwError, HwErrorKind, Pc104, Rig, SIMULATED_CARD_ID, SimulatedCard,
-    VirtualClock,
+    Clock, CycleKind, EppPort, LoopFault, Pc104, PortError, PortErrorKind, Rig, RigError,
+    SIMULATED_CARD_ID, SimulatedCard, VirtualClock,
 };
-use ctrlab::lab::{Calibration, FrictionPlant, MassSpringRig, SimulatedRig};
+use ctrlab::lab::{
+    Calibration, CardSettings, Friction, FrictionPlant, MassSpringRig, SimulatedRig,
+};
 use ctrlab::{Cart, Discretization, MassSpring};
 use nalgebra::{SVector, vector};
 
@@ -57,7 +59,7 @@ fn card_id_and_probe() {
         SIMULATED_CARD_ID
     );
     let err = pc104.probe_id(0x3c).unwrap_err();
-    assert_eq!(err.kind(), HwErrorKind::NotPresent);
+    assert_eq!(err.kind(), PortErrorKind::NotPresent);
     assert!(err.to_string().contains("0xa5"), "{err}");
     // An unmapped address reads an open bus.
     assert_eq!(pc104.port_mut().read_register(0x99).unwrap(), 0xff);
@@ -70,7 +72,10 @@ fn plant_matches_the_exact_zoh_discretisation() {
     // The ideal rig: friction and the PWM delay are not in the linear model.
     let truth = SimulatedRig::default_truth();
     let (clock, card) = sim(SimulatedRig {
-        watchdog_timeout: None,
+        calibration: Calibration {
+            watchdog_timeout: None,
+            ..ideal().calibration
+        },
         ..ideal()
     });
     let mut pc104 = Pc104::new(card);
@@ -103,8 +108,11 @@ fn plant_matches_the_exact_zoh_discretisation() {
 fn a_latch_captures_the_counts_of_the_state_at_that_instant() {
     let (clock, card) = sim(SimulatedRig {
         initial_state: [0.004, 0.0, -0.013, 0.0],
-        watchdog_timeout: None,
         // Noiseless: the count is exactly the rounded state.
+        calibration: Calibration {
+            watchdog_timeout: None,
+            ..ideal().calibration
+        },
         ..ideal()
     });
     let mut pc104 = Pc104::new(card);
@@ -179,7 +187,10 @@ fn watchdog_zeroes_the_pwm_when_not_kicked() {
     // The trip happened at exactly 150 ms of card time: the same card with no
     // watchdog, switched off by hand at 150 ms, ends in the same state.
     let (clock2, card2) = sim(SimulatedRig {
-        watchdog_timeout: None,
+        calibration: Calibration {
+            watchdog_timeout: None,
+            ..config.calibration
+        },
         ..config
     });
     let mut reference = Pc104::new(card2);
@@ -200,14 +211,20 @@ fn the_pwm_delay_applies_a_duty_exactly_that_long_after_its_write() {
     // cards are accessed at the same instants, so they integrate the same
     // sub-steps and end in the same state.
     let delayed = SimulatedRig {
-        watchdog_timeout: None,
+        calibration: Calibration {
+            watchdog_timeout: None,
+            ..Calibration::default()
+        },
         ..Default::default()
     };
-    let delay = delayed.pwm_delay;
+    let delay = delayed.card.pwm_delay;
     assert_eq!(delay, 0.15e-3);
     let (clock, card) = sim(delayed.clone());
     let (clock2, card2) = sim(SimulatedRig {
-        pwm_delay: 0.0,
+        card: CardSettings {
+            pwm_delay: 0.0,
+            ..delayed.card
+        },
         ..delayed
     });
     let (mut a, mut b) = (Pc104::new(card), Pc104::new(card2));
@@ -271,8 +288,11 @@ fn the_watchdog_also_cancels_a_pwm_write_in_flight() {
 fn noise_is_seeded_and_of_the_configured_size() {
     let run = |seed: u64| {
         let (_clock, card) = sim(SimulatedRig {
-            encoder_noise: 3.0,
-            seed,
+            card: CardSettings {
+                encoder_noise: 3.0,
+                seed,
+                ..CardSettings::default()
+            },
             ..Default::default()
         });
         let mut pc104 = Pc104::new(card);
@@ -306,8 +326,11 @@ fn coulomb_friction_sticks_below_breakaway_and_stops_in_the_dead_band() {
     // Coulomb force): the breakaway force is 2 N.
     let truth = MassSpring::nominal();
     let (clock, card) = sim(SimulatedRig {
-        coulomb_friction: [0.0, 2.0],
-        watchdog_timeout: None,
+        friction: Friction::coulomb([0.0, 2.0]),
+        calibration: Calibration {
+            watchdog_timeout: None,
+            ..Calibration::default()
+        },
         ..SimulatedRig::ideal(truth)
     });
     let mut pc104 = Pc104::new(card);
@@ -339,9 +362,14 @@ fn stiction_holds_a_cart_that_coulomb_friction_alone_would_let_slide() {
     // sliding friction, less than the 2.4 N breakaway of the default rig.
     let run = |stiction: [f64; 2]| {
         let (clock, card) = sim(SimulatedRig {
-            coulomb_friction: [0.0, 2.0],
-            stiction,
-            watchdog_timeout: None,
+            friction: Friction {
+                coulomb: [0.0, 2.0],
+                stiction,
+            },
+            calibration: Calibration {
+                watchdog_timeout: None,
+                ..Calibration::default()
+            },
             ..SimulatedRig::ideal(MassSpring::nominal())
         });
         let mut pc104 = Pc104::new(card);
@@ -352,7 +380,7 @@ fn stiction_holds_a_cart_that_coulomb_friction_alone_would_let_slide() {
     };
     assert_eq!(run([0.0, 2.4]), SVector::<f64, 4>::zeros());
     assert!(run([0.0, 0.0])[2] > 0.0);
-    assert_eq!(SimulatedRig::default().stiction, [1.2, 2.4]);
+    assert_eq!(SimulatedRig::default().friction.stiction, [1.2, 2.4]);
 }
 
 #[test]
@@ -361,31 +389,43 @@ fn invalid_configurations_are_refused() {
     for (bad, name) in [
         (
             SimulatedRig {
-                max_substep: 0.0,
+                card: CardSettings {
+                    max_substep: 0.0,
+                    ..default.card
+                },
                 ..default.clone()
             },
-            "max_substep",
+            "card.max_substep",
         ),
         (
             SimulatedRig {
-                encoder_noise: -1.0,
+                card: CardSettings {
+                    encoder_noise: -1.0,
+                    ..default.card
+                },
                 ..default.clone()
             },
-            "encoder_noise",
+            "card.encoder_noise",
         ),
         (
             SimulatedRig {
-                encoder_channels: [1, 1],
+                calibration: Calibration {
+                    encoder_channels: [1, 1],
+                    ..default.calibration
+                },
                 ..default.clone()
             },
-            "encoder_channels",
+            "calibration.encoder_channels[1]",
         ),
         (
             SimulatedRig {
-                watchdog_timeout: Some(f64::NAN),
+                calibration: Calibration {
+                    watchdog_timeout: Some(f64::NAN),
+                    ..default.calibration
+                },
                 ..default.clone()
             },
-            "watchdog_timeout",
+            "calibration.watchdog_timeout",
         ),
         (
             SimulatedRig {
@@ -395,12 +435,12 @@ fn invalid_configurations_are_refused() {
                 },
                 ..default.clone()
             },
-            "m2",
+            "truth.m2",
         ),
     ] {
         match bad.card(&Clock::RealTime) {
-            Err(HwError::InvalidConfig { name: got, .. }) => assert_eq!(got, name),
-            other => panic!("expected InvalidConfig for {name}, got {other:?}"),
+            Err(e) => assert_eq!(e.key(), name),
+            Ok(_) => panic!("expected {name} refused"),
         }
     }
 }
@@ -411,6 +451,39 @@ fn rig_on(config: SimulatedRig) -> (VirtualClock, MassSpringRig<Card>) {
     let clock = VirtualClock::new();
     let rig = config.rig(&Clock::Virtual(clock.clone())).unwrap();
     (clock, rig)
+}
+
+#[test]
+fn a_rig_on_another_register_map_reads_and_drives_its_card() {
+    // The driver takes the card's map: the same run reads the same counts
+    // whatever the addresses.
+    let run = |map: ctrlab::hw::RegisterMap| {
+        let sim = SimulatedRig {
+            card: CardSettings {
+                map,
+                ..ideal().card
+            },
+            ..ideal()
+        };
+        let (clock, mut rig) = rig_on(sim);
+        let mut x = rig.read_state().unwrap();
+        for _ in 0..250 {
+            rig.apply_voltage(6.0).unwrap();
+            clock.advance_nanos(PERIOD_NS);
+            x = rig.read_state().unwrap();
+        }
+        x
+    };
+    let default = run(ctrlab::hw::RegisterMap::default());
+    let moved = run(ctrlab::hw::RegisterMap {
+        control: 0x02,
+        pwm_low: [0x40, 0x42, 0x44, 0x46],
+        pwm_high: [0x41, 0x43, 0x45, 0x47],
+        encoder: [0x80, 0x84, 0x88, 0x8c],
+        ..ctrlab::hw::RegisterMap::default()
+    });
+    assert!(default[2] > 0.005, "{default}");
+    assert_eq!(moved, default);
 }
 
 /// Holds `volts` for `seconds`, reading every 2 ms; returns the last state.
@@ -465,7 +538,7 @@ fn the_realistic_rig_stops_within_its_friction_dead_band() {
     // on each are within its breakaway force, not at the frictionless
     // static deflection.
     let sim = SimulatedRig::default();
-    let (truth, stiction) = (sim.truth, sim.stiction);
+    let (truth, stiction) = (sim.truth, sim.friction.stiction);
     let volts = 3.0; // 125 duty steps exactly
     let (clock, mut rig) = rig_on(sim.clone());
     let measured = hold(&clock, &mut rig, volts, 10.0);
@@ -543,7 +616,7 @@ fn non_finite_voltage_halts_the_rig() {
         rig.apply_voltage(10.0).unwrap();
         assert_eq!(rig.card().port().pwm_duty(0), 417); // 10 V / 24 mV
         let err = rig.apply_voltage(bad).unwrap_err();
-        assert_eq!(err.kind(), HwErrorKind::InvalidCommand, "{bad}");
+        assert_eq!(err.kind(), PortErrorKind::InvalidCommand, "{bad}");
         assert_eq!(rig.card().port().pwm_duty(0), 0, "{bad}");
     }
 }
@@ -555,7 +628,7 @@ fn travel_limit_breach_halts_the_rig() {
     // step overshoots: past the ±50 mm limit.
     let sim = SimulatedRig::default();
     let (_, x2_static) = sim.truth.static_deflection(sim.truth.gain * 24.0).unwrap();
-    assert!(x2_static > 0.054 && sim.travel_limits == [0.05, 0.05]);
+    assert!(x2_static > 0.054 && sim.calibration.travel_limits == [0.05, 0.05]);
     let (clock, mut rig) = rig_on(sim);
     let mut err = None;
     for _ in 0..5000 {
@@ -568,11 +641,11 @@ fn travel_limit_breach_halts_the_rig() {
     }
     match err {
         // Axis 2 is cart 2.
-        Some(HwError::TravelLimit {
+        Some(RigError::Fault(LoopFault::TravelLimit {
             axis: 2,
             position,
             limit,
-        }) => {
+        })) => {
             assert_eq!(limit, 0.05);
             // Found at the first sample past it: within one period at the
             // largest speed the rig accepts (any faster is a bus fault).
@@ -583,7 +656,9 @@ fn travel_limit_breach_halts_the_rig() {
     }
     // The halt was written; the drive takes it the PWM delay later.
     assert_eq!(rig.card().port().pwm_duty(0), 1000, "24 V until then");
-    clock.advance(SimulatedRig::default().pwm_delay).unwrap();
+    clock
+        .advance(SimulatedRig::default().card.pwm_delay)
+        .unwrap();
     rig.card_mut().port_mut().sync().unwrap();
     assert_eq!(rig.card().port().pwm_duty(0), 0);
 }
@@ -620,8 +695,11 @@ fn read_state_kicks_the_watchdog_and_stopping_trips_it() {
 fn encoder_signs_and_channels_follow_the_calibration() {
     let (clock, card) = sim(SimulatedRig {
         initial_state: [0.002, 0.0, 0.005, 0.0],
-        encoder_channels: [3, 2],
         // Noiseless: the counts are exactly the rounded state.
+        calibration: Calibration {
+            encoder_channels: [3, 2],
+            ..ideal().calibration
+        },
         ..ideal()
     });
     let cal = Calibration {
@@ -647,10 +725,10 @@ fn a_dead_port_surfaces_as_an_error_from_the_rig() {
     let err = MassSpringRig::new(Pc104::new(port), Calibration::default(), 0.002).unwrap_err();
     assert!(matches!(
         err,
-        HwError::Timeout {
+        RigError::Port(PortError::Timeout {
             cycle: CycleKind::AddressWrite,
             register: Some(0x00)
-        }
+        })
     ));
     // Dead after the probe (cycles 0–1): cycle 2 is the latch's address write.
     let (_clock, card) = sim(SimulatedRig::default());
@@ -659,10 +737,10 @@ fn a_dead_port_surfaces_as_an_error_from_the_rig() {
     let err = rig.read_state().unwrap_err();
     assert!(matches!(
         err,
-        HwError::Timeout {
+        RigError::Port(PortError::Timeout {
             cycle: CycleKind::AddressWrite,
             register: Some(0x01)
-        }
+        })
     ));
 }
 
@@ -691,7 +769,7 @@ fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
             .read_state()
             .and_then(|_| rig.apply_voltage(3.0).map(drop));
         let err = result.expect_err("the injected fault surfaces");
-        assert_eq!(err.kind(), HwErrorKind::Timeout, "cycle {k}");
+        assert_eq!(err.kind(), PortErrorKind::Timeout, "cycle {k}");
         // Cut in the read (k < 18) the new command is never sent; cut in the
         // PWM write (even after its low byte, k = 20, 21) the card keeps the
         // previous duty whole: only the high byte applies a duty.
@@ -701,3 +779,157 @@ fn a_fault_at_any_cycle_of_an_iteration_is_reported_and_halting_still_works() {
         assert_eq!(rig.card().port().inner().pwm_duty(0), 0, "cycle {k}");
     }
 }
+
+// ---- bit for bit -------------------------------------------------------------
+
+/// FNV-1a over the bits of every time, input and measurement of `rec`.
+fn bits(rec: &ctrlab::Recording) -> u64 {
+    let mut hash = 0xcbf2_9ce4_8422_2325_u64;
+    let mut eat = |v: f64| {
+        for byte in v.to_bits().to_le_bytes() {
+            hash = (hash ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    rec.time().iter().for_each(|&t| eat(t));
+    for i in 0.. {
+        let Some(u) = rec.input(i) else { break };
+        u.iter().for_each(|&v| eat(v));
+    }
+    for i in 0.. {
+        let Some(y) = rec.measurement(i) else { break };
+        y.iter().for_each(|&v| eat(v));
+    }
+    hash
+}
+
+/// A rig with every field of the truth file away from its default.
+fn every_field_changed() -> SimulatedRig {
+    SimulatedRig {
+        truth: MassSpring {
+            m1: 1.25,
+            m2: 0.75,
+            k1: 900.0,
+            k2: 1100.0,
+            b1: 9.0,
+            b2: 6.5,
+            gain: 1.3,
+        },
+        initial_state: [0.004, 0.0, -0.006, 0.01],
+        period: 0.001,
+        friction: Friction {
+            coulomb: [0.5, 1.5],
+            stiction: [0.7, 1.8],
+        },
+        card: CardSettings {
+            pwm_delay: 0.2e-3,
+            map: ctrlab::hw::RegisterMap::default(),
+            encoder_noise: 0.6,
+            seed: 42,
+            max_substep: 0.1e-3,
+        },
+        calibration: Calibration {
+            card_id: 0x3c,
+            volts_full_scale: 12.0,
+            // 2048 counts per 30 mm.
+            metres_per_count: 0.03 / 2048.0,
+            pwm_channel: 2,
+            encoder_channels: [3, 1],
+            watchdog_timeout: Some(0.05),
+            travel_limits: [0.06, 0.07],
+            ..Calibration::default()
+        },
+    }
+}
+
+/// The recordings of seeded runs on the simulated rig, and of the
+/// sampled-data simulation that predicts them, hashed bit by bit: a
+/// refactoring of the rig's configuration must leave every bit of them
+/// alone. (The hashes were taken before `SimulatedRig` was composed of its
+/// parts, at 91112b5.)
+#[test]
+fn seeded_runs_are_unchanged_bit_for_bit() {
+    use ctrlab::hw::{LoopConfig, run};
+    use ctrlab::{OpenLoop, StateFeedback};
+    let law = StateFeedback::new(
+        nalgebra::matrix![0.0, 0.0, 10_000.0, 100.0],
+        nalgebra::matrix![10_000.0],
+    )
+    .unwrap();
+    let mut hashes = Vec::new();
+    for sim in [SimulatedRig::default(), every_field_changed(), ideal()] {
+        let config = LoopConfig {
+            duration: 1.5,
+            ..LoopConfig::default()
+        };
+        let closed = {
+            let clock = VirtualClock::new();
+            let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
+            run(rig, law, |_| vector![0.02], &Clock::Virtual(clock), &config)
+                .unwrap()
+                .recording
+        };
+        let open = {
+            let clock = VirtualClock::new();
+            let rig = sim.rig(&Clock::Virtual(clock.clone())).unwrap();
+            let square = |t: f64| vector![if (t * 3.0) as i64 % 2 == 0 { 5.0 } else { -4.0 }];
+            run(rig, OpenLoop, square, &Clock::Virtual(clock), &config)
+                .unwrap()
+                .recording
+        };
+        let predicted = ctrlab::sim::run_sampled(
+            sim.plant(),
+            sim.sensor(),
+            law,
+            |_| vector![0.02],
+            SVector::from(sim.initial_state),
+            &sim.sampled_config(1.5),
+        )
+        .unwrap();
+        // The runs move the carts: the hashes pin behaviour, not a rest.
+        let x2 = closed.channel("x2").unwrap();
+        assert!(x2[x2.len() - 1] > 0.005, "{}", x2[x2.len() - 1]);
+        let x2 = open.channel("x2").unwrap();
+        let range = x2.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(range > 0.002, "{range}");
+        let model = sim.simulation_model();
+        let scalars = [
+            sim.metres_per_count(),
+            model.max_substep,
+            model.input_delay,
+            model.stiction_ratio[0],
+            model.stiction_ratio[1],
+        ];
+        hashes.push([
+            bits(&closed),
+            bits(&open),
+            bits(&predicted),
+            scalars
+                .iter()
+                .fold(0, |h: u64, v| h.rotate_left(7) ^ v.to_bits()),
+        ]);
+    }
+    assert_eq!(hashes, EXPECTED_BITS, "{hashes:#x?}");
+}
+
+/// Per rig (default, every field changed, ideal): the closed loop, the
+/// open loop, the sampled-data prediction, and the scalars.
+const EXPECTED_BITS: [[u64; 4]; 3] = [
+    [
+        0x37a2_671a_7b5b_e822,
+        0x9162_0aef_3754_fa0b,
+        0x1c67_e2ae_06d2_60a0,
+        0x71e0_99cd_6a5b_44c6,
+    ],
+    [
+        0x2608_bb43_ce9a_7a0f,
+        0x1491_a858_7c36_973e,
+        0x7dc0_b7b8_1c31_99b5,
+        0x8b9d_88a4_f682_4725,
+    ],
+    [
+        0xb8a1_5d25_28ec_5fd3,
+        0x2987_65ee_ee30_3d06,
+        0x3dfb_653e_298b_ee3b,
+        0x9a30_bf72_8c69_a1bd,
+    ],
+];

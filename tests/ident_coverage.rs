@@ -15,10 +15,10 @@
 mod common;
 
 use ctrlab::ident::Covariance;
-use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
     Bootstrap, Estimate, Options, Scheme, SpringModel, bootstrap, identify_with, refine_with,
 };
+use ctrlab::lab::{CardSettings, SimulatedRig};
 use ctrlab::signal::SquareWave;
 use ctrlab::{MassSpring, Recording};
 
@@ -27,7 +27,10 @@ use ctrlab::{MassSpring, Recording};
 /// everything else a linear model lacks is kept.
 fn equal_springs(seed: u64) -> SimulatedRig {
     let mut sim = SimulatedRig {
-        seed,
+        card: CardSettings {
+            seed,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     };
     sim.truth.k2 = sim.truth.k1;
@@ -177,7 +180,10 @@ fn measure_coverage() {
     let recordings: Vec<Recording> = (1..=runs)
         .map(|seed| {
             record(&SimulatedRig {
-                seed,
+                card: CardSettings {
+                    seed,
+                    ..CardSettings::default()
+                },
                 ..SimulatedRig::default()
             })
         })
@@ -253,7 +259,10 @@ fn newey_west_errors_match_the_spread_and_cover_all_but_the_bias() {
 /// `resamples`, their bootstrap standard errors (else 0).
 fn refined_with_errors(seed: u64, resamples: Option<usize>) -> Vec<Estimate> {
     let sim = SimulatedRig {
-        seed,
+        card: CardSettings {
+            seed,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     };
     let rec = record(&sim);
@@ -294,7 +303,7 @@ fn refined(seed: u64) -> [f64; 7] {
 fn refined_truth() -> [f64; 7] {
     let (t, f) = (
         SimulatedRig::default_truth(),
-        SimulatedRig::default().coulomb_friction,
+        SimulatedRig::default().friction.coulomb,
     );
     [t.k1, t.k2, t.b1, t.b2, t.gain, f[0], f[1]]
 }

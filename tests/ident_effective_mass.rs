@@ -26,7 +26,7 @@ fn rig(m2: f64, friction: [f64; 2], seed: u64) -> SimulatedRig {
 
 /// The lab's square wave, 5 s, of force `8 + 2 F_max` N.
 fn square_run(sim: &SimulatedRig) -> Recording {
-    let f = sim.coulomb_friction[0].max(sim.coulomb_friction[1]);
+    let f = sim.friction.coulomb[0].max(sim.friction.coulomb[1]);
     let volts = (8.0 + 2.0 * f) / sim.truth.gain;
     open_loop(sim, &SquareWave::new(volts, 0.2).unwrap(), 5.0)
 }

@@ -7,11 +7,11 @@
 mod common;
 
 use ctrlab::data::{Channel, Schema};
-use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
     AverageError, MIN_SAMPLES, MassSpringEstimate, Options, Scheme, SpringModel, Springs, average,
     identify, identify_with,
 };
+use ctrlab::lab::{CardSettings, SimulatedRig};
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{Cart, Error, MassSpring, Recording};
@@ -433,7 +433,10 @@ fn each_spring_model_gives_the_former_pipelines_numbers_bit_for_bit() {
     let former: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
     let (fixture, _) = fixture();
     let sim = SimulatedRig {
-        seed: 11,
+        card: CardSettings {
+            seed: 11,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     };
     let card = common::open_loop(&sim, &SquareWave::new(8.0, 0.2).unwrap(), 3.0);

@@ -10,12 +10,12 @@
 mod common;
 
 use common::{friction_rig, open_loop, try_open_loop};
-use ctrlab::hw::HwErrorKind;
+use ctrlab::hw::LoopFaultKind;
 use ctrlab::lab::ident::{
     Bootstrap, MassSpringEstimate, Options, Refined, SimulationModel, SpringModel, bootstrap,
     identify_with, refine_with, validate, validate_with,
 };
-use ctrlab::lab::{MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, MassSpring, SimulatedRig};
 use ctrlab::signal::{Prbs, SquareWave};
 use ctrlab::{Error, Recording};
 
@@ -28,7 +28,7 @@ fn square_run(sim: &SimulatedRig) -> Recording {
     let mut volts = volts(sim);
     loop {
         match try_open_loop(sim, &SquareWave::new(volts, 0.2).unwrap(), 5.0) {
-            Err(e) if e.error.kind() == HwErrorKind::TravelLimit && volts > 1.0 => volts *= 0.9,
+            Err(e) if e.error.kind() == LoopFaultKind::TravelLimit && volts > 1.0 => volts *= 0.9,
             run => return run.unwrap(),
         }
     }
@@ -40,7 +40,7 @@ fn square_run(sim: &SimulatedRig) -> Recording {
 /// force overshoot the ±50 mm travel).
 fn volts(sim: &SimulatedRig) -> f64 {
     let compliance = |p: &MassSpring| 1.0 / p.k1 + 1.0 / p.k2;
-    let force = 8.0 + 2.0 * sim.coulomb_friction[0].max(sim.coulomb_friction[1]);
+    let force = 8.0 + 2.0 * sim.friction.coulomb[0].max(sim.friction.coulomb[1]);
     force * compliance(&SimulatedRig::default_truth()) / compliance(&sim.truth) / sim.truth.gain
 }
 
@@ -75,7 +75,7 @@ fn refine_square_run(
     let rec = square_run(sim);
     let ls = identify_with(&rec, 1.3, 0.7, &options).unwrap();
     let r = refine_with(&rec, &ls, &sim.simulation_model()).unwrap();
-    let (t, f) = (sim.truth, sim.coulomb_friction);
+    let (t, f) = (sim.truth, sim.friction.coulomb);
     let err = |got: f64, want: f64| (got / want - 1.0) * 100.0;
     let errors = [
         ("k1", err(r.plant.k1, t.k1)),
@@ -145,14 +145,12 @@ fn refinement_recovers_the_truth_and_validates_on_a_fresh_run() {
 /// 34× on the PRBS.
 #[test]
 fn the_cards_structure_reproduces_the_card_to_its_quantisation() {
-    let sim = SimulatedRig {
-        encoder_noise: 0.0,
-        ..rig(1.11, [1.0, 2.0], 1)
-    };
+    let mut sim = rig(1.11, [1.0, 2.0], 1);
+    sim.card.encoder_noise = 0.0;
     let model = sim.simulation_model();
     let count = sim.metres_per_count();
     for rec in [square_run(&sim), prbs_run(&sim)] {
-        let v = validate_with(&rec, &sim.truth, sim.coulomb_friction, &model).unwrap();
+        let v = validate_with(&rec, &sim.truth, sim.friction.coulomb, &model).unwrap();
         println!("card's structure: RMS {:.3e} m", v.rms_error[1]);
         assert!(v.rms_error.iter().all(|e| *e < 0.35 * count), "{v:?}");
         for other in [
@@ -169,7 +167,7 @@ fn the_cards_structure_reproduces_the_card_to_its_quantisation() {
                 ..model
             },
         ] {
-            let w = validate_with(&rec, &sim.truth, sim.coulomb_friction, &other).unwrap();
+            let w = validate_with(&rec, &sim.truth, sim.friction.coulomb, &other).unwrap();
             println!("{other:?}: RMS {:.3e} m", w.rms_error[1]);
             assert!(w.rms_error[1] > 1.4 * v.rms_error[1], "{other:?}: {w:?}");
         }
@@ -331,7 +329,10 @@ proptest::proptest! {
 #[test]
 fn bootstrap_errors_are_the_size_of_the_spread() {
     let sim = SimulatedRig {
-        seed: 1,
+        card: CardSettings {
+            seed: 1,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     };
     let options = Options {
@@ -349,7 +350,7 @@ fn bootstrap_errors_are_the_size_of_the_spread() {
         ..Bootstrap::default()
     };
     let se = bootstrap(&rec, &options, &r, &model, &resampling).unwrap();
-    let (t, f) = (sim.truth, sim.coulomb_friction);
+    let (t, f) = (sim.truth, sim.friction.coulomb);
     let truth = [t.k1, t.k2, t.b1, t.b2, t.gain, f[0], f[1]];
     let relative: Vec<f64> = se
         .to_array()

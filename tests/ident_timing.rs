@@ -12,11 +12,11 @@ use std::time::Duration;
 use ctrlab::data::{Channel, Schema};
 use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
 use ctrlab::ident::Covariance;
-use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{
     Estimate, GAP_RATIO, MassSpringEstimate, Options, Scheme, Spread, SpringModel, identify,
     identify_with,
 };
+use ctrlab::lab::{CardSettings, SimulatedRig};
 use ctrlab::signal::{Rng, Signal, SquareWave};
 use ctrlab::sim::{Solver, simulate};
 use ctrlab::{Cart, Controller, Error, MassSpring, OpenLoop, Recording};
@@ -423,7 +423,10 @@ fn rig_runs() -> &'static [(SimulatedRig, Recording)] {
         (1..=5)
             .map(|seed| {
                 let sim = SimulatedRig {
-                    seed,
+                    card: CardSettings {
+                        seed,
+                        ..CardSettings::default()
+                    },
                     ..SimulatedRig::default()
                 };
                 let clock = VirtualClock::new();
@@ -468,13 +471,13 @@ fn rig_identification(coulomb: bool) -> [f64; 7] {
         let forces = e.coulomb.map_or(String::new(), |[f1, f2]| {
             format!(
                 ", F1 {}, F2 {}",
-                pct(&f1, sim.coulomb_friction[0]),
-                pct(&f2, sim.coulomb_friction[1])
+                pct(&f1, sim.friction.coulomb[0]),
+                pct(&f2, sim.friction.coulomb[1])
             )
         });
         println!(
             "seed {} (coulomb {coulomb}): k1 {}, k2 {}, b1 {}, K {}, b2 {}{forces}; rows {} / {} of {}",
-            sim.seed,
+            sim.card.seed,
             pct(&e.k1(), t.k1),
             pct(&e.k2(), t.k2),
             pct(&e.b1, t.b1),
@@ -487,7 +490,7 @@ fn rig_identification(coulomb: bool) -> [f64; 7] {
         estimates.push(e);
     }
     let (sim, _) = &rig_runs()[0];
-    let (t, f) = (sim.truth, sim.coulomb_friction);
+    let (t, f) = (sim.truth, sim.friction.coulomb);
     let mean = |get: &dyn Fn(&MassSpringEstimate) -> f64| {
         Spread::of(&estimates.iter().map(get).collect::<Vec<_>>())
             .unwrap()
@@ -512,7 +515,7 @@ const NAMES: [&str; 7] = ["k1", "k2", "b1", "K", "b2", "F1", "F2"];
 fn coulomb_friction_is_recovered_from_the_simulated_rig() {
     let sim = &rig_runs()[0].0;
     assert_eq!(
-        (sim.coulomb_friction, sim.stiction),
+        (sim.friction.coulomb, sim.friction.stiction),
         ([1.0, 2.0], [1.2, 2.4])
     );
     let errors = rig_identification(true);
@@ -636,8 +639,8 @@ fn a_stalled_real_time_tick_leaves_a_gap_and_the_rest_identifies() {
             ("b1", e.b1.value, truth.b1),
             ("K", e.gain.value, truth.gain),
             ("b2", e.b2.value, truth.b2),
-            ("F1", f1.value, sim.coulomb_friction[0]),
-            ("F2", f2.value, sim.coulomb_friction[1]),
+            ("F1", f1.value, sim.friction.coulomb[0]),
+            ("F2", f2.value, sim.friction.coulomb[1]),
         ] {
             println!(
                 "real time, 1 s: {name} {got:.4} vs {want} ({:+.2} %)",

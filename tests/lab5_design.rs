@@ -12,7 +12,7 @@ use common::run_on_rig;
 use ctrlab::lab::ident::{SEPARATE_SPRINGS, identify_with};
 use ctrlab::lab::lqi::{self, Design, Metrics, Spec};
 use ctrlab::lab::protocol::{self, IDENT_DURATION};
-use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, Cart, Friction, MassSpring, SimulatedRig};
 use std::sync::OnceLock;
 
 const SETPOINT: f64 = 0.030;
@@ -45,8 +45,8 @@ fn design() -> &'static Design {
     DESIGN.get_or_init(|| {
         let sim = SimulatedRig::default();
         let (model, coulomb) = identified(&sim);
-        let rig = lqi::predicted_rig(model, coulomb, &sim.calibration(), sim.period);
-        let spec = Spec::new(Cart::Two, SETPOINT, sim.supply_voltage);
+        let rig = lqi::predicted_rig(model, coulomb, &sim.calibration, sim.period);
+        let spec = Spec::new(Cart::Two, SETPOINT, sim.calibration.volts_full_scale);
         lqi::design_search(&rig, spec).unwrap()
     })
 }
@@ -72,7 +72,11 @@ fn run(sim: &SimulatedRig) -> Metrics {
 #[test]
 fn cart_2_on_the_simulated_rig_meets_overshoot_settling_and_drive_and_rests_within_3_counts() {
     let sim = SimulatedRig {
-        seed: 202, // lab5's run of this design
+        // lab5's run of this design
+        card: CardSettings {
+            seed: 202,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     };
     let rig = run(&sim);
@@ -111,8 +115,14 @@ fn cart_2_meets_the_whole_spec_on_a_rig_with_only_what_the_prediction_models() {
     // identification error.
     let defaults = SimulatedRig::default();
     let sim = SimulatedRig {
-        stiction: defaults.coulomb_friction,
-        encoder_noise: 0.0,
+        friction: Friction {
+            stiction: defaults.friction.coulomb,
+            ..defaults.friction
+        },
+        card: CardSettings {
+            encoder_noise: 0.0,
+            ..defaults.card
+        },
         ..defaults
     };
     let rig = run(&sim);

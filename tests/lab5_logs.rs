@@ -16,8 +16,8 @@ use std::path::PathBuf;
 use common::open_loop;
 use ctrlab::Recording;
 use ctrlab::data::CsvOptions;
-use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{Options, SpringModel, identify_with};
+use ctrlab::lab::{CardSettings, SimulatedRig};
 use ctrlab::signal::SquareWave;
 
 /// The default rig's encoders: 8192 counts per 80 mm.
@@ -60,7 +60,10 @@ fn write_the_student_logs() {
     std::fs::create_dir_all(dir()).unwrap();
     for seed in SEEDS {
         let sim = SimulatedRig {
-            seed,
+            card: CardSettings {
+                seed,
+                ..CardSettings::default()
+            },
             ..SimulatedRig::default()
         };
         let rec = open_loop(&sim, &SquareWave::new(8.0, 0.2).unwrap(), 5.0);

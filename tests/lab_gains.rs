@@ -1,5 +1,5 @@
-//! The lab's per-millimetre gains and back: `from_lab_gains` and
-//! `to_lab_gains` / `LabGains::state_feedback` are inverses.
+//! The lab's per-millimetre gains and back: `LabGains::state_feedback` and
+//! `LabGains::from_state_feedback` are inverses.
 
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
@@ -26,8 +26,8 @@ fn the_lab_tables_round_trip_exactly() {
         ([1.0, 0.0, 0.0, 0.2], Cart::One),
     ];
     for (kf, cart) in rows {
-        let law = StateFeedback::from_lab_gains(kf, cart).unwrap();
-        let lab = law.to_lab_gains(cart).unwrap();
+        let law = LabGains::new(kf, cart).state_feedback().unwrap();
+        let lab = LabGains::from_state_feedback(&law, cart).unwrap();
         for (got, want) in lab.kf.iter().zip(kf) {
             assert!(close(*got, want), "{kf:?}: {got} vs {want}");
         }
@@ -35,6 +35,15 @@ fn the_lab_tables_round_trip_exactly() {
         g[cart.state_index()] = 1.0;
         assert_eq!(lab.g, g, "G selects the cart");
         assert_eq!(lab.state_feedback().unwrap(), law);
+        // Bit for bit the law `StateFeedback::from_lab_gains` built:
+        // K = 1000 Kf, N = K on the cart's position.
+        let k = kf.map(|kf| kf * 1000.0);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(law.gain().as_slice()), bits(&k));
+        assert_eq!(
+            bits(law.reference_gain().as_slice()),
+            bits(&[k[cart.state_index()]])
+        );
     }
 }
 
@@ -44,7 +53,7 @@ fn an_lqr_law_reaches_the_lab_units_and_acts_the_same() {
     let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e4, 0.0, 1e6, 10.0]);
     let k = lqr(&plant, &q, &matrix![1.0]).unwrap().gain;
     let mut law = StateFeedback::with_prefilter(&plant, k).unwrap();
-    let lab = law.to_lab_gains(Cart::Two).unwrap();
+    let lab = LabGains::from_state_feedback(&law, Cart::Two).unwrap();
     // The lab's formula, evaluated in millimetres by hand, gives the SI
     // law's input.
     let (x, r) = (vector![0.004, -0.02, 0.011, 0.05], 0.030);
@@ -63,14 +72,19 @@ fn an_lqr_law_reaches_the_lab_units_and_acts_the_same() {
 #[test]
 fn a_law_without_gain_on_the_cart_has_no_lab_form_for_it() {
     let law = StateFeedback::new(matrix![1.0, 0.0, 0.0, 0.0], vector![2.0]).unwrap();
-    let err = law.to_lab_gains(Cart::Two).unwrap_err();
+    let err = LabGains::from_state_feedback(&law, Cart::Two).unwrap_err();
     assert!(
         matches!(err, Error::InvalidParameter { name: "K", .. }),
         "{err:?}"
     );
     // With no reference gain either, G = 0 reproduces it.
     let regulator = StateFeedback::new(matrix![1.0, 0.0, 0.0, 0.0], vector![0.0]).unwrap();
-    assert_eq!(regulator.to_lab_gains(Cart::Two).unwrap().g, [0.0; 4]);
+    assert_eq!(
+        LabGains::from_state_feedback(&regulator, Cart::Two)
+            .unwrap()
+            .g,
+        [0.0; 4]
+    );
 }
 
 #[test]
@@ -99,7 +113,8 @@ proptest! {
     ) {
         let cart = if two { Cart::Two } else { Cart::One };
         prop_assume!(kf[cart.state_index()] != 0.0);
-        let lab = StateFeedback::from_lab_gains(kf, cart).unwrap().to_lab_gains(cart).unwrap();
+        let lab = LabGains::from_state_feedback(&LabGains::new(kf, cart).state_feedback().unwrap(), cart)
+            .unwrap();
         for (got, want) in lab.kf.iter().zip(kf) {
             prop_assert!(close(*got, want), "{} vs {}", got, want);
         }
@@ -115,7 +130,7 @@ proptest! {
         let cart = if two { Cart::Two } else { Cart::One };
         prop_assume!(k[cart.state_index()].abs() > 1e-3);
         let law = StateFeedback::new(SMatrix::<f64, 1, 4>::from_row_slice(&k), vector![n]).unwrap();
-        let back = law.to_lab_gains(cart).unwrap().state_feedback().unwrap();
+        let back = LabGains::from_state_feedback(&law, cart).unwrap().state_feedback().unwrap();
         for (got, want) in back.gain().iter().zip(k) {
             prop_assert!(close(*got, want));
         }

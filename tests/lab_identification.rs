@@ -23,13 +23,16 @@ use ctrlab::lab::protocol::{
     IDENT_DURATION, IDENT_HALF_PERIOD, IDENT_RUNS, IDENT_VOLTS, M1, M2, PERIOD, ident_square_wave,
 };
 use ctrlab::lab::validation::{ModelKind, validate_models};
-use ctrlab::lab::{SimulatedRig, lqi};
+use ctrlab::lab::{CardSettings, SimulatedRig, lqi};
 use ctrlab::signal::Signal;
 
 /// The default simulated rig with noise `seed`, at the lab's period.
 fn rig(seed: u64) -> SimulatedRig {
     SimulatedRig {
-        seed,
+        card: CardSettings {
+            seed,
+            ..CardSettings::default()
+        },
         period: PERIOD,
         ..SimulatedRig::default()
     }
@@ -98,10 +101,7 @@ fn every_parameter_has_its_uncertainty_beside_the_spread() {
 
 #[test]
 fn the_equal_springs_run_isolates_the_schemes_own_bias() {
-    let card = SimulatedRig {
-        seed: 99,
-        ..EqualSprings::card(&rig(99))
-    };
+    let card = EqualSprings::card(&rig(99));
     let rec = open_loop(&card, &ident_square_wave().unwrap(), IDENT_DURATION);
     let e = EqualSprings::identify(&rec, card.truth, M1, M2).unwrap();
     // Measured: Lab K −1.8 %, Central +0.1 %.
@@ -217,7 +217,7 @@ fn the_frequency_response_shows_both_modes_on_model_and_rig() {
     let ms = frequency::multisine(IDENT_VOLTS).unwrap();
     let rec = open_loop(&rig(1), &ms, DURATION);
     let s = summary();
-    let model = lqi::predicted_rig(s.model(), s.coulomb(), &sim.calibration(), PERIOD);
+    let model = lqi::predicted_rig(s.model(), s.coulomb(), &sim.calibration, PERIOD);
     let r = frequency::frequency_response(&rec, &model, Some(&sim.truth), &ms).unwrap();
     // The default rig's modes are 3.25 and 8.05 Hz; the measured gain
     // peaks sit within a few lines of them (friction lowers the first:

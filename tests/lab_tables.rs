@@ -13,13 +13,12 @@ mod common;
 use std::sync::OnceLock;
 
 use common::try_run_on_rig;
-use ctrlab::StateFeedback;
 use ctrlab::lab::protocol::{PERIOD, STEP_DURATION};
 use ctrlab::lab::tables::{
     FORCES, Gain, GainTable, GroupEffect, OvershootTrend, Prediction, RIG_TABLES, RigOutcome,
     RigRun, TABLE2, table1, table2,
 };
-use ctrlab::lab::{MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, LabGains, MassSpring, SimulatedRig};
 
 #[test]
 fn table_1_holds_every_force_at_its_static_deflection() {
@@ -72,18 +71,21 @@ fn table_2_measures_every_stable_row_and_names_the_unstable_ones() {
 /// `model`'s prediction.
 fn run_table(table: &GainTable, model: &MassSpring) -> Vec<RigRun> {
     let sim = SimulatedRig::default();
-    let full_scale = sim.calibration().volts_full_scale;
+    let full_scale = sim.calibration.volts_full_scale;
     table
         .rows()
         .into_iter()
         .enumerate()
         .map(|(i, kf)| {
             let rig = SimulatedRig {
-                seed: 100 + i as u64,
+                card: CardSettings {
+                    seed: 100 + i as u64,
+                    ..sim.card
+                },
                 period: PERIOD,
                 ..sim.clone()
             };
-            let ctrl = StateFeedback::from_lab_gains(kf, table.cart).unwrap();
+            let ctrl = LabGains::new(kf, table.cart).state_feedback().unwrap();
             let setpoint = table.setpoint_mm / 1e3;
             let outcome = match try_run_on_rig(&rig, ctrl, setpoint, STEP_DURATION) {
                 Ok(out) => {

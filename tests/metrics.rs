@@ -6,11 +6,12 @@
 
 mod common;
 
+use ctrlab::lab::LabGains;
 use ctrlab::metrics::step_info_channel;
 use ctrlab::sim::{Solver, simulate, time_grid};
 use ctrlab::{
-    Cart, Controller, Error, MassSpring, Recording, StateFeedback, StateSpace, StepInfoOptions,
-    step_info, step_info_of,
+    Cart, Controller, Error, MassSpring, Recording, StateSpace, StepInfoOptions, step_info,
+    step_info_of,
 };
 use nalgebra::{SVector, matrix, vector};
 use proptest::prelude::*;
@@ -30,7 +31,9 @@ fn table_2_rows_match_python_control() {
             .collect();
         assert_eq!(row["cart"].as_u64(), Some(2));
         let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
-        let ctrl = StateFeedback::from_lab_gains([kf[0], kf[1], kf[2], kf[3]], Cart::Two).unwrap();
+        let ctrl = LabGains::new([kf[0], kf[1], kf[2], kf[3]], Cart::Two)
+            .state_feedback()
+            .unwrap();
         let cl = ctrl.closed_loop(&plant).unwrap();
         let setpoint = f("setpoint_mm") / 1000.0;
         // The fixture's grid: 0.5 ms out to 20 s.
@@ -98,7 +101,9 @@ fn step_info_of_a_recorded_channel() {
     // Table 2, row [0 0 10 0.1], recorded in the lab's schema (u, x1, v1,
     // x2, v2) as the rig's loop records it; the input is the controller's.
     let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
-    let mut ctrl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap();
+    let mut ctrl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
     let cl = ctrl.closed_loop(&plant).unwrap();
     let setpoint = 0.030;
     let t = time_grid(2.0, 0.0005).unwrap();

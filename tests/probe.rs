@@ -7,7 +7,9 @@
 use ctrlab::hw::probe::{Hands, Operator, Probe, ProbeError, ProbeOptions};
 use ctrlab::hw::testing::{RecordingPort, RegisterFile};
 use ctrlab::hw::{Clock, CycleKind, RegisterMap, SimulatedCard, VirtualClock};
-use ctrlab::lab::{Calibration, FrictionPlant, RigConfig, SimulatedOperator, SimulatedRig};
+use ctrlab::lab::{
+    Calibration, CardSettings, FrictionPlant, RigConfig, SimulatedOperator, SimulatedRig,
+};
 
 type Card = SimulatedCard<FrictionPlant, 4>;
 
@@ -24,11 +26,11 @@ fn the_probe_rediscovers_the_simulated_cards_map_and_calibration() {
     let mut probe = probe_of(&rig, &[true, true]);
     let report = probe.run().unwrap();
     assert_eq!(report.map, RegisterMap::default());
-    assert_eq!(report.map, rig.map);
-    assert_eq!(report.card_id, rig.card_id);
+    assert_eq!(report.map, rig.card.map);
+    assert_eq!(report.card_id, rig.calibration.card_id);
     assert_eq!(report.watchdog_timeout, Some(0.100));
     let calibration = Calibration::from_probe(&report, &Calibration::default());
-    assert_eq!(calibration, rig.calibration());
+    assert_eq!(calibration, rig.calibration);
     // The card file it writes is the one the rest of the crate loads.
     let file = RigConfig {
         map: report.map,
@@ -38,7 +40,7 @@ fn the_probe_rediscovers_the_simulated_cards_map_and_calibration() {
     let loaded = RigConfig::from_toml(&file).unwrap();
     assert_eq!(
         (loaded.map, loaded.calibration),
-        (rig.map, rig.calibration())
+        (rig.card.map, rig.calibration)
     );
     // Each step said what it would do before asking or doing it.
     let said = &probe.operator().transcript;
@@ -61,11 +63,17 @@ fn the_probe_finds_a_map_other_than_the_default() {
         encoder: [0x40, 0x48, 0x50, 0x58],
     };
     let rig = SimulatedRig {
-        map,
-        card_id: 0x5a,
-        // Cart 1 on the second counter, cart 2 on the first.
-        encoder_channels: [1, 0],
-        watchdog_timeout: Some(0.05),
+        card: CardSettings {
+            map,
+            ..CardSettings::default()
+        },
+        calibration: Calibration {
+            card_id: 0x5a,
+            // Cart 1 on the second counter, cart 2 on the first.
+            encoder_channels: [1, 0],
+            watchdog_timeout: Some(0.05),
+            ..Calibration::default()
+        },
         ..SimulatedRig::default()
     };
     let report = probe_of(&rig, &[true, true]).run().unwrap();

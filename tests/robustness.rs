@@ -8,7 +8,7 @@
 use ctrlab::data::CsvError;
 use ctrlab::design::{acker, lqr};
 use ctrlab::discretize::expm;
-use ctrlab::hw::{Clock, HwErrorKind, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
+use ctrlab::hw::{Clock, Pc104, PortErrorKind, SimulatedCard, SimulatedCardConfig, VirtualClock};
 use ctrlab::ident::{LeastSquares, Rls};
 use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::{Scheme, Spread, identify};
@@ -171,7 +171,7 @@ fn the_virtual_clock_never_runs_backwards() {
     // u64::MAX ns is 1.8e10 s: a jump past it is refused, time unchanged.
     clock.advance(1e10).unwrap();
     let err = clock.advance(1e10).unwrap_err();
-    assert_eq!(err.kind(), HwErrorKind::InvalidCommand);
+    assert_eq!(err.kind(), PortErrorKind::InvalidCommand);
     assert_eq!(clock.now_nanos(), 10_000_000_001_000_000_000);
     clock.advance_nanos(u64::MAX);
     assert_eq!(clock.now_nanos(), u64::MAX);
@@ -191,7 +191,7 @@ fn the_simulated_card_bounds_its_work_after_a_long_jump() {
     // 1e6 s at 0.25 ms would be 4e9 RK4 steps for one register read.
     clock.advance(1e6).unwrap();
     let err = pc104.latch().unwrap_err();
-    assert_eq!(err.kind(), HwErrorKind::Simulation);
+    assert_eq!(err.kind(), PortErrorKind::Simulation);
     assert!(err.to_string().contains("RK4 sub-steps"), "{err}");
     assert_eq!(pc104.port().time(), 0.0);
     // Within the bound, the card catches up.
@@ -220,7 +220,7 @@ fn a_diverging_simulated_plant_is_an_error_not_zero_counts() {
     // x' = x² from 1 blows up at t = 1 s.
     clock.advance(2.0).unwrap();
     let err = pc104.latch().unwrap_err();
-    assert_eq!(err.kind(), HwErrorKind::Simulation);
+    assert_eq!(err.kind(), PortErrorKind::Simulation);
     assert!(err.to_string().contains("diverged"), "{err}");
     assert_eq!(pc104.port().time(), 0.0);
     assert!(pc104.port().true_state()[0].is_finite());

@@ -14,8 +14,8 @@ mod common;
 use common::{last, run_on_rig, saturated, simulate_on};
 use ctrlab::data::Recording;
 use ctrlab::design::{AntiWindup, EstimatorForm, IntegralFeedback, Observer, dlqe, dlqi};
-use ctrlab::hw::{self, Clock, HwErrorKind, LoopConfig, VirtualClock};
-use ctrlab::lab::{self, SimulatedRig};
+use ctrlab::hw::{self, Clock, ConfigErrorKind, LoopConfig, VirtualClock};
+use ctrlab::lab::{self, CardSettings, Friction, LabGains, SimulatedRig};
 use ctrlab::sim::run_sampled;
 use ctrlab::{Cart, Controller, Discretization, Error, MassSpring, StateFeedback, StateSpace};
 use nalgebra::{SMatrix, SVector, matrix, vector};
@@ -38,7 +38,7 @@ const ROUNDING: f64 = 1e-9;
 /// stiction beyond it, no PWM delay, no noise, the 24 V drive.
 fn nominal_rig(coulomb_friction: [f64; 2]) -> SimulatedRig {
     SimulatedRig {
-        coulomb_friction,
+        friction: Friction::coulomb(coulomb_friction),
         ..SimulatedRig::ideal(MassSpring::nominal())
     }
 }
@@ -48,7 +48,10 @@ fn nominal_rig(coulomb_friction: [f64; 2]) -> SimulatedRig {
 /// the two paths draw differently (each from its own generator).
 fn realistic_noiseless_rig() -> SimulatedRig {
     SimulatedRig {
-        encoder_noise: 0.0,
+        card: CardSettings {
+            encoder_noise: 0.0,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     }
 }
@@ -96,7 +99,9 @@ fn assert_agree(sim: &SimulatedRig, simulated: &Recording, measured: &Recording)
 
 /// The lab's Table 2 row on cart 2: `Kf = [0 0 10 0.1]` per mm.
 fn lab_law() -> StateFeedback<4, 1> {
-    StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two).unwrap()
+    LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap()
 }
 
 #[test]
@@ -131,8 +136,8 @@ fn the_lab_state_feedback_agrees_on_the_realistic_rig_without_noise() {
     // paths: the same FrictionPlant, and `sampled_config` sets the
     // simulator's input delay to the card's PWM delay.
     let sim = realistic_noiseless_rig();
-    assert_eq!(sim.sampled_config(DURATION).input_delay, sim.pwm_delay);
-    assert!(sim.pwm_delay > 0.0 && sim.stiction[1] > sim.coulomb_friction[1]);
+    assert_eq!(sim.sampled_config(DURATION).input_delay, sim.card.pwm_delay);
+    assert!(sim.card.pwm_delay > 0.0 && sim.friction.stiction[1] > sim.friction.coulomb[1]);
     let simulated = simulate(&sim, lab_law());
     let measured = on_rig(&sim, lab_law());
     assert_agree(&sim, &simulated, &measured);
@@ -147,7 +152,7 @@ fn the_lab_state_feedback_agrees_on_the_realistic_rig_without_noise() {
     let compliance = 1.0 / truth.k1 + 1.0 / truth.k2;
     let loop_gain = compliance * truth.gain * 10_000.0;
     let steady = SETPOINT * loop_gain / (1.0 + loop_gain);
-    let band = sim.stiction[1] * compliance / (1.0 + loop_gain);
+    let band = sim.friction.stiction[1] * compliance / (1.0 + loop_gain);
     let x2 = last(&measured, "x2");
     println!("x2 {x2} m, frictionless {steady} m, band ±{band} m");
     assert!((x2 - steady).abs() <= band + sim.metres_per_count(), "{x2}");
@@ -387,7 +392,7 @@ fn a_controller_designed_for_another_period_is_refused_by_both_loops() {
         &config,
     )
     .unwrap_err();
-    assert_eq!(err.error.kind(), HwErrorKind::InvalidConfig);
+    assert_eq!(err.error.kind(), ConfigErrorKind::Conflict);
     assert!(err.recording.is_empty());
     // Nothing ran: no time passed and the drive is off.
     assert_eq!(clock.now_nanos(), 0);

@@ -6,11 +6,11 @@
 use std::path::PathBuf;
 
 use ctrlab::hw::{
-    Clock, HwError, LoopConfig, LoopStats, RealTime, RunError, RunOutcome, StopSignal,
+    Clock, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome, StopSignal,
     VirtualClock, run,
 };
 use ctrlab::lab::protocol::PERIOD;
-use ctrlab::lab::{Calibration, FrictionPlant, MassSpring, SimulatedRig};
+use ctrlab::lab::{Calibration, CardSettings, FrictionPlant, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::SVector;
 use ctrlab::{Controller, Recording};
 
@@ -106,7 +106,7 @@ impl Backend {
     /// from its card file (its encoders, drive full scale, travel limits).
     pub fn calibration(&self) -> Calibration {
         match &self.kind {
-            BackendKind::Simulated { sim, .. } => sim.calibration(),
+            BackendKind::Simulated { sim, .. } => sim.calibration,
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
             BackendKind::Card { config, .. } => config.calibration,
         }
@@ -154,7 +154,7 @@ impl Backend {
         let outcome = match &self.kind {
             BackendKind::Simulated { sim, real_time } => {
                 let sim = SimulatedRig {
-                    seed,
+                    card: CardSettings { seed, ..sim.card },
                     period: PERIOD,
                     ..(**sim).clone()
                 };
@@ -181,7 +181,7 @@ impl Backend {
         };
         let path = self.save(name, recording)?;
         if let Err(e) = &outcome
-            && let HwError::Interrupted { .. } = e.error
+            && let RigError::Fault(LoopFault::Interrupted { .. }) = e.error
         {
             return Err(format!("{e}; the run's recording is in {}", path.display()).into());
         }

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use ctrlab::hw::{HwError, Pc104, Ppdev};
+use ctrlab::hw::{Pc104, Ppdev, RigError};
 use ctrlab::lab::{MassSpringRig, RigConfig};
 
 /// The card file named by `--card` and its configuration, checked;
@@ -55,15 +55,15 @@ pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> S
 
 /// Opens the port with the file's map and reads the card's ID: the first
 /// access, and a read. Dropping the card releases the port.
-pub fn check_id(port: &Path, config: &RigConfig) -> Result<u8, HwError> {
+pub fn check_id(port: &Path, config: &RigConfig) -> Result<u8, RigError> {
     let mut card = Pc104::with_map(Ppdev::open(port)?, config.map)?;
-    card.probe_id(config.calibration.card_id)
+    Ok(card.probe_id(config.calibration.card_id)?)
 }
 
 /// The rig on the card with the file's map and calibration: the ID is
 /// probed (building the rig) before the counters are cleared, the first
 /// write.
-pub fn rig(port: &Path, config: &RigConfig, period: f64) -> Result<MassSpringRig<Ppdev>, HwError> {
+pub fn rig(port: &Path, config: &RigConfig, period: f64) -> Result<MassSpringRig<Ppdev>, RigError> {
     let card = Pc104::with_map(Ppdev::open(port)?, config.map)?;
     let mut rig = MassSpringRig::new(card, config.calibration, period)?;
     rig.card_mut().clear_counters()?;

@@ -58,12 +58,12 @@ pub fn section(
     // Coulomb force (stiction is not identified).
     let breakaway = |i: usize| {
         backend.sim().map_or(coulomb[i], |sim| {
-            sim.stiction[i].max(sim.coulomb_friction[i])
+            sim.friction.stiction[i].max(sim.friction.coulomb[i])
         })
     };
     let mut cases = Vec::new();
     for (cart, setpoint) in CASES {
-        let spec = Spec::new(cart, setpoint, rig.supply_voltage);
+        let spec = Spec::new(cart, setpoint, rig.calibration.volts_full_scale);
         let design = lqi::design_search(&rig, spec)?;
         let n = cart.number();
         backend.save(&format!("design_cart{n}_predicted"), &design.predicted)?;

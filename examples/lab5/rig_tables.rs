@@ -1,11 +1,11 @@
 //! Tables 5 and 6 on the rig: every row of `lab::tables::TABLE5` and
 //! `TABLE6` run, with what the identified model predicted for it.
 
-use ctrlab::lab::MassSpring;
+use ctrlab::Recording;
 use ctrlab::lab::protocol::{PERIOD, STEP_DURATION};
 use ctrlab::lab::tables::{GainTable, Prediction, RigOutcome, RigRun};
+use ctrlab::lab::{LabGains, MassSpring};
 use ctrlab::nalgebra::vector;
-use ctrlab::{Recording, StateFeedback};
 
 use crate::backend::{Backend, LoopTiming};
 
@@ -40,7 +40,7 @@ pub fn run(
     for (i, kf) in table.rows().into_iter().enumerate() {
         let prediction = Prediction::of(model, kf, table.cart, PERIOD)?;
         let name = format!("table{}_row{}", table.number, i + 1);
-        let ctrl = StateFeedback::from_lab_gains(kf, table.cart)?;
+        let ctrl = LabGains::new(kf, table.cart).state_feedback()?;
         let (outcome, rec) = match backend.experiment(
             &name,
             100 + i as u64,

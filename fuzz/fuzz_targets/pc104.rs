@@ -2,7 +2,7 @@
 //! byte (and fails some cycles): every call returns, and nothing panics.
 #![no_main]
 
-use ctrlab::hw::{CycleKind, EppPort, HwError, Pc104};
+use ctrlab::hw::{CycleKind, EppPort, PortError, Pc104};
 use libfuzzer_sys::fuzz_target;
 
 /// A port whose reads return the fuzz input byte by byte; a byte whose top
@@ -23,23 +23,23 @@ impl FuzzPort<'_> {
 }
 
 impl EppPort for FuzzPort<'_> {
-    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         self.address = address;
         Ok(())
     }
-    fn read_data(&mut self) -> Result<u8, HwError> {
+    fn read_data(&mut self) -> Result<u8, PortError> {
         let b = self.next();
         if b & 0xc0 == 0xc0 && self.next() & 1 == 1 {
-            return Err(HwError::Timeout {
+            return Err(PortError::Timeout {
                 cycle: CycleKind::DataRead,
                 register: Some(self.address),
             });
         }
         Ok(b)
     }
-    fn write_data(&mut self, _value: u8) -> Result<(), HwError> {
+    fn write_data(&mut self, _value: u8) -> Result<(), PortError> {
         if self.next() == 0xff {
-            return Err(HwError::Timeout {
+            return Err(PortError::Timeout {
                 cycle: CycleKind::DataWrite,
                 register: Some(self.address),
             });

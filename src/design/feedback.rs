@@ -12,7 +12,7 @@ use crate::model::{Domain, StateSpace};
 /// The textbook's law with `N` chosen for zero steady-state error is
 /// [`with_prefilter`](Self::with_prefilter). The lab's `u = Kf (G r − x)`
 /// (LAB.md, Figure 8) is the same law with `K = Kf`, `N = Kf G`; the lab
-/// module's [`from_lab_gains`](crate::lab) builds it from the lab's
+/// module's [`LabGains`](crate::lab) builds it from the lab's
 /// per-millimetre gains.
 ///
 /// Everything is stored in SI: `K` in input units per SI state unit (N/m and

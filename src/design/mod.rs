@@ -19,7 +19,7 @@
 //!   differenced speeds).
 //!
 //! The lab's per-millimetre gains are a named conversion in the lab module,
-//! [`StateFeedback::from_lab_gains`](crate::lab).
+//! [`LabGains`](crate::lab).
 //!
 //! # Examples
 //!

@@ -5,7 +5,7 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::HwError;
+use super::PortError;
 
 /// Where the control loop and the simulated card take their time from.
 ///
@@ -51,7 +51,7 @@ pub enum Clock {
 /// clock.advance(0.002)?;
 /// assert_eq!(card_side.now_nanos(), 2_000_000);
 /// assert_eq!(card_side.now(), 0.002);
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::PortError>(())
 /// ```
 #[derive(Debug, Clone, Default)]
 pub struct VirtualClock {
@@ -104,27 +104,28 @@ impl VirtualClock {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidCommand`] when `dt` is negative or not finite, or
+    /// [`PortError::InvalidCommand`] when `dt` is negative or not finite, or
     /// when the clock would pass `u64::MAX` ns (584 years); time is then
-    /// left unchanged.
+    /// left unchanged. (The clock is the simulated card's time: refusing to
+    /// move it is the simulated card refusing a command.)
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::hw::{HwErrorKind, VirtualClock};
+    /// # use ctrlab::hw::{PortErrorKind, VirtualClock};
     /// let clock = VirtualClock::new();
     /// clock.advance(0.25)?;
     /// assert_eq!(clock.now_nanos(), 250_000_000);
-    /// assert_eq!(clock.advance(-1.0).unwrap_err().kind(), HwErrorKind::InvalidCommand);
+    /// assert_eq!(clock.advance(-1.0).unwrap_err().kind(), PortErrorKind::InvalidCommand);
     /// // Never wraps around to the past (u64::MAX ns is 1.8e10 s).
     /// clock.advance(1e10)?;
     /// assert!(clock.advance(1e10).is_err());
     /// assert_eq!(clock.now(), 1e10 + 0.25);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn advance(&self, dt: f64) -> Result<(), HwError> {
+    pub fn advance(&self, dt: f64) -> Result<(), PortError> {
         let nanos = dt * 1e9;
-        let refuse = |now: u64| HwError::InvalidCommand {
+        let refuse = |now: u64| PortError::InvalidCommand {
             what: "clock advance (s)",
             channel: None,
             value: dt,

@@ -1,7 +1,7 @@
 //! The [`EppPort`] trait: the three IEEE 1284 EPP primitives a card driver
 //! is built on.
 
-use super::HwError;
+use super::PortError;
 
 /// An IEEE 1284 EPP port: address write, data read, data write.
 ///
@@ -27,29 +27,29 @@ use super::HwError;
 /// // Through a `&mut` borrow, as a driver would use it.
 /// let mut borrowed = &mut card;
 /// assert_eq!(borrowed.read_register(0x10)?, 0x2c);
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::PortError>(())
 /// ```
 pub trait EppPort {
     /// Writes `address` in an EPP address cycle, selecting a card register.
     ///
     /// # Errors
     ///
-    /// [`HwError::Timeout`] when the card does not answer, or an OS error.
-    fn write_address(&mut self, address: u8) -> Result<(), HwError>;
+    /// [`PortError::Timeout`] when the card does not answer, or an OS error.
+    fn write_address(&mut self, address: u8) -> Result<(), PortError>;
 
     /// Reads one byte from the selected register in an EPP data cycle.
     ///
     /// # Errors
     ///
-    /// [`HwError::Timeout`] when the card does not answer, or an OS error.
-    fn read_data(&mut self) -> Result<u8, HwError>;
+    /// [`PortError::Timeout`] when the card does not answer, or an OS error.
+    fn read_data(&mut self) -> Result<u8, PortError>;
 
     /// Writes one byte to the selected register in an EPP data cycle.
     ///
     /// # Errors
     ///
-    /// [`HwError::Timeout`] when the card does not answer, or an OS error.
-    fn write_data(&mut self, value: u8) -> Result<(), HwError>;
+    /// [`PortError::Timeout`] when the card does not answer, or an OS error.
+    fn write_data(&mut self, value: u8) -> Result<(), PortError>;
 
     /// Writes `value` to register `address`: an address cycle, then a data
     /// write. A timeout names the register.
@@ -66,10 +66,10 @@ pub trait EppPort {
     /// let mut port = RecordingPort::default();
     /// port.write_register(0x01, 0x04)?;
     /// assert_eq!(port.log(), &[Cycle::AddressWrite(0x01), Cycle::DataWrite(0x04)]);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     #[inline]
-    fn write_register(&mut self, address: u8, value: u8) -> Result<(), HwError> {
+    fn write_register(&mut self, address: u8, value: u8) -> Result<(), PortError> {
         self.write_address(address)
             .and_then(|()| self.write_data(value))
             .map_err(|e| e.at_register(address))
@@ -90,10 +90,10 @@ pub trait EppPort {
     /// let mut card = RegisterFile::new();
     /// card.set(0x00, 0xa5);
     /// assert_eq!(card.read_register(0x00)?, 0xa5);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     #[inline]
-    fn read_register(&mut self, address: u8) -> Result<u8, HwError> {
+    fn read_register(&mut self, address: u8) -> Result<u8, PortError> {
         self.write_address(address)
             .and_then(|()| self.read_data())
             .map_err(|e| e.at_register(address))
@@ -102,23 +102,23 @@ pub trait EppPort {
 
 impl<T: EppPort + ?Sized> EppPort for &mut T {
     #[inline]
-    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         (**self).write_address(address)
     }
     #[inline]
-    fn read_data(&mut self) -> Result<u8, HwError> {
+    fn read_data(&mut self) -> Result<u8, PortError> {
         (**self).read_data()
     }
     #[inline]
-    fn write_data(&mut self, value: u8) -> Result<(), HwError> {
+    fn write_data(&mut self, value: u8) -> Result<(), PortError> {
         (**self).write_data(value)
     }
     #[inline]
-    fn write_register(&mut self, address: u8, value: u8) -> Result<(), HwError> {
+    fn write_register(&mut self, address: u8, value: u8) -> Result<(), PortError> {
         (**self).write_register(address, value)
     }
     #[inline]
-    fn read_register(&mut self, address: u8) -> Result<u8, HwError> {
+    fn read_register(&mut self, address: u8) -> Result<u8, PortError> {
         (**self).read_register(address)
     }
 }

@@ -5,7 +5,7 @@
 //! The layers, bottom up:
 //!
 //! - [`EppPort`]: the three IEEE 1284 EPP primitives (address write, data
-//!   read, data write), with [`HwError`]. Implemented by `Ppdev` (Linux
+//!   read, data write), with [`PortError`]. Implemented by `Ppdev` (Linux
 //!   `/dev/parportN`, feature `ppdev`), by [`SimulatedCard`], and by the
 //!   fakes in [`testing`].
 //! - [`Pc104`]: the card driver (PWM duty, counters latched together and
@@ -17,6 +17,12 @@
 //! - [`Rig`]: measurements in, inputs out, at a fixed period; [`run`]
 //!   drives one with any [`Controller`](crate::Controller) and returns a
 //!   [`Recording`](crate::Recording).
+//!
+//! Errors follow concerns, each with a `kind()`: [`PortError`] for talking
+//! to the card, [`ConfigError`] for a configuration value (named by its
+//! key), [`LoopFault`] for what halts a run, [`RealTimeError`] for
+//! real-time scheduling; [`RigError`], what a [`Rig`] and [`run`] return, is
+//! any of them, and `?` converts each into it.
 //!
 //! This module names no cart: the lab's two-cart rig on the card is
 //! [`lab::MassSpringRig`](crate::lab::MassSpringRig), and the simulated one
@@ -42,7 +48,7 @@
 //! }
 //! // 12 N over two 1000 N/m springs in series: x2 = 24 mm, within a count.
 //! assert!((x[2] - 0.024).abs() < 1e-5);
-//! # Ok::<(), ctrlab::hw::HwError>(())
+//! # Ok::<(), ctrlab::hw::RigError>(())
 //! ```
 
 mod clock;
@@ -63,7 +69,11 @@ pub mod testing;
 
 pub use clock::{Clock, VirtualClock};
 pub use epp::EppPort;
-pub use error::{CycleKind, HwError, HwErrorKind};
+pub use error::{
+    ConfigError, ConfigErrorKind, CycleKind, LoopFault, LoopFaultKind, PortError, PortErrorKind,
+    RealTimeError, RealTimeErrorKind, RigError, RigErrorKind,
+};
+pub(crate) use error::{check_all_positive, check_positive};
 pub use pc104::{
     ENCODER_CHANNELS, MAX_DUTY, PWM_CHANNELS, PWM_DIRECTION_BIT, Pc104, RegisterMap,
     duty_from_bytes, pwm_bytes,

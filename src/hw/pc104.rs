@@ -3,7 +3,7 @@
 //! The default register map is documented on [`RegisterMap`] and in the
 //! README.
 
-use super::{EppPort, HwError};
+use super::{ConfigError, EppPort, PortError};
 
 /// Number of PWM channels on the card.
 ///
@@ -130,16 +130,21 @@ impl RegisterMap {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field and its value.
+    /// [`ConfigError`] naming the first bad field and its value, indexed
+    /// for an array (`encoder[3]`): [`Invalid`](ConfigError::Invalid) for a
+    /// zero bit mask or a counter past `0xfc`,
+    /// [`Conflict`](ConfigError::Conflict) for a mask or an address that
+    /// another field already uses (the later of the two is named).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{HwErrorKind, RegisterMap};
+    /// use ctrlab::hw::{ConfigErrorKind, RegisterMap};
     /// let clash = RegisterMap { control: 0x10, ..RegisterMap::default() };
-    /// assert_eq!(clash.validate().unwrap_err().kind(), HwErrorKind::InvalidConfig);
+    /// let err = clash.validate().unwrap_err();
+    /// assert_eq!((err.kind(), err.key()), (ConfigErrorKind::Conflict, "pwm_low[0]"));
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         let bits = [
             ("latch_bit", self.latch_bit),
             ("clear_bit", self.clear_bit),
@@ -147,44 +152,51 @@ impl RegisterMap {
         ];
         let mut seen_bits = 0u8;
         for (name, bit) in bits {
-            if bit == 0 || seen_bits & bit != 0 {
-                return Err(HwError::InvalidConfig {
+            if bit == 0 {
+                return Err(ConfigError::invalid(
                     name,
-                    value: f64::from(bit),
-                    reason: "control bit masks must be non-zero and must not overlap",
-                });
+                    f64::from(bit),
+                    "control bit masks must be non-zero and must not overlap",
+                ));
+            }
+            if seen_bits & bit != 0 {
+                return Err(ConfigError::conflict(
+                    name,
+                    f64::from(bit),
+                    "control bit masks must be non-zero and must not overlap",
+                ));
             }
             seen_bits |= bit;
         }
         let mut used = [false; 256];
-        let mut claim = |name: &'static str, address: u8| {
+        let mut claim = |key: String, address: u8| {
             let slot = &mut used[usize::from(address)];
             if *slot {
-                return Err(HwError::InvalidConfig {
-                    name,
-                    value: f64::from(address),
-                    reason: "two registers share this address",
-                });
+                return Err(ConfigError::conflict(
+                    key,
+                    f64::from(address),
+                    "two registers share this address",
+                ));
             }
             *slot = true;
             Ok(())
         };
-        claim("id", self.id)?;
-        claim("control", self.control)?;
+        claim("id".to_owned(), self.id)?;
+        claim("control".to_owned(), self.control)?;
         for n in 0..PWM_CHANNELS {
-            claim("pwm_low", self.pwm_low[n])?;
-            claim("pwm_high", self.pwm_high[n])?;
+            claim(format!("pwm_low[{n}]"), self.pwm_low[n])?;
+            claim(format!("pwm_high[{n}]"), self.pwm_high[n])?;
         }
-        for base in self.encoder {
+        for (n, base) in self.encoder.into_iter().enumerate() {
             if base > 0xfc {
-                return Err(HwError::InvalidConfig {
-                    name: "encoder",
-                    value: f64::from(base),
-                    reason: "a 4-byte counter must start at or below 0xfc",
-                });
+                return Err(ConfigError::invalid(
+                    format!("encoder[{n}]"),
+                    f64::from(base),
+                    "a 4-byte counter must start at or below 0xfc",
+                ));
             }
             for i in 0..4 {
-                claim("encoder", base + i)?;
+                claim(format!("encoder[{n}]"), base + i)?;
             }
         }
         Ok(())
@@ -253,7 +265,7 @@ pub fn duty_from_bytes(low: u8, high: u8) -> i16 {
 /// clock.advance(0.1)?;
 /// pc104.latch()?;
 /// assert!(pc104.read_counter(1)? > 0); // cart 2 moved forward
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, Clone)]
 pub struct Pc104<P> {
@@ -287,7 +299,7 @@ impl<P: EppPort> Pc104<P> {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] from [`RegisterMap::validate`].
+    /// [`ConfigError`] from [`RegisterMap::validate`].
     ///
     /// # Examples
     ///
@@ -295,9 +307,9 @@ impl<P: EppPort> Pc104<P> {
     /// use ctrlab::hw::{Pc104, RegisterMap, testing::RegisterFile};
     /// let map = RegisterMap { id: 0x0f, ..RegisterMap::default() };
     /// assert_eq!(Pc104::with_map(RegisterFile::new(), map)?.map().id, 0x0f);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::ConfigError>(())
     /// ```
-    pub fn with_map(port: P, map: RegisterMap) -> Result<Self, HwError> {
+    pub fn with_map(port: P, map: RegisterMap) -> Result<Self, ConfigError> {
         map.validate()?;
         Ok(Self {
             map,
@@ -338,7 +350,7 @@ impl<P: EppPort> Pc104<P> {
     /// let mut pc104 = Pc104::new(RegisterFile::new());
     /// pc104.port_mut().set(0x00, 0x5a);
     /// assert_eq!(pc104.read_id()?, 0x5a);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn port_mut(&mut self) -> &mut P {
         &mut self.port
@@ -353,7 +365,7 @@ impl<P: EppPort> Pc104<P> {
     /// let mut pc104 = Pc104::new(RegisterFile::new());
     /// pc104.set_pwm(0, 7)?;
     /// assert_eq!(pc104.into_port().get(0x10), 7);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn into_port(self) -> P {
         self.port
@@ -371,9 +383,9 @@ impl<P: EppPort> Pc104<P> {
     /// use ctrlab::hw::{Clock, Pc104, SIMULATED_CARD_ID};
     /// let mut pc104 = Pc104::new(ctrlab::lab::SimulatedRig::default().card(&Clock::RealTime)?);
     /// assert_eq!(pc104.read_id()?, SIMULATED_CARD_ID);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn read_id(&mut self) -> Result<u8, HwError> {
+    pub fn read_id(&mut self) -> Result<u8, PortError> {
         self.port.read_register(self.map.id)
     }
 
@@ -382,18 +394,18 @@ impl<P: EppPort> Pc104<P> {
     ///
     /// # Errors
     ///
-    /// [`HwError::NotPresent`] when the ID differs, saying whether the bus
+    /// [`PortError::NotPresent`] when the ID differs, saying whether the bus
     /// is open (`0x00` or `0xff`: no card answers) or another card answers;
     /// port errors otherwise.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{HwErrorKind, Pc104, testing::RegisterFile};
+    /// use ctrlab::hw::{PortErrorKind, Pc104, testing::RegisterFile};
     /// let mut pc104 = Pc104::new(RegisterFile::new());
-    /// assert_eq!(pc104.probe_id(0xa5).unwrap_err().kind(), HwErrorKind::NotPresent);
+    /// assert_eq!(pc104.probe_id(0xa5).unwrap_err().kind(), PortErrorKind::NotPresent);
     /// ```
-    pub fn probe_id(&mut self, expected: u8) -> Result<u8, HwError> {
+    pub fn probe_id(&mut self, expected: u8) -> Result<u8, PortError> {
         let found = self.read_id()?;
         if found == expected {
             return Ok(found);
@@ -410,7 +422,7 @@ impl<P: EppPort> Pc104<P> {
                 self.map.id
             )
         };
-        Err(HwError::NotPresent {
+        Err(PortError::NotPresent {
             device: "PC104 card".to_owned(),
             reason,
         })
@@ -422,23 +434,23 @@ impl<P: EppPort> Pc104<P> {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidCommand`] for a channel beyond 3 or a duty beyond
+    /// [`PortError::InvalidCommand`] for a channel beyond 3 or a duty beyond
     /// ±1000 (nothing is written); port errors naming the register.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{HwErrorKind, Pc104, testing::RegisterFile};
+    /// use ctrlab::hw::{PortErrorKind, Pc104, testing::RegisterFile};
     /// let mut pc104 = Pc104::new(RegisterFile::new());
     /// pc104.set_pwm(1, -300)?;
     /// assert_eq!((pc104.port().get(0x12), pc104.port().get(0x13)), (0x2c, 0x81));
-    /// assert_eq!(pc104.set_pwm(1, 1001).unwrap_err().kind(), HwErrorKind::InvalidCommand);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// assert_eq!(pc104.set_pwm(1, 1001).unwrap_err().kind(), PortErrorKind::InvalidCommand);
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn set_pwm(&mut self, channel: usize, duty: i16) -> Result<(), HwError> {
+    pub fn set_pwm(&mut self, channel: usize, duty: i16) -> Result<(), PortError> {
         check_channel("PWM channel", channel, PWM_CHANNELS)?;
         if !(-MAX_DUTY..=MAX_DUTY).contains(&duty) {
-            return Err(HwError::InvalidCommand {
+            return Err(PortError::InvalidCommand {
                 what: "PWM duty",
                 channel: Some(channel),
                 value: f64::from(duty),
@@ -451,7 +463,7 @@ impl<P: EppPort> Pc104<P> {
     }
 
     /// Strobes control bits (one register write).
-    fn control(&mut self, bits: u8) -> Result<(), HwError> {
+    fn control(&mut self, bits: u8) -> Result<(), PortError> {
         self.port.write_register(self.map.control, bits)
     }
 
@@ -468,9 +480,9 @@ impl<P: EppPort> Pc104<P> {
     /// let mut pc104 = Pc104::new(RecordingPort::default());
     /// pc104.latch()?;
     /// assert_eq!(pc104.port().log(), &[Cycle::AddressWrite(0x01), Cycle::DataWrite(0x01)]);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn latch(&mut self) -> Result<(), HwError> {
+    pub fn latch(&mut self) -> Result<(), PortError> {
         self.control(self.map.latch_bit)
     }
 
@@ -487,9 +499,9 @@ impl<P: EppPort> Pc104<P> {
     /// let mut pc104 = Pc104::new(RegisterFile::new());
     /// pc104.kick_watchdog()?;
     /// assert_eq!(pc104.port().get(0x01), 0x04);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn kick_watchdog(&mut self) -> Result<(), HwError> {
+    pub fn kick_watchdog(&mut self) -> Result<(), PortError> {
         self.control(self.map.watchdog_bit)
     }
 
@@ -507,9 +519,9 @@ impl<P: EppPort> Pc104<P> {
     /// let mut pc104 = Pc104::new(RegisterFile::new());
     /// pc104.latch_and_kick()?;
     /// assert_eq!(pc104.port().get(0x01), 0x05);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn latch_and_kick(&mut self) -> Result<(), HwError> {
+    pub fn latch_and_kick(&mut self) -> Result<(), PortError> {
         self.control(self.map.latch_bit | self.map.watchdog_bit)
     }
 
@@ -531,9 +543,9 @@ impl<P: EppPort> Pc104<P> {
     /// pc104.clear_counters()?;
     /// pc104.port_mut().set_u32_le(0x20, 0); // what the card does
     /// assert_eq!(pc104.read_counter(0)?, 0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn clear_counters(&mut self) -> Result<(), HwError> {
+    pub fn clear_counters(&mut self) -> Result<(), PortError> {
         self.control(self.map.clear_bit)?;
         self.last_raw = [0; ENCODER_CHANNELS];
         self.position = [0; ENCODER_CHANNELS];
@@ -545,7 +557,7 @@ impl<P: EppPort> Pc104<P> {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidCommand`] for a channel beyond 3; port errors
+    /// [`PortError::InvalidCommand`] for a channel beyond 3; port errors
     /// naming the register.
     ///
     /// # Examples
@@ -555,9 +567,9 @@ impl<P: EppPort> Pc104<P> {
     /// let mut pc104 = Pc104::new(RegisterFile::new());
     /// pc104.port_mut().set_u32_le(0x2c, 0xdead_beef);
     /// assert_eq!(pc104.read_raw_counter(3)?, 0xdead_beef);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn read_raw_counter(&mut self, channel: usize) -> Result<u32, HwError> {
+    pub fn read_raw_counter(&mut self, channel: usize) -> Result<u32, PortError> {
         check_channel("encoder channel", channel, ENCODER_CHANNELS)?;
         let base = self.map.encoder[channel];
         let mut bytes = [0u8; 4];
@@ -585,9 +597,9 @@ impl<P: EppPort> Pc104<P> {
     /// assert_eq!(pc104.read_counter(0)?, 0x7fff_fffe);
     /// pc104.port_mut().set_u32_le(0x20, 0x8000_0002); // wrapped to negative
     /// assert_eq!(pc104.read_counter(0)?, 0x8000_0002); // but still counting up
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
-    pub fn read_counter(&mut self, channel: usize) -> Result<i64, HwError> {
+    pub fn read_counter(&mut self, channel: usize) -> Result<i64, PortError> {
         let raw = self.read_raw_counter(channel)?;
         let delta = raw.wrapping_sub(self.last_raw[channel]) as i32;
         self.last_raw[channel] = raw;
@@ -596,11 +608,11 @@ impl<P: EppPort> Pc104<P> {
     }
 }
 
-fn check_channel(what: &'static str, channel: usize, count: usize) -> Result<(), HwError> {
+fn check_channel(what: &'static str, channel: usize, count: usize) -> Result<(), PortError> {
     if channel < count {
         Ok(())
     } else {
-        Err(HwError::InvalidCommand {
+        Err(PortError::InvalidCommand {
             what,
             channel: Some(channel),
             value: channel as f64,

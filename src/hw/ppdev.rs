@@ -11,7 +11,7 @@ use std::os::fd::AsRawFd;
 use std::os::unix::fs::OpenOptionsExt;
 use std::path::Path;
 
-use super::{CycleKind, EppPort, HwError};
+use super::{CycleKind, EppPort, PortError};
 
 mod diagnosis;
 
@@ -142,19 +142,19 @@ pub mod ioctl {
 /// `tests/hw.rs`, `one_rig_tick_costs_22_cycles_and_22_mode_switches`).
 ///
 /// Errors say what is wrong and what to do: a short read or write is
-/// [`HwError::Timeout`]; `EACCES`/`EPERM` are [`HwError::Permission`]
-/// (the `lp` group); `ENXIO`/`EBUSY` when claiming are [`HwError::Busy`]
+/// [`PortError::Timeout`]; `EACCES`/`EPERM` are [`PortError::Permission`]
+/// (the `lp` group); `ENXIO`/`EBUSY` when claiming are [`PortError::Busy`]
 /// (the printer driver `lp` holds the port: how to free it); `ENOENT`,
 /// `ENODEV` and `ENXIO` otherwise, and a port without hardware EPP, are
-/// [`HwError::NotPresent`] (with the likely causes); anything else is
-/// [`HwError::Io`] naming the failed step.
+/// [`PortError::NotPresent`] (with the likely causes); anything else is
+/// [`PortError::Io`] naming the failed step.
 ///
 /// # Examples
 ///
 /// ```
-/// use ctrlab::hw::{HwErrorKind, Ppdev};
+/// use ctrlab::hw::{PortErrorKind, Ppdev};
 /// let err = Ppdev::open("/dev/nonexistent").unwrap_err();
-/// assert_eq!(err.kind(), HwErrorKind::NotPresent);
+/// assert_eq!(err.kind(), PortErrorKind::NotPresent);
 /// ```
 #[derive(Debug)]
 pub struct Ppdev {
@@ -170,20 +170,20 @@ impl Ppdev {
     ///
     /// # Errors
     ///
-    /// [`HwError::NotPresent`] (no such device, or no hardware EPP),
-    /// [`HwError::Permission`], [`HwError::Busy`] (another driver holds
-    /// the port), [`HwError::Io`] naming the failed step.
+    /// [`PortError::NotPresent`] (no such device, or no hardware EPP),
+    /// [`PortError::Permission`], [`PortError::Busy`] (another driver holds
+    /// the port), [`PortError::Io`] naming the failed step.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{HwErrorKind, Ppdev};
+    /// use ctrlab::hw::{PortErrorKind, Ppdev};
     /// // /dev/null opens but is no parallel port: the first ioctl fails.
     /// let err = Ppdev::open("/dev/null").unwrap_err();
-    /// assert_eq!(err.kind(), HwErrorKind::Io);
+    /// assert_eq!(err.kind(), PortErrorKind::Io);
     /// assert!(err.to_string().contains("PPEXCL"));
     /// ```
-    pub fn open(path: impl AsRef<Path>) -> Result<Self, HwError> {
+    pub fn open(path: impl AsRef<Path>) -> Result<Self, PortError> {
         let (file, device) = open_device(path.as_ref())?;
         ioctl_none(&file, ioctl::PPEXCL).map_err(|e| port_error(&device, "PPEXCL", e))?;
         ioctl_none(&file, ioctl::PPCLAIM).map_err(|e| port_error(&device, "PPCLAIM", e))?;
@@ -212,11 +212,11 @@ impl Ppdev {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{HwErrorKind, Ppdev};
+    /// use ctrlab::hw::{PortErrorKind, Ppdev};
     /// let err = Ppdev::modes_of("/dev/nonexistent").unwrap_err();
-    /// assert_eq!(err.kind(), HwErrorKind::NotPresent);
+    /// assert_eq!(err.kind(), PortErrorKind::NotPresent);
     /// ```
-    pub fn modes_of(path: impl AsRef<Path>) -> Result<PortModes, HwError> {
+    pub fn modes_of(path: impl AsRef<Path>) -> Result<PortModes, PortError> {
         let (file, device) = open_device(path.as_ref())?;
         get_modes(&file).map_err(|e| port_error(&device, "PPGETMODES", e))
     }
@@ -230,7 +230,7 @@ impl Ppdev {
     /// let port = Ppdev::open("/dev/parport0")?;
     /// assert!(port.modes().epp); // open refuses a port without
     /// println!("{}: {}", port.device(), port.modes()); // PCSPP,TRISTATE,EPP,ECP,COMPAT
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn modes(&self) -> PortModes {
         self.modes
@@ -244,14 +244,14 @@ impl Ppdev {
     /// use ctrlab::hw::Ppdev;
     /// let port = Ppdev::open("/dev/parport0")?;
     /// assert_eq!(port.device(), "/dev/parport0");
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn device(&self) -> &str {
         &self.device
     }
 
     /// Writes the port's control register (`PPWCONTROL`).
-    fn write_control(&mut self, value: u8) -> Result<(), HwError> {
+    fn write_control(&mut self, value: u8) -> Result<(), PortError> {
         let value: libc::c_uchar = value;
         // SAFETY: PPWCONTROL reads one `unsigned char` through its pointer
         // argument; `value` is a live c_uchar for the whole call, and the fd
@@ -274,7 +274,7 @@ impl Ppdev {
     }
 
     /// Selects EPP address (`true`) or data (`false`) cycles, if not already.
-    fn set_mode(&mut self, address: bool) -> Result<(), HwError> {
+    fn set_mode(&mut self, address: bool) -> Result<(), PortError> {
         if self.address_mode == Some(address) {
             return Ok(());
         }
@@ -305,7 +305,7 @@ impl Ppdev {
         Ok(())
     }
 
-    fn write_byte(&mut self, cycle: CycleKind, byte: u8) -> Result<(), HwError> {
+    fn write_byte(&mut self, cycle: CycleKind, byte: u8) -> Result<(), PortError> {
         match self.file.write(&[byte]) {
             Ok(1) => Ok(()),
             Ok(_) => Err(timeout(cycle)),
@@ -315,12 +315,12 @@ impl Ppdev {
 }
 
 impl EppPort for Ppdev {
-    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         self.set_mode(true)?;
         self.write_byte(CycleKind::AddressWrite, address)
     }
 
-    fn read_data(&mut self) -> Result<u8, HwError> {
+    fn read_data(&mut self) -> Result<u8, PortError> {
         self.set_mode(false)?;
         let mut byte = [0u8; 1];
         match self.file.read(&mut byte) {
@@ -330,7 +330,7 @@ impl EppPort for Ppdev {
         }
     }
 
-    fn write_data(&mut self, value: u8) -> Result<(), HwError> {
+    fn write_data(&mut self, value: u8) -> Result<(), PortError> {
         self.set_mode(false)?;
         self.write_byte(CycleKind::DataWrite, value)
     }
@@ -347,7 +347,7 @@ impl Drop for Ppdev {
 /// Opens the device at `path` for reading and writing, non-blocking (a
 /// read or write the card does not answer is a timeout, not a hang); the
 /// file and the path as errors name it.
-fn open_device(path: &Path) -> Result<(File, String), HwError> {
+fn open_device(path: &Path) -> Result<(File, String), PortError> {
     let device = path.display().to_string();
     let file = OpenOptions::new()
         .read(true)
@@ -391,15 +391,15 @@ fn ioctl_none(file: &File, request: u32) -> io::Result<()> {
     }
 }
 
-fn timeout(cycle: CycleKind) -> HwError {
-    HwError::Timeout {
+fn timeout(cycle: CycleKind) -> PortError {
+    PortError::Timeout {
         cycle,
         register: None,
     }
 }
 
 /// A failed read or write: would-block and timeouts are EPP timeouts.
-fn transfer_error(device: &str, cycle: CycleKind, e: io::Error) -> HwError {
+fn transfer_error(device: &str, cycle: CycleKind, e: io::Error) -> PortError {
     match e.raw_os_error() {
         Some(libc::EAGAIN | libc::ETIMEDOUT) => timeout(cycle),
         _ => port_error(

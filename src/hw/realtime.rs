@@ -9,7 +9,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::HwError;
+use super::{RealTimeError, RigError};
 
 /// Opt-in real-time settings for [`run`](super::run)'s thread, as
 /// cyclictest uses them: SCHED_FIFO at `priority`, all memory locked
@@ -22,7 +22,7 @@ use super::HwError;
 /// `@realtime - rtprio 99` and `memlock unlimited` in
 /// `/etc/security/limits.conf`), `CAP_SYS_NICE` and `CAP_IPC_LOCK`
 /// (`setcap cap_sys_nice,cap_ipc_lock+ep` on the binary), or root. Without
-/// it [`run`](super::run) refuses to start with [`HwError::RealTime`], which
+/// it [`run`](super::run) refuses to start with a [`RealTimeError`], which
 /// says how to grant it.
 ///
 /// A SCHED_FIFO thread that never sleeps starves everything else on its
@@ -64,10 +64,6 @@ impl Default for RealTime {
     }
 }
 
-const HINT_PRIORITY: &str = "Grant real-time priority: raise the rtprio limit (`ulimit -r 99`, or `@realtime - rtprio 99` in /etc/security/limits.conf and add the user to group realtime), give the binary CAP_SYS_NICE (`sudo setcap cap_sys_nice,cap_ipc_lock+ep <binary>`), or run as root";
-const HINT_MEMORY: &str = "Grant memory locking: raise the memlock limit (`ulimit -l unlimited`, or `@realtime - memlock unlimited` in /etc/security/limits.conf), give the binary CAP_IPC_LOCK, or set `lock_memory: false`";
-const HINT_CPU: &str = "Pick a CPU this process may run on (see `nproc` and `taskset -p $$`)";
-
 /// What [`enter`] changed, restored on drop.
 #[derive(Debug)]
 pub(crate) struct Guard {
@@ -80,17 +76,9 @@ pub(crate) struct Guard {
     locked: bool,
 }
 
-fn refused(what: String, hint: &'static str) -> HwError {
-    HwError::RealTime {
-        what,
-        reason: std::io::Error::last_os_error().to_string(),
-        hint,
-    }
-}
-
 /// Applies `rt` to the calling thread; the guard undoes it.
 #[cfg(target_os = "linux")]
-pub(crate) fn enter(rt: &RealTime) -> Result<Guard, HwError> {
+pub(crate) fn enter(rt: &RealTime) -> Result<Guard, RigError> {
     // SAFETY: sched_getscheduler and sched_getparam only read the calling
     // thread's (pid 0) attributes into a sched_param we own.
     let (policy, param) = unsafe {
@@ -105,11 +93,12 @@ pub(crate) fn enter(rt: &RealTime) -> Result<Guard, HwError> {
     // SAFETY: as above.
     let max = unsafe { libc::sched_get_priority_max(libc::SCHED_FIFO) };
     if !(min..=max).contains(&rt.priority) {
-        return Err(HwError::InvalidConfig {
-            name: "priority",
-            value: f64::from(rt.priority),
-            reason: "SCHED_FIFO priority must be within 1–99",
-        });
+        return Err(super::ConfigError::invalid(
+            "priority",
+            f64::from(rt.priority),
+            "SCHED_FIFO priority must be within 1–99",
+        )
+        .into());
     }
     let mut guard = Guard {
         policy,
@@ -136,13 +125,22 @@ pub(crate) fn enter(rt: &RealTime) -> Result<Guard, HwError> {
         };
         match applied {
             Some(old) => guard.affinity = Some(old),
-            None => return Err(refused(format!("pin the loop to CPU {cpu}"), HINT_CPU)),
+            None => {
+                return Err(RealTimeError::Affinity {
+                    cpu,
+                    source: std::io::Error::last_os_error(),
+                }
+                .into());
+            }
         }
     }
     if rt.lock_memory {
         // SAFETY: mlockall takes flags only.
         if unsafe { libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) } != 0 {
-            return Err(refused("lock memory (mlockall)".to_owned(), HINT_MEMORY));
+            return Err(RealTimeError::LockMemory {
+                source: std::io::Error::last_os_error(),
+            }
+            .into());
         }
         guard.locked = true;
     }
@@ -151,21 +149,18 @@ pub(crate) fn enter(rt: &RealTime) -> Result<Guard, HwError> {
     };
     // SAFETY: sets the calling thread's policy from a sched_param we own.
     if unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &fifo) } != 0 {
-        return Err(refused(
-            format!("set SCHED_FIFO priority {}", rt.priority),
-            HINT_PRIORITY,
-        ));
+        return Err(RealTimeError::Priority {
+            priority: rt.priority,
+            source: std::io::Error::last_os_error(),
+        }
+        .into());
     }
     Ok(guard)
 }
 
 #[cfg(not(target_os = "linux"))]
-pub(crate) fn enter(_rt: &RealTime) -> Result<Guard, HwError> {
-    Err(HwError::RealTime {
-        what: "set real-time scheduling".to_owned(),
-        reason: "only implemented on Linux".to_owned(),
-        hint: "Run without `realtime`",
-    })
+pub(crate) fn enter(_rt: &RealTime) -> Result<Guard, RigError> {
+    Err(RealTimeError::Unsupported.into())
 }
 
 #[cfg(target_os = "linux")]

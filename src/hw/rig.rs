@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::HwError;
+use super::RigError;
 use crate::data::Schema;
 
 /// A plant a controller can run against, with `M` inputs and `P`
@@ -21,27 +21,27 @@ use crate::data::Schema;
 /// the power applied.
 ///
 /// ```
-/// use ctrlab::hw::{HwError, Rig};
+/// use ctrlab::hw::{Rig, RigError};
 /// use nalgebra::{SVector, vector};
 ///
 /// struct Heater { temperature: f64, power: f64 }
 /// impl Rig<1, 1> for Heater {
-///     fn read(&mut self) -> Result<SVector<f64, 1>, HwError> {
+///     fn read(&mut self) -> Result<SVector<f64, 1>, RigError> {
 ///         self.temperature += 0.1 * self.power; // one period of heating
 ///         Ok(vector![self.temperature])
 ///     }
-///     fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HwError> {
+///     fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, RigError> {
 ///         self.power = u[0].clamp(0.0, 100.0);
 ///         Ok(vector![self.power])
 ///     }
-///     fn halt(&mut self) -> Result<(), HwError> { self.power = 0.0; Ok(()) }
+///     fn halt(&mut self) -> Result<(), RigError> { self.power = 0.0; Ok(()) }
 ///     fn period(&self) -> f64 { 1.0 }
 /// }
 ///
 /// let mut heater = Heater { temperature: 20.0, power: 0.0 };
 /// assert_eq!(heater.apply(&vector![150.0])?, vector![100.0]); // saturated
 /// assert_eq!(heater.read()?, vector![30.0]);
-/// # Ok::<(), HwError>(())
+/// # Ok::<(), RigError>(())
 /// ```
 pub trait Rig<const M: usize, const P: usize> {
     /// Samples the measurements now, in the units of
@@ -49,9 +49,9 @@ pub trait Rig<const M: usize, const P: usize> {
     ///
     /// # Errors
     ///
-    /// Port errors, and whatever the rig checks (travel limits, …), after
-    /// halting.
-    fn read(&mut self) -> Result<SVector<f64, P>, HwError>;
+    /// [`RigError::Port`] for port errors, and whatever the rig checks
+    /// ([`RigError::Fault`]: travel limits, …), after halting.
+    fn read(&mut self) -> Result<SVector<f64, P>, RigError>;
 
     /// Applies the inputs `u` (saturated and quantised to what the rig can
     /// do) and returns the inputs actually applied, which is what a
@@ -59,16 +59,16 @@ pub trait Rig<const M: usize, const P: usize> {
     ///
     /// # Errors
     ///
-    /// Port errors; [`HwError::InvalidCommand`] (after halting) for a
-    /// non-finite input.
-    fn apply(&mut self, u: &SVector<f64, M>) -> Result<SVector<f64, M>, HwError>;
+    /// Port errors; [`PortError::InvalidCommand`](super::PortError::InvalidCommand)
+    /// (after halting) for a non-finite input.
+    fn apply(&mut self, u: &SVector<f64, M>) -> Result<SVector<f64, M>, RigError>;
 
     /// Stops the actuators (zero input).
     ///
     /// # Errors
     ///
     /// Port errors.
-    fn halt(&mut self) -> Result<(), HwError>;
+    fn halt(&mut self) -> Result<(), RigError>;
 
     /// The sampling period the rig runs at, s: the loop runs at this
     /// period (it is given once, to the rig).
@@ -84,7 +84,7 @@ pub trait Rig<const M: usize, const P: usize> {
     /// use ctrlab::lab::SimulatedRig;
     /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(rig.schema().measurements()[2].name, "x2");
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     fn schema(&self) -> Schema {
         Schema::numbered(M, P)
@@ -109,7 +109,7 @@ pub trait Rig<const M: usize, const P: usize> {
     /// rig.restart();
     /// let x = rig.read_state()?;
     /// assert!(x[2] > 0.0 && x[3] == 0.0); // moved, but no speed from a 0.5 s gap
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     fn restart(&mut self) {}
 
@@ -123,7 +123,7 @@ pub trait Rig<const M: usize, const P: usize> {
     /// use ctrlab::lab::SimulatedRig;
     /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(rig.watchdog_timeout(), Some(0.1));
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     fn watchdog_timeout(&self) -> Option<f64> {
         None
@@ -136,22 +136,22 @@ pub trait Rig<const M: usize, const P: usize> {
     /// # Errors
     ///
     /// Port errors.
-    fn kick_watchdog(&mut self) -> Result<(), HwError> {
+    fn kick_watchdog(&mut self) -> Result<(), RigError> {
         Ok(())
     }
 }
 
 impl<R: Rig<M, P> + ?Sized, const M: usize, const P: usize> Rig<M, P> for &mut R {
     #[inline]
-    fn read(&mut self) -> Result<SVector<f64, P>, HwError> {
+    fn read(&mut self) -> Result<SVector<f64, P>, RigError> {
         (**self).read()
     }
     #[inline]
-    fn apply(&mut self, u: &SVector<f64, M>) -> Result<SVector<f64, M>, HwError> {
+    fn apply(&mut self, u: &SVector<f64, M>) -> Result<SVector<f64, M>, RigError> {
         (**self).apply(u)
     }
     #[inline]
-    fn halt(&mut self) -> Result<(), HwError> {
+    fn halt(&mut self) -> Result<(), RigError> {
         (**self).halt()
     }
     #[inline]
@@ -169,7 +169,7 @@ impl<R: Rig<M, P> + ?Sized, const M: usize, const P: usize> Rig<M, P> for &mut R
         (**self).restart()
     }
     #[inline]
-    fn kick_watchdog(&mut self) -> Result<(), HwError> {
+    fn kick_watchdog(&mut self) -> Result<(), RigError> {
         (**self).kick_watchdog()
     }
 }

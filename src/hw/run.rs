@@ -9,16 +9,16 @@
 //! - a rig error (port fault, travel limit, bus fault, a motor that does
 //!   not respond, a non-finite command);
 //! - a panic in the controller or the reference function
-//!   ([`HwError::Panicked`]);
+//!   ([`LoopFault::Panicked`]);
 //! - too many timing faults — overruns (a tick whose work ends after the
 //!   next deadline) and skipped deadlines (the loop fell a period or more
-//!   behind) — within a window ([`HwError::TimingFaults`]);
+//!   behind) — within a window ([`LoopFault::TimingFaults`]);
 //! - a gap: two samples, or a controller update, further apart than
 //!   `max_gap` (by default half the rig's watchdog timeout), after which the
 //!   card's watchdog would cut the motor and the next kick would silently
-//!   re-energise it with a stale command ([`HwError::Gap`]);
+//!   re-energise it with a stale command ([`LoopFault::Gap`]);
 //! - a stop request, e.g. Ctrl-C through [`StopSignal::on_interrupt`]
-//!   ([`HwError::Interrupted`]).
+//!   ([`LoopFault::Interrupted`]).
 //!
 //! The recording's time stamps are the actual sampling (latch) instants on
 //! the monotonic clock, so a missed tick shows as a gap, never papered over;
@@ -32,7 +32,7 @@ use nalgebra::SVector;
 use super::realtime::{self, RealTime};
 use crate::data::Recording;
 use crate::design::Controller;
-use crate::hw::{Clock, HwError, Rig, StopSignal};
+use crate::hw::{Clock, ConfigError, LoopFault, Rig, RigError, StopSignal};
 
 /// Settings of a [`run`].
 ///
@@ -145,7 +145,7 @@ impl std::fmt::Display for LoopStats {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::hw::{Clock, HwErrorKind, LoopConfig, VirtualClock, run};
+/// use ctrlab::hw::{Clock, LoopConfig, LoopFaultKind, VirtualClock, run};
 /// use ctrlab::{OpenLoop, lab::SimulatedRig};
 /// use nalgebra::vector;
 ///
@@ -153,14 +153,14 @@ impl std::fmt::Display for LoopStats {
 /// let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
 /// // Full drive (26.7 N at 24 V on the default truth) runs cart 2 past its ±50 mm limit.
 /// let err = run(rig, OpenLoop, |_| vector![24.0], &Clock::Virtual(clock), &LoopConfig::default()).unwrap_err();
-/// assert_eq!(err.error.kind(), HwErrorKind::TravelLimit);
+/// assert_eq!(err.error.kind(), LoopFaultKind::TravelLimit);
 /// assert!(!err.recording.is_empty()); // everything before the breach
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug)]
 pub struct RunError {
     /// What went wrong.
-    pub error: HwError,
+    pub error: RigError,
     /// Every sample completed before the fault.
     pub recording: Recording,
     /// The measurements read in the failing tick, when the fault came after
@@ -244,18 +244,21 @@ const SPIN: Duration = Duration::from_micros(200);
 /// error, every sample recorded before it, the measurements read in the
 /// failing tick if there were any, and the statistics. The rig has been
 /// halted (best effort: a dead port cannot be told, but then the card's
-/// watchdog stops the motor). Causes: a rig error (port fault, travel
-/// limit, [`HwError::BusFault`], [`HwError::NotResponding`], a non-finite
-/// command); a panic in the controller or the reference
-/// ([`HwError::Panicked`]); `max_timing_faults` overruns and skipped
-/// deadlines within `timing_window` ([`HwError::TimingFaults`]); two
-/// samples, or one controller update, further apart than `max_gap`
-/// ([`HwError::Gap`]); a stop request ([`HwError::Interrupted`]); and
-/// [`HwError::InvalidConfig`] for a bad `config`, a rig whose period is
-/// not finite and > 0, a controller designed for another period, or a rig
-/// whose schema does not have `M` inputs and `P` measurements, and
-/// [`HwError::RealTime`] when real-time scheduling was asked for and not
-/// granted (nothing is run then).
+/// watchdog stops the motor). Causes, by the [`RigError`] they come as:
+///
+/// - [`RigError::Port`] and [`RigError::Fault`] from the rig (a port fault,
+///   [`LoopFault::TravelLimit`], [`LoopFault::BusFault`],
+///   [`LoopFault::NotResponding`], a non-finite command);
+/// - [`RigError::Fault`] from the loop: a panic in the controller or the
+///   reference ([`LoopFault::Panicked`]); `max_timing_faults` overruns and
+///   skipped deadlines within `timing_window` ([`LoopFault::TimingFaults`]);
+///   two samples, or one controller update, further apart than `max_gap`
+///   ([`LoopFault::Gap`]); a stop request ([`LoopFault::Interrupted`]);
+/// - [`RigError::Config`] for a bad `config` (named by its field), a rig
+///   whose period is not finite and ≥ 1 µs, a controller designed for
+///   another period, or a rig whose schema does not have `M` inputs and `P`
+///   measurements, and [`RigError::RealTime`] when real-time scheduling was
+///   asked for and not granted (nothing is run then).
 ///
 /// # Examples
 ///
@@ -264,14 +267,13 @@ const SPIN: Duration = Duration::from_micros(200);
 ///
 /// ```
 /// use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
-/// use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
-/// use ctrlab::StateFeedback;
+/// use ctrlab::lab::{Cart, LabGains, MassSpring, SimulatedRig};
 /// use nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
 /// let mut rig = SimulatedRig::ideal(MassSpring::nominal())
 ///     .rig(&Clock::Virtual(clock.clone()))?;
-/// let controller = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
+/// let controller = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?;
 /// let loop_config = LoopConfig { duration: 1.0, ..LoopConfig::default() };
 ///
 /// let out = run(&mut rig, controller, |_t| vector![0.030], &Clock::Virtual(clock), &loop_config)?;
@@ -299,18 +301,18 @@ where
         if let Some(p) = controller.period()
             && (p - period).abs() > 1e-9 * period
         {
-            return Err(HwError::InvalidConfig {
-                name: "period",
-                value: period,
-                reason: "the rig's period differs from the one the controller was designed for",
-            });
+            return Err(ConfigError::conflict(
+                "period",
+                period,
+                "the rig's period differs from the one the controller was designed for",
+            ));
         }
         if schema.inputs().len() != M || schema.measurements().len() != P {
-            return Err(HwError::InvalidConfig {
-                name: "schema",
-                value: schema.len() as f64,
-                reason: "the rig's schema does not have one channel per input and measurement",
-            });
+            return Err(ConfigError::conflict(
+                "schema",
+                schema.len() as f64,
+                "the rig's schema does not have one channel per input and measurement",
+            ));
         }
         Ok(ticks)
     });
@@ -320,18 +322,18 @@ where
         .unwrap_or(f64::INFINITY);
     let checked = checked.and_then(|ticks| {
         if max_gap < period {
-            return Err(HwError::InvalidConfig {
-                name: "max_gap",
-                value: max_gap,
-                reason: "must be at least the rig's period (half the watchdog timeout by default)",
-            });
+            return Err(ConfigError::conflict(
+                "max_gap",
+                max_gap,
+                "must be at least the rig's period (half the watchdog timeout by default)",
+            ));
         }
         Ok(ticks)
     });
     let realtime = match (checked, &config.realtime) {
         (Ok(ticks), Some(rt)) => realtime::enter(rt).map(|guard| (ticks, Some(guard))),
         (Ok(ticks), None) => Ok((ticks, None)),
-        (Err(e), _) => Err(e),
+        (Err(e), _) => Err(e.into()),
     };
     let (ticks, _realtime_guard) = match realtime {
         Ok(ok) => ok,
@@ -370,7 +372,7 @@ where
 
     macro_rules! fail {
         ($error:expr, $last:expr) => {
-            return Err(stop(rig, $error, recording, $last, stats, lateness))
+            return Err(stop(rig, $error.into(), recording, $last, stats, lateness))
         };
     }
 
@@ -378,7 +380,7 @@ where
     while k < ticks {
         let deadline = k as f64 * period;
         if config.stop.as_ref().is_some_and(StopSignal::is_requested) {
-            fail!(HwError::Interrupted { at: deadline }, None);
+            fail!(LoopFault::Interrupted { at: deadline }, None);
         }
         // Wait for the absolute deadline k·T; `t` is the sampling instant.
         let (t, late) = match clock {
@@ -421,7 +423,7 @@ where
             let interval = t - previous;
             stats.max_interval = stats.max_interval.max(interval);
             if interval > max_gap {
-                let error = HwError::Gap {
+                let error = LoopFault::Gap {
                     what: "the interval between two samples",
                     gap: interval,
                     limit: max_gap,
@@ -455,7 +457,7 @@ where
             // took too long must not have its stale command applied.
             let took = wall_start.elapsed().as_secs_f64() - t;
             if took > max_gap {
-                let error = HwError::Gap {
+                let error = LoopFault::Gap {
                     what: "the controller",
                     gap: took,
                     limit: max_gap,
@@ -536,8 +538,8 @@ impl FaultWindow {
     }
 }
 
-fn timing_faults(faults: &FaultWindow, period: f64, at: f64) -> HwError {
-    HwError::TimingFaults {
+fn timing_faults(faults: &FaultWindow, period: f64, at: f64) -> LoopFault {
+    LoopFault::TimingFaults {
         faults: faults.limit,
         window: faults.window,
         period,
@@ -546,19 +548,19 @@ fn timing_faults(faults: &FaultWindow, period: f64, at: f64) -> HwError {
 }
 
 /// The message of a caught panic.
-fn panicked(what: &'static str, payload: &Box<dyn std::any::Any + Send>, at: f64) -> HwError {
+fn panicked(what: &'static str, payload: &Box<dyn std::any::Any + Send>, at: f64) -> LoopFault {
     let message = payload
         .downcast_ref::<&str>()
         .map(|s| (*s).to_owned())
         .or_else(|| payload.downcast_ref::<String>().cloned())
         .unwrap_or_else(|| "(a panic without a message)".to_owned());
-    HwError::Panicked { what, message, at }
+    LoopFault::Panicked { what, message, at }
 }
 
 /// Halts the rig after `error` and packs up what was recorded.
 fn stop<G: Rig<M, P>, const M: usize, const P: usize>(
     mut rig: G,
-    error: HwError,
+    error: RigError,
     recording: Recording,
     last_measurement: Option<Vec<f64>>,
     mut stats: LoopStats,
@@ -588,12 +590,8 @@ fn finish_stats(stats: &mut LoopStats, lateness: &mut [f64]) {
     stats.lateness_max = at(1.0);
 }
 
-fn check_config(config: &LoopConfig, period: f64) -> Result<usize, HwError> {
-    let invalid = |name, value, reason| HwError::InvalidConfig {
-        name,
-        value,
-        reason,
-    };
+fn check_config(config: &LoopConfig, period: f64) -> Result<usize, ConfigError> {
+    let invalid = |key: &'static str, value, reason| ConfigError::invalid(key, value, reason);
     if !(period.is_finite() && period >= 1e-6) {
         return Err(invalid(
             "period",

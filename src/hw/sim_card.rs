@@ -6,7 +6,7 @@ use std::time::Instant;
 use crate::nalgebra::{SVector, vector};
 
 use super::pc104::{ENCODER_CHANNELS, PWM_CHANNELS, duty_from_bytes};
-use super::{Clock, EppPort, HwError, SimulatedCardConfig, VirtualClock};
+use super::{Clock, ConfigError, EppPort, PortError, SimulatedCardConfig, VirtualClock};
 use crate::integrate::{Integrator, Rk4};
 use crate::model::Dynamics;
 use crate::signal::Rng;
@@ -14,7 +14,7 @@ use crate::signal::Rng;
 /// The most RK4 sub-steps one access of a [`SimulatedCard`] takes to catch
 /// its plant up with its clock (at the default `max_substep` of 0.25 ms,
 /// 2500 s of plant time): a bound on the work of any single register
-/// access. A card further behind refuses with [`HwError::Simulation`].
+/// access. A card further behind refuses with [`PortError::Simulation`].
 ///
 /// # Examples
 ///
@@ -88,7 +88,7 @@ enum Time {
 /// // Settled at x = 6, i.e. 6 / (0.08 / 8192) counts.
 /// assert_eq!(pc104.read_counter(0)?, (6.0 * 8192.0 / 0.080f64).round() as i64);
 /// assert_eq!(pc104.port().voltage(), 6.0);
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, Clone)]
 pub struct SimulatedCard<D, const N: usize> {
@@ -125,7 +125,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] from [`SimulatedCardConfig::validate`].
+    /// [`ConfigError`] from [`SimulatedCardConfig::validate`].
     ///
     /// # Examples
     ///
@@ -135,9 +135,13 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// let still = |_t: f64, _x: &SVector<f64, 1>, _u: &SVector<f64, 1>| SVector::<f64, 1>::zeros();
     /// let card = SimulatedCard::new(still, SimulatedCardConfig::default(), Clock::RealTime)?;
     /// assert!(card.clock().is_none());
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn new(plant: D, config: SimulatedCardConfig<N>, clock: Clock) -> Result<Self, HwError> {
+    pub fn new(
+        plant: D,
+        config: SimulatedCardConfig<N>,
+        clock: Clock,
+    ) -> Result<Self, ConfigError> {
         config.validate()?;
         let map = config.map;
         let mut decode = [Reg::Open; 256];
@@ -195,7 +199,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// let card = SimulatedRig::default().card(&Clock::RealTime)?;
     /// assert_eq!(card.config().supply_voltage, 24.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn config(&self) -> &SimulatedCardConfig<N> {
         &self.config
@@ -210,7 +214,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// let rig = SimulatedRig::default();
     /// let card = rig.card(&Clock::RealTime)?;
     /// assert_eq!(card.plant().truth(), rig.truth);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn plant(&self) -> &D {
         &self.plant
@@ -225,7 +229,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// let card = SimulatedRig::default().card(&Clock::Virtual(VirtualClock::new()))?;
     /// card.clock().unwrap().advance(0.5)?;
     /// assert_eq!(card.clock().unwrap().now(), 0.5);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn clock(&self) -> Option<&VirtualClock> {
         match &self.time {
@@ -248,7 +252,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// assert_eq!(card.time(), 0.0);
     /// card.sync()?;
     /// assert_eq!(card.time(), 0.002);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn time(&self) -> f64 {
         self.t_nanos as f64 * 1e-9
@@ -258,7 +262,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     ///
     /// # Errors
     ///
-    /// [`HwError::Simulation`] when the clock is more than
+    /// [`PortError::Simulation`] when the clock is more than
     /// [`MAX_CATCH_UP_STEPS`] sub-steps of `max_substep` ahead (at the
     /// default 0.25 ms, 2500 s: a clock advanced by hand far past a card
     /// nobody read), or when the plant's state stops being finite. Time,
@@ -268,7 +272,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::{Clock, HwErrorKind, VirtualClock}, lab::SimulatedRig};
+    /// use ctrlab::{hw::{Clock, PortErrorKind, VirtualClock}, lab::SimulatedRig};
     /// let clock = VirtualClock::new();
     /// let mut card = SimulatedRig::default().card(&Clock::Virtual(clock.clone()))?;
     /// clock.advance(1.0)?;
@@ -276,11 +280,11 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// assert_eq!(card.time(), 1.0);
     /// // A million seconds would be four billion RK4 steps: refused, not run.
     /// clock.advance(1e6)?;
-    /// assert_eq!(card.sync().unwrap_err().kind(), HwErrorKind::Simulation);
+    /// assert_eq!(card.sync().unwrap_err().kind(), PortErrorKind::Simulation);
     /// assert_eq!(card.time(), 1.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn sync(&mut self) -> Result<(), HwError> {
+    pub fn sync(&mut self) -> Result<(), PortError> {
         let now = match &self.time {
             Time::Virtual(clock) => clock.now_nanos(),
             Time::Real(start) => u64::try_from(start.elapsed().as_nanos()).unwrap_or(u64::MAX),
@@ -310,8 +314,8 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     }
 
     #[cold]
-    fn too_far_behind(&self, behind: f64) -> HwError {
-        HwError::Simulation {
+    fn too_far_behind(&self, behind: f64) -> PortError {
+        PortError::Simulation {
             reason: format!(
                 "its clock is {behind:.6e} s ahead, more than the {:.6e} s it catches up in \
                  at most {MAX_CATCH_UP_STEPS} RK4 sub-steps of {} s",
@@ -323,8 +327,8 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     }
 
     #[cold]
-    fn diverged(&self, state: usize, value: f64, at: f64) -> HwError {
-        HwError::Simulation {
+    fn diverged(&self, state: usize, value: f64, at: f64) -> PortError {
+        PortError::Simulation {
             reason: format!(
                 "plant state {state} became {value} on the way to this time (the model \
                  diverged); the card stays at t = {:.4} s",
@@ -340,7 +344,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     ///
     /// # Errors
     ///
-    /// [`sync`](Self::sync)'s; [`HwError::InvalidCommand`] for a
+    /// [`sync`](Self::sync)'s; [`PortError::InvalidCommand`] for a
     /// non-finite state (the plant is left unchanged).
     ///
     /// # Examples
@@ -352,11 +356,11 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// card.set_true_state(vector![0.02, 0.0, 0.0, 0.0])?;
     /// assert_eq!(card.true_state()[0], 0.02);
     /// assert!(card.set_true_state(vector![f64::NAN, 0.0, 0.0, 0.0]).is_err());
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn set_true_state(&mut self, x: SVector<f64, N>) -> Result<(), HwError> {
+    pub fn set_true_state(&mut self, x: SVector<f64, N>) -> Result<(), PortError> {
         if let Some(&value) = x.iter().find(|v| !v.is_finite()) {
-            return Err(HwError::InvalidCommand {
+            return Err(PortError::InvalidCommand {
                 what: "simulated plant state",
                 channel: None,
                 value,
@@ -378,7 +382,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// use nalgebra::vector;
     /// let rig = SimulatedRig { initial_state: [0.01, 0.0, 0.02, 0.0], ..Default::default() };
     /// assert_eq!(rig.card(&Clock::RealTime)?.true_state()[2], 0.02);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn true_state(&self) -> SVector<f64, N> {
         self.state
@@ -396,7 +400,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// let mut pc104 = Pc104::new(card);
     /// pc104.set_pwm(2, -125)?;
     /// assert_eq!(pc104.port().pwm_duty(2), -125);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn pwm_duty(&self, channel: usize) -> i16 {
         self.duty.get(channel).copied().unwrap_or(0)
@@ -413,7 +417,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// let mut pc104 = Pc104::new(card);
     /// pc104.set_pwm(0, -1000)?;
     /// assert_eq!(pc104.port().voltage(), -24.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn voltage(&self) -> f64 {
         self.config.supply_voltage * f64::from(self.duty[self.config.pwm_channel]) / 1000.0
@@ -535,13 +539,13 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
 }
 
 impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
-    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         self.sync()?;
         self.address = address;
         Ok(())
     }
 
-    fn read_data(&mut self) -> Result<u8, HwError> {
+    fn read_data(&mut self) -> Result<u8, PortError> {
         self.sync()?;
         Ok(match self.decode[usize::from(self.address)] {
             Reg::Id => self.config.card_id,
@@ -550,7 +554,7 @@ impl<D: Dynamics<N, 1>, const N: usize> EppPort for SimulatedCard<D, N> {
         })
     }
 
-    fn write_data(&mut self, value: u8) -> Result<(), HwError> {
+    fn write_data(&mut self, value: u8) -> Result<(), PortError> {
         self.sync()?;
         match self.decode[usize::from(self.address)] {
             Reg::Control => {

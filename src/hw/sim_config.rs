@@ -4,7 +4,7 @@
 use nalgebra::SVector;
 
 use super::pc104::{ENCODER_CHANNELS, PWM_CHANNELS};
-use super::{HwError, RegisterMap};
+use super::{ConfigError, RegisterMap, check_positive};
 
 /// The ID the simulated card answers in its ID register (`0xa5`).
 ///
@@ -15,7 +15,7 @@ use super::{HwError, RegisterMap};
 /// use ctrlab::lab::SimulatedRig;
 /// let mut card = SimulatedRig::default().card(&ctrlab::hw::Clock::Virtual(Default::default()))?;
 /// assert_eq!(Pc104::new(card).read_id()?, SIMULATED_CARD_ID);
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 pub const SIMULATED_CARD_ID: u8 = 0xa5;
 
@@ -112,60 +112,69 @@ impl<const N: usize> SimulatedCardConfig<N> {
         self.travel_per_revolution / self.counts_per_revolution
     }
 
-    /// Checks every field.
+    /// Checks every field, and the resolution they make.
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
+    /// [`ConfigError`] naming the first bad field by its name (indexed for
+    /// an array, `encoders[2]`; the map's under `map.`, `map.encoder[3]`);
+    /// a resolution that is not a finite positive number
+    /// ([`units_per_count`](Self::units_per_count) over- or underflowing) is
+    /// named `travel_per_revolution`.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{HwError, SimulatedCardConfig};
+    /// use ctrlab::hw::SimulatedCardConfig;
     /// let bad = SimulatedCardConfig::<4> { supply_voltage: 0.0, ..Default::default() };
-    /// assert!(matches!(bad.validate(), Err(HwError::InvalidConfig { name: "supply_voltage", .. })));
+    /// assert_eq!(bad.validate().unwrap_err().key(), "supply_voltage");
+    /// let overflow = SimulatedCardConfig::<4> {
+    ///     travel_per_revolution: 1e300,
+    ///     counts_per_revolution: 1e-300,
+    ///     ..Default::default()
+    /// };
+    /// assert_eq!(overflow.validate().unwrap_err().key(), "travel_per_revolution");
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        self.map.validate()?;
-        let positive = [
-            ("supply_voltage", self.supply_voltage),
-            ("counts_per_revolution", self.counts_per_revolution),
-            ("travel_per_revolution", self.travel_per_revolution),
-            ("max_substep", self.max_substep),
-            ("watchdog_timeout", self.watchdog_timeout.unwrap_or(1.0)),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(HwError::invalid_config(
-                    name,
-                    value,
-                    "must be finite and > 0",
-                ));
-            }
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.map.validate().map_err(|e| e.in_table("map"))?;
+        check_positive("supply_voltage", self.supply_voltage)?;
+        check_positive("counts_per_revolution", self.counts_per_revolution)?;
+        check_positive("travel_per_revolution", self.travel_per_revolution)?;
+        let units = self.units_per_count();
+        if !(units.is_finite() && units > 0.0) {
+            return Err(ConfigError::invalid(
+                "travel_per_revolution",
+                self.travel_per_revolution,
+                "its ratio to counts_per_revolution (the travel per count) must be finite and > 0",
+            ));
+        }
+        check_positive("max_substep", self.max_substep)?;
+        if let Some(timeout) = self.watchdog_timeout {
+            check_positive("watchdog_timeout", timeout)?;
         }
         if self.max_substep < 1e-9 {
-            return Err(HwError::invalid_config(
+            return Err(ConfigError::invalid(
                 "max_substep",
                 self.max_substep,
                 "must be ≥ 1 ns",
             ));
         }
         if !(self.pwm_delay.is_finite() && (0.0..1.0).contains(&self.pwm_delay)) {
-            return Err(HwError::invalid_config(
+            return Err(ConfigError::invalid(
                 "pwm_delay",
                 self.pwm_delay,
                 "must be finite, ≥ 0 and below 1 s",
             ));
         }
         if !(self.encoder_noise.is_finite() && self.encoder_noise >= 0.0) {
-            return Err(HwError::invalid_config(
+            return Err(ConfigError::invalid(
                 "encoder_noise",
                 self.encoder_noise,
                 "must be finite and ≥ 0",
             ));
         }
         if self.pwm_channel >= PWM_CHANNELS {
-            return Err(HwError::invalid_config(
+            return Err(ConfigError::invalid(
                 "pwm_channel",
                 self.pwm_channel as f64,
                 "must be 0–3",
@@ -174,24 +183,24 @@ impl<const N: usize> SimulatedCardConfig<N> {
         for (i, state) in self.encoders.iter().enumerate() {
             let Some(state) = *state else { continue };
             if state >= N {
-                return Err(HwError::invalid_config(
-                    "encoders",
+                return Err(ConfigError::invalid(
+                    format!("encoders[{i}]"),
                     state as f64,
                     "names a state beyond the plant's",
                 ));
             }
             if self.encoders[..i].contains(&Some(state)) {
-                return Err(HwError::invalid_config(
-                    "encoders",
+                return Err(ConfigError::conflict(
+                    format!("encoders[{i}]"),
                     state as f64,
                     "two encoder channels count the same state",
                 ));
             }
         }
-        if let Some(value) = self.initial_state.iter().find(|v| !v.is_finite()) {
-            return Err(HwError::invalid_config(
-                "initial_state",
-                *value,
+        if let Some(i) = self.initial_state.iter().position(|v| !v.is_finite()) {
+            return Err(ConfigError::invalid(
+                format!("initial_state[{i}]"),
+                self.initial_state[i],
                 "must be finite",
             ));
         }

@@ -4,10 +4,8 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use super::HwError;
-
 /// A shared flag that stops [`run`](super::run) at its next tick: the rig is
-/// halted and the run returns [`HwError::Interrupted`] with everything
+/// halted and the run returns [`LoopFault::Interrupted`](super::LoopFault::Interrupted) with everything
 /// recorded so far. Clones share the flag.
 ///
 /// [`on_interrupt`](Self::on_interrupt) sets it on SIGINT (Ctrl-C) and
@@ -18,7 +16,7 @@ use super::HwError;
 /// # Examples
 ///
 /// ```
-/// use ctrlab::hw::{Clock, HwErrorKind, LoopConfig, StopSignal, VirtualClock, run};
+/// use ctrlab::hw::{Clock, LoopConfig, LoopFaultKind, StopSignal, VirtualClock, run};
 /// use ctrlab::{OpenLoop, lab::SimulatedRig, nalgebra::vector};
 ///
 /// let stop = StopSignal::new();
@@ -31,9 +29,9 @@ use super::HwError;
 ///     if t >= 0.1 { trigger.request() }
 ///     vector![1.0]
 /// }, &Clock::Virtual(clock), &config).unwrap_err();
-/// assert_eq!(err.error.kind(), HwErrorKind::Interrupted);
+/// assert_eq!(err.error.kind(), LoopFaultKind::Interrupted);
 /// assert_eq!(err.recording.len(), 51); // 0 … 0.1 s, kept
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, Clone, Default)]
 pub struct StopSignal {
@@ -67,35 +65,34 @@ impl StopSignal {
     ///
     /// # Errors
     ///
-    /// [`HwError::Io`] when the handlers cannot be registered (or on a
-    /// platform without Unix signals).
+    /// The operating system's error, saying what failed, when the handlers
+    /// cannot be registered (or on a platform without Unix signals).
     ///
     /// # Examples
     ///
     /// ```no_run
     /// use ctrlab::hw::StopSignal;
     /// let stop = StopSignal::on_interrupt()?;
+    /// assert!(!stop.is_requested()); // until Ctrl-C
     /// // … pass `Some(stop.clone())` in `LoopConfig::stop`; Ctrl-C now halts the rig.
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), std::io::Error>(())
     /// ```
-    pub fn on_interrupt() -> Result<Self, HwError> {
+    pub fn on_interrupt() -> Result<Self, std::io::Error> {
         let stop = Self::new();
+        let refused = |source: std::io::Error| {
+            std::io::Error::new(
+                source.kind(),
+                format!("register SIGINT/SIGTERM on signal handler failed: {source}"),
+            )
+        };
         #[cfg(unix)]
         for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            signal_hook::flag::register(signal, Arc::clone(&stop.flag)).map_err(|source| {
-                HwError::Io {
-                    device: "signal handler".to_owned(),
-                    operation: "register SIGINT/SIGTERM",
-                    source,
-                }
-            })?;
+            signal_hook::flag::register(signal, Arc::clone(&stop.flag)).map_err(refused)?;
         }
         #[cfg(not(unix))]
-        return Err(HwError::Io {
-            device: "signal handler".to_owned(),
-            operation: "register SIGINT/SIGTERM",
-            source: std::io::Error::other("no Unix signals on this platform"),
-        });
+        return Err(refused(std::io::Error::other(
+            "no Unix signals on this platform",
+        )));
         #[cfg(unix)]
         Ok(stop)
     }

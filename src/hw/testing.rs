@@ -8,18 +8,18 @@
 //! # Examples
 //!
 //! ```
-//! use ctrlab::hw::{EppPort, HwErrorKind, testing::{Cycle, RecordingPort}};
+//! use ctrlab::hw::{EppPort, PortErrorKind, testing::{Cycle, RecordingPort}};
 //!
 //! // Every cycle from the third on times out.
 //! let mut port = RecordingPort::default().fail_from(2);
 //! port.write_register(0x10, 7)?;
 //! let err = port.read_register(0x10).unwrap_err();
-//! assert_eq!(err.kind(), HwErrorKind::Timeout);
+//! assert_eq!(err.kind(), PortErrorKind::Timeout);
 //! assert_eq!(port.log(), &[Cycle::AddressWrite(0x10), Cycle::DataWrite(7)]);
-//! # Ok::<(), ctrlab::hw::HwError>(())
+//! # Ok::<(), ctrlab::hw::PortError>(())
 //! ```
 
-use super::{CycleKind, EppPort, HwError};
+use super::{CycleKind, EppPort, PortError};
 
 /// A fake card: 256 bytes of memory behind an EPP port. A data write stores
 /// the byte at the selected address, a data read returns it.
@@ -32,7 +32,7 @@ use super::{CycleKind, EppPort, HwError};
 /// card.set_u32_le(0x20, 0x1234_5678);
 /// assert_eq!(card.get(0x20), 0x78);
 /// assert_eq!(card.read_register(0x23)?, 0x12);
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::PortError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RegisterFile {
@@ -116,7 +116,7 @@ impl RegisterFile {
     /// let mut card = RegisterFile::new();
     /// card.write_address(0x42)?;
     /// assert_eq!(card.address(), 0x42);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn address(&self) -> u8 {
         self.address
@@ -124,14 +124,14 @@ impl RegisterFile {
 }
 
 impl EppPort for RegisterFile {
-    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         self.address = address;
         Ok(())
     }
-    fn read_data(&mut self) -> Result<u8, HwError> {
+    fn read_data(&mut self) -> Result<u8, PortError> {
         Ok(self.get(self.address))
     }
-    fn write_data(&mut self, value: u8) -> Result<(), HwError> {
+    fn write_data(&mut self, value: u8) -> Result<(), PortError> {
         self.set(self.address, value);
         Ok(())
     }
@@ -185,7 +185,7 @@ enum Fault {
 
 /// Wraps any [`EppPort`] (by default a [`RegisterFile`]), logs every
 /// successful cycle as a [`Cycle`], and can make cycle `k` fail with
-/// [`HwError::Timeout`].
+/// [`PortError::Timeout`].
 ///
 /// Cycles are counted from 0 over all attempts, failed ones included. A
 /// failed cycle does not reach the inner port and is not logged.
@@ -193,11 +193,11 @@ enum Fault {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::hw::{EppPort, HwErrorKind, testing::{Cycle, RecordingPort}};
+/// use ctrlab::hw::{EppPort, PortErrorKind, testing::{Cycle, RecordingPort}};
 ///
 /// // Only cycle 1 (the first data write) fails.
 /// let mut port = RecordingPort::default().fail_at(1);
-/// assert_eq!(port.write_register(0x10, 5).unwrap_err().kind(), HwErrorKind::Timeout);
+/// assert_eq!(port.write_register(0x10, 5).unwrap_err().kind(), PortErrorKind::Timeout);
 /// port.write_register(0x10, 6)?;
 /// assert_eq!(port.attempts(), 4);
 /// assert_eq!(port.inner().get(0x10), 6);
@@ -205,7 +205,7 @@ enum Fault {
 ///     port.log(),
 ///     &[Cycle::AddressWrite(0x10), Cycle::AddressWrite(0x10), Cycle::DataWrite(6)]
 /// );
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::PortError>(())
 /// ```
 #[derive(Debug, Clone)]
 pub struct RecordingPort<P = RegisterFile> {
@@ -231,7 +231,7 @@ impl<P: EppPort> RecordingPort<P> {
     /// let mut port = RecordingPort::new(RegisterFile::new());
     /// port.write_address(3)?;
     /// assert_eq!(port.log().len(), 1);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn new(inner: P) -> Self {
         Self {
@@ -298,7 +298,7 @@ impl<P: EppPort> RecordingPort<P> {
     /// let mut port = RecordingPort::default();
     /// port.read_register(0)?;
     /// assert_eq!(port.log(), &[Cycle::AddressWrite(0), Cycle::DataRead(0)]);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn log(&self) -> &[Cycle] {
         &self.log
@@ -315,7 +315,7 @@ impl<P: EppPort> RecordingPort<P> {
     /// port.clear_log();
     /// assert!(port.log().is_empty());
     /// assert_eq!(port.attempts(), 1);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn clear_log(&mut self) {
         self.log.clear();
@@ -356,14 +356,14 @@ impl<P: EppPort> RecordingPort<P> {
     /// let mut port = RecordingPort::default();
     /// port.inner_mut().set(0, 0xa5);
     /// assert_eq!(port.read_register(0)?, 0xa5);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn inner_mut(&mut self) -> &mut P {
         &mut self.inner
     }
 
     /// Counts an attempt and reports whether it is injected to fail.
-    fn attempt(&mut self, cycle: CycleKind) -> Result<(), HwError> {
+    fn attempt(&mut self, cycle: CycleKind) -> Result<(), PortError> {
         let k = self.attempts;
         self.attempts += 1;
         let fails = match self.fault {
@@ -372,7 +372,7 @@ impl<P: EppPort> RecordingPort<P> {
             Fault::From(at) => k >= at,
         };
         if fails {
-            Err(HwError::Timeout {
+            Err(PortError::Timeout {
                 cycle,
                 register: None,
             })
@@ -383,19 +383,19 @@ impl<P: EppPort> RecordingPort<P> {
 }
 
 impl<P: EppPort> EppPort for RecordingPort<P> {
-    fn write_address(&mut self, address: u8) -> Result<(), HwError> {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         self.attempt(CycleKind::AddressWrite)?;
         self.inner.write_address(address)?;
         self.log.push(Cycle::AddressWrite(address));
         Ok(())
     }
-    fn read_data(&mut self) -> Result<u8, HwError> {
+    fn read_data(&mut self) -> Result<u8, PortError> {
         self.attempt(CycleKind::DataRead)?;
         let value = self.inner.read_data()?;
         self.log.push(Cycle::DataRead(value));
         Ok(value)
     }
-    fn write_data(&mut self, value: u8) -> Result<(), HwError> {
+    fn write_data(&mut self, value: u8) -> Result<(), PortError> {
         self.attempt(CycleKind::DataWrite)?;
         self.inner.write_data(value)?;
         self.log.push(Cycle::DataWrite(value));

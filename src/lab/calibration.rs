@@ -1,7 +1,7 @@
 //! [`Calibration`]: how the lab's rig maps counts and volts to SI, and
 //! what it checks.
 
-use crate::hw::{ENCODER_CHANNELS, HwError, PWM_CHANNELS};
+use crate::hw::{ConfigError, ENCODER_CHANNELS, PWM_CHANNELS, check_all_positive, check_positive};
 
 /// How the rig's counts and volts map to SI, and which channels are wired
 /// where.
@@ -95,76 +95,75 @@ impl Calibration {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
+    /// [`ConfigError`] naming the first bad field, indexed for an array
+    /// (`travel_limits[1]`): [`Conflict`](ConfigError::Conflict) for cart 2
+    /// on cart 1's encoder, [`Invalid`](ConfigError::Invalid) otherwise.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::HwError, lab::Calibration};
+    /// use ctrlab::lab::Calibration;
     /// let bad = Calibration { sign: [1.0, 0.5], ..Calibration::default() };
-    /// assert!(matches!(bad.validate(), Err(HwError::InvalidConfig { name: "sign", .. })));
+    /// let err = bad.validate().unwrap_err();
+    /// assert_eq!((err.key(), err.value()), ("sign[1]", 0.5));
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        let positive = [
-            ("metres_per_count", self.metres_per_count),
-            ("volts_full_scale", self.volts_full_scale),
-            ("travel_limits", self.travel_limits[0]),
-            ("travel_limits", self.travel_limits[1]),
-            ("watchdog_timeout", self.watchdog_timeout.unwrap_or(1.0)),
-            ("max_speed", self.max_speed),
-            ("stall_volts", self.stall_volts),
-            ("stall_time", self.stall_time),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(HwError::invalid_config(
-                    name,
-                    value,
-                    "must be finite and > 0",
-                ));
-            }
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        check_positive("metres_per_count", self.metres_per_count)?;
+        check_positive("volts_full_scale", self.volts_full_scale)?;
+        check_all_positive("travel_limits", &self.travel_limits)?;
+        if let Some(timeout) = self.watchdog_timeout {
+            check_positive("watchdog_timeout", timeout)?;
         }
-        for s in self.sign {
-            if s != 1.0 && s != -1.0 {
-                return Err(HwError::invalid_config("sign", s, "must be +1 or -1"));
-            }
+        check_positive("max_speed", self.max_speed)?;
+        check_positive("stall_volts", self.stall_volts)?;
+        check_positive("stall_time", self.stall_time)?;
+        if let Some(i) = self.sign.iter().position(|&s| s != 1.0 && s != -1.0) {
+            return Err(ConfigError::invalid(
+                format!("sign[{i}]"),
+                self.sign[i],
+                "must be +1 or -1",
+            ));
         }
         if self.pwm_channel >= PWM_CHANNELS {
-            return Err(HwError::invalid_config(
+            return Err(ConfigError::invalid(
                 "pwm_channel",
                 self.pwm_channel as f64,
                 "must be 0–3",
             ));
         }
         if self.card_id == 0x00 || self.card_id == 0xff {
-            return Err(HwError::invalid_config(
+            return Err(ConfigError::invalid(
                 "card_id",
                 f64::from(self.card_id),
                 "must be neither 0x00 nor 0xff, which an open bus reads",
             ));
         }
         if self.stall_counts < 1 {
-            return Err(HwError::invalid_config(
+            return Err(ConfigError::invalid(
                 "stall_counts",
                 self.stall_counts as f64,
                 "must be at least 1",
             ));
         }
-        check_encoder_channels(self.encoder_channels)
+        let [e1, e2] = self.encoder_channels;
+        for (i, e) in [e1, e2].into_iter().enumerate() {
+            if e >= ENCODER_CHANNELS {
+                return Err(ConfigError::invalid(
+                    format!("encoder_channels[{i}]"),
+                    e as f64,
+                    "must be two distinct channels 0–3",
+                ));
+            }
+        }
+        if e1 == e2 {
+            return Err(ConfigError::conflict(
+                "encoder_channels[1]",
+                e2 as f64,
+                "must be two distinct channels 0–3",
+            ));
+        }
+        Ok(())
     }
-}
-
-/// The carts' encoder channels must be two distinct channels 0–3 (shared by
-/// [`Calibration::validate`] and the simulated rig's validation).
-pub(super) fn check_encoder_channels([e1, e2]: [usize; 2]) -> Result<(), HwError> {
-    if e1 >= ENCODER_CHANNELS || e2 >= ENCODER_CHANNELS || e1 == e2 {
-        return Err(HwError::invalid_config(
-            "encoder_channels",
-            e2 as f64,
-            "must be two distinct channels 0–3",
-        ));
-    }
-    Ok(())
 }
 
 /// `watchdog_timeout` in a file: a number of seconds, or `"none"` for a card

@@ -6,9 +6,9 @@
 use std::fmt;
 use std::path::Path;
 
-use super::{Calibration, file};
-use crate::error::Error;
-use crate::hw::{HwError, RegisterMap};
+use super::Calibration;
+use super::file::{self, FileError};
+use crate::hw::{ConfigError, RegisterMap};
 
 /// A rig's card file (`card.toml`): where the card's registers are and how
 /// the rig's counts and volts map to SI.
@@ -56,7 +56,7 @@ use crate::hw::{HwError, RegisterMap};
 /// "#)?;
 /// assert_eq!((config.calibration.card_id, config.map.encoder[1]), (0x3c, 0x24));
 /// assert_eq!(config.calibration.sign[1], -1.0);
-/// # Ok::<(), ctrlab::Error>(())
+/// # Ok::<(), ctrlab::lab::FileError>(())
 /// ```
 ///
 /// # Why every key is required
@@ -73,18 +73,16 @@ use crate::hw::{HwError, RegisterMap};
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Error, hw::RegisterMap, lab::{Calibration, RigConfig}};
+/// use ctrlab::{hw::RegisterMap, lab::{Calibration, FileError, FileErrorKind, RigConfig}};
 ///
 /// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
 /// let text = config.to_toml();
 /// assert_eq!(RigConfig::from_toml(&text)?, config);
 /// // A key left out is refused, and named.
 /// let without = text.replace("card_id = 0xa5", "");
-/// match RigConfig::from_toml(&without) {
-///     Err(Error::Toml { key, .. }) => assert_eq!(key.as_deref(), Some("calibration.card_id")),
-///     other => panic!("{other:?}"),
-/// }
-/// # Ok::<(), Error>(())
+/// let err = RigConfig::from_toml(&without).unwrap_err();
+/// assert_eq!((err.kind(), err.key()), (FileErrorKind::MissingKey, Some("calibration.card_id")));
+/// # Ok::<(), FileError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -194,38 +192,6 @@ fn lookup(section: &str, name: &str) -> Option<&'static Field> {
     })
 }
 
-/// A validator's error with its field's name made the file's dotted key.
-fn qualify(section: &str, error: HwError) -> HwError {
-    match error {
-        HwError::InvalidConfig {
-            name,
-            value,
-            reason,
-        } => HwError::InvalidConfig {
-            name: lookup(section, name).map_or(name, |f| f.key),
-            value,
-            reason,
-        },
-        other => other,
-    }
-}
-
-/// The one-based line of dotted `key` in `text` (a `key = …` line under its
-/// `[section]` header), if written that way.
-fn line_of(text: &str, key: &str) -> Option<usize> {
-    let (section, name) = key.split_once('.')?;
-    let mut current = "";
-    for (i, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if let Some(header) = line.strip_prefix('[') {
-            current = header.split(']').next().unwrap_or("").trim();
-        } else if current == section && line.split('=').next().map(str::trim) == Some(name) {
-            return Some(i + 1);
-        }
-    }
-    None
-}
-
 /// Every decimal integer in `value` (a TOML integer or array of them)
 /// written in hex.
 fn hex(value: &str) -> String {
@@ -252,49 +218,28 @@ impl RigConfig {
     ///
     /// # Errors
     ///
-    /// [`Error::Toml`] with the line and the dotted key at fault: a syntax
+    /// [`FileError`] with the line and the dotted key at fault: a syntax
     /// error, an unknown or missing key, a value of the wrong type, or a
-    /// value the checks refuse (its message says what it must be).
+    /// value the checks refuse ([`FileError::Invalid`], holding the
+    /// [`ConfigError`] of [`validate`](Self::validate); its message says
+    /// what the value must be).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Error, hw::RegisterMap, lab::{Calibration, RigConfig}};
+    /// use ctrlab::{hw::RegisterMap, lab::{Calibration, FileError, RigConfig}};
     /// let good = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
     /// let bad = good.to_toml().replace("travel_limits = [0.05, 0.05]", "travel_limits = [0.05, -0.05]");
     /// match RigConfig::from_toml(&bad) {
-    ///     Err(Error::Toml { key, line: Some(_), .. }) => {
-    ///         assert_eq!(key.as_deref(), Some("calibration.travel_limits"))
+    ///     Err(FileError::Invalid { error, line: Some(_), .. }) => {
+    ///         assert_eq!(error.key(), "calibration.travel_limits[1]")
     ///     }
     ///     other => panic!("{other:?}"),
     /// }
     /// ```
-    pub fn from_toml(text: &str) -> Result<Self, Error> {
+    pub fn from_toml(text: &str) -> Result<Self, FileError> {
         let config: Self = file::parse(text)?;
-        config.validate().map_err(|e| match e {
-            HwError::InvalidConfig {
-                name,
-                value,
-                reason,
-            } => {
-                let shown = match FIELDS.iter().find(|f| f.key == name) {
-                    Some(f) if f.hex && (0.0..=255.0).contains(&value) => {
-                        format!("{:#04x}", value as u8)
-                    }
-                    _ => value.to_string(),
-                };
-                Error::Toml {
-                    line: line_of(text, name),
-                    key: Some(name.to_owned()),
-                    message: format!("{shown} is refused: {reason}"),
-                }
-            }
-            other => Error::Toml {
-                line: None,
-                key: None,
-                message: other.to_string(),
-            },
-        })?;
+        config.validate().map_err(|e| FileError::invalid(text, e))?;
         Ok(config)
     }
 
@@ -302,17 +247,17 @@ impl RigConfig {
     ///
     /// # Errors
     ///
-    /// [`Error::Io`] with the path; the errors of
-    /// [`from_toml`](Self::from_toml).
+    /// [`FileError`] with the path: [`FileError::Io`] when it cannot be
+    /// read, and the errors of [`from_toml`](Self::from_toml).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Error, lab::RigConfig};
-    /// assert!(matches!(RigConfig::read_toml("no/such/card.toml"), Err(Error::Io { .. })));
+    /// use ctrlab::lab::{FileError, RigConfig};
+    /// assert!(matches!(RigConfig::read_toml("no/such/card.toml"), Err(FileError::Io { .. })));
     /// ```
-    pub fn read_toml(path: impl AsRef<Path>) -> Result<Self, Error> {
-        Self::from_toml(&file::read(path.as_ref())?)
+    pub fn read_toml(path: impl AsRef<Path>) -> Result<Self, FileError> {
+        file::read_with(path.as_ref(), Self::from_toml)
     }
 
     /// The card file's text: every key, with what it means and its unit in
@@ -328,7 +273,7 @@ impl RigConfig {
     /// assert!(text.contains("encoder = [0x20, 0x24, 0x28, 0x2c]"));
     /// assert!(text.contains("# m per encoder count"));
     /// assert_eq!(RigConfig::from_toml(&text)?, config);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), ctrlab::lab::FileError>(())
     /// ```
     pub fn to_toml(&self) -> String {
         // Plain numbers, arrays, a string and two tables: serialisation
@@ -366,8 +311,8 @@ impl RigConfig {
     ///
     /// # Errors
     ///
-    /// [`Error::Toml`] naming the key of an invalid value (nothing is
-    /// written); [`Error::Io`] with the path.
+    /// [`FileError::Invalid`] naming the key of an invalid value (nothing
+    /// is written); [`FileError::Io`] with the path.
     ///
     /// # Examples
     ///
@@ -378,9 +323,9 @@ impl RigConfig {
     /// config.write_toml(&path)?;
     /// assert_eq!(RigConfig::read_toml(&path)?, config);
     /// # std::fs::remove_file(&path).ok();
-    /// # Ok::<(), ctrlab::Error>(())
+    /// # Ok::<(), ctrlab::lab::FileError>(())
     /// ```
-    pub fn write_toml(&self, path: impl AsRef<Path>) -> Result<(), Error> {
+    pub fn write_toml(&self, path: impl AsRef<Path>) -> Result<(), FileError> {
         let text = self.to_toml();
         // The same checks, with the same errors, as reading the file back.
         Self::from_toml(&text)?;
@@ -392,24 +337,24 @@ impl RigConfig {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] whose name is the file's dotted key
-    /// (`map.encoder`, `calibration.travel_limits`).
+    /// [`ConfigError`] whose key is the file's dotted key (`map.encoder[3]`,
+    /// `calibration.travel_limits[1]`).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::{HwError, RegisterMap}, lab::{Calibration, RigConfig}};
+    /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
     /// let config = RigConfig {
     ///     map: RegisterMap { encoder: [0x20, 0x24, 0x28, 0xfe], ..RegisterMap::default() },
     ///     calibration: Calibration::default(),
     /// };
-    /// assert!(matches!(config.validate(), Err(HwError::InvalidConfig { name: "map.encoder", .. })));
+    /// assert_eq!(config.validate().unwrap_err().key(), "map.encoder[3]");
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        self.map.validate().map_err(|e| qualify("map", e))?;
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.map.validate().map_err(|e| e.in_table("map"))?;
         self.calibration
             .validate()
-            .map_err(|e| qualify("calibration", e))
+            .map_err(|e| e.in_table("calibration"))
     }
 }
 

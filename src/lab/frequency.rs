@@ -201,7 +201,7 @@ pub struct FrequencyResponse {
 /// use ctrlab::signal::Signal;
 /// use nalgebra::vector;
 /// let sim = SimulatedRig::default();
-/// let rig = lqi::predicted_rig(sim.truth, sim.coulomb_friction, &sim.calibration(), sim.period);
+/// let rig = lqi::predicted_rig(sim.truth, sim.friction.coulomb, &sim.calibration, sim.period);
 /// let ms = frequency::multisine(8.0)?;
 /// // The model's own run as the measurement: both peaks where the model's are.
 /// let rec = ctrlab::run_sampled(rig.plant(), rig.sensor(), OpenLoop, |t| vector![ms.value(t)],

@@ -4,16 +4,17 @@
 //!
 //! - the plant: [`MassSpring`] (equations (1)–(3), (14)) and [`Cart`];
 //! - the lab's per-millimetre gains,
-//!   [`StateFeedback::from_lab_gains`](crate::StateFeedback::from_lab_gains),
-//!   and back, [`StateFeedback::to_lab_gains`](crate::StateFeedback::to_lab_gains)
-//!   into [`LabGains`];
+//!   [`LabGains`] (Kf in V/mm and V/(mm/s), and the setpoint's column
+//!   `G`), to an SI [`StateFeedback`](crate::StateFeedback) and back;
 //! - the identification of equations (4)–(11) from a recording, in
 //!   [`ident`];
 //! - the rig: [`MassSpringRig`] on the PC104 card with its [`Calibration`]
 //!   (a real card's register map and calibration come from its card file,
-//!   [`RigConfig`]),
+//!   [`RigConfig`]; a file's faults are a [`FileError`] that says the
+//!   path, the line and the key),
 //!   and in simulation [`SimulatedRig`] (the plant with stick–slip
-//!   [`FrictionPlant`] inside the register-level card, in one call), with
+//!   [`FrictionPlant`] inside the register-level card, in one call), made
+//!   of its truth, [`Friction`], [`CardSettings`] and [`Calibration`], with
 //!   its [`EncoderSensor`] for the sampled-data simulator;
 //! - the lab's recording layout, [`schema`]: input `u` (V), measurements
 //!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s);
@@ -36,12 +37,12 @@
 //!
 //! ```
 //! use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-//! use ctrlab::lab::{Cart, MassSpring, SimulatedRig};
-//! use ctrlab::{StateFeedback, sim::run_sampled};
+//! use ctrlab::lab::{Cart, LabGains, MassSpring, SimulatedRig};
+//! use ctrlab::sim::run_sampled;
 //! use nalgebra::vector;
 //!
 //! let sim = SimulatedRig::ideal(MassSpring::nominal());
-//! let law = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
+//! let law = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?;
 //! let simulated = run_sampled(sim.plant(), sim.sensor(), law, |_| vector![0.030],
 //!                             vector![0.0, 0.0, 0.0, 0.0], &sim.sampled_config(1.0))?;
 //!
@@ -74,12 +75,13 @@ pub mod validation;
 
 pub use calibration::Calibration;
 pub use config::RigConfig;
+pub use file::{FileError, FileErrorKind};
 pub use gains::LabGains;
 pub use plant::{Cart, MassSpring};
 pub use probe::SimulatedOperator;
 pub use rig::MassSpringRig;
 pub use sensor::EncoderSensor;
-pub use simulated::{FrictionPlant, SimulatedRig};
+pub use simulated::{CardSettings, Friction, FrictionPlant, SimulatedRig};
 
 use nalgebra::SMatrix;
 

@@ -37,7 +37,7 @@ const HAND_STEP: f64 = 0.005;
 /// assert!((card.true_state()[2] - 0.02).abs() < 1e-3);
 /// assert!(hand.confirm("ready?"));
 /// assert!(!hand.confirm("and again?")); // answers run out: no
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, Clone)]
 pub struct SimulatedOperator {

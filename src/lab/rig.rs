@@ -6,7 +6,9 @@ use crate::nalgebra::{SVector, vector};
 
 use super::Calibration;
 use crate::data::Schema;
-use crate::hw::{Clock, EppPort, HwError, MAX_DUTY, Pc104, Rig};
+use crate::hw::{
+    Clock, ConfigError, EppPort, LoopFault, MAX_DUTY, Pc104, PortError, Rig, RigError,
+};
 
 /// The lab's two-cart rig on a [`Pc104`] card: counts to metres, volts to
 /// PWM duty, with the safety the rig needs. A [`Rig`] with one input (the
@@ -22,16 +24,16 @@ use crate::hw::{Clock, EppPort, HwError, MAX_DUTY, Pc104, Rig};
 ///   the actual interval since the previous read, timed on the rig's
 ///   [`Clock`] (the first read reports zero speeds).
 /// - Every read checks the measurement is physical, halting the rig
-///   otherwise: a cart beyond its travel limit ([`HwError::TravelLimit`]),
+///   otherwise: a cart beyond its travel limit ([`LoopFault::TravelLimit`]),
 ///   a count change faster than [`Calibration::max_speed`]
-///   ([`HwError::BusFault`]: a flipped bit, a glitch on the bus), or a
-///   change of drive that moves no encoder ([`HwError::NotResponding`]).
+///   ([`LoopFault::BusFault`]: a flipped bit, a glitch on the bus), or a
+///   change of drive that moves no encoder ([`LoopFault::NotResponding`]).
 /// - [`apply_voltage`](Self::apply_voltage) saturates to
 ///   ±`volts_full_scale` and quantises to the card's 0.1 % duty steps; a
 ///   non-finite command halts the rig and returns
-///   [`HwError::InvalidCommand`]. A command more than the watchdog timeout
+///   [`PortError::InvalidCommand`]. A command more than the watchdog timeout
 ///   after the last read would re-energise a motor the card has cut: it is
-///   refused ([`HwError::Gap`]) and the rig halted.
+///   refused ([`LoopFault::Gap`]) and the rig halted.
 /// - Dropping the rig sets the PWM to zero (errors ignored: there is no one
 ///   left to tell).
 ///
@@ -55,7 +57,7 @@ use crate::hw::{Clock, EppPort, HwError, MAX_DUTY, Pc104, Rig};
 /// clock.advance(0.001)?; // past the PWM delay
 /// rig.card_mut().port_mut().sync()?;
 /// assert_eq!(rig.card().port().pwm_duty(0), 0); // halted
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug)]
 pub struct MassSpringRig<P: EppPort> {
@@ -86,14 +88,14 @@ impl<P: EppPort> MassSpringRig<P> {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] for an invalid calibration or a period
-    /// that is not finite and > 0; [`HwError::NotPresent`] when the ID
+    /// [`RigError::Config`] for an invalid calibration or a period that is
+    /// not finite and > 0; [`PortError::NotPresent`] when the ID
     /// register reads an open bus or another ID; port errors.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::{HwErrorKind, Pc104, testing::RegisterFile};
+    /// use ctrlab::hw::{ConfigErrorKind, Pc104, PortErrorKind, testing::RegisterFile};
     /// use ctrlab::lab::{Calibration, MassSpringRig};
     ///
     /// let mut regs = RegisterFile::new();
@@ -101,15 +103,15 @@ impl<P: EppPort> MassSpringRig<P> {
     /// let rig = MassSpringRig::new(Pc104::new(regs.clone()), Calibration::default(), 0.002)?;
     /// assert_eq!(rig.period(), 0.002);
     /// let bad = MassSpringRig::new(Pc104::new(regs), Calibration::default(), 0.0);
-    /// assert_eq!(bad.unwrap_err().kind(), HwErrorKind::InvalidConfig);
+    /// assert_eq!(bad.unwrap_err().kind(), ConfigErrorKind::Invalid);
     /// // No card: the bus reads 0xff.
     /// let mut open = RegisterFile::new();
     /// open.set(0x00, 0xff);
     /// let err = MassSpringRig::new(Pc104::new(open), Calibration::default(), 0.002).unwrap_err();
-    /// assert_eq!(err.kind(), HwErrorKind::NotPresent);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// assert_eq!(err.kind(), PortErrorKind::NotPresent);
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn new(card: Pc104<P>, calibration: Calibration, period: f64) -> Result<Self, HwError> {
+    pub fn new(card: Pc104<P>, calibration: Calibration, period: f64) -> Result<Self, RigError> {
         Self::with_clock(card, calibration, period, Clock::RealTime)
     }
 
@@ -127,23 +129,19 @@ impl<P: EppPort> MassSpringRig<P> {
     /// use ctrlab::lab::{MassSpringRig, SimulatedRig};
     /// let sim = SimulatedRig::default();
     /// let clock = Clock::Virtual(VirtualClock::new());
-    /// let rig = MassSpringRig::with_clock(Pc104::new(sim.card(&clock)?), sim.calibration(), 0.002, clock)?;
+    /// let rig = MassSpringRig::with_clock(Pc104::new(sim.card(&clock)?), sim.calibration, 0.002, clock)?;
     /// assert_eq!(rig.calibration().card_id, 0xa5);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn with_clock(
         mut card: Pc104<P>,
         calibration: Calibration,
         period: f64,
         clock: Clock,
-    ) -> Result<Self, HwError> {
+    ) -> Result<Self, RigError> {
         calibration.validate()?;
         if !(period.is_finite() && period > 0.0) {
-            return Err(HwError::InvalidConfig {
-                name: "period",
-                value: period,
-                reason: "must be finite and > 0 s",
-            });
+            return Err(ConfigError::invalid("period", period, "must be finite and > 0 s").into());
         }
         card.probe_id(calibration.card_id)?;
         Ok(Self {
@@ -168,7 +166,7 @@ impl<P: EppPort> MassSpringRig<P> {
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(rig.card().port().voltage(), 0.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn card(&self) -> &Pc104<P> {
         &self.card
@@ -182,7 +180,7 @@ impl<P: EppPort> MassSpringRig<P> {
     /// use ctrlab::{hw::{Clock, SIMULATED_CARD_ID}, lab::SimulatedRig};
     /// let mut rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(rig.card_mut().probe_id(SIMULATED_CARD_ID)?, SIMULATED_CARD_ID);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn card_mut(&mut self) -> &mut Pc104<P> {
         &mut self.card
@@ -196,7 +194,7 @@ impl<P: EppPort> MassSpringRig<P> {
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(rig.calibration().volts_full_scale, 24.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn calibration(&self) -> &Calibration {
         &self.calibration
@@ -210,7 +208,7 @@ impl<P: EppPort> MassSpringRig<P> {
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// let rig = SimulatedRig { period: 0.001, ..Default::default() }.rig(&Clock::RealTime)?;
     /// assert_eq!(rig.period(), 0.001);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn period(&self) -> f64 {
         self.period
@@ -233,9 +231,9 @@ impl<P: EppPort> MassSpringRig<P> {
 
     /// Halts and returns `error`: the fault is what to report; should the
     /// halt fail too, the caller's own halt or the card's watchdog follows.
-    fn fault<T>(&mut self, error: HwError) -> Result<T, HwError> {
+    fn fault<T>(&mut self, error: impl Into<RigError>) -> Result<T, RigError> {
         self.halt_motor().ok();
-        Err(error)
+        Err(error.into())
     }
 
     /// Samples the state `[x1, v1, x2, v2]` (m, m/s): latches the counters
@@ -244,9 +242,9 @@ impl<P: EppPort> MassSpringRig<P> {
     ///
     /// # Errors
     ///
-    /// Port errors; after halting: [`HwError::TravelLimit`] when a cart is
-    /// beyond its limit, [`HwError::BusFault`] for a count change faster
-    /// than the carts can move, [`HwError::NotResponding`] for sustained
+    /// Port errors; after halting: [`LoopFault::TravelLimit`] when a cart is
+    /// beyond its limit, [`LoopFault::BusFault`] for a count change faster
+    /// than the carts can move, [`LoopFault::NotResponding`] for sustained
     /// drive with no motion.
     ///
     /// # Examples
@@ -258,9 +256,9 @@ impl<P: EppPort> MassSpringRig<P> {
     ///     .rig(&Clock::RealTime)?;
     /// let x = rig.read_state()?; // the counters count from where they were cleared: 0
     /// assert_eq!(x[3], 0.0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn read_state(&mut self) -> Result<SVector<f64, 4>, HwError> {
+    pub fn read_state(&mut self) -> Result<SVector<f64, 4>, RigError> {
         let cal = self.calibration;
         // The latch happens between these two instants: a preemption in
         // between widens the bracket, never shortens an interval.
@@ -289,7 +287,7 @@ impl<P: EppPort> MassSpringRig<P> {
                 if fastest.abs() > cal.max_speed {
                     // The sample is not a measurement: forget it.
                     self.previous = None;
-                    return self.fault(HwError::BusFault {
+                    return self.fault(LoopFault::BusFault {
                         channel: cal.encoder_channels[cart],
                         counts: moved,
                         interval: longest,
@@ -303,7 +301,7 @@ impl<P: EppPort> MassSpringRig<P> {
         for cart in 0..2 {
             let (position, limit) = (x[2 * cart], cal.travel_limits[cart]);
             if position.abs() > limit {
-                return self.fault(HwError::TravelLimit {
+                return self.fault(LoopFault::TravelLimit {
                     axis: cart + 1,
                     position,
                     limit,
@@ -319,7 +317,7 @@ impl<P: EppPort> MassSpringRig<P> {
     /// was when an encoder last moved, so a deflection held against the
     /// springs, or carts stuck in their friction under a steady drive, is
     /// not a fault, while a motor that does not answer a new command is.
-    fn check_response(&mut self, counts: [i64; 2], now: f64) -> Result<(), HwError> {
+    fn check_response(&mut self, counts: [i64; 2], now: f64) -> Result<(), RigError> {
         let cal = self.calibration;
         let (reference, drive) = *self.motion.get_or_insert((counts, 0.0));
         let motion = (0..2)
@@ -340,7 +338,7 @@ impl<P: EppPort> MassSpringRig<P> {
         *weakest = weakest.min(change);
         let (since, weakest) = (*since, *weakest);
         if now - since >= cal.stall_time {
-            return self.fault(HwError::NotResponding {
+            return self.fault(LoopFault::NotResponding {
                 volts: weakest,
                 seconds: now - since,
                 counts: cal.stall_counts,
@@ -355,8 +353,8 @@ impl<P: EppPort> MassSpringRig<P> {
     ///
     /// # Errors
     ///
-    /// Port errors; after halting: [`HwError::InvalidCommand`] for a
-    /// non-finite voltage, [`HwError::Gap`] when the watchdog timeout has
+    /// Port errors; after halting: [`PortError::InvalidCommand`] for a
+    /// non-finite voltage, [`LoopFault::Gap`] when the watchdog timeout has
     /// passed since the last read (the card has cut the motor; applying now
     /// would re-energise it with a stale command).
     ///
@@ -366,11 +364,11 @@ impl<P: EppPort> MassSpringRig<P> {
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// let mut rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(rig.apply_voltage(1.01)?, 1.008); // 42 duty steps of 24 mV
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn apply_voltage(&mut self, volts: f64) -> Result<f64, HwError> {
+    pub fn apply_voltage(&mut self, volts: f64) -> Result<f64, RigError> {
         if !volts.is_finite() {
-            let error = HwError::InvalidCommand {
+            let error = PortError::InvalidCommand {
                 what: "voltage",
                 channel: Some(self.calibration.pwm_channel),
                 value: volts,
@@ -381,7 +379,7 @@ impl<P: EppPort> MassSpringRig<P> {
         if let (Some(timeout), Some(kick)) = (self.calibration.watchdog_timeout, self.last_kick) {
             let now = self.now();
             if now - kick >= timeout && volts != 0.0 {
-                let error = HwError::Gap {
+                let error = LoopFault::Gap {
                     what: "the time since the last watchdog kick",
                     gap: now - kick,
                     limit: timeout,
@@ -396,7 +394,7 @@ impl<P: EppPort> MassSpringRig<P> {
         Ok(self.volts)
     }
 
-    fn halt_motor(&mut self) -> Result<(), HwError> {
+    fn halt_motor(&mut self) -> Result<(), PortError> {
         self.volts = 0.0;
         self.card.set_pwm(self.calibration.pwm_channel, 0)
     }
@@ -404,17 +402,17 @@ impl<P: EppPort> MassSpringRig<P> {
 
 impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
     #[inline]
-    fn read(&mut self) -> Result<SVector<f64, 4>, HwError> {
+    fn read(&mut self) -> Result<SVector<f64, 4>, RigError> {
         self.read_state()
     }
 
     #[inline]
-    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, HwError> {
+    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, RigError> {
         Ok(vector![self.apply_voltage(u[0])?])
     }
 
-    fn halt(&mut self) -> Result<(), HwError> {
-        self.halt_motor()
+    fn halt(&mut self) -> Result<(), RigError> {
+        Ok(self.halt_motor()?)
     }
 
     fn period(&self) -> f64 {
@@ -429,7 +427,7 @@ impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
         self.calibration.watchdog_timeout
     }
 
-    fn kick_watchdog(&mut self) -> Result<(), HwError> {
+    fn kick_watchdog(&mut self) -> Result<(), RigError> {
         self.card.kick_watchdog()?;
         self.last_kick = Some(self.now());
         Ok(())

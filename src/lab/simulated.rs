@@ -1,14 +1,16 @@
 //! The lab's rig in simulation: the two-cart plant with stick–slip Coulomb
 //! friction ([`FrictionPlant`]) inside the register-level simulated card,
-//! and the whole simulated rig in one call ([`SimulatedRig`]).
+//! and the whole simulated rig in one call ([`SimulatedRig`]), made of its
+//! parts: the truth, its [`Friction`], the card's [`CardSettings`] and the
+//! rig's [`Calibration`].
 
 use nalgebra::SVector;
 
+use super::file::{self, FileError};
 use super::{Calibration, EncoderSensor, MassSpring, MassSpringRig, schema};
-use crate::error::Error;
 use crate::hw::{
-    Clock, ENCODER_CHANNELS, HwError, MAX_DUTY, Pc104, RegisterMap, SIMULATED_CARD_ID,
-    SimulatedCard, SimulatedCardConfig,
+    Clock, ConfigError, ENCODER_CHANNELS, MAX_DUTY, Pc104, RegisterMap, RigError, SimulatedCard,
+    SimulatedCardConfig,
 };
 use crate::model::Dynamics;
 use crate::sim::SampledConfig;
@@ -248,9 +250,222 @@ impl Dynamics<4, 1> for FrictionPlant {
     }
 }
 
+/// Coulomb (sliding) and breakaway (static) friction on the lab's two
+/// carts, N: part of a [`SimulatedRig`]'s truth, the `[friction]` table of
+/// its file. The default is the lab's rig's (see [the reasoning
+/// there](SimulatedRig#the-default-rig-and-why)): 1 N sliding and 1.2 N
+/// breakaway on cart 1, 2 N and 2.4 N on cart 2.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::Friction;
+/// let f = Friction::default();
+/// assert_eq!((f.coulomb, f.stiction), ([1.0, 2.0], [1.2, 2.4]));
+/// assert!(Friction::NONE.validate().is_ok());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Friction {
+    /// Coulomb (sliding) friction force on cart 1 and cart 2, N (≥ 0), see
+    /// [`FrictionPlant`].
+    pub coulomb: [f64; 2],
+    /// Breakaway (static) friction force on cart 1 and cart 2, N (≥ 0;
+    /// taken as at least the Coulomb force).
+    pub stiction: [f64; 2],
+}
+
+impl Default for Friction {
+    fn default() -> Self {
+        Self {
+            coulomb: [1.0, 2.0],
+            stiction: [1.2, 2.4],
+        }
+    }
+}
+
+impl Friction {
+    /// No friction on either cart (a linear plant).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::Friction;
+    /// assert_eq!(Friction::NONE.coulomb, [0.0; 2]);
+    /// ```
+    pub const NONE: Self = Self {
+        coulomb: [0.0; 2],
+        stiction: [0.0; 2],
+    };
+
+    /// Coulomb friction `coulomb` (N, cart 1 and cart 2) that breaks away
+    /// at the same force: no stiction beyond it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::Friction;
+    /// let f = Friction::coulomb([0.5, 1.5]);
+    /// assert_eq!((f.coulomb, f.stiction), ([0.5, 1.5], [0.5, 1.5]));
+    /// assert_eq!(f.stiction_ratio(), [1.0, 1.0]);
+    /// ```
+    pub fn coulomb(coulomb: [f64; 2]) -> Self {
+        Self {
+            coulomb,
+            stiction: coulomb,
+        }
+    }
+
+    /// Each cart's breakaway over Coulomb force (at least 1; 1 for a cart
+    /// without friction), as
+    /// [`SimulationModel::stiction_ratio`](crate::lab::ident::SimulationModel::stiction_ratio)
+    /// takes it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::Friction;
+    /// let r = Friction::default().stiction_ratio();
+    /// assert!(r.iter().all(|r| (r - 1.2).abs() < 1e-12));
+    /// ```
+    pub fn stiction_ratio(&self) -> [f64; 2] {
+        [0, 1].map(|c| {
+            let f = self.coulomb[c];
+            if f > 0.0 {
+                (self.stiction[c] / f).max(1.0)
+            } else {
+                1.0
+            }
+        })
+    }
+
+    /// Checks the forces: finite and ≥ 0, and each cart's breakaway over
+    /// Coulomb force ([`stiction_ratio`](Self::stiction_ratio)) finite.
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError`] naming the first bad force as the file does
+    /// (`coulomb[1]`, `stiction[0]`); a ratio that overflows (a Coulomb
+    /// force too small for the stiction over it) is named by the Coulomb
+    /// force.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::Friction;
+    /// let bad = Friction { coulomb: [1.0, -2.0], ..Friction::default() };
+    /// assert_eq!(bad.validate().unwrap_err().key(), "coulomb[1]");
+    /// let tiny = Friction { coulomb: [5e-324, 2.0], ..Friction::default() };
+    /// assert_eq!(tiny.validate().unwrap_err().key(), "coulomb[0]");
+    /// ```
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        for (name, forces) in [("coulomb", self.coulomb), ("stiction", self.stiction)] {
+            if let Some(c) = forces.iter().position(|f| !(f.is_finite() && *f >= 0.0)) {
+                return Err(ConfigError::invalid(
+                    format!("{name}[{c}]"),
+                    forces[c],
+                    "must be finite and ≥ 0",
+                ));
+            }
+        }
+        let ratio = self.stiction_ratio();
+        if let Some(c) = ratio.iter().position(|r| !r.is_finite()) {
+            return Err(ConfigError::conflict(
+                format!("coulomb[{c}]"),
+                self.coulomb[c],
+                "too small for the stiction over it: stiction / coulomb overflows",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The simulated card's own settings, those the rig's [`Calibration`] does
+/// not describe: where its registers are, the noise on its counts, the
+/// delay of its drive and how finely it integrates the plant. The
+/// `[card]` table of a [`SimulatedRig`]'s file. (Its ID, watchdog, supply,
+/// resolution and channels are the calibration's: the simulated card is
+/// built to match it.)
+///
+/// The default is the lab's rig's (see [the reasoning
+/// there](SimulatedRig#the-default-rig-and-why)): the default
+/// [`RegisterMap`], σ = 0.3 count of noise from seed `0x5eed`, a 0.15 ms PWM
+/// delay, RK4 sub-steps of at most 0.25 ms.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::CardSettings;
+/// let card = CardSettings::default();
+/// assert_eq!((card.encoder_noise, card.pwm_delay, card.max_substep), (0.3, 0.15e-3, 0.25e-3));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CardSettings {
+    /// Standard deviation of Gaussian noise added to each latched count,
+    /// counts (≥ 0; 0 = noiseless).
+    pub encoder_noise: f64,
+    /// Seed of the noise generator: the same seed gives the same noise.
+    pub seed: u64,
+    /// Delay from a PWM write to the drive applying it, s (≥ 0, below the
+    /// rig's period).
+    pub pwm_delay: f64,
+    /// Largest RK4 sub-step, s (≥ 1 ns, at most 10⁶ per period).
+    pub max_substep: f64,
+    /// Where the card's registers are (the `[card.map]` table).
+    pub map: RegisterMap,
+}
+
+impl CardSettings {
+    /// The card without what a linear model lacks: no PWM delay, no noise
+    /// on the counts (the default map, seed and sub-step), as
+    /// [`SimulatedRig::ideal`] has it.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::CardSettings;
+    /// let card = CardSettings::ideal();
+    /// assert_eq!((card.pwm_delay, card.encoder_noise), (0.0, 0.0));
+    /// assert_eq!(card.max_substep, CardSettings::default().max_substep);
+    /// ```
+    pub fn ideal() -> Self {
+        Self {
+            pwm_delay: 0.0,
+            encoder_noise: 0.0,
+            ..Self::default()
+        }
+    }
+}
+
+impl Default for CardSettings {
+    fn default() -> Self {
+        let card = SimulatedCardConfig::<4>::default();
+        Self {
+            encoder_noise: 0.3,
+            seed: card.seed,
+            pwm_delay: 0.15e-3,
+            max_substep: card.max_substep,
+            map: card.map,
+        }
+    }
+}
+
 /// The lab's rig in simulation, in one call: the plant with friction inside
 /// the register-level [`SimulatedCard`], read through [`Pc104`] by a
-/// [`MassSpringRig`] whose [`Calibration`] matches the card.
+/// [`MassSpringRig`] with the rig's [`Calibration`].
+///
+/// It is made of its parts: the plant's truth ([`MassSpring`]), its
+/// [`Friction`], the card's own [`CardSettings`], the [`Calibration`] the
+/// software uses, and where the carts start and how often they are read.
+/// The simulated card is built to match the calibration: its ID register
+/// reads [`card_id`](Calibration::card_id), its watchdog is
+/// [`watchdog_timeout`](Calibration::watchdog_timeout), its drive gives
+/// ±[`volts_full_scale`](Calibration::volts_full_scale), it counts
+/// [`metres_per_count`](Calibration::metres_per_count), and the motor and
+/// the carts are on the calibration's channels; each of these is said in
+/// one place, the calibration. (The simulated encoders count up as the
+/// carts move away from the wall: the calibration's signs are +1.)
 ///
 /// # The default rig, and why
 ///
@@ -268,34 +483,37 @@ impl Dynamics<4, 1> for FrictionPlant {
 ///   (26.7 N at 24 V) and a back-EMF damping (kt / r)² / R = 3.7 N·s/m on
 ///   cart 2, which with 1.8 N·s/m of rail friction makes b2 = 5.5 N·s/m.
 ///   (A gain of 8.5 N/V would need R ≤ 0.084 Ω and 285 A at stall.)
-/// - **Coulomb friction and stiction:** 1 N sliding and 1.2 N breakaway on
-///   cart 1, 2 N and 2.4 N on cart 2 (the motor's brushes and gears): small
-///   carts on a rail stop short of where the springs alone would put them.
+/// - **Coulomb friction and stiction** ([`Friction::default`]): 1 N sliding
+///   and 1.2 N breakaway on cart 1, 2 N and 2.4 N on cart 2 (the motor's
+///   brushes and gears): small carts on a rail stop short of where the
+///   springs alone would put them.
 /// - **Delay:** 0.15 ms from the PWM write to the drive applying it.
 /// - **Sensing:** encoders of 8192 counts (2048 pulses × 4) per 80 mm,
 ///   9.765625 µm per count, with σ = 0.3 count of noise (edge jitter).
 /// - **Safety:** travel limits ±50 mm (full drive, 24 V, would deflect
 ///   cart 2 by 54 mm), the card's 100 ms watchdog.
 ///
-/// Everything else is the card's default: register map, ID `0xa5`, motor on
-/// PWM channel 0, cart 1 on encoder 0 and cart 2 on encoder 1, RK4
-/// sub-steps of at most 0.25 ms, both carts at rest at 0, read every 2 ms.
+/// Everything else is the default [`Calibration`] and [`CardSettings`]:
+/// register map, ID `0xa5`, motor on PWM channel 0, cart 1 on encoder 0 and
+/// cart 2 on encoder 1, RK4 sub-steps of at most 0.25 ms; both carts at
+/// rest at 0, read every 2 ms.
 ///
 /// # In a file
 ///
 /// Every field can be set from a TOML file ([`from_toml`](Self::from_toml),
-/// `lab5 --truth truth.toml`); fields left out keep their default, unknown
-/// fields are an error:
+/// `lab5 --truth truth.toml`), in the tables of the parts: `[truth]`,
+/// `[friction]`, `[card]` (with `[card.map]`) and `[calibration]` (the keys
+/// of a card file's, [`RigConfig`](super::RigConfig)), and `period` and
+/// `initial_state` on top. Keys left out keep their default (a table given
+/// in part keeps the default of the keys it lacks); unknown keys are an
+/// error, as is a value [`validate`](Self::validate) refuses, named by the
+/// key the file spells:
 ///
 /// ```
 /// use ctrlab::lab::SimulatedRig;
 ///
 /// let rig = SimulatedRig::from_toml(r#"
-///     coulomb_friction = [0.5, 1.5]   # N, cart 1 and cart 2
-///     stiction = [0.6, 1.8]           # N, breakaway
-///     pwm_delay = 0.0002              # s
-///     encoder_noise = 0.5             # counts
-///     seed = 42
+///     period = 0.002                  # s
 ///
 ///     [truth]                         # SI: kg, N/m, N·s/m, N/V
 ///     m1 = 1.3
@@ -305,97 +523,75 @@ impl Dynamics<4, 1> for FrictionPlant {
 ///     b1 = 11.0
 ///     b2 = 6.0
 ///     gain = 1.2
+///
+///     [friction]                      # N, cart 1 and cart 2
+///     coulomb = [0.5, 1.5]
+///     stiction = [0.6, 1.8]           # breakaway
+///
+///     [card]
+///     pwm_delay = 0.0002              # s
+///     encoder_noise = 0.5             # counts
+///     seed = 42
+///
+///     [calibration]
+///     travel_limits = [0.04, 0.05]    # m
 /// "#)?;
-/// assert_eq!((rig.truth.gain, rig.coulomb_friction[1]), (1.2, 1.5));
-/// assert_eq!(rig.travel_limits, [0.05, 0.05]); // a default
-/// assert!(SimulatedRig::from_toml("gian = 1.2").is_err()); // a typo is refused
-/// # Ok::<(), ctrlab::Error>(())
+/// assert_eq!((rig.truth.gain, rig.friction.coulomb[1]), (1.2, 1.5));
+/// assert_eq!(rig.calibration.travel_limits, [0.04, 0.05]);
+/// assert_eq!(rig.calibration.watchdog_timeout, Some(0.1)); // a default
+/// assert!(SimulatedRig::from_toml("[truth]\ngian = 1.2").is_err()); // a typo is refused
+/// let err = SimulatedRig::from_toml("[friction]\ncoulomb = [1.0, -2.0]").unwrap_err();
+/// assert_eq!((err.key(), err.line()), (Some("friction.coulomb[1]"), Some(2)));
+/// # Ok::<(), ctrlab::lab::FileError>(())
 /// ```
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::hw::{Clock, VirtualClock};
-/// use ctrlab::lab::{MassSpring, SimulatedRig};
+/// use ctrlab::lab::{Calibration, MassSpring, SimulatedRig};
 ///
 /// let clock = VirtualClock::new();
 /// let sim = SimulatedRig {
-///     watchdog_timeout: None, // nobody kicks it in this example
+///     // nobody kicks the watchdog in this example
+///     calibration: Calibration { watchdog_timeout: None, ..Calibration::default() },
 ///     ..SimulatedRig::ideal(MassSpring::nominal())
 /// };
 /// let mut rig = sim.rig(&Clock::Virtual(clock.clone()))?;
 /// rig.apply_voltage(10.0)?;
 /// clock.advance(5.0)?;
 /// assert!((rig.read_state()?[2] - 0.020).abs() < 1e-4); // 10 N: 20 mm
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(deny_unknown_fields)]
 pub struct SimulatedRig {
+    /// The rig's sampling period, s (finite, ≥ 1 µs).
+    pub period: f64,
+    /// Plant state `[x1, v1, x2, v2]` (m, m/s) when the card is created:
+    /// within the travel limits, no faster than the calibration's
+    /// `max_speed`.
+    pub initial_state: [f64; 4],
     /// The linear plant inside; `truth.gain` is the motor's N per volt.
     pub truth: MassSpring,
-    /// Coulomb (sliding) friction force on cart 1 and cart 2, N (≥ 0), see
-    /// [`FrictionPlant`].
-    pub coulomb_friction: [f64; 2],
-    /// Breakaway (static) friction force on cart 1 and cart 2, N (taken as
-    /// at least the Coulomb force).
-    pub stiction: [f64; 2],
-    /// Delay from a PWM write to the drive applying it, s (≥ 0, < 1).
-    pub pwm_delay: f64,
-    /// Where the card's registers are.
-    pub map: RegisterMap,
-    /// What the ID register reads.
-    pub card_id: u8,
-    /// Driver voltage at 100 % duty, V (the lab's motor: 24 V).
-    pub supply_voltage: f64,
-    /// Encoder counts per revolution after ×4 decoding (> 0).
-    pub counts_per_revolution: f64,
-    /// Cart travel per encoder revolution, m (> 0).
-    pub travel_per_revolution: f64,
-    /// The PWM channel that drives the motor (0–3).
-    pub pwm_channel: usize,
-    /// The encoder channels that see cart 1 and cart 2 (0–3, distinct).
-    pub encoder_channels: [usize; 2],
-    /// Standard deviation of Gaussian noise added to each latched count,
-    /// counts (≥ 0; 0 = noiseless).
-    pub encoder_noise: f64,
-    /// Seed of the noise generator: the same seed gives the same noise.
-    pub seed: u64,
-    /// Watchdog timeout, s: with no kick for this long (card time), all PWM
-    /// outputs go to zero. `None` disables the watchdog.
-    pub watchdog_timeout: Option<f64>,
-    /// Largest RK4 sub-step, s (> 0).
-    pub max_substep: f64,
-    /// Plant state `[x1, v1, x2, v2]` (m, m/s) when the card is created.
-    pub initial_state: [f64; 4],
-    /// The rig's sampling period, s.
-    pub period: f64,
-    /// Software travel limits of cart 1 and cart 2, m.
-    pub travel_limits: [f64; 2],
+    /// The Coulomb friction and stiction on the carts.
+    pub friction: Friction,
+    /// The simulated card's own settings.
+    pub card: CardSettings,
+    /// What the software uses, and what the simulated card is built to
+    /// match (see [`SimulatedRig`]).
+    pub calibration: Calibration,
 }
 
 impl Default for SimulatedRig {
     fn default() -> Self {
-        let card = SimulatedCardConfig::<4>::default();
         Self {
-            truth: Self::default_truth(),
-            coulomb_friction: [1.0, 2.0],
-            stiction: [1.2, 2.4],
-            pwm_delay: 0.15e-3,
-            map: card.map,
-            card_id: SIMULATED_CARD_ID,
-            supply_voltage: card.supply_voltage,
-            counts_per_revolution: card.counts_per_revolution,
-            travel_per_revolution: card.travel_per_revolution,
-            pwm_channel: 0,
-            encoder_channels: [0, 1],
-            encoder_noise: 0.3,
-            seed: card.seed,
-            watchdog_timeout: card.watchdog_timeout,
-            max_substep: card.max_substep,
-            initial_state: [0.0; 4],
             period: 0.002,
-            travel_limits: Calibration::default().travel_limits,
+            initial_state: [0.0; 4],
+            truth: Self::default_truth(),
+            friction: Friction::default(),
+            card: CardSettings::default(),
+            calibration: Calibration::default(),
         }
     }
 }
@@ -437,78 +633,90 @@ impl SimulatedRig {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::lab::{MassSpring, SimulatedRig};
+    /// use ctrlab::lab::{Friction, MassSpring, SimulatedRig};
     /// let rig = SimulatedRig::ideal(MassSpring::nominal());
-    /// assert_eq!((rig.coulomb_friction, rig.pwm_delay, rig.encoder_noise), ([0.0; 2], 0.0, 0.0));
-    /// assert_eq!(rig.travel_limits, SimulatedRig::default().travel_limits);
+    /// assert_eq!((rig.friction, rig.card.pwm_delay, rig.card.encoder_noise), (Friction::NONE, 0.0, 0.0));
+    /// assert_eq!(rig.calibration, SimulatedRig::default().calibration);
     /// ```
     pub fn ideal(truth: MassSpring) -> Self {
         Self {
             truth,
-            coulomb_friction: [0.0; 2],
-            stiction: [0.0; 2],
-            pwm_delay: 0.0,
-            encoder_noise: 0.0,
+            friction: Friction::NONE,
+            card: CardSettings::ideal(),
             ..Self::default()
         }
     }
 
-    /// A simulated rig from TOML text: every field of [`SimulatedRig`],
-    /// each optional (see [In a file](Self#in-a-file)).
+    /// A simulated rig from TOML text (see [In a file](Self#in-a-file)),
+    /// checked ([`validate`](Self::validate)).
     ///
     /// # Errors
     ///
-    /// [`Error::Toml`] with the line, the dotted key at fault (an unknown
-    /// field, a value of the wrong type) and the parser's message. The values
-    /// themselves are checked when the rig is built
-    /// ([`validate`](Self::validate)).
+    /// [`FileError`] with the line and the dotted key at fault: a syntax
+    /// error, an unknown key, a value of the wrong type, or a value
+    /// [`validate`](Self::validate) refuses
+    /// ([`FileError::Invalid`], holding the same [`ConfigError`] as the
+    /// same value in code).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::lab::SimulatedRig;
+    /// use ctrlab::lab::{FileError, SimulatedRig};
     /// assert_eq!(SimulatedRig::from_toml("")?, SimulatedRig::default());
     /// let err = SimulatedRig::from_toml("[truth]\nm1 = \"heavy\"").unwrap_err();
     /// assert!(err.to_string().contains("key `truth.m1`"), "{err}");
-    /// # Ok::<(), ctrlab::Error>(())
+    /// let err = SimulatedRig::from_toml("[card]\nmax_substep = 0.0").unwrap_err();
+    /// let FileError::Invalid { error, .. } = err else { panic!("{err}") };
+    /// let code = SimulatedRig { card: ctrlab::lab::CardSettings { max_substep: 0.0, ..Default::default() }, ..Default::default() };
+    /// assert_eq!(code.validate(), Err(error));
+    /// # Ok::<(), FileError>(())
     /// ```
-    pub fn from_toml(text: &str) -> Result<Self, Error> {
-        super::file::parse(text)
+    pub fn from_toml(text: &str) -> Result<Self, FileError> {
+        let rig: Self = file::parse_over(text, &Self::default())?;
+        rig.validate().map_err(|e| FileError::invalid(text, e))?;
+        Ok(rig)
     }
 
     /// The simulated rig in `path` ([`from_toml`](Self::from_toml)).
     ///
     /// # Errors
     ///
-    /// [`Error::Io`] with the path, and the errors of
-    /// [`from_toml`](Self::from_toml).
+    /// [`FileError`] with the path: [`FileError::Io`] when it cannot be
+    /// read, and the errors of [`from_toml`](Self::from_toml).
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Error, lab::SimulatedRig};
-    /// assert!(matches!(SimulatedRig::read_toml("no/such/truth.toml"), Err(Error::Io { .. })));
+    /// use ctrlab::lab::{FileErrorKind, SimulatedRig};
+    /// let err = SimulatedRig::read_toml("no/such/truth.toml").unwrap_err();
+    /// assert_eq!(err.kind(), FileErrorKind::Io);
     /// ```
-    pub fn read_toml(path: impl AsRef<std::path::Path>) -> Result<Self, Error> {
-        Self::from_toml(&super::file::read(path.as_ref())?)
+    pub fn read_toml(path: impl AsRef<std::path::Path>) -> Result<Self, FileError> {
+        file::read_with(path.as_ref(), Self::from_toml)
     }
 
-    /// The rig as TOML text, every field written; reads back equal.
+    /// The rig as TOML text, every key written, in the tables of its
+    /// parts; reads back equal when the rig is valid (and its seed within
+    /// TOML's integers, below 2⁶³).
     ///
     /// # Examples
     ///
     /// ```
     /// use ctrlab::lab::SimulatedRig;
     /// let rig = SimulatedRig::default();
-    /// assert_eq!(SimulatedRig::from_toml(&rig.to_toml())?, rig);
-    /// # Ok::<(), ctrlab::Error>(())
+    /// let text = rig.to_toml();
+    /// assert!(text.contains("[friction]") && text.contains("[card.map]"));
+    /// assert_eq!(SimulatedRig::from_toml(&text)?, rig);
+    /// # Ok::<(), ctrlab::lab::FileError>(())
     /// ```
     pub fn to_toml(&self) -> String {
-        // Plain numbers, arrays and tables: serialisation cannot fail.
+        // Plain numbers, arrays and tables: serialisation cannot fail but
+        // for a seed beyond TOML's integers.
         toml::to_string(self).unwrap_or_default()
     }
 
-    /// Cart travel per encoder count, m.
+    /// Cart travel per encoder count, m: the calibration's, which the
+    /// simulated card counts in.
     ///
     /// # Examples
     ///
@@ -517,75 +725,62 @@ impl SimulatedRig {
     /// assert_eq!(SimulatedRig::default().metres_per_count(), 9.765625e-6);
     /// ```
     pub fn metres_per_count(&self) -> f64 {
-        self.travel_per_revolution / self.counts_per_revolution
+        self.calibration.metres_per_count
     }
 
-    /// The plant inside the card: the truth with its Coulomb friction.
+    /// The plant inside the card: the truth with its friction.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::lab::SimulatedRig;
-    /// let sim = SimulatedRig { coulomb_friction: [1.0, 2.0], ..Default::default() };
+    /// use ctrlab::lab::{Friction, SimulatedRig};
+    /// let sim = SimulatedRig { friction: Friction::coulomb([1.0, 2.0]), ..Default::default() };
     /// assert_eq!(sim.plant().friction(), [1.0, 2.0]);
     /// ```
     pub fn plant(&self) -> FrictionPlant {
-        FrictionPlant::new(self.truth, self.coulomb_friction).with_stiction(self.stiction)
+        FrictionPlant::new(self.truth, self.friction.coulomb).with_stiction(self.friction.stiction)
     }
 
-    /// The card's configuration: encoders on the carts' positions.
+    /// The card's configuration: the card's settings, what the calibration
+    /// says of the card (ID, watchdog, supply, resolution, PWM channel),
+    /// and encoders on the carts' positions as the calibration wires them.
+    ///
+    /// The card counts `counts_per_revolution` (its default 8192) per
+    /// `8192 × metres_per_count` of travel: exactly the calibration's
+    /// resolution, since scaling by a power of two is exact.
     ///
     /// # Examples
     ///
     /// ```
     /// use ctrlab::lab::SimulatedRig;
-    /// let card = SimulatedRig::default().card_config();
+    /// let sim = SimulatedRig::default();
+    /// let card = sim.card_config();
     /// assert_eq!(card.encoders, [Some(0), Some(2), None, None]);
+    /// assert_eq!(card.units_per_count(), sim.metres_per_count());
     /// ```
     pub fn card_config(&self) -> SimulatedCardConfig<4> {
+        let cal = &self.calibration;
         let mut encoders = [None; ENCODER_CHANNELS];
-        for (cart, &channel) in self.encoder_channels.iter().enumerate() {
+        for (cart, &channel) in cal.encoder_channels.iter().enumerate() {
             if let Some(slot) = encoders.get_mut(channel) {
                 *slot = Some(2 * cart);
             }
         }
+        let counts_per_revolution = SimulatedCardConfig::<4>::default().counts_per_revolution;
         SimulatedCardConfig {
-            map: self.map,
-            card_id: self.card_id,
-            supply_voltage: self.supply_voltage,
-            counts_per_revolution: self.counts_per_revolution,
-            travel_per_revolution: self.travel_per_revolution,
-            pwm_channel: self.pwm_channel,
+            map: self.card.map,
+            card_id: cal.card_id,
+            supply_voltage: cal.volts_full_scale,
+            counts_per_revolution,
+            travel_per_revolution: cal.metres_per_count * counts_per_revolution,
+            pwm_channel: cal.pwm_channel,
             encoders,
-            encoder_noise: self.encoder_noise,
-            seed: self.seed,
-            watchdog_timeout: self.watchdog_timeout,
-            max_substep: self.max_substep,
-            pwm_delay: self.pwm_delay,
+            encoder_noise: self.card.encoder_noise,
+            seed: self.card.seed,
+            watchdog_timeout: cal.watchdog_timeout,
+            max_substep: self.card.max_substep,
+            pwm_delay: self.card.pwm_delay,
             initial_state: SVector::from(self.initial_state),
-        }
-    }
-
-    /// The calibration that matches the card: its counts per metre, supply
-    /// and channels, and the travel limits.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::{Calibration, SimulatedRig};
-    /// assert_eq!(SimulatedRig::default().calibration(), Calibration::default());
-    /// ```
-    pub fn calibration(&self) -> Calibration {
-        Calibration {
-            metres_per_count: self.metres_per_count(),
-            sign: [1.0, 1.0],
-            volts_full_scale: self.supply_voltage,
-            pwm_channel: self.pwm_channel,
-            encoder_channels: self.encoder_channels,
-            travel_limits: self.travel_limits,
-            card_id: self.card_id,
-            watchdog_timeout: self.watchdog_timeout,
-            ..Calibration::default()
         }
     }
 
@@ -593,8 +788,7 @@ impl SimulatedRig {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field (of the truth
-    /// or the card).
+    /// [`ConfigError`] from [`validate`](Self::validate).
     ///
     /// # Examples
     ///
@@ -602,19 +796,20 @@ impl SimulatedRig {
     /// use ctrlab::{hw::{Clock, Pc104, SIMULATED_CARD_ID}, lab::SimulatedRig};
     /// let card = SimulatedRig::default().card(&Clock::RealTime)?;
     /// assert_eq!(Pc104::new(card).read_id()?, SIMULATED_CARD_ID);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn card(&self, clock: &Clock) -> Result<SimulatedCard<FrictionPlant, 4>, HwError> {
+    pub fn card(&self, clock: &Clock) -> Result<SimulatedCard<FrictionPlant, 4>, ConfigError> {
         self.validate()?;
         SimulatedCard::new(self.plant(), self.card_config(), clock.clone())
     }
 
-    /// The whole simulated rig on `clock`: card, driver and
-    /// [`MassSpringRig`], ready for [`hw::run`](crate::hw::run).
+    /// The whole simulated rig on `clock`: card, driver (with the card's
+    /// register map) and [`MassSpringRig`], ready for
+    /// [`hw::run`](crate::hw::run).
     ///
     /// # Errors
     ///
-    /// As [`card`](Self::card), and for an invalid period or travel limit.
+    /// [`RigError::Config`] from [`validate`](Self::validate).
     ///
     /// # Examples
     ///
@@ -622,15 +817,15 @@ impl SimulatedRig {
     /// use ctrlab::{hw::{Clock, Rig}, lab::SimulatedRig};
     /// let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
     /// assert_eq!(Rig::period(&rig), 0.002);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn rig(
         &self,
         clock: &Clock,
-    ) -> Result<MassSpringRig<SimulatedCard<FrictionPlant, 4>>, HwError> {
+    ) -> Result<MassSpringRig<SimulatedCard<FrictionPlant, 4>>, RigError> {
         MassSpringRig::with_clock(
-            Pc104::new(self.card(clock)?),
-            self.calibration(),
+            Pc104::with_map(self.card(clock)?, self.card.map)?,
+            self.calibration,
             self.period,
             clock.clone(),
         )
@@ -649,8 +844,8 @@ impl SimulatedRig {
         EncoderSensor::new(
             self.metres_per_count(),
             self.period,
-            self.encoder_noise,
-            self.seed,
+            self.card.encoder_noise,
+            self.card.seed,
         )
     }
 
@@ -670,20 +865,21 @@ impl SimulatedRig {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn sampled_config(&self, duration: f64) -> SampledConfig<1, 4> {
+        let supply = self.calibration.volts_full_scale;
         SampledConfig {
-            max_substep: self.max_substep,
-            input_delay: self.pwm_delay,
-            saturation: [self.supply_voltage],
-            input_quantisation: [self.supply_voltage / f64::from(MAX_DUTY)],
+            max_substep: self.card.max_substep,
+            input_delay: self.card.pwm_delay,
+            saturation: [supply],
+            input_quantisation: [supply / f64::from(MAX_DUTY)],
             schema: Some(schema()),
-            seed: self.seed,
+            seed: self.card.seed,
             ..SampledConfig::new(self.period, duration)
         }
     }
 
     /// The structure that reproduces this rig in output-error validation
     /// and refinement: its sub-step, its PWM delay and each cart's
-    /// breakaway over Coulomb force (1 for a cart without friction).
+    /// breakaway over Coulomb force ([`Friction::stiction_ratio`]).
     ///
     /// # Examples
     ///
@@ -694,63 +890,207 @@ impl SimulatedRig {
     /// assert!(m.stiction_ratio.iter().all(|r| (r - 1.2).abs() < 1e-12));
     /// ```
     pub fn simulation_model(&self) -> crate::lab::ident::SimulationModel {
-        let ratio = |c: usize| {
-            let f = self.coulomb_friction[c];
-            if f > 0.0 {
-                (self.stiction[c] / f).max(1.0)
-            } else {
-                1.0
-            }
-        };
         crate::lab::ident::SimulationModel {
-            max_substep: self.max_substep,
-            input_delay: self.pwm_delay,
-            stiction_ratio: [ratio(0), ratio(1)],
+            max_substep: self.card.max_substep,
+            input_delay: self.card.pwm_delay,
+            stiction_ratio: self.friction.stiction_ratio(),
         }
     }
 
-    /// Checks the truth and the friction (the card's fields are checked by
-    /// [`SimulatedCardConfig::validate`]).
+    /// Checks everything: each part, and what the parts make together, so
+    /// that a rig this accepts builds ([`card`](Self::card),
+    /// [`rig`](Self::rig)), runs ([`hw::run`](crate::hw::run) with the
+    /// default [`LoopConfig`](crate::hw::LoopConfig)) and simulates
+    /// ([`sampled_config`](Self::sampled_config),
+    /// [`simulation_model`](Self::simulation_model)) without a later
+    /// configuration error:
+    ///
+    /// - the truth ([`MassSpring::validate`]) and the accelerations it
+    ///   gives with the friction, finite;
+    /// - the friction ([`Friction::validate`]);
+    /// - the calibration ([`Calibration::validate`]), with signs +1 (the
+    ///   simulated encoders count up away from the wall), a resolution the
+    ///   card's 32-bit counters hold over the travel limits, and a watchdog
+    ///   of at least two periods (the loop halts at half of it);
+    /// - the card's settings, and the card they make with the calibration
+    ///   ([`SimulatedCardConfig::validate`]);
+    /// - the period (finite, ≥ 1 µs, at most 10⁶ sub-steps), a PWM delay
+    ///   below it, and the initial state within the travel limits and the
+    ///   calibration's `max_speed`.
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
+    /// [`ConfigError`] naming the first bad value by its key in the file
+    /// ([`from_toml`](Self::from_toml) reports the same error):
+    /// `truth.m1`, `friction.coulomb[1]`, `card.max_substep`,
+    /// `card.map.encoder[3]`, `calibration.travel_limits[0]`, `period`,
+    /// `initial_state[2]`. A derived quantity that fails is reported under
+    /// the key it comes from: a stiction over a Coulomb force that overflows
+    /// under `friction.coulomb[i]`, an acceleration that overflows under the
+    /// mass, a resolution the card cannot count in under
+    /// `calibration.metres_per_count`.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{hw::HwError, lab::SimulatedRig};
-    /// let bad = SimulatedRig { coulomb_friction: [-1.0, 0.0], ..Default::default() };
-    /// assert!(matches!(bad.validate(), Err(HwError::InvalidConfig { name: "coulomb_friction", .. })));
+    /// use ctrlab::lab::{Calibration, Friction, SimulatedRig};
+    /// let bad = SimulatedRig { friction: Friction { coulomb: [-1.0, 0.0], ..Friction::NONE }, ..Default::default() };
+    /// assert_eq!(bad.validate().unwrap_err().key(), "friction.coulomb[0]");
+    /// let quick = SimulatedRig {
+    ///     calibration: Calibration { watchdog_timeout: Some(0.003), ..Calibration::default() },
+    ///     ..Default::default()
+    /// };
+    /// assert_eq!(quick.validate().unwrap_err().key(), "calibration.watchdog_timeout");
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        self.truth.validate().map_err(|e| match e {
-            crate::Error::InvalidParameter {
-                name,
-                value,
-                reason,
-            } => HwError::InvalidConfig {
-                name,
-                value,
-                reason,
-            },
-            _ => HwError::InvalidConfig {
-                name: "truth",
-                value: f64::NAN,
-                reason: "invalid plant parameters",
-            },
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.truth.validate().map_err(|e| {
+            match e {
+                crate::Error::InvalidParameter {
+                    name,
+                    value,
+                    reason,
+                } => ConfigError::invalid(name, value, reason),
+                _ => ConfigError::invalid("m1", self.truth.m1, "invalid plant parameters"),
+            }
+            .in_table("truth")
         })?;
-        for (name, forces) in [
-            ("coulomb_friction", self.coulomb_friction),
-            ("stiction", self.stiction),
-        ] {
-            for f in forces {
-                if !(f.is_finite() && f >= 0.0) {
-                    return Err(HwError::invalid_config(name, f, "must be finite and ≥ 0"));
-                }
+        self.friction
+            .validate()
+            .map_err(|e| e.in_table("friction"))?;
+        self.check_accelerations()?;
+        self.calibration
+            .validate()
+            .map_err(|e| e.in_table("calibration"))?;
+        let cal = &self.calibration;
+        if let Some(c) = cal.sign.iter().position(|&s| s != 1.0) {
+            return Err(ConfigError::invalid(
+                format!("calibration.sign[{c}]"),
+                cal.sign[c],
+                "must be +1: the simulated encoders count up as the carts move away from the wall",
+            ));
+        }
+        self.card_config().validate().map_err(Self::card_key)?;
+        self.check_timing()?;
+        self.check_counts()
+    }
+
+    /// A [`SimulatedCardConfig::validate`] error under the key of the
+    /// file's value it comes from.
+    fn card_key(e: ConfigError) -> ConfigError {
+        let key = e.key().to_owned();
+        let (name, index) = key.split_at(key.find('[').unwrap_or(key.len()));
+        let file_key = match name {
+            "supply_voltage" => "calibration.volts_full_scale".to_owned(),
+            "counts_per_revolution" | "travel_per_revolution" => {
+                "calibration.metres_per_count".to_owned()
+            }
+            "watchdog_timeout" | "pwm_channel" => format!("calibration.{name}"),
+            "encoders" => "calibration.encoder_channels".to_owned(),
+            "initial_state" => key.clone(),
+            _ => format!("card.{name}{index}"),
+        };
+        e.with_key(file_key)
+    }
+
+    /// Each cart's acceleration per unit of what acts on it, finite: a mass
+    /// too small for its springs, damping, motor or friction would make
+    /// the simulated card diverge at its first step.
+    fn check_accelerations(&self) -> Result<(), ConfigError> {
+        let p = &self.truth;
+        let per_mass = [
+            (
+                "truth.m1",
+                p.m1,
+                [p.k1 + p.k2, p.b1, p.k2, self.friction.coulomb[0]],
+            ),
+            (
+                "truth.m2",
+                p.m2,
+                [p.k2, p.b2, p.gain, self.friction.coulomb[1]],
+            ),
+        ];
+        for (key, mass, forces) in per_mass {
+            if forces.iter().any(|f| !(f / mass).is_finite()) {
+                return Err(ConfigError::conflict(
+                    key,
+                    mass,
+                    "too small for the forces on it: an acceleration overflows",
+                ));
             }
         }
-        super::calibration::check_encoder_channels(self.encoder_channels)?;
-        self.card_config().validate()
+        Ok(())
+    }
+
+    /// The period against what the card, the loop and the sampled-data
+    /// simulation need of it.
+    fn check_timing(&self) -> Result<(), ConfigError> {
+        let period = self.period;
+        if !(period.is_finite() && period >= 1e-6) {
+            return Err(ConfigError::invalid(
+                "period",
+                period,
+                "must be finite and ≥ 1 µs",
+            ));
+        }
+        let card = &self.card;
+        if card.pwm_delay >= period {
+            return Err(ConfigError::conflict(
+                "card.pwm_delay",
+                card.pwm_delay,
+                "must be below the period (the sampled-data simulation delays the input by less than one)",
+            ));
+        }
+        if period / card.max_substep > 1e6 {
+            return Err(ConfigError::conflict(
+                "card.max_substep",
+                card.max_substep,
+                "more than 10^6 sub-steps per period",
+            ));
+        }
+        if let Some(timeout) = self.calibration.watchdog_timeout
+            && 0.5 * timeout < period
+        {
+            return Err(ConfigError::conflict(
+                "calibration.watchdog_timeout",
+                timeout,
+                "must be at least two periods: the loop halts when half of it passes without a sample",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The counts the card makes: within its 32-bit counters over the
+    /// travel limits, and the carts starting inside them.
+    fn check_counts(&self) -> Result<(), ConfigError> {
+        let cal = &self.calibration;
+        let widest = cal.travel_limits[0].max(cal.travel_limits[1]);
+        if widest / cal.metres_per_count >= f64::from(i32::MAX) {
+            return Err(ConfigError::conflict(
+                "calibration.metres_per_count",
+                cal.metres_per_count,
+                "too fine for the card's 32-bit counters over the travel limits",
+            ));
+        }
+        for cart in 0..2 {
+            let (x, v) = (
+                self.initial_state[2 * cart],
+                self.initial_state[2 * cart + 1],
+            );
+            if x.abs() > cal.travel_limits[cart] {
+                return Err(ConfigError::conflict(
+                    format!("initial_state[{}]", 2 * cart),
+                    x,
+                    "beyond the cart's travel limit: the first sample would halt the rig",
+                ));
+            }
+            if v.abs() > cal.max_speed {
+                return Err(ConfigError::conflict(
+                    format!("initial_state[{}]", 2 * cart + 1),
+                    v,
+                    "faster than the calibration's max_speed: the first samples would read a bus fault",
+                ));
+            }
+        }
+        Ok(())
     }
 }

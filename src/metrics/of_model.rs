@@ -31,7 +31,7 @@ use crate::sim::step_response;
 /// use ctrlab::{MassSpring, Cart, Discretization, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
-/// let cl = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?.closed_loop(&plant)?;
+/// let cl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?.closed_loop(&plant)?;
 /// let info = step_info_of(&cl, 2.0, 0.0005, &StepInfoOptions { reference: Some(1.0), ..Default::default() })?;
 /// // Table 2, row [0 0 10 0.1]: about 5 % overshoot, settled in about 0.2 s.
 /// assert!((info.overshoot - 5.03).abs() < 0.5 && (info.settling_time - 0.2).abs() < 0.01);

@@ -2,7 +2,7 @@
 
 use ctrlab::data::Recording;
 use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
-use ctrlab::lab::{SimulatedRig, lqi};
+use ctrlab::lab::{CardSettings, Friction, SimulatedRig, lqi};
 use ctrlab::signal::Signal;
 use ctrlab::{Cart, Controller, Discrete, MassSpring, StateSpace};
 use nalgebra::{SVector, vector};
@@ -67,9 +67,14 @@ fn run_loop<C: Controller<4, 1, 1>>(
 pub fn friction_rig(truth: MassSpring, friction: [f64; 2], seed: u64) -> SimulatedRig {
     SimulatedRig {
         truth,
-        coulomb_friction: friction,
-        stiction: friction.map(|f| 1.2 * f),
-        seed,
+        friction: Friction {
+            coulomb: friction,
+            stiction: friction.map(|f| 1.2 * f),
+        },
+        card: CardSettings {
+            seed,
+            ..CardSettings::default()
+        },
         ..SimulatedRig::default()
     }
 }

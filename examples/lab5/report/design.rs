@@ -23,7 +23,7 @@ impl Report {
     ) -> Result<(), Box<dyn std::error::Error>> {
         self.heading(2, "Design: predict, then run");
         let count = d.rig.metres_per_count();
-        let supply = d.rig.supply_voltage;
+        let supply = d.rig.calibration.volts_full_scale;
         let spec = d
             .cases
             .first()
@@ -267,7 +267,10 @@ impl Report {
 /// cart 2's travel, against the larger alternative, on the identified
 /// model.
 fn setpoint_reason(d: &DesignSection) -> String {
-    let (supply, travel) = (d.rig.supply_voltage, d.rig.travel_limits[1]);
+    let (supply, travel) = (
+        d.rig.calibration.volts_full_scale,
+        d.rig.calibration.travel_limits[1],
+    );
     let model = &d.model;
     let friction = (d.coulomb[0] + d.coulomb[1]) / model.gain;
     let (chosen, alternative) = (CASES[1].1, CART1_ALTERNATIVE);
@@ -387,15 +390,15 @@ fn friction_reason(backend: &Backend, coulomb: [f64; 2], cart: Cart) -> String {
     let i = cart.number() - 1;
     match backend.sim() {
         Some(sim) => {
-            let breakaway = sim.stiction[i].max(sim.coulomb_friction[i]);
+            let breakaway = sim.friction.stiction[i].max(sim.friction.coulomb[i]);
             format!(
                 "the prediction's cart {} breaks away at the identified Coulomb force, {:.2} N; the card's at {:.2} N ({} over its {:.2} N Coulomb force), a stiction the identification cannot see (it uses only rows where the carts move), and the card adds σ = {} count of encoder noise the prediction has none of",
                 cart.number(),
                 coulomb[i],
                 breakaway,
-                pct(breakaway, sim.coulomb_friction[i]),
-                sim.coulomb_friction[i],
-                sim.encoder_noise
+                pct(breakaway, sim.friction.coulomb[i]),
+                sim.friction.coulomb[i],
+                sim.card.encoder_noise
             )
         }
         None => format!(

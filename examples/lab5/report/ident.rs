@@ -369,10 +369,10 @@ impl Report {
         if let Some(sim) = backend.and_then(Backend::sim) {
             s += &format!(
                 " The card's Coulomb friction is {} N and {} N: identified {} and {}.",
-                sim.coulomb_friction[0],
-                sim.coulomb_friction[1],
-                pct(f1, sim.coulomb_friction[0]),
-                pct(f2, sim.coulomb_friction[1]),
+                sim.friction.coulomb[0],
+                sim.friction.coulomb[1],
+                pct(f1, sim.friction.coulomb[0]),
+                pct(f2, sim.friction.coulomb[1]),
             );
             let t = sim.truth;
             let lab_k = ident.summary.lab_average.gain.mean;

@@ -209,12 +209,12 @@ fn describe(backend: &crate::backend::Backend) -> String {
                 t.b1,
                 t.b2,
                 t.gain,
-                sim.coulomb_friction[0],
-                sim.coulomb_friction[1],
-                sim.stiction[0],
-                sim.stiction[1],
-                sim.pwm_delay * 1e3,
-                sim.encoder_noise
+                sim.friction.coulomb[0],
+                sim.friction.coulomb[1],
+                sim.friction.stiction[0],
+                sim.friction.stiction[1],
+                sim.card.pwm_delay * 1e3,
+                sim.card.encoder_noise
             )
         }
         #[cfg(all(feature = "ppdev", target_os = "linux"))]

@@ -6,7 +6,7 @@ use std::fmt;
 use std::io;
 
 use super::ioctl;
-use crate::hw::HwError;
+use crate::hw::PortError;
 
 /// Every `PARPORT_MODE_*` bit of `linux/parport.h`.
 const KNOWN: u32 = ioctl::PARPORT_MODE_PCSPP
@@ -126,11 +126,11 @@ impl fmt::Display for PortModes {
 }
 
 /// Refuses a port without hardware EPP, saying what to check.
-pub(super) fn require_epp(device: &str, modes: PortModes) -> Result<(), HwError> {
+pub(super) fn require_epp(device: &str, modes: PortModes) -> Result<(), PortError> {
     if modes.epp {
         return Ok(());
     }
-    Err(HwError::NotPresent {
+    Err(PortError::NotPresent {
         device: device.to_owned(),
         reason: format!(
             "the port has no hardware EPP (PPGETMODES: {modes}). Likely causes: the BIOS \
@@ -145,17 +145,17 @@ pub(super) fn require_epp(device: &str, modes: PortModes) -> Result<(), HwError>
 }
 
 /// Maps a failed `ppdev` step (`"open"`, `"PPEXCL"`, `"PPCLAIM"`,
-/// `"read"`, …) and its OS error to the [`HwError`] that says what is
+/// `"read"`, …) and its OS error to the [`PortError`] that says what is
 /// wrong and what to do.
-pub(super) fn port_error(device: &str, operation: &'static str, error: io::Error) -> HwError {
+pub(super) fn port_error(device: &str, operation: &'static str, error: io::Error) -> PortError {
     let errno = error.raw_os_error();
     let claiming = matches!(operation, "PPEXCL" | "PPCLAIM");
     match errno {
-        Some(libc::EACCES | libc::EPERM) => HwError::Permission {
+        Some(libc::EACCES | libc::EPERM) => PortError::Permission {
             device: device.to_owned(),
             source: error,
         },
-        Some(libc::ENXIO | libc::EBUSY) if claiming => HwError::Busy {
+        Some(libc::ENXIO | libc::EBUSY) if claiming => PortError::Busy {
             device: device.to_owned(),
             reason: format!(
                 "{operation} failed ({error}), so the port cannot be had exclusively. Most \
@@ -168,7 +168,7 @@ pub(super) fn port_error(device: &str, operation: &'static str, error: io::Error
                  {device}: see `dmesg | grep parport`.)"
             ),
         },
-        Some(libc::ENOENT | libc::ENODEV | libc::ENXIO) => HwError::NotPresent {
+        Some(libc::ENOENT | libc::ENODEV | libc::ENXIO) => PortError::NotPresent {
             device: device.to_owned(),
             reason: format!(
                 "{operation}: {error}. Load the parallel-port drivers \
@@ -176,7 +176,7 @@ pub(super) fn port_error(device: &str, operation: &'static str, error: io::Error
                  `ls /dev/parport*` and `dmesg | grep parport`"
             ),
         },
-        _ => HwError::Io {
+        _ => PortError::Io {
             device: device.to_owned(),
             operation,
             source: error,
@@ -187,16 +187,16 @@ pub(super) fn port_error(device: &str, operation: &'static str, error: io::Error
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hw::HwErrorKind;
+    use crate::hw::PortErrorKind;
 
     const PORT: &str = "/dev/parport0";
 
-    fn error(operation: &'static str, errno: i32) -> HwError {
+    fn error(operation: &'static str, errno: i32) -> PortError {
         port_error(PORT, operation, io::Error::from_raw_os_error(errno))
     }
 
     /// Checks `e` is of `kind` and its message says every one of `hints`.
-    fn says(e: &HwError, kind: HwErrorKind, hints: &[&str]) {
+    fn says(e: &PortError, kind: PortErrorKind, hints: &[&str]) {
         assert_eq!(e.kind(), kind, "{e}");
         let text = e.to_string();
         for hint in hints {
@@ -217,8 +217,8 @@ mod tests {
         ];
         for operation in ["PPEXCL", "PPCLAIM"] {
             for errno in [libc::ENXIO, libc::EBUSY] {
-                says(&error(operation, errno), HwErrorKind::Busy, &hints);
-                says(&error(operation, errno), HwErrorKind::Busy, &[operation]);
+                says(&error(operation, errno), PortErrorKind::Busy, &hints);
+                says(&error(operation, errno), PortErrorKind::Busy, &[operation]);
             }
         }
     }
@@ -228,7 +228,7 @@ mod tests {
         let hints = [PORT, "`lp` group", "sudo usermod -aG lp $USER", "log out"];
         for operation in ["open", "PPCLAIM"] {
             for errno in [libc::EACCES, libc::EPERM] {
-                says(&error(operation, errno), HwErrorKind::Permission, &hints);
+                says(&error(operation, errno), PortErrorKind::Permission, &hints);
             }
         }
     }
@@ -242,15 +242,15 @@ mod tests {
             ("PPGETMODES", libc::ENODEV),
         ] {
             let hints = [operation, "modprobe parport_pc ppdev"];
-            says(&error(operation, errno), HwErrorKind::NotPresent, &hints);
+            says(&error(operation, errno), PortErrorKind::NotPresent, &hints);
         }
     }
 
     #[test]
     fn anything_else_is_an_io_error_naming_the_step() {
         let hints = ["PPEXCL on /dev/parport0"];
-        says(&error("PPEXCL", libc::ENOTTY), HwErrorKind::Io, &hints);
-        says(&error("read", libc::EIO), HwErrorKind::Io, &["read"]);
+        says(&error("PPEXCL", libc::ENOTTY), PortErrorKind::Io, &hints);
+        says(&error("read", libc::EIO), PortErrorKind::Io, &["read"]);
     }
 
     #[test]
@@ -267,7 +267,7 @@ mod tests {
             "too slow",
         ];
         let e = require_epp(PORT, PortModes::from_bits(0x1b)).unwrap_err();
-        says(&e, HwErrorKind::NotPresent, &hints);
+        says(&e, PortErrorKind::NotPresent, &hints);
         assert!(require_epp(PORT, PortModes::from_bits(0x1f)).is_ok());
     }
 

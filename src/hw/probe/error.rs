@@ -1,6 +1,6 @@
 //! [`ProbeError`]: why the probe stopped.
 
-use crate::hw::HwError;
+use crate::hw::{ConfigError, PortError};
 
 /// Why the probe stopped.
 ///
@@ -22,14 +22,19 @@ use crate::hw::HwError;
 /// let err = probe.scan().unwrap_err();
 /// assert!(matches!(err, ProbeError::NoCard { .. }));
 /// assert!(err.to_string().contains("every address reads 0x00"));
-/// # Ok::<(), ctrlab::hw::HwError>(())
+/// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ProbeError {
     /// The port failed (a timeout here means no card answers).
     #[error(transparent)]
-    Hw(#[from] HwError),
+    Port(#[from] PortError),
+    /// The register map the steps found does not hold together (two
+    /// registers at one address): the card is not the one the probe
+    /// understands.
+    #[error("the register map found is invalid: {0}")]
+    InvalidMap(#[from] ConfigError),
     /// No card answers: every address reads the same idle value, or EPP
     /// cycles time out. Nothing was written.
     #[error(

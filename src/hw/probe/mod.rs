@@ -48,7 +48,7 @@ pub use error::ProbeError;
 pub use options::ProbeOptions;
 pub use scan::{OPEN_BUS, RegisterClass, Scan, Snapshot};
 
-use super::{EppPort, HwError, RegisterMap};
+use super::{ConfigError, EppPort, PortError, RegisterMap};
 
 /// What the user's hands are doing, as the probe asks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -200,7 +200,7 @@ pub struct ProbeReport {
 /// let hand = SimulatedOperator::new(clock, [true, true]);
 /// let mut probe = Probe::new(card, hand, ProbeOptions::default())?;
 /// let report = probe.run()?;
-/// assert_eq!(report.map, rig.map);
+/// assert_eq!(report.map, rig.card.map);
 /// assert_eq!(report.watchdog_timeout, Some(0.1));
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
@@ -245,9 +245,9 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// let probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
     /// let (port, _operator) = probe.into_parts();
     /// assert_eq!(port.get(0), 0);
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
-    pub fn new(port: P, operator: O, options: ProbeOptions) -> Result<Self, HwError> {
+    pub fn new(port: P, operator: O, options: ProbeOptions) -> Result<Self, ConfigError> {
         options.validate()?;
         Ok(Self {
             port,
@@ -331,11 +331,11 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             "step 1/4, scan: reading all 256 addresses twice (read-only), to tell constant, \
              volatile and open-bus registers apart and find the card's ID register",
         );
-        let no_card = |e: HwError| match e {
-            HwError::Timeout { .. } => ProbeError::NoCard {
+        let no_card = |e: PortError| match e {
+            PortError::Timeout { .. } => ProbeError::NoCard {
                 reason: format!("EPP cycles time out ({e})"),
             },
-            other => ProbeError::Hw(other),
+            other => ProbeError::Port(other),
         };
         let first = scan::snapshot(&mut self.port).map_err(no_card)?;
         self.operator.wait(&mut self.port, 0.05);
@@ -393,7 +393,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// # }
     /// let probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
     /// assert!(matches!(probe.report(), Err(ProbeError::OutOfOrder { .. })));
-    /// # Ok::<(), ctrlab::hw::HwError>(())
+    /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn report(&self) -> Result<ProbeReport, ProbeError> {
         let missing = |needs| ProbeError::OutOfOrder {
@@ -465,19 +465,21 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
 
     /// Writes `value` to `address`, saying nothing (the steps say what
     /// they write before their loops).
-    fn write(&mut self, address: u8, value: u8) -> Result<(), HwError> {
+    fn write(&mut self, address: u8, value: u8) -> Result<(), PortError> {
         self.port.write_register(address, value)
     }
 
-    fn read_u32_le(&mut self, address: u8) -> Result<u32, HwError> {
+    fn read_u32_le(&mut self, address: u8) -> Result<u32, PortError> {
         let mut bytes = [0u8; 4];
         for (offset, byte) in (0u8..).zip(bytes.iter_mut()) {
-            let a = address.checked_add(offset).ok_or(HwError::InvalidCommand {
-                what: "counter address",
-                channel: None,
-                value: f64::from(address),
-                limit: 252.0,
-            })?;
+            let a = address
+                .checked_add(offset)
+                .ok_or(PortError::InvalidCommand {
+                    what: "counter address",
+                    channel: None,
+                    value: f64::from(address),
+                    limit: 252.0,
+                })?;
             *byte = self.port.read_register(a)?;
         }
         Ok(u32::from_le_bytes(bytes))

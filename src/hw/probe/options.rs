@@ -1,6 +1,6 @@
 //! [`ProbeOptions`]: how the probe moves and waits.
 
-use crate::hw::HwError;
+use crate::hw::ConfigError;
 
 /// How the probe moves and waits.
 ///
@@ -50,7 +50,7 @@ impl ProbeOptions {
     ///
     /// # Errors
     ///
-    /// [`HwError::InvalidConfig`] naming the first bad field.
+    /// [`ConfigError`] naming the first bad field.
     ///
     /// # Examples
     ///
@@ -59,11 +59,15 @@ impl ProbeOptions {
     /// let bad = ProbeOptions { pulse_duties: [48, 96, 400], ..Default::default() };
     /// assert!(bad.validate().is_err());
     /// ```
-    pub fn validate(&self) -> Result<(), HwError> {
-        if let Some(&d) = self.pulse_duties.iter().find(|&&d| !(1..=250).contains(&d)) {
-            return Err(HwError::invalid_config(
-                "pulse_duties",
-                f64::from(d),
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        if let Some(i) = self
+            .pulse_duties
+            .iter()
+            .position(|d| !(1..=250).contains(d))
+        {
+            return Err(ConfigError::invalid(
+                format!("pulse_duties[{i}]"),
+                f64::from(self.pulse_duties[i]),
                 "must be 1–250 per mille",
             ));
         }
@@ -76,7 +80,7 @@ impl ProbeOptions {
         ];
         for (name, value, low, high) in ranges {
             if !(low..=high).contains(&value) {
-                return Err(HwError::invalid_config(name, value, "out of its range"));
+                return Err(ConfigError::invalid(name, value, "out of its range"));
             }
         }
         Ok(())

@@ -1,6 +1,6 @@
 //! Read-only scans of all 256 card addresses, and what they tell apart.
 
-use super::super::{EppPort, HwError};
+use super::super::{EppPort, PortError};
 
 /// The value an EPP data read returns where nothing drives the bus (the
 /// port's pull-ups): unmapped and write-only registers alike.
@@ -15,7 +15,7 @@ pub type Snapshot = [u8; 256];
 /// # Errors
 ///
 /// The port's, with the register named.
-pub(super) fn snapshot<P: EppPort>(port: &mut P) -> Result<Snapshot, HwError> {
+pub(super) fn snapshot<P: EppPort>(port: &mut P) -> Result<Snapshot, PortError> {
     let mut out = [0u8; 256];
     for (address, byte) in (0..=u8::MAX).zip(out.iter_mut()) {
         *byte = port.read_register(address)?;

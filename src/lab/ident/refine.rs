@@ -437,7 +437,7 @@ pub fn refine(rec: &Recording, start: &MassSpringEstimate) -> Result<Refined, Er
 /// let ls = identify_with(&rec, 1.3, 0.7, &options)?;
 /// let r = refine_with(&rec, &ls, &sim.simulation_model())?;
 /// assert!((r.plant.gain / sim.truth.gain - 1.0).abs() < 0.01);
-/// assert!((r.coulomb[1] / sim.coulomb_friction[1] - 1.0).abs() < 0.1);
+/// assert!((r.coulomb[1] / sim.friction.coulomb[1] - 1.0).abs() < 0.1);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn refine_with(

@@ -9,7 +9,7 @@ use super::{
 };
 use crate::data::Recording;
 use crate::error::Error;
-use crate::lab::{FrictionPlant, MassSpring, SimulatedRig};
+use crate::lab::{Friction, FrictionPlant, MassSpring, SimulatedRig};
 
 /// The separate-springs identification the lab's model comes from: the
 /// central scheme, with each cart's Coulomb friction.
@@ -336,7 +336,7 @@ impl EqualSprings {
     /// ```
     /// use ctrlab::lab::{SimulatedRig, ident::EqualSprings};
     /// let card = EqualSprings::card(&SimulatedRig::default());
-    /// assert_eq!((card.truth.k2, card.coulomb_friction), (950.0, [0.0; 2]));
+    /// assert_eq!((card.truth.k2, card.friction.coulomb), (950.0, [0.0; 2]));
     /// ```
     pub fn card(sim: &SimulatedRig) -> SimulatedRig {
         SimulatedRig {
@@ -344,8 +344,7 @@ impl EqualSprings {
                 k2: sim.truth.k1,
                 ..sim.truth
             },
-            coulomb_friction: [0.0; 2],
-            stiction: [0.0; 2],
+            friction: Friction::NONE,
             ..sim.clone()
         }
     }

@@ -104,11 +104,11 @@ impl Transient {
 ///
 /// ```
 /// use ctrlab::lab::{Cart, SimulatedRig, lqi::{self, Comparison, Metrics, Spec}};
-/// use ctrlab::StateFeedback;
+/// use ctrlab::lab::LabGains;
 ///
 /// let sim = SimulatedRig::default();
 /// let spec = Spec::new(Cart::Two, 0.030, 24.0);
-/// let law = StateFeedback::from_lab_gains([0.0, 0.0, 10.0, 0.1], Cart::Two)?;
+/// let law = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?;
 /// let rec = lqi::predict(&sim, law, spec.setpoint, 3.0)?;
 /// let m = Metrics::of(&rec, &spec, sim.metres_per_count())?;
 /// // A run against itself agrees everywhere.
@@ -281,9 +281,10 @@ impl KnownDifferences {
                 ("b1", model.b1, t.b1),
                 ("b2", model.b2, t.b2),
             ],
-            delay: ((truth.pwm_delay - DRIVE_DELAY).abs() > 1e-6).then_some(truth.pwm_delay),
-            stiction: (0..2).any(|i| truth.stiction[i] > truth.coulomb_friction[i]),
-            encoder_noise: (truth.encoder_noise > 0.0).then_some(truth.encoder_noise),
+            delay: ((truth.card.pwm_delay - DRIVE_DELAY).abs() > 1e-6)
+                .then_some(truth.card.pwm_delay),
+            stiction: (0..2).any(|i| truth.friction.stiction[i] > truth.friction.coulomb[i]),
+            encoder_noise: (truth.card.encoder_noise > 0.0).then_some(truth.card.encoder_noise),
         }
     }
 

@@ -45,7 +45,7 @@ use crate::design::{
 };
 use crate::discretize::Discretization;
 use crate::error::Error;
-use crate::lab::{self, Calibration, Cart, MassSpring, SimulatedRig};
+use crate::lab::{self, Calibration, CardSettings, Cart, Friction, MassSpring, SimulatedRig};
 use crate::model::{Discrete, StateSpace};
 use crate::sim::run_sampled;
 
@@ -189,8 +189,8 @@ pub fn positions_lqi(
 /// ```
 /// use ctrlab::lab::{Calibration, MassSpring, lqi};
 /// let rig = lqi::predicted_rig(MassSpring::nominal(), [1.0, 2.0], &Calibration::default(), 0.002);
-/// assert_eq!((rig.stiction, rig.encoder_noise, rig.supply_voltage), ([1.0, 2.0], 0.0, 24.0));
-/// assert_eq!(rig.metres_per_count(), Calibration::default().metres_per_count);
+/// assert_eq!((rig.friction.stiction, rig.card.encoder_noise), ([1.0, 2.0], 0.0));
+/// assert_eq!(rig.calibration, Calibration::default());
 /// ```
 pub fn predicted_rig(
     model: MassSpring,
@@ -201,15 +201,13 @@ pub fn predicted_rig(
     let defaults = SimulatedRig::default();
     SimulatedRig {
         truth: model,
-        coulomb_friction: coulomb,
-        stiction: coulomb,
-        pwm_delay: DRIVE_DELAY,
-        encoder_noise: 0.0,
-        supply_voltage: calibration.volts_full_scale,
-        travel_per_revolution: calibration.metres_per_count * defaults.counts_per_revolution,
-        pwm_channel: calibration.pwm_channel,
-        encoder_channels: calibration.encoder_channels,
-        travel_limits: calibration.travel_limits,
+        friction: Friction::coulomb(coulomb),
+        card: CardSettings {
+            pwm_delay: DRIVE_DELAY,
+            encoder_noise: 0.0,
+            ..defaults.card
+        },
+        calibration: *calibration,
         period,
         ..defaults
     }
@@ -226,9 +224,9 @@ pub fn predicted_rig(
 /// # Examples
 ///
 /// ```
-/// use ctrlab::StateFeedback;
+/// use ctrlab::lab::LabGains;
 /// use ctrlab::lab::{Cart, SimulatedRig, lqi};
-/// let law = StateFeedback::from_lab_gains([0.0, 0.0, 1.0, 0.0], Cart::Two)?;
+/// let law = LabGains::new([0.0, 0.0, 1.0, 0.0], Cart::Two).state_feedback()?;
 /// let rec = lqi::predict(&SimulatedRig::default(), law, 0.030, 1.0)?;
 /// assert_eq!(rec.len(), 500);
 /// # Ok::<(), ctrlab::Error>(())

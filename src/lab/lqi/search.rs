@@ -104,7 +104,7 @@ impl Design {
 /// ```no_run
 /// use ctrlab::lab::{Cart, MassSpring, SimulatedRig, lqi};
 /// let sim = SimulatedRig::default();
-/// let rig = lqi::predicted_rig(sim.truth, sim.coulomb_friction, &sim.calibration(), sim.period);
+/// let rig = lqi::predicted_rig(sim.truth, sim.friction.coulomb, &sim.calibration, sim.period);
 /// let design = lqi::design_search(&rig, lqi::Spec::new(Cart::Two, 0.030, 24.0))?;
 /// assert!(design.metrics.passes(&design.spec));
 /// # Ok::<(), ctrlab::Error>(())
@@ -112,8 +112,8 @@ impl Design {
 pub fn design_search(rig: &SimulatedRig, spec: Spec) -> Result<Design, Error> {
     rig.truth.validate()?;
     for (name, forces) in [
-        ("coulomb_friction", rig.coulomb_friction),
-        ("stiction", rig.stiction),
+        ("friction.coulomb", rig.friction.coulomb),
+        ("friction.stiction", rig.friction.stiction),
     ] {
         if let Some(&f) = forces.iter().find(|f| !(f.is_finite() && **f >= 0.0)) {
             return Err(Error::InvalidParameter {

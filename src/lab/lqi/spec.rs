@@ -131,10 +131,10 @@ impl Verdict {
 /// # Examples
 ///
 /// ```
-/// use ctrlab::StateFeedback;
+/// use ctrlab::lab::LabGains;
 /// use ctrlab::lab::{Cart, SimulatedRig, lqi::{self, Metrics, Spec}};
 /// let sim = SimulatedRig::default();
-/// let law = StateFeedback::from_lab_gains([0.0, 0.0, 1.0, 0.0], Cart::Two)?;
+/// let law = LabGains::new([0.0, 0.0, 1.0, 0.0], Cart::Two).state_feedback()?;
 /// let rec = lqi::predict(&sim, law, 0.030, 3.0)?;
 /// let spec = Spec::new(Cart::Two, 0.030, 24.0);
 /// let m = Metrics::of(&rec, &spec, sim.metres_per_count())?;

@@ -12,7 +12,7 @@
 //!
 //! The lab writes its tables in millimetres (setpoints, positions, errors)
 //! with gains per millimetre: fields in mm say so in their names (`_mm`),
-//! and [`StateFeedback::from_lab_gains`](crate::StateFeedback::from_lab_gains)
+//! and [`LabGains::state_feedback`](crate::lab::LabGains::state_feedback)
 //! is where the gains become SI.
 //!
 //! # Examples

@@ -5,11 +5,10 @@ use nalgebra::Complex;
 
 use super::{Gain, GainGroup};
 use crate::data::Recording;
-use crate::design::StateFeedback;
 use crate::discretize::Discretization;
 use crate::error::Error;
-use crate::hw::HwError;
-use crate::lab::{self, Cart, MassSpring};
+use crate::hw::{LoopFault, RigError};
+use crate::lab::{self, Cart, LabGains, MassSpring};
 use crate::metrics::{StepInfo, StepInfoOptions, step_info};
 
 /// What the identified linear model predicts for a row: the closed loop
@@ -48,7 +47,7 @@ impl Prediction {
         // The rig samples every period: the loop that can be stable or not
         // is the sampled one, so predict with the ZOH-discretised model.
         let sampled = sys.discretize(period, Discretization::Zoh)?;
-        let ctrl = StateFeedback::from_lab_gains(kf, cart)?;
+        let ctrl = LabGains::new(kf, cart).state_feedback()?;
         let poles = ctrl.closed_loop(&sys)?.poles()?;
         let radius = ctrl
             .closed_loop(&sampled)?
@@ -175,11 +174,12 @@ impl RigOutcome {
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::{Recording, hw::HwError};
+    /// use ctrlab::Recording;
+    /// use ctrlab::hw::{LoopFault, RigError};
     /// use ctrlab::lab::tables::{Halt, RigOutcome};
     /// let columns = vec![vec![0.0; 2]; 5];
     /// let rec = Recording::from_columns(ctrlab::lab::schema(), vec![0.0, 0.002], columns)?;
-    /// let e = HwError::TravelLimit { axis: 1, position: 0.051, limit: 0.05 };
+    /// let e = RigError::Fault(LoopFault::TravelLimit { axis: 1, position: 0.051, limit: 0.05 });
     /// let o = RigOutcome::halted(&rec, &e);
     /// assert_eq!(o, RigOutcome::Diverged {
     ///     at: 0.002,
@@ -187,13 +187,13 @@ impl RigOutcome {
     /// });
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
-    pub fn halted(rec: &Recording, error: &HwError) -> Self {
+    pub fn halted(rec: &Recording, error: &RigError) -> Self {
         let why = match error {
-            HwError::TravelLimit {
+            RigError::Fault(LoopFault::TravelLimit {
                 axis,
                 position,
                 limit,
-            } => Halt::TravelLimit {
+            }) => Halt::TravelLimit {
                 cart: *axis,
                 position: *position,
                 limit: *limit,

@@ -3,9 +3,8 @@
 use crate::nalgebra::{Complex, SVector, vector};
 
 use super::TABLE2;
-use crate::design::StateFeedback;
 use crate::error::Error;
-use crate::lab::{Cart, MassSpring};
+use crate::lab::{Cart, LabGains, MassSpring};
 use crate::metrics::{StepInfo, StepInfoOptions, step_info};
 use crate::sim::{Solver, simulate, time_grid};
 
@@ -159,7 +158,9 @@ pub fn table2() -> Result<Table2, Error> {
     let setpoint_mm = TABLE2.setpoint_mm;
     let mut rows = Vec::new();
     for kf in TABLE2.rows() {
-        let cl = StateFeedback::from_lab_gains(kf, TABLE2.cart)?.closed_loop(&plant)?;
+        let cl = LabGains::new(kf, TABLE2.cart)
+            .state_feedback()?
+            .closed_loop(&plant)?;
         let poles = cl.poles()?;
         if !cl.is_stable()? {
             rows.push(Table2Row {
