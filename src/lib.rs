@@ -128,7 +128,7 @@ pub mod sim;
 /// user need not match its version: `ctrlab::nalgebra::vector![…]`.
 pub use nalgebra;
 
-pub use analysis::Damping;
+pub use analysis::{Damping, Poles};
 pub use data::{Channel, Recording, Schema};
 pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place};
 pub use discretize::Discretization;

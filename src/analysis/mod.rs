@@ -3,8 +3,8 @@
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
-//! `dyn_state_space.rs`), except [`rank`]. These are design-time
-//! computations, not inner loops:
+//! `dyn_state_space.rs`), except [`rank`]; [`Poles`] prints a list of
+//! poles. These are design-time computations, not inner loops:
 //! each is written once, on run-time-sized matrices (eigenvalues by a
 //! balanced Hessenberg QR on the stack up to 8 states, then nalgebra's
 //! Schur and faer's multishift QR; singular values through nalgebra's SVD),
@@ -27,10 +27,12 @@
 mod controllability;
 mod dyn_state_space;
 mod gain;
+mod poles;
 mod stability;
 mod state_space;
 
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
+pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
 
 use nalgebra::{Complex, DMatrix, SMatrix};

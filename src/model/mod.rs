@@ -6,7 +6,7 @@
 //! This is the bottom layer: it names no particular plant (the lab's
 //! two-cart plant is [`lab::MassSpring`](crate::lab::MassSpring)).
 
-mod display;
+pub(crate) mod display;
 mod dyn_state_space;
 mod dynamics;
 mod interconnect;
