@@ -1,5 +1,5 @@
 //! Fixed-step ODE integration: the [`Rk4`] and [`Euler`] steppers for any
-//! [`Dynamics`](crate::Dynamics) (the plant trait, in [`model`](crate::model)).
+//! [`Dynamics`] (the plant trait, in [`model`](crate::model)).
 //!
 //! Steppers hold the input constant over a step (a zero-order hold, as a
 //! sampled-data controller applies it). Stage vectors live on the stack, so a
