@@ -142,8 +142,13 @@ pub use integrate::{Euler, Integrator, Rk4};
 #[cfg(feature = "lab")]
 pub use lab::{Cart, MassSpring};
 pub use metrics::{StepInfo, StepInfoOptions, step_info, step_info_mimo, step_info_of};
-pub use model::{Continuous, Discrete, Domain, DynStateSpace, Dynamics, StateSpace};
-pub use sim::{Response, impulse_response, initial_response, run_sampled, step_response};
+pub use model::{
+    Continuous, Discrete, Domain, DynStateSpace, Dynamics, LinearSystem, SingleInput, Siso,
+    StateSpace,
+};
+pub use sim::{
+    DynResponse, Response, Simulate, impulse_response, initial_response, run_sampled, step_response,
+};
 
 // The README's code blocks are compiled and run as doctests.
 #[cfg(doctest)]

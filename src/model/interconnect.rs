@@ -296,6 +296,32 @@ impl<D: Domain> DynStateSpace<D> {
         ))
     }
 
+    /// The model with input `j` alone (`B`'s and `D`'s column `j`), e.g. to
+    /// take the step response of one input of a multi-input model:
+    /// [`StateSpace::select_input`](crate::StateSpace::select_input) for a
+    /// model sized at run time.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::OutOfRange`] (`"input"`) unless `j` is below the number of
+    /// inputs.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::DynStateSpace;
+    /// use nalgebra::dmatrix;
+    ///
+    /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0, 2.0], dmatrix![1.0], dmatrix![0.0, 0.5])?;
+    /// let second = sys.select_input(1)?;
+    /// assert_eq!((second.b(), second.d()), (&dmatrix![2.0], &dmatrix![0.5]));
+    /// assert!(sys.select_input(2).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn select_input(&self, j: usize) -> Result<Self, Error> {
+        self.select_inputs(&[j])
+    }
+
     /// The model seen from the listed inputs only, in the order given
     /// (repeats allowed): the columns of `B` and `D`.
     ///
