@@ -130,7 +130,9 @@ pub use nalgebra;
 
 pub use analysis::{Damping, Poles};
 pub use data::{Channel, Recording, Schema};
-pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place};
+pub use design::{
+    Controller, Design, DynLqr, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place,
+};
 pub use discretize::Discretization;
 pub use error::Error;
 pub use freq::{

@@ -280,12 +280,12 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     ];
     let dynamic = DynStateSpace::from(&fixed);
     let ka = rel(
-        dynamic.acker(&targets).unwrap().as_slice(),
-        acker(&fixed, &targets).unwrap().as_slice(),
+        acker(&dynamic, targets).unwrap().as_slice(),
+        acker(&fixed, targets).unwrap().as_slice(),
     );
     let kp = rel(
-        dynamic.place(&targets).unwrap().as_slice(),
-        place(&fixed, &targets).unwrap().as_slice(),
+        place(&dynamic, targets).unwrap().as_slice(),
+        place(&fixed, targets).unwrap().as_slice(),
     );
     let observed = fixed
         .with_output(
@@ -295,11 +295,10 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
         .unwrap();
     let observer_targets = [-100.0, -100.0, -150.0, -150.0].map(|re| Complex::new(re, 0.0));
     let kl = rel(
-        DynStateSpace::from(&observed)
-            .place_observer(&observer_targets)
+        place_observer(&DynStateSpace::from(&observed), observer_targets)
             .unwrap()
             .as_slice(),
-        place_observer(&observed, &observer_targets)
+        place_observer(&observed, observer_targets)
             .unwrap()
             .as_slice(),
     );
@@ -308,12 +307,12 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     let fz = fixed.discretize(0.002, Discretization::Zoh).unwrap();
     let dz = DynStateSpace::from(&fz);
     let kz = rel(
-        dz.place(&z_targets).unwrap().as_slice(),
-        place(&fz, &z_targets).unwrap().as_slice(),
+        place(&dz, z_targets).unwrap().as_slice(),
+        place(&fz, z_targets).unwrap().as_slice(),
     )
     .max(rel(
-        dz.acker(&z_targets).unwrap().as_slice(),
-        acker(&fz, &z_targets).unwrap().as_slice(),
+        acker(&dz, z_targets).unwrap().as_slice(),
+        acker(&fz, z_targets).unwrap().as_slice(),
     ));
     println!(
         "gains, largest relative difference: acker {ka:e}, place {kp:e}, observer {kl:e}, discrete {kz:e}"
@@ -482,7 +481,7 @@ fn a_chain_sized_at_run_time_matches_python_control() {
     // poles are checked (python-control's six decimals), and Ackermann's
     // unique single-input gain against python-control's.
     let targets = complexes(&fx["place"]["targets"]);
-    let k = sys.place(&targets).unwrap();
+    let k = place(&sys, &targets).unwrap();
     let closed = DynStateSpace::continuous(
         sys.a() - sys.b() * &k,
         sys.b().clone(),
@@ -494,7 +493,7 @@ fn a_chain_sized_at_run_time_matches_python_control() {
         &flat_complex(&closed.poles().unwrap()),
         &flat_complex(&complexes(&fx["place"]["achieved"])),
     );
-    let k_acker = sys.select_input(0).unwrap().acker(&targets).unwrap();
+    let k_acker = acker(&sys.select_input(0).unwrap(), &targets).unwrap();
     let acker_gain = rel(k_acker.as_slice(), matrix(&fx["acker"]["K"]).as_slice());
     println!("place: achieved poles {achieved:e}; acker gain {acker_gain:e}");
     assert!(achieved <= 1e-6);
@@ -506,7 +505,7 @@ fn wrong_sizes_are_errors_not_panics() {
     let sys = chain(7);
     let one = |re| Complex::new(re, 0.0);
     assert!(matches!(
-        sys.place(&[one(-1.0); 3]),
+        place(&sys, [one(-1.0); 3]),
         Err(Error::LengthMismatch {
             what: "poles",
             expected: 7,
@@ -514,7 +513,7 @@ fn wrong_sizes_are_errors_not_panics() {
         })
     ));
     assert!(matches!(
-        sys.acker(&[one(-1.0); 7]),
+        acker(&sys, [one(-1.0); 7]),
         Err(Error::DimensionMismatch { matrix: "B", .. })
     ));
     assert!(matches!(
@@ -646,9 +645,9 @@ proptest! {
         }
         // Wrong and right numbers of targets.
         let targets = vec![Complex::new(re, 0.0); n + extra];
-        if let Ok(k) = sys.place(&targets) { prop_assert!(finite(&k) && extra == 0); }
-        if let Ok(k) = sys.place_observer(&targets) { prop_assert!(finite(&k) && extra == 0); }
-        if let Ok(k) = sys.acker(&targets) { prop_assert!(finite(&k) && extra == 0 && m == 1); }
+        if let Ok(k) = place(&sys, &targets) { prop_assert!(finite(&k) && extra == 0); }
+        if let Ok(k) = place_observer(&sys, &targets) { prop_assert!(finite(&k) && extra == 0); }
+        if let Ok(k) = acker(&sys, &targets) { prop_assert!(finite(&k) && extra == 0 && m == 1); }
         if m == 1 {
             if let Ok(r) = step_response(&sys, 0.05, 0.01) {
                 prop_assert!(r.y.iter().all(|y| y.iter().all(|v| v.is_finite())));

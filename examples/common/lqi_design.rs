@@ -82,7 +82,7 @@ pub fn positions_lqi(
     Ok(Lqi {
         controller: SelectOutputs::new(controller, lab::position_output_matrix())?,
         gain: lqi.gain,
-        poles: lqi.poles,
+        poles: lqi.poles.into(),
     })
 }
 

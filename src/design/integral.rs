@@ -3,7 +3,7 @@
 //! [`dlqi`]), and the discrete controller with anti-windup
 //! ([`IntegralFeedback`]).
 
-use nalgebra::{DMatrix, SMatrix, SVector};
+use nalgebra::{Const, DMatrix, SMatrix, SVector};
 
 use super::lqr::{Lqr, dlqr, lqr};
 use crate::design::Controller;
@@ -123,7 +123,7 @@ pub fn lqi<const N: usize, const M: usize, const P: usize, const NA: usize>(
     sys: &StateSpace<N, M, P, Continuous>,
     q: &SMatrix<f64, NA, NA>,
     r: &SMatrix<f64, M, M>,
-) -> Result<Lqr<NA, M>, Error> {
+) -> Result<Lqr<Const<NA>, Const<M>>, Error> {
     lqr(&augment_integral(sys)?, q, r)
 }
 
@@ -152,7 +152,7 @@ pub fn dlqi<const N: usize, const M: usize, const P: usize, const NA: usize>(
     sys: &StateSpace<N, M, P, Discrete>,
     q: &SMatrix<f64, NA, NA>,
     r: &SMatrix<f64, M, M>,
-) -> Result<Lqr<NA, M>, Error> {
+) -> Result<Lqr<Const<NA>, Const<M>>, Error> {
     dlqr(&augment_integral(sys)?, q, r)
 }
 
