@@ -6,9 +6,9 @@ use nalgebra::{
 };
 
 use super::Kalman;
-use super::lqr::{Lqr, check_shape, regulator};
+use super::lqr::{Lqr, regulator};
 use super::riccati::{Weights, check_weights};
-use crate::error::{Error, check_finite_dyn};
+use crate::error::{Error, check_finite_dyn, check_shape};
 use crate::kernels::linalg::{Lu, SystemAlloc};
 use crate::model::{Continuous, Discrete, Token};
 #[cfg(doc)]

@@ -12,7 +12,7 @@ use nalgebra::{
 use super::Design;
 use super::riccati::{self, Solution, Weights};
 use crate::analysis::Poles;
-use crate::error::Error;
+use crate::error::{Error, check_shape};
 use crate::kernels::linalg::SystemAlloc;
 use crate::model::{Continuous, Discrete, Token, display};
 
@@ -288,28 +288,4 @@ where
         Some(dt) => riccati::discrete(a, b, q, r, weights, Some(dt))?,
     };
     Ok(Lqr::from(sol))
-}
-
-/// [`Error::DimensionMismatch`] naming `matrix` unless it is
-/// `rows × cols` (a run-time-sized argument; a fixed-size one always is).
-pub(crate) fn check_shape<R: Dim, C: Dim>(
-    matrix: &'static str,
-    m: &OMatrix<f64, R, C>,
-    rows: usize,
-    cols: usize,
-) -> Result<(), Error>
-where
-    DefaultAllocator: Allocator<R, C>,
-{
-    if m.shape() == (rows, cols) {
-        Ok(())
-    } else {
-        Err(Error::DimensionMismatch {
-            matrix,
-            expected_rows: rows,
-            expected_cols: cols,
-            found_rows: m.nrows(),
-            found_cols: m.ncols(),
-        })
-    }
 }

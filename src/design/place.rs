@@ -88,17 +88,28 @@ pub(super) fn check_targets(poles: &[Complex<f64>], states: usize) -> Result<(),
 }
 
 /// [`acker`] on a bare pair `(A, b)`, `b` one column, one target per state
-/// (the callers' checks): the gain as a `1 × n` row. Written once over
-/// nalgebra's dimensions, so a fixed-size model's runs on the stack.
+/// (the callers' checks): the gain as the `1 × n` row of the model's gain
+/// type. Written once over nalgebra's dimensions, so a fixed-size model's
+/// runs on the stack.
 pub(super) fn acker_pair<N: Dim, M: Dim>(
     a: &OMatrix<f64, N, N>,
     b: &OMatrix<f64, N, M>,
     poles: &[Complex<f64>],
-) -> Result<OMatrix<f64, U1, N>, Error>
+) -> Result<OMatrix<f64, M, N>, Error>
 where
-    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N> + Allocator<U1, N>,
+    DefaultAllocator:
+        Allocator<N, N> + Allocator<N, M> + Allocator<M, N> + Allocator<N> + Allocator<U1, N>,
 {
-    let (dim, _) = a.shape_generic();
+    let (dim, dim_m) = b.shape_generic();
+    if dim_m.value() != 1 {
+        return Err(Error::DimensionMismatch {
+            matrix: "B",
+            expected_rows: dim.value(),
+            expected_cols: 1,
+            found_rows: dim.value(),
+            found_cols: dim_m.value(),
+        });
+    }
     let n = dim.value();
     let coeffs = real_polynomial(poles)?;
     // Controllability matrix [B, A B, …, A^(N−1) B], each new column
@@ -159,7 +170,7 @@ where
     // A − b K, with b's one column (on the stack for a fixed size).
     let a_cl = OMatrix::<f64, N, N>::from_fn_generic(dim, dim, |i, j| a[(i, j)] - b[(i, 0)] * k[j]);
     check_placement(a_cl.as_slice(), n, poles)?;
-    Ok(k)
+    Ok(OMatrix::from_row_slice_generic(dim_m, dim, k.as_slice()))
 }
 
 /// A copy on the heap, for the code written for run-time-sized matrices.

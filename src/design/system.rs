@@ -132,107 +132,84 @@ pub trait Kalman<G>: Design {
     ) -> Result<Self::Lqe, Error>;
 }
 
-impl<const N: usize, const M: usize, const P: usize, D: Domain> Design for StateSpace<N, M, P, D> {
-    type StateWeight = SMatrix<f64, N, N>;
-    type InputWeight = SMatrix<f64, M, M>;
-    type OutputWeight = SMatrix<f64, P, P>;
-    type Gain = SMatrix<f64, M, N>;
-    type ObserverGain = SMatrix<f64, N, P>;
-    type Lqr = Lqr<Const<N>, Const<M>>;
-    type Lqe = Lqe<Const<N>, Const<P>>;
+/// The design operations of both model types: the same code, each on its
+/// own matrices (the types are all that differ).
+macro_rules! design_for {
+    ($([$($generics:tt)*] $model:ty {
+        $(type $name:ident = $ty:ty;)*
+        [$($kalman_generics:tt)*] Kalman<$noise:ty, $covariance:ty>
+    })*) => {$(
+        impl<$($generics)*> Design for $model {
+            $(type $name = $ty;)*
 
-    fn regulator(
-        &self,
-        _: Token,
-        q: &Self::StateWeight,
-        r: &Self::InputWeight,
-    ) -> Result<Self::Lqr, Error> {
-        lqr::regulator(self.a(), self.b(), q, r, period_of(&self.domain()))
-    }
+            fn regulator(
+                &self,
+                _: Token,
+                q: &Self::StateWeight,
+                r: &Self::InputWeight,
+            ) -> Result<Self::Lqr, Error> {
+                lqr::regulator(self.a(), self.b(), q, r, period_of(&self.domain()))
+            }
 
-    fn place_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::Gain, Error> {
-        check_targets(poles, N)?;
-        place_pair(self.a(), self.b(), poles)
-    }
+            fn place_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::Gain, Error> {
+                check_targets(poles, self.states())?;
+                place_pair(self.a(), self.b(), poles)
+            }
 
-    fn acker_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::Gain, Error> {
-        single_input(N, M)?;
-        check_targets(poles, N)?;
-        // One row: `M` is 1 here (the `SingleInput` bound of `acker`).
-        let k = acker_pair(self.a(), self.b(), poles)?;
-        Ok(SMatrix::from_row_slice(k.as_slice()))
-    }
+            fn acker_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::Gain, Error> {
+                single_input(self.states(), self.inputs())?;
+                check_targets(poles, self.states())?;
+                acker_pair(self.a(), self.b(), poles)
+            }
 
-    fn observer_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::ObserverGain, Error> {
-        check_targets(poles, N)?;
-        observer_pair(self.a(), self.c(), poles)
-    }
+            fn observer_gain(
+                &self,
+                _: Token,
+                poles: &[Complex<f64>],
+            ) -> Result<Self::ObserverGain, Error> {
+                check_targets(poles, self.states())?;
+                observer_pair(self.a(), self.c(), poles)
+            }
+        }
+
+        impl<$($kalman_generics)*> Kalman<$noise> for $model {
+            type NoiseCovariance = $covariance;
+
+            fn estimator(
+                &self,
+                _: Token,
+                g: &$noise,
+                qn: &Self::NoiseCovariance,
+                rn: &Self::OutputWeight,
+            ) -> Result<Self::Lqe, Error> {
+                kalman::estimator(self.a(), self.c(), g, qn, rn, period_of(&self.domain()))
+            }
+        }
+    )*};
 }
 
-impl<D: Domain> Design for DynStateSpace<D> {
-    type StateWeight = DMatrix<f64>;
-    type InputWeight = DMatrix<f64>;
-    type OutputWeight = DMatrix<f64>;
-    type Gain = DMatrix<f64>;
-    type ObserverGain = DMatrix<f64>;
-    type Lqr = Lqr<Dyn, Dyn>;
-    type Lqe = Lqe<Dyn, Dyn>;
-
-    fn regulator(
-        &self,
-        _: Token,
-        q: &Self::StateWeight,
-        r: &Self::InputWeight,
-    ) -> Result<Self::Lqr, Error> {
-        lqr::regulator(self.a(), self.b(), q, r, period_of(&self.domain()))
+design_for! {
+    [const N: usize, const M: usize, const P: usize, D: Domain] StateSpace<N, M, P, D> {
+        type StateWeight = SMatrix<f64, N, N>;
+        type InputWeight = SMatrix<f64, M, M>;
+        type OutputWeight = SMatrix<f64, P, P>;
+        type Gain = SMatrix<f64, M, N>;
+        type ObserverGain = SMatrix<f64, N, P>;
+        type Lqr = Lqr<Const<N>, Const<M>>;
+        type Lqe = Lqe<Const<N>, Const<P>>;
+        [const N: usize, const M: usize, const P: usize, const W: usize, D: Domain]
+        Kalman<SMatrix<f64, N, W>, SMatrix<f64, W, W>>
     }
 
-    fn place_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::Gain, Error> {
-        check_targets(poles, self.states())?;
-        place_pair(self.a(), self.b(), poles)
-    }
-
-    fn acker_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::Gain, Error> {
-        let n = self.states();
-        single_input(n, self.inputs())?;
-        check_targets(poles, n)?;
-        let k = acker_pair(self.a(), self.b(), poles)?;
-        Ok(DMatrix::from_row_slice(1, n, k.as_slice()))
-    }
-
-    fn observer_gain(&self, _: Token, poles: &[Complex<f64>]) -> Result<Self::ObserverGain, Error> {
-        check_targets(poles, self.states())?;
-        observer_pair(self.a(), self.c(), poles)
-    }
-}
-
-impl<const N: usize, const M: usize, const P: usize, const W: usize, D: Domain>
-    Kalman<SMatrix<f64, N, W>> for StateSpace<N, M, P, D>
-{
-    type NoiseCovariance = SMatrix<f64, W, W>;
-
-    fn estimator(
-        &self,
-        _: Token,
-        g: &SMatrix<f64, N, W>,
-        qn: &Self::NoiseCovariance,
-        rn: &Self::OutputWeight,
-    ) -> Result<Self::Lqe, Error> {
-        kalman::estimator(self.a(), self.c(), g, qn, rn, period_of(&self.domain()))
-    }
-}
-
-impl<D: Domain> Kalman<DMatrix<f64>> for DynStateSpace<D> {
-    type NoiseCovariance = DMatrix<f64>;
-
-    fn estimator(
-        &self,
-        _: Token,
-        g: &DMatrix<f64>,
-        qn: &Self::NoiseCovariance,
-        rn: &Self::OutputWeight,
-    ) -> Result<Self::Lqe, Error> {
-        kalman::estimator(self.a(), self.c(), g, qn, rn, period_of(&self.domain()))
+    [D: Domain] DynStateSpace<D> {
+        type StateWeight = DMatrix<f64>;
+        type InputWeight = DMatrix<f64>;
+        type OutputWeight = DMatrix<f64>;
+        type Gain = DMatrix<f64>;
+        type ObserverGain = DMatrix<f64>;
+        type Lqr = Lqr<Dyn, Dyn>;
+        type Lqe = Lqe<Dyn, Dyn>;
+        [D: Domain] Kalman<DMatrix<f64>, DMatrix<f64>>
     }
 }
 

@@ -119,11 +119,9 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> fmt::Display
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write_header(f, &self.domain())?;
-        write_matrix(f, "A", self.a())?;
-        write_matrix(f, "B", self.b())?;
-        write_matrix(f, "C", self.c())?;
-        write_matrix(f, "D", self.d())
+        // One implementation: a copy on the heap costs nothing that
+        // printing does not.
+        fmt::Display::fmt(&DynStateSpace::from(self), f)
     }
 }
 

@@ -10,7 +10,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::error::Error;
+use crate::error::{Error, check_len};
 use crate::kernels::reduce::pow2_floor;
 use crate::model::{Domain, DynStateSpace, period_of};
 
@@ -68,15 +68,7 @@ impl<D: Domain> DynStateSpace<D> {
 
     /// A size check between the two sides of a connection.
     fn conforming(what: &'static str, expected: usize, found: usize) -> Result<(), Error> {
-        if expected == found {
-            Ok(())
-        } else {
-            Err(Error::LengthMismatch {
-                what,
-                expected,
-                found,
-            })
-        }
+        check_len(what, expected, found)
     }
 
     /// `self` followed by `next`: `next`'s input is `self`'s output, the

@@ -44,7 +44,7 @@ pub use responses::{impulse_response, initial_response, step_response};
 pub use sampled::{SampledConfig, Sensor, run_sampled};
 
 use crate::discretize::{Held, zoh};
-use crate::error::{Error, check_dt, check_finite_dyn};
+use crate::error::{Error, check_dt, check_finite_dyn, check_len};
 use crate::kernels::reduce::max_step_deviation;
 use crate::model::{
     Continuous, Discrete, Domain, DynStateSpace, LinearSystem, StateSpace, Token, period_of,
@@ -255,82 +255,54 @@ pub trait Simulate: LinearSystem {
     ) -> Result<Self::Response, Error>;
 }
 
-impl<const N: usize, const M: usize, const P: usize, D: Domain> Simulate
-    for StateSpace<N, M, P, D>
-{
-    type Response = Response<Const<N>, Const<P>>;
+/// The simulations of both model types: the same code, each on its own
+/// matrices (the types are all that differ).
+macro_rules! simulate_for {
+    ($([$($generics:tt)*] $model:ty => $response:ty),* $(,)?) => {$(
+        impl<$($generics)*> Simulate for $model {
+            type Response = $response;
 
-    fn respond(
-        &self,
-        _: Token,
-        test: Test<Self::State>,
-        t_end: f64,
-        dt: f64,
-    ) -> Result<Self::Response, Error> {
-        let abcd = (self.a(), self.b(), self.c(), self.d());
-        responses::respond(abcd, self.domain(), test, t_end, dt)
-    }
+            fn respond(
+                &self,
+                _: Token,
+                test: Test<Self::State>,
+                t_end: f64,
+                dt: f64,
+            ) -> Result<Self::Response, Error> {
+                let abcd = (self.a(), self.b(), self.c(), self.d());
+                responses::respond(abcd, self.domain(), test, t_end, dt)
+            }
 
-    fn lsim<F: FnMut(f64) -> Self::Input>(
-        &self,
-        _: Token,
-        t: &[f64],
-        x0: Self::State,
-        input: F,
-        solver: Solver,
-    ) -> Result<Self::Response, Error> {
-        let abcd = (self.a(), self.b(), self.c(), self.d());
-        lsim(abcd, period_of(&self.domain()), t, x0, input, solver)
-    }
+            fn lsim<F: FnMut(f64) -> Self::Input>(
+                &self,
+                _: Token,
+                t: &[f64],
+                x0: Self::State,
+                input: F,
+                solver: Solver,
+            ) -> Result<Self::Response, Error> {
+                let abcd = (self.a(), self.b(), self.c(), self.d());
+                lsim(abcd, period_of(&self.domain()), t, x0, input, solver)
+            }
 
-    fn dsim<F: FnMut(usize, &Self::State) -> Self::Input>(
-        &self,
-        _: Token,
-        x0: Self::State,
-        steps: usize,
-        control: F,
-    ) -> Result<Self::Response, Error> {
-        let abcd = (self.a(), self.b(), self.c(), self.d());
-        dsim(abcd, period_of(&self.domain()), x0, steps, control)
-    }
+            fn dsim<F: FnMut(usize, &Self::State) -> Self::Input>(
+                &self,
+                _: Token,
+                x0: Self::State,
+                steps: usize,
+                control: F,
+            ) -> Result<Self::Response, Error> {
+                let abcd = (self.a(), self.b(), self.c(), self.d());
+                dsim(abcd, period_of(&self.domain()), x0, steps, control)
+            }
+        }
+    )*};
 }
 
-impl<D: Domain> Simulate for DynStateSpace<D> {
-    type Response = DynResponse;
-
-    fn respond(
-        &self,
-        _: Token,
-        test: Test<Self::State>,
-        t_end: f64,
-        dt: f64,
-    ) -> Result<Self::Response, Error> {
-        let abcd = (self.a(), self.b(), self.c(), self.d());
-        responses::respond(abcd, self.domain(), test, t_end, dt)
-    }
-
-    fn lsim<F: FnMut(f64) -> Self::Input>(
-        &self,
-        _: Token,
-        t: &[f64],
-        x0: Self::State,
-        input: F,
-        solver: Solver,
-    ) -> Result<Self::Response, Error> {
-        let abcd = (self.a(), self.b(), self.c(), self.d());
-        lsim(abcd, period_of(&self.domain()), t, x0, input, solver)
-    }
-
-    fn dsim<F: FnMut(usize, &Self::State) -> Self::Input>(
-        &self,
-        _: Token,
-        x0: Self::State,
-        steps: usize,
-        control: F,
-    ) -> Result<Self::Response, Error> {
-        let abcd = (self.a(), self.b(), self.c(), self.d());
-        dsim(abcd, period_of(&self.domain()), x0, steps, control)
-    }
+simulate_for! {
+    [const N: usize, const M: usize, const P: usize, D: Domain] StateSpace<N, M, P, D>
+        => Response<Const<N>, Const<P>>,
+    [D: Domain] DynStateSpace<D> => DynResponse,
 }
 
 /// How [`simulate`] advances a continuous model between grid points.
@@ -554,13 +526,7 @@ fn check_state<N: Dim>(x0: &OVector<f64, N>, states: usize) -> Result<(), Error>
 where
     DefaultAllocator: Allocator<N>,
 {
-    if x0.len() != states {
-        return Err(Error::LengthMismatch {
-            what: "x0",
-            expected: states,
-            found: x0.len(),
-        });
-    }
+    check_len("x0", states, x0.len())?;
     check_finite_dyn("x0", x0)
 }
 
@@ -722,13 +688,7 @@ fn check_input<M: Dim>(u: &OVector<f64, M>, inputs: usize) -> Result<(), Error>
 where
     DefaultAllocator: Allocator<M>,
 {
-    if u.len() != inputs {
-        return Err(Error::LengthMismatch {
-            what: "input",
-            expected: inputs,
-            found: u.len(),
-        });
-    }
+    check_len("input", inputs, u.len())?;
     match u.iter().find(|v| !v.is_finite()) {
         Some(&value) => Err(Error::InvalidParameter {
             name: "input",
@@ -832,13 +792,7 @@ where
             reason: "more samples than MAX_SAMPLES",
         });
     }
-    if x0.len() != abcd.0.nrows() {
-        return Err(Error::LengthMismatch {
-            what: "x0",
-            expected: abcd.0.nrows(),
-            found: x0.len(),
-        });
-    }
+    check_len("x0", abcd.0.nrows(), x0.len())?;
     if let Some(&value) = x0.iter().find(|v| !v.is_finite()) {
         return Err(Error::InvalidParameter {
             name: "x0",

@@ -12,7 +12,7 @@
 use nalgebra::{DefaultAllocator, Dim, OVector, U1, allocator::Allocator};
 
 use super::{Abcd, Response, Simulate, discrete_feedback, lsim_zoh, time_grid};
-use crate::error::{Error, check_finite_dyn};
+use crate::error::{Error, check_finite_dyn, check_len};
 #[cfg(doc)]
 use crate::model::StateSpace;
 use crate::model::{Domain, SingleInput, Token, period_of};
@@ -89,13 +89,7 @@ where
             }
         },
         Test::Initial(x0) => {
-            if x0.len() != n {
-                return Err(Error::LengthMismatch {
-                    what: "x0",
-                    expected: n,
-                    found: x0.len(),
-                });
-            }
+            check_len("x0", n, x0.len())?;
             run(abcd, domain, t_end, dt, x0, |_| 0.0)
         }
     }
