@@ -5,7 +5,7 @@
 //! each `Display`.
 
 use ctrlab::analysis::Poles;
-use ctrlab::design::{acker, dlqe, dlqr, lqe, lqr, place, place_observer};
+use ctrlab::design::{acker, dlqe, dlqi, dlqr, lqe, lqi, lqr, place, place_observer};
 use ctrlab::freq::{TransferFunction, TransferMatrix, Zpk, bandwidth, stability_margins};
 use ctrlab::integrate::{Integrator, Rk4};
 use ctrlab::sim::{
@@ -63,6 +63,34 @@ fn lqr_and_dlqr_agree_across_sizes() {
     assert!(matches!(
         dlqr(&dd, &heap(&q), &DMatrix::identity(2, 2)),
         Err(Error::DimensionMismatch { matrix: "R", .. })
+    ));
+}
+
+#[test]
+fn integral_designs_agree_across_sizes() {
+    let plant = two_carts();
+    let dynamic = DynStateSpace::from(&plant);
+    let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
+    let r = matrix![1.0];
+    let f = lqi(&plant, &q, &r).unwrap();
+    let d = lqi(&dynamic, &heap(&q), &heap(&r)).unwrap();
+    assert_eq!(f.gain.as_slice(), d.gain.as_slice());
+    assert_eq!(f.riccati.as_slice(), d.riccati.as_slice());
+    assert_eq!(f.poles.as_slice(), d.poles.as_slice());
+    let fd = plant.discretize(0.002, Discretization::Zoh).unwrap();
+    let dd = DynStateSpace::from(&fd);
+    let f = dlqi(&fd, &q, &r).unwrap();
+    let d = dlqi(&dd, &heap(&q), &heap(&r)).unwrap();
+    assert_eq!(f.gain.as_slice(), d.gain.as_slice());
+    assert_eq!(f.poles.as_slice(), d.poles.as_slice());
+    // Q weighs n + p = 5 states.
+    assert!(matches!(
+        dlqi(&dd, &DMatrix::identity(4, 4), &heap(&r)),
+        Err(Error::DimensionMismatch {
+            matrix: "Q",
+            expected_rows: 5,
+            ..
+        })
     ));
 }
 

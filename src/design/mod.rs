@@ -69,4 +69,4 @@ pub use observer_controller::{ObserverController, SelectOutputs};
 pub use place::acker;
 pub use riccati::{care, dare};
 pub use robust_place::{place, place_observer};
-pub use system::{Design, Kalman, PoleTargets};
+pub use system::{Design, IntegralAction, Kalman, PoleTargets};

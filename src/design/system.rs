@@ -7,6 +7,7 @@ use std::fmt::{Debug, Display};
 
 use nalgebra::{Complex, Const, DMatrix, Dim, Dyn, SMatrix};
 
+use super::integral::{augment_integral, augmented};
 use super::kalman::{self, Lqe};
 use super::lqr::{self, Lqr};
 use super::place::{acker_pair, check_targets};
@@ -130,6 +131,72 @@ pub trait Kalman<G>: Design {
         qn: &Self::NoiseCovariance,
         rn: &Self::OutputWeight,
     ) -> Result<Self::Lqe, Error>;
+}
+
+/// Integral action ([`lqi`](super::lqi), [`dlqi`](super::dlqi)) on a
+/// model of either size: `Q` weighs the augmented state `[x; z]`, an
+/// `SMatrix<f64, NA, NA>` with `NA = N + P` for a `StateSpace<N, M, P, _>`
+/// (a wrong `NA` does not compile) or a `DMatrix<f64>` for a
+/// `DynStateSpace`; [`Lqi`](Self::Lqi) is the regulator of the augmented
+/// model, `Lqr<Const<NA>, Const<M>>` or [`DynLqr`](super::DynLqr).
+///
+/// Sealed: implemented by the two model types only.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{DynStateSpace, StateSpace, design::lqi};
+/// use nalgebra::{dmatrix, matrix};
+///
+/// // A lag with an integrator on its output.
+/// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+/// let fixed = lqi(&sys, &matrix![1.0, 0.0; 0.0, 10.0], &matrix![1.0])?;
+/// let dynamic = lqi(&DynStateSpace::from(&sys), &dmatrix![1.0, 0.0; 0.0, 10.0], &dmatrix![1.0])?;
+/// assert_eq!(fixed.gain.as_slice(), dynamic.gain.as_slice());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub trait IntegralAction<Q>: Design {
+    /// The regulator of the model augmented with its integrators.
+    type Lqi: Debug + Clone + Display;
+
+    /// The regulator of the augmented model, in the model's time domain.
+    #[doc(hidden)]
+    fn integral_regulator(
+        &self,
+        _: Token,
+        q: &Q,
+        r: &Self::InputWeight,
+    ) -> Result<Self::Lqi, Error>;
+}
+
+impl<const N: usize, const M: usize, const P: usize, const NA: usize, D: Domain>
+    IntegralAction<SMatrix<f64, NA, NA>> for StateSpace<N, M, P, D>
+{
+    type Lqi = Lqr<Const<NA>, Const<M>>;
+
+    fn integral_regulator(
+        &self,
+        _: Token,
+        q: &SMatrix<f64, NA, NA>,
+        r: &Self::InputWeight,
+    ) -> Result<Self::Lqi, Error> {
+        let aug = augment_integral::<N, M, P, NA, D>(self)?;
+        lqr::regulator(aug.a(), aug.b(), q, r, period_of(&self.domain()))
+    }
+}
+
+impl<D: Domain> IntegralAction<DMatrix<f64>> for DynStateSpace<D> {
+    type Lqi = Lqr<Dyn, Dyn>;
+
+    fn integral_regulator(
+        &self,
+        _: Token,
+        q: &DMatrix<f64>,
+        r: &Self::InputWeight,
+    ) -> Result<Self::Lqi, Error> {
+        let aug = augmented(self)?;
+        lqr::regulator(aug.a(), aug.b(), q, r, period_of(&self.domain()))
+    }
 }
 
 /// The design operations of both model types: the same code, each on its
