@@ -435,13 +435,17 @@ where
     }
 }
 
-/// Checks a run-time-sized matrix's shape.
-pub(crate) fn check_shape(
+/// Checks a matrix's shape (a run-time-sized one's; a fixed-size one's
+/// always holds).
+pub(crate) fn check_shape<R: nalgebra::Dim, C: nalgebra::Dim, S>(
     matrix: &'static str,
-    m: &nalgebra::DMatrix<f64>,
+    m: &nalgebra::Matrix<f64, R, C, S>,
     rows: usize,
     cols: usize,
-) -> Result<(), Error> {
+) -> Result<(), Error>
+where
+    S: nalgebra::RawStorage<f64, R, C>,
+{
     if m.shape() == (rows, cols) {
         Ok(())
     } else {
@@ -451,6 +455,19 @@ pub(crate) fn check_shape(
             expected_cols: cols,
             found_rows: m.nrows(),
             found_cols: m.ncols(),
+        })
+    }
+}
+
+/// [`Error::LengthMismatch`] named `what` unless `found == expected`.
+pub(crate) fn check_len(what: &'static str, expected: usize, found: usize) -> Result<(), Error> {
+    if found == expected {
+        Ok(())
+    } else {
+        Err(Error::LengthMismatch {
+            what,
+            expected,
+            found,
         })
     }
 }

@@ -11,9 +11,8 @@
 //! Modelling and simulation:
 //!
 //! - [`model`]: [`StateSpace`] with its sizes and time domain in the type,
-//!   [`DynStateSpace`] with its sizes chosen at run time (the same
-//!   analysis, discretisation, responses, step metrics and pole placement,
-//!   as methods, by the same code; [`series`](DynStateSpace::series),
+//!   [`DynStateSpace`] with its sizes chosen at run time (interconnections
+//!   [`series`](DynStateSpace::series),
 //!   [`parallel`](DynStateSpace::parallel),
 //!   [`feedback`](DynStateSpace::feedback) and
 //!   [`append`](DynStateSpace::append)), and the [`Dynamics`] trait any
@@ -76,7 +75,7 @@
 //!
 //! | feature | default | what it adds | what it pulls |
 //! |---|---|---|---|
-//! | (core) | always | models, discretisation, analysis, frequency tools, design, simulation, metrics, recordings and CSV, identification, signals | nalgebra, faer, rustfft, csv, thiserror |
+//! | (core) | always | models, discretisation, analysis, frequency tools, design, simulation, metrics, recordings and CSV, identification, signals | nalgebra, faer, rustfft, csv-core, thiserror |
 //! | `hw` | via `lab` | [`hw`]: the `Rig` trait, the fixed-period loop, real-time scheduling, stop signals, the PC104 card driver and its simulation, the probe | serde, signal-hook, libc |
 //! | `lab` | yes | [`lab`]: the two-cart plant, its identification and refinement, the simulated rig, card and truth files (implies `hw`) | toml, serde_path_to_error |
 //! | `plot` | yes | `plot`, `bode_svg`, `nyquist_svg`: SVG figures | plotters (SVG backend only) |
@@ -85,6 +84,30 @@
 //! A crate that wants the mathematics only depends on
 //! `ctrlab = { version = "0.3", default-features = false }`: the hardware
 //! and lab stacks and their dependencies are not compiled.
+//!
+//! ## One calling style
+//!
+//! An operation is one free function (or one method of a sealed trait) that
+//! takes either model size, with one result shape whose dimensions follow the
+//! model's: `lqr(&sys, &q, &r)`, `place(&sys, [-2.0, -3.0])`,
+//! `step_response(&sys, t_end, dt)`, `step_info_of(&sys, ..)`, `bode(&sys,
+//! &w)` and `stability_margins(&sys)` accept a [`StateSpace`] and a
+//! [`DynStateSpace`] alike (the frequency tools any transfer-function form
+//! too), through the sealed traits [`LinearSystem`], [`Design`] and
+//! [`Simulate`]. Target poles may be plain `f64` (real) or
+//! [`Complex`](nalgebra::Complex). Results such as [`Lqr`] and [`Response`]
+//! are generic over nalgebra's dimensions, so a fixed-size model gets
+//! fixed-size matrices and a run-time-sized one `DMatrix`es ([`DynLqr`],
+//! [`DynResponse`]).
+//!
+//! ## Errors by concern
+//!
+//! [`Error`] is the numeric error (a bad argument, a singular matrix, an
+//! unstable system), with [`Error::kind`]. Whatever does I/O has its own:
+//! [`data::CsvError`] for recordings, `plot::PlotError` for figures,
+//! `hw::PortError` for the bus, `hw::LoopFault` for the loop's safety
+//! halts, `hw::ConfigError` for settings, `lab::FileError` for the lab's
+//! TOML files; each keeps its cause as `source()` and has a `kind()`.
 //!
 //! Layers point one way: private kernels and [`model`] at the bottom;
 //! [`discretize`], [`integrate`], [`analysis`], [`freq`] on them; [`design`],
@@ -139,9 +162,11 @@ pub mod prelude;
 pub mod signal;
 pub mod sim;
 
-pub use analysis::Damping;
+pub use analysis::{Damping, Poles};
 pub use data::{Channel, Recording, Schema};
-pub use design::{Controller, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place};
+pub use design::{
+    Controller, Design, DynLqr, Lqr, OpenLoop, StateFeedback, acker, dlqr, lqr, place,
+};
 pub use discretize::Discretization;
 pub use error::{Error, ErrorKind};
 pub use freq::{
@@ -153,8 +178,13 @@ pub use integrate::{Euler, Integrator, Rk4};
 #[cfg(feature = "lab")]
 pub use lab::{Cart, MassSpring};
 pub use metrics::{StepInfo, StepInfoOptions, step_info, step_info_mimo, step_info_of};
-pub use model::{Continuous, Discrete, Domain, DynStateSpace, Dynamics, StateSpace};
-pub use sim::{Response, impulse_response, initial_response, run_sampled, step_response};
+pub use model::{
+    Continuous, Discrete, Domain, DynStateSpace, Dynamics, LinearSystem, SingleInput, Siso,
+    StateSpace,
+};
+pub use sim::{
+    DynResponse, Response, Simulate, impulse_response, initial_response, run_sampled, step_response,
+};
 
 // The README's code blocks are compiled and run as doctests.
 #[cfg(doctest)]

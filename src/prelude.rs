@@ -2,7 +2,8 @@
 //!
 //! Small on purpose (as faer's): the model types and their time domains,
 //! discretisation, the controller seam, the everyday design, simulation and
-//! metrics calls, recordings, and the error. Everything else is imported
+//! metrics calls (free functions that take either model size), the pole
+//! printer, recordings, and the error. Everything else is imported
 //! from its module by name.
 //!
 //! # Examples
@@ -20,14 +21,18 @@
 //! )?;
 //! let discrete = plant.discretize(0.002, Discretization::Zoh)?;
 //! assert!(discrete.is_stable()?);
+//! let k = place(&plant, [-20.0, -30.0])?; // real poles as plain numbers
+//! let closed = StateSpace::continuous(plant.a() - plant.b() * k, *plant.b(), *plant.c(), *plant.d())?;
+//! assert_eq!(Poles(&closed.poles()?).to_string(), "-30, -20");
 //! let (t_end, dt) = (10.0, 0.001); // s
 //! let info = step_info_of(&plant, t_end, dt, &StepInfoOptions::default())?;
 //! assert!((info.steady_state_value - 0.01).abs() < 1e-6); // 1 N / 100 N/m
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
+pub use crate::analysis::Poles;
 pub use crate::data::Recording;
-pub use crate::design::{Controller, StateFeedback, acker, dlqr, lqr, place};
+pub use crate::design::{Controller, StateFeedback, acker, dlqr, lqr, place, place_observer};
 pub use crate::discretize::Discretization;
 pub use crate::error::Error;
 pub use crate::metrics::{StepInfo, StepInfoOptions, step_info, step_info_of};

@@ -418,3 +418,40 @@ fn least_squares_push_row_allocates_nothing_within_capacity() {
     assert_eq!(n, 0);
     assert!((ls.solve().unwrap().theta[1] - 3.0).abs() < 1e-12);
 }
+
+#[test]
+fn generic_simulations_of_a_fixed_size_model_allocate_per_run_not_per_sample() {
+    use ctrlab::sim::{Solver, simulate, simulate_discrete_feedback, step_response, time_grid};
+    // The free functions take either model size; a fixed-size model keeps
+    // its stack vectors in the loops, so a run allocates its output
+    // buffers up front and nothing per sample, whatever its length.
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
+    let discrete = plant.discretize(0.002, Discretization::Zoh).unwrap();
+    let counted = |seconds: f64| {
+        let t = time_grid(seconds, 0.002).unwrap();
+        [
+            allocations(|| drop(step_response(&plant, seconds, 0.002).unwrap())),
+            allocations(|| drop(step_response(&discrete, seconds, 0.002).unwrap())),
+            allocations(|| {
+                drop(simulate(&plant, &t, SVector::zeros(), |_| vector![1.0], Solver::Zoh).unwrap())
+            }),
+            allocations(|| {
+                let rk4 = Solver::Rk4 { substeps: 2 };
+                drop(simulate(&plant, &t, SVector::zeros(), |_| vector![1.0], rk4).unwrap())
+            }),
+            allocations(|| {
+                let steps = t.len();
+                drop(
+                    simulate_discrete_feedback(&discrete, SVector::zeros(), steps, |_, x| {
+                        vector![-10.0 * x[2]]
+                    })
+                    .unwrap(),
+                )
+            }),
+        ]
+    };
+    let (short, long) = (counted(0.2), counted(2.0));
+    println!("simulations: {short:?} allocations for 100 samples, {long:?} for 1000");
+    assert_eq!(short, long, "allocations grow with the number of samples");
+    assert!(long.iter().all(|&n| n > 0), "the counter sees the buffers");
+}

@@ -195,7 +195,7 @@ fn acker_places_the_lab_plant_poles() {
         Complex::new(-20.0, -15.0),
         Complex::new(-60.0, 0.0),
     ];
-    let k = acker(&plant, &targets).unwrap();
+    let k = acker(&plant, targets).unwrap();
     let a_cl = plant.a() - plant.b() * k;
     let cl = StateSpace::continuous(a_cl, *plant.b(), *plant.c(), *plant.d()).unwrap();
     let mut want = targets;
@@ -216,7 +216,7 @@ fn acker_refuses_uncontrollable_plants_and_unpaired_targets() {
     .unwrap();
     let targets = [Complex::new(-3.0, 0.0), Complex::new(-4.0, 0.0)];
     assert_eq!(
-        acker(&sys, &targets).unwrap_err(),
+        acker(&sys, targets).unwrap_err(),
         Error::Uncontrollable { rank: 1, states: 2 }
     );
     let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
@@ -227,12 +227,12 @@ fn acker_refuses_uncontrollable_plants_and_unpaired_targets() {
         Complex::new(-3.0, 0.0),
     ];
     assert!(matches!(
-        acker(&plant, &unpaired),
+        acker(&plant, unpaired),
         Err(Error::InvalidPole { index: 0, .. })
     ));
     let nan = [Complex::new(f64::NAN, 0.0); 4];
     assert!(matches!(
-        acker(&plant, &nan),
+        acker(&plant, nan),
         Err(Error::InvalidPole { index: 0, .. })
     ));
 }
@@ -489,7 +489,7 @@ proptest! {
             Complex::new(fast, 0.0),
         ];
         let sys = StateSpace::continuous(a, b, matrix![1.0, 0.0, 0.0, 0.0], matrix![0.0]).unwrap();
-        let k = acker(&sys, &targets).unwrap();
+        let k = acker(&sys, targets).unwrap();
         let a_cl = a - b * k;
         let scale = targets.iter().map(|p| p.norm()).fold(0.0, f64::max);
         // Skip plants that need a huge gain (an input that barely reaches

@@ -13,7 +13,7 @@ use ctrlab::lab::LabGains;
 use ctrlab::sim::{Solver, impulse_response, initial_response, simulate, step_response, time_grid};
 use ctrlab::{
     Cart, Continuous, Discrete, Discretization, DynStateSpace, Error, MassSpring, StateSpace,
-    StepInfoOptions, step_info, step_info_of,
+    StepInfoOptions, step_info, step_info_mimo, step_info_of,
 };
 use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector, dvector, vector};
 use proptest::prelude::*;
@@ -155,21 +155,25 @@ fn responses_agree_with_the_fixed_size_functions() {
 
     let (f, d) = (
         step_response(&fixed, 2.0, 0.001).unwrap(),
-        dynamic.step_response(2.0, 0.001).unwrap(),
+        step_response(&dynamic, 2.0, 0.001).unwrap(),
     );
     assert_eq!(f.t, d.t);
     let step = rel(&outputs(&d.y), &fixed_out(&f.y));
     let (f, d) = (
         impulse_response(&fixed, 2.0, 0.001).unwrap(),
-        dynamic.impulse_response(2.0, 0.001).unwrap(),
+        impulse_response(&dynamic, 2.0, 0.001).unwrap(),
     );
     let impulse = rel(&outputs(&d.y), &fixed_out(&f.y));
     let x0 = vector![0.001, 0.0, -0.002, 0.1];
     let (f, d) = (
         initial_response(&fixed, 2.0, 0.001, x0).unwrap(),
-        dynamic
-            .initial_response(2.0, 0.001, &DVector::from_column_slice(x0.as_slice()))
-            .unwrap(),
+        initial_response(
+            &dynamic,
+            2.0,
+            0.001,
+            DVector::from_column_slice(x0.as_slice()),
+        )
+        .unwrap(),
     );
     let initial = rel(&outputs(&d.y), &fixed_out(&f.y));
     // A non-uniform grid: one discretisation per interval length.
@@ -184,9 +188,14 @@ fn responses_agree_with_the_fixed_size_functions() {
         Solver::Zoh,
     )
     .unwrap();
-    let d = dynamic
-        .simulate(&t, &DVector::zeros(4), |t| dvector![(5.0 * t).sin()])
-        .unwrap();
+    let d = simulate(
+        &dynamic,
+        &t,
+        DVector::zeros(4),
+        |t| dvector![(5.0 * t).sin()],
+        Solver::Zoh,
+    )
+    .unwrap();
     let lsim = rel(&outputs(&d.y), &fixed_out(&f.y));
     let states =
         d.x.iter()
@@ -199,11 +208,11 @@ fn responses_agree_with_the_fixed_size_functions() {
     let dd = dynamic.discretize(0.002, Discretization::Zoh).unwrap();
     let discrete = [
         rel(
-            &outputs(&dd.step_response(1.0, 0.002).unwrap().y),
+            &outputs(&step_response(&dd, 1.0, 0.002).unwrap().y),
             &fixed_out(&step_response(&fd, 1.0, 0.002).unwrap().y),
         ),
         rel(
-            &outputs(&dd.impulse_response(1.0, 0.002).unwrap().y),
+            &outputs(&impulse_response(&dd, 1.0, 0.002).unwrap().y),
             &fixed_out(&impulse_response(&fd, 1.0, 0.002).unwrap().y),
         ),
     ]
@@ -214,11 +223,10 @@ fn responses_agree_with_the_fixed_size_functions() {
         vector![10.0 * (0.03 - x[2]) - 0.1 * x[3]]
     })
     .unwrap();
-    let dr = dd
-        .simulate_feedback(&DVector::zeros(4), 500, |_k, x| {
-            dvector![k[2] * (0.03 - x[2]) - k[3] * x[3]]
-        })
-        .unwrap();
+    let dr = ctrlab::sim::simulate_discrete_feedback(&dd, DVector::zeros(4), 500, |_k, x| {
+        dvector![k[2] * (0.03 - x[2]) - k[3] * x[3]]
+    })
+    .unwrap();
     let feedback = rel(&outputs(&dr.y), &fixed_out(&fr.y));
     println!(
         "responses, largest relative difference: step {step:e}, impulse {impulse:e}, \
@@ -241,8 +249,8 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     let dcl = DynStateSpace::from(&cl);
     let options = StepInfoOptions::default();
     let f = step_info_of(&cl, 2.0, 0.0005, &options).unwrap();
-    let d = dcl.step_info(2.0, 0.0005, &options).unwrap();
-    let r = dcl.step_response(2.0, 0.0005).unwrap();
+    let d = step_info_of(&dcl, 2.0, 0.0005, &options).unwrap();
+    let r = step_response(&dcl, 2.0, 0.0005).unwrap();
     let from_response = step_info(&r.t, &r.output(0).unwrap(), &options).unwrap();
     let figures = |i: &ctrlab::StepInfo| {
         vec![
@@ -263,7 +271,7 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     let dd = dcl.discretize(0.002, Discretization::Zoh).unwrap();
     let (a, b) = (
         step_info_of(&fd, 2.0, 0.002, &options).unwrap(),
-        dd.step_info(2.0, 0.002, &options).unwrap(),
+        step_info_of(&dd, 2.0, 0.002, &options).unwrap(),
     );
     assert!(rel(&figures(&b), &figures(&a)) <= ROUNDING);
 
@@ -275,12 +283,12 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     ];
     let dynamic = DynStateSpace::from(&fixed);
     let ka = rel(
-        dynamic.acker(&targets).unwrap().as_slice(),
-        acker(&fixed, &targets).unwrap().as_slice(),
+        acker(&dynamic, targets).unwrap().as_slice(),
+        acker(&fixed, targets).unwrap().as_slice(),
     );
     let kp = rel(
-        dynamic.place(&targets).unwrap().as_slice(),
-        place(&fixed, &targets).unwrap().as_slice(),
+        place(&dynamic, targets).unwrap().as_slice(),
+        place(&fixed, targets).unwrap().as_slice(),
     );
     let observed = fixed
         .with_output(
@@ -290,11 +298,10 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
         .unwrap();
     let observer_targets = [-100.0, -100.0, -150.0, -150.0].map(|re| Complex::new(re, 0.0));
     let kl = rel(
-        DynStateSpace::from(&observed)
-            .place_observer(&observer_targets)
+        place_observer(&DynStateSpace::from(&observed), observer_targets)
             .unwrap()
             .as_slice(),
-        place_observer(&observed, &observer_targets)
+        place_observer(&observed, observer_targets)
             .unwrap()
             .as_slice(),
     );
@@ -303,12 +310,12 @@ fn step_metrics_and_placement_agree_with_the_fixed_size_functions() {
     let fz = fixed.discretize(0.002, Discretization::Zoh).unwrap();
     let dz = DynStateSpace::from(&fz);
     let kz = rel(
-        dz.place(&z_targets).unwrap().as_slice(),
-        place(&fz, &z_targets).unwrap().as_slice(),
+        place(&dz, z_targets).unwrap().as_slice(),
+        place(&fz, z_targets).unwrap().as_slice(),
     )
     .max(rel(
-        dz.acker(&z_targets).unwrap().as_slice(),
-        acker(&fz, &z_targets).unwrap().as_slice(),
+        acker(&dz, z_targets).unwrap().as_slice(),
+        acker(&fz, z_targets).unwrap().as_slice(),
     ));
     println!(
         "gains, largest relative difference: acker {ka:e}, place {kp:e}, observer {kl:e}, discrete {kz:e}"
@@ -453,9 +460,7 @@ fn a_chain_sized_at_run_time_matches_python_control() {
         DMatrix::zeros(1, 1),
     )
     .unwrap();
-    let info = siso
-        .step_info(t_end, grid_dt, &StepInfoOptions::default())
-        .unwrap();
+    let info = step_info_of(&siso, t_end, grid_dt, &StepInfoOptions::default()).unwrap();
     let get = |k: &str| si[k].as_f64().unwrap();
     println!(
         "step_info: rise {} vs {}, settling {} vs {}, steady state {} vs {}",
@@ -471,9 +476,7 @@ fn a_chain_sized_at_run_time_matches_python_control() {
     assert!((info.steady_state_value - get("SteadyStateValue")).abs() <= 1e-12);
     assert!((info.overshoot - get("Overshoot")).abs() <= 1e-9);
     // The same channel through step_info_mimo.
-    let mimo = sys
-        .step_info_mimo(t_end, grid_dt, &StepInfoOptions::default())
-        .unwrap();
+    let mimo = step_info_mimo(&sys, t_end, grid_dt, &StepInfoOptions::default()).unwrap();
     assert_eq!(mimo[0][0].as_ref().unwrap(), &info);
     assert_eq!((mimo.len(), mimo[0].len()), (2, 2));
 
@@ -481,7 +484,7 @@ fn a_chain_sized_at_run_time_matches_python_control() {
     // poles are checked (python-control's six decimals), and Ackermann's
     // unique single-input gain against python-control's.
     let targets = complexes(&fx["place"]["targets"]);
-    let k = sys.place(&targets).unwrap();
+    let k = place(&sys, &targets).unwrap();
     let closed = DynStateSpace::continuous(
         sys.a() - sys.b() * &k,
         sys.b().clone(),
@@ -493,7 +496,7 @@ fn a_chain_sized_at_run_time_matches_python_control() {
         &flat_complex(&closed.poles().unwrap()),
         &flat_complex(&complexes(&fx["place"]["achieved"])),
     );
-    let k_acker = sys.select_input(0).unwrap().acker(&targets).unwrap();
+    let k_acker = acker(&sys.select_input(0).unwrap(), &targets).unwrap();
     let acker_gain = rel(k_acker.as_slice(), matrix(&fx["acker"]["K"]).as_slice());
     println!("place: achieved poles {achieved:e}; acker gain {acker_gain:e}");
     assert!(achieved <= 1e-6);
@@ -505,7 +508,7 @@ fn wrong_sizes_are_errors_not_panics() {
     let sys = chain(7);
     let one = |re| Complex::new(re, 0.0);
     assert!(matches!(
-        sys.place(&[one(-1.0); 3]),
+        place(&sys, [one(-1.0); 3]),
         Err(Error::LengthMismatch {
             what: "poles",
             expected: 7,
@@ -513,24 +516,24 @@ fn wrong_sizes_are_errors_not_panics() {
         })
     ));
     assert!(matches!(
-        sys.acker(&[one(-1.0); 7]),
+        acker(&sys, [one(-1.0); 7]),
         Err(Error::DimensionMismatch { matrix: "B", .. })
     ));
     assert!(matches!(
-        sys.step_response(1.0, 0.01),
+        step_response(&sys, 1.0, 0.01),
         Err(Error::DimensionMismatch { matrix: "B", .. })
     ));
     assert!(matches!(
-        sys.step_info(1.0, 0.01, &StepInfoOptions::default()),
+        step_info_of(&sys, 1.0, 0.01, &StepInfoOptions::default()),
         Err(Error::DimensionMismatch { .. })
     ));
     assert!(matches!(
-        sys.initial_response(1.0, 0.01, &DVector::zeros(6)),
+        initial_response(&sys, 1.0, 0.01, DVector::zeros(6)),
         Err(Error::LengthMismatch { what: "x0", .. })
     ));
     let t = time_grid(1.0, 0.01).unwrap();
     assert!(matches!(
-        sys.simulate(&t, &DVector::zeros(7), |_| dvector![1.0]),
+        simulate(&sys, &t, DVector::zeros(7), |_| dvector![1.0], Solver::Zoh),
         Err(Error::LengthMismatch {
             what: "input",
             expected: 2,
@@ -538,17 +541,21 @@ fn wrong_sizes_are_errors_not_panics() {
         })
     ));
     assert!(matches!(
-        sys.simulate(&t, &DVector::from_element(7, f64::NAN), |_| dvector![
-            1.0, 0.0
-        ]),
+        simulate(
+            &sys,
+            &t,
+            DVector::from_element(7, f64::NAN),
+            |_| dvector![1.0, 0.0],
+            Solver::Zoh
+        ),
         Err(Error::NonFinite { matrix: "x0", .. })
     ));
     let d = sys.discretize(0.01, Discretization::Zoh).unwrap();
     assert!(matches!(
-        d.simulate_feedback(&DVector::zeros(7), 5, |_, _| DVector::zeros(3)),
+        ctrlab::sim::simulate_discrete_feedback(&d, DVector::zeros(7), 5, |_, _| DVector::zeros(3)),
         Err(Error::LengthMismatch { what: "input", .. })
     ));
-    assert!(d.step_response(1.0, 0.02).is_err()); // not its period
+    assert!(step_response(&d, 1.0, 0.02).is_err()); // not its period
     assert!(matches!(
         expm_dyn(&DMatrix::zeros(2, 3)),
         Err(Error::DimensionMismatch { .. })
@@ -564,7 +571,7 @@ fn wrong_sizes_are_errors_not_panics() {
     assert_eq!(gain.dc_gain().unwrap()[(0, 0)], 3.0);
     assert!(gain.is_stable().unwrap() && gain.is_controllable().unwrap());
     assert_eq!(
-        gain.step_response(0.1, 0.05).unwrap().output(0).unwrap(),
+        step_response(&gain, 0.1, 0.05).unwrap().output(0).unwrap(),
         vec![3.0; 3]
     );
     let _: DynStateSpace<Continuous> = gain;
@@ -634,29 +641,29 @@ proptest! {
                 prop_assert!(finite(z.a()) && finite(z.b()) && finite(z.c()) && finite(z.d()));
                 if let Ok(g) = z.dc_gain() { prop_assert!(finite(&g)); }
                 let _ = z.is_stable();
-                if let Ok(r) = z.simulate_feedback(&DVector::zeros(n), 20, |_, _| DVector::from_element(m, 1.0)) {
+                if let Ok(r) = ctrlab::sim::simulate_discrete_feedback(&z, DVector::zeros(n), 20, |_, _| DVector::from_element(m, 1.0)) {
                     prop_assert!(r.y.iter().all(|y| y.iter().all(|v| v.is_finite())));
                 }
             }
         }
         // Wrong and right numbers of targets.
         let targets = vec![Complex::new(re, 0.0); n + extra];
-        if let Ok(k) = sys.place(&targets) { prop_assert!(finite(&k) && extra == 0); }
-        if let Ok(k) = sys.place_observer(&targets) { prop_assert!(finite(&k) && extra == 0); }
-        if let Ok(k) = sys.acker(&targets) { prop_assert!(finite(&k) && extra == 0 && m == 1); }
+        if let Ok(k) = place(&sys, &targets) { prop_assert!(finite(&k) && extra == 0); }
+        if let Ok(k) = place_observer(&sys, &targets) { prop_assert!(finite(&k) && extra == 0); }
+        if let Ok(k) = acker(&sys, &targets) { prop_assert!(finite(&k) && extra == 0 && m == 1); }
         if m == 1 {
-            if let Ok(r) = sys.step_response(0.05, 0.01) {
+            if let Ok(r) = step_response(&sys, 0.05, 0.01) {
                 prop_assert!(r.y.iter().all(|y| y.iter().all(|v| v.is_finite())));
             }
-            if let Ok(r) = sys.impulse_response(0.05, 0.01) {
+            if let Ok(r) = impulse_response(&sys, 0.05, 0.01) {
                 prop_assert!(r.x.iter().all(|x| x.iter().all(|v| v.is_finite())));
             }
         }
-        if let Ok(info) = sys.step_info(1.0, 0.01, &StepInfoOptions::default()) {
+        if let Ok(info) = step_info_of(&sys, 1.0, 0.01, &StepInfoOptions::default()) {
             prop_assert!(info.rise_time.is_finite() && info.settling_time.is_finite());
         }
         let t = [0.0, 0.01, 0.03];
-        if let Ok(r) = sys.simulate(&t, &DVector::zeros(n), |_| DVector::from_element(m + extra, re)) {
+        if let Ok(r) = simulate(&sys, &t, DVector::zeros(n), |_| DVector::from_element(m + extra, re), Solver::Zoh) {
             prop_assert!(extra == 0 && r.y.iter().all(|y| y.iter().all(|v| v.is_finite())));
         }
         if let Ok(e) = expm_dyn(&a) { prop_assert!(finite(&e)); }

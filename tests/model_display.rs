@@ -1,5 +1,6 @@
 //! `Display` for `StateSpace`: the header of each domain, precision, and
-//! every matrix entry in its place.
+//! every matrix entry in its place (exactly with `{:#}`; the default's five
+//! significant digits are checked in `tests/calling_style.rs`).
 
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
@@ -80,11 +81,10 @@ fn check_entries<const N: usize, const M: usize, const P: usize, D: ctrlab::Doma
 #[test]
 fn continuous_header_and_every_entry_exactly() {
     let sys = MassSpring::nominal().state_space(Cart::Two).unwrap();
-    let text = format!("{sys}");
+    let text = format!("{sys:#}");
     let (header, _) = blocks(&text);
     assert_eq!(header, "x' = A x + B u, y = C x + D u");
-    // Without a precision each entry is the shortest form that reads back
-    // exactly.
+    // With `#` each entry is the shortest form that reads back exactly.
     check_entries(&sys, &text, |v| format!("{v}"));
     let (_, got) = blocks(&text);
     for (r, row) in got[0].1.iter().enumerate() {
@@ -97,8 +97,8 @@ fn continuous_header_and_every_entry_exactly() {
         text.lines().count(),
         1 + (1 + 4) + (1 + 4) + (1 + 1) + (1 + 1)
     );
-    // to_string is the same.
-    assert_eq!(sys.to_string(), text);
+    // to_string is `{}`.
+    assert_eq!(sys.to_string(), format!("{sys}"));
 }
 
 #[test]
@@ -108,7 +108,7 @@ fn discrete_header_shows_the_period() {
         .unwrap()
         .discretize(0.002, Discretization::Zoh)
         .unwrap();
-    let text = format!("{d}");
+    let text = format!("{d:#}");
     let (header, _) = blocks(&text);
     assert_eq!(
         header,
@@ -154,9 +154,9 @@ fn precision_applies_to_every_entry() {
          C =\n   1.000  -2.500\n\
          D =\n  0.125\n"
     );
-    // Without a precision: the shortest exact form, aligned per matrix.
+    // With `#`: the shortest exact form, aligned per matrix.
     assert_eq!(
-        format!("{sys}"),
+        format!("{sys:#}"),
         "x' = A x + B u, y = C x + D u\n\
          A =\n           0           1\n  -1234.5678    -0.00044\n\
          B =\n                   0\n  1.4285714285714286\n\
@@ -175,7 +175,7 @@ fn non_square_shapes_print_every_row_and_column() {
         matrix![0.0, 0.0; 0.0, 0.0; 0.5, -0.5],
     )
     .unwrap();
-    let text = sys.to_string();
+    let text = format!("{sys:#}");
     check_entries(&sys, &text, |v| format!("{v}"));
     let (_, got) = blocks(&text);
     let shapes: Vec<(usize, usize)> = got
@@ -203,7 +203,7 @@ proptest! {
             dt,
         )
         .unwrap();
-        let text = format!("{sys}");
+        let text = format!("{sys:#}");
         check_entries(&sys, &text, |v| format!("{v}"));
         let expected_header = format!("x[k+1] = A x[k] + B u[k], y[k] = C x[k] + D u[k], dt = {dt} s");
         prop_assert_eq!(text.lines().next(), Some(expected_header.as_str()));

@@ -283,11 +283,11 @@ proptest! {
     ) {
         let Some(sys) = model(a, b, SMatrix::from_element(1.0)) else { return Ok(()) };
         let targets = [0, 1, 2].map(|i| Complex::new(poles[i].0, poles[i].1));
-        if let Ok(k) = acker(&sys, &targets) { prop_assert!(finite_all(k.as_slice())); }
+        if let Ok(k) = acker(&sys, targets) { prop_assert!(finite_all(k.as_slice())); }
         let q = (q + q.transpose()) * 0.5;
         let r = SMatrix::<f64, 1, 1>::new(r);
         if let Ok(sol) = lqr(&sys, &q, &r) {
-            prop_assert!(finite_all(sol.gain.as_slice()) && finite_all(sol.riccati.as_slice()) && finite_c(&sol.poles));
+            prop_assert!(finite_all(sol.gain.as_slice()) && finite_all(sol.riccati.as_slice()) && finite_c(sol.poles.as_slice()));
         }
         if let Ok(d) = sys.discretize(dt, Discretization::Zoh)
             && let Ok(sol) = dlqr(&d, &q, &r)

@@ -15,7 +15,7 @@ mod common;
 use common::matrix;
 use ctrlab::sim::{impulse_response, initial_response, step_response};
 use ctrlab::{Discretization, Domain, Error, Response, StateSpace};
-use nalgebra::{SVector, matrix, vector};
+use nalgebra::{Const, SVector, matrix, vector};
 use serde_json::Value;
 
 fn series(v: &Value) -> Vec<f64> {
@@ -38,7 +38,11 @@ fn assert_series(what: &str, got: &[f64], want: &[f64]) {
     }
 }
 
-fn check_outputs<const N: usize, const P: usize>(what: &str, r: &Response<N, P>, want: &Value) {
+fn check_outputs<const N: usize, const P: usize>(
+    what: &str,
+    r: &Response<Const<N>, Const<P>>,
+    want: &Value,
+) {
     for i in 0..P {
         assert_series(
             &format!("{what}, output {i}"),

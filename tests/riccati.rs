@@ -195,17 +195,15 @@ fn fixed_and_run_time_lqr_agree_on_the_lab_plant() {
     let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e4, 0.0, 1e6, 0.0]);
     let r = nalgebra::matrix![1.0];
     let fixed = lqr(&plant, &q, &r).unwrap();
-    let dynamic = DynStateSpace::from(plant)
-        .lqr(&heap(&q), &heap(&r))
-        .unwrap();
+    let dynamic = lqr(&DynStateSpace::from(plant), &heap(&q), &heap(&r)).unwrap();
     assert!((heap(&fixed.gain) - &dynamic.gain).amax() <= 1e-12 * fixed.gain.amax());
     assert!((heap(&fixed.riccati) - &dynamic.riccati).amax() <= 1e-12 * fixed.riccati.amax());
-    assert_eq!(fixed.poles.to_vec(), dynamic.poles);
+    assert_eq!(fixed.poles.as_slice(), dynamic.poles.as_slice());
     assert!(fixed.residual < 1e-12 && dynamic.residual < 1e-12);
 
     let d = plant.discretize(0.002, Discretization::Zoh).unwrap();
     let fixed = dlqr(&d, &q, &r).unwrap();
-    let dynamic = DynStateSpace::from(d).lqr(&heap(&q), &heap(&r)).unwrap();
+    let dynamic = dlqr(&DynStateSpace::from(d), &heap(&q), &heap(&r)).unwrap();
     assert!((heap(&fixed.gain) - &dynamic.gain).amax() <= 1e-12 * fixed.gain.amax());
     assert!((heap(&fixed.riccati) - &dynamic.riccati).amax() <= 1e-12 * fixed.riccati.amax());
     assert!(dynamic.poles.iter().all(|z| z.norm() < 1.0));
@@ -228,7 +226,7 @@ fn typed_errors_never_panics() {
     assert!(mismatch(dare(&a, &b, &q, &q).unwrap_err(), "R"));
     let sys =
         DynStateSpace::continuous(a.clone(), b.clone(), dmatrix![1.0, 0.0], dmatrix![0.0]).unwrap();
-    assert!(mismatch(sys.lqr(&r, &r).unwrap_err(), "Q"));
+    assert!(mismatch(lqr(&sys, &r, &r).unwrap_err(), "Q"));
     assert!(matches!(
         care(&dmatrix![f64::NAN, 1.0; 0.0, 0.0], &b, &q, &r),
         Err(Error::NonFinite { matrix: "A", .. })
@@ -246,7 +244,7 @@ fn typed_errors_never_panics() {
     assert!(invalid(dare(&a, &b, &q, &dmatrix![-1.0]), "R"));
     // An LQR weight must be semidefinite; a bare equation's need not be.
     let indefinite = dmatrix![1.0, 0.0; 0.0, -0.1];
-    assert!(invalid(sys.lqr(&indefinite, &r), "Q"));
+    assert!(invalid(lqr(&sys, &indefinite, &r), "Q"));
     assert!(care(&a, &b, &indefinite, &r).is_ok());
     // No input: R is 0 × 0, not definite.
     let no_input = DMatrix::<f64>::zeros(2, 0);
@@ -324,14 +322,14 @@ proptest! {
         let r = DMatrix::identity(b.ncols(), b.ncols());
         let sys = DynStateSpace::continuous(a.clone(), b.clone(), DMatrix::zeros(0, n), DMatrix::zeros(0, b.ncols())).unwrap();
         let bound = |x: &DMatrix<f64>| 1e-9f64.max(1e-15 * x.norm());
-        if let Ok(sol) = sys.lqr(&q, &r) {
+        if let Ok(sol) = lqr(&sys, &q, &r) {
             prop_assert!(sol.riccati.iter().all(|v| v.is_finite()));
             prop_assert!(sol.residual < bound(&sol.riccati), "residual {}, ‖X‖ {}", sol.residual, sol.riccati.norm());
             prop_assert!(sol.poles.iter().all(|p| p.re < 0.0));
         }
         // The same plant sampled: A/2 keeps some modes outside the circle.
         let d = DynStateSpace::discrete(&a * 0.5, b, DMatrix::zeros(0, n), DMatrix::zeros(0, r.nrows()), 0.01).unwrap();
-        if let Ok(sol) = d.lqr(&q, &r) {
+        if let Ok(sol) = dlqr(&d, &q, &r) {
             prop_assert!(sol.riccati.iter().all(|v| v.is_finite()));
             prop_assert!(sol.residual < bound(&sol.riccati), "residual {}, ‖X‖ {}", sol.residual, sol.riccati.norm());
             prop_assert!(sol.poles.iter().all(|z| z.norm() < 1.0));

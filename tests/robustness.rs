@@ -470,7 +470,7 @@ fn acker_refuses_gains_that_miss_their_poles() {
     .unwrap();
     let targets: [Complex<f64>; 8] =
         std::array::from_fn(|i| Complex::new(-3.0 * (i + 1) as f64, 0.0));
-    match acker(&sys, &targets) {
+    match acker(&sys, targets) {
         Ok(k) => {
             // Any gain returned places the poles.
             let cl =
@@ -536,7 +536,7 @@ fn acker_names_the_unpaired_pole() {
         matrix![0.0],
     )
     .unwrap();
-    let err = acker(&sys, &[Complex::new(-2.0, 1.0), Complex::new(-3.0, 0.0)]).unwrap_err();
+    let err = acker(&sys, [Complex::new(-2.0, 1.0), Complex::new(-3.0, 0.0)]).unwrap_err();
     assert!(
         matches!(
             err,

@@ -1,9 +1,10 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test.
 //!
-//! Everything here is a method on [`StateSpace`] and on
-//! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time),
-//! except [`rank`]. These are design-time computations, not inner loops:
+//! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
+//! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
+//! `dyn_state_space.rs`), except [`rank`]; [`Poles`] prints a list of
+//! poles. These are design-time computations, not inner loops:
 //! each is written once, on run-time-sized matrices (eigenvalues by a
 //! balanced Hessenberg QR on the stack up to 8 states, then nalgebra's
 //! Schur and faer's multishift QR; singular values through nalgebra's SVD),
@@ -24,12 +25,14 @@
 //! ```
 
 mod controllability;
-mod dynamic;
-mod fixed;
+mod dyn_state_space;
 mod gain;
+mod poles;
 mod stability;
+mod state_space;
 
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
+pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
 
 use nalgebra::{Complex, DMatrix, SMatrix};

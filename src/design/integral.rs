@@ -5,10 +5,12 @@
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 
-use super::lqr::{Lqr, dlqr, lqr};
+use super::IntegralAction;
+#[cfg(doc)]
+use super::lqr::{dlqr, lqr};
 use crate::design::Controller;
 use crate::error::{Error, check_finite};
-use crate::model::{Continuous, Discrete, Domain, StateSpace, period_of};
+use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, Token, period_of};
 
 /// `sys` augmented with one integrator per output, the plant that
 /// linear-quadratic-integral design works on (MATLAB's `lqi` convention).
@@ -63,34 +65,35 @@ where
     D: Domain,
 {
     const { assert!(NA == N + P, "the augmented model has NA = N + P states") };
+    StateSpace::try_from(&augmented(&DynStateSpace::from(sys))?)
+}
+
+/// [`augment_integral`] of a model of any size: the one implementation
+/// (a fixed-size model's is copied to the heap and back, design-time work).
+pub(super) fn augmented<D: Domain>(sys: &DynStateSpace<D>) -> Result<DynStateSpace<D>, Error> {
+    let (n, m, p) = (sys.states(), sys.inputs(), sys.outputs());
     let (scale, keep) = match period_of(&sys.domain()) {
         None => (1.0, 0.0),
         Some(dt) => (dt, 1.0),
     };
-    let mut a = SMatrix::<f64, NA, NA>::zeros();
-    a.fixed_view_mut::<N, N>(0, 0).copy_from(sys.a());
-    a.fixed_view_mut::<P, N>(N, 0)
-        .copy_from(&(sys.c() * -scale));
-    a.fixed_view_mut::<P, P>(N, N)
-        .copy_from(&(SMatrix::<f64, P, P>::identity() * keep));
-    let mut b = SMatrix::<f64, NA, M>::zeros();
-    b.fixed_view_mut::<N, M>(0, 0).copy_from(sys.b());
-    b.fixed_view_mut::<P, M>(N, 0)
-        .copy_from(&(sys.d() * -scale));
-    let mut c = SMatrix::<f64, P, NA>::zeros();
-    c.fixed_view_mut::<P, N>(0, 0).copy_from(sys.c());
-    let overflow = |_| Error::Overflow {
-        operation: "integral augmentation",
-    };
-    check_finite("A", &a).map_err(overflow)?;
-    check_finite("B", &b).map_err(overflow)?;
-    Ok(StateSpace::from_parts_unchecked(
+    let mut a = DMatrix::zeros(n + p, n + p);
+    a.view_mut((0, 0), (n, n)).copy_from(sys.a());
+    a.view_mut((n, 0), (p, n)).copy_from(&(sys.c() * -scale));
+    a.view_mut((n, n), (p, p))
+        .copy_from(&(DMatrix::<f64>::identity(p, p) * keep));
+    let mut b = DMatrix::zeros(n + p, m);
+    b.view_mut((0, 0), (n, m)).copy_from(sys.b());
+    b.view_mut((n, 0), (p, m)).copy_from(&(sys.d() * -scale));
+    let mut c = DMatrix::zeros(p, n + p);
+    c.view_mut((0, 0), (p, n)).copy_from(sys.c());
+    DynStateSpace::from_computed(
         a,
         b,
         c,
-        *sys.d(),
+        sys.d().clone(),
         sys.domain(),
-    ))
+        "integral augmentation",
+    )
 }
 
 /// Continuous-time linear-quadratic-integral design (MATLAB's `lqi`): the
@@ -99,9 +102,17 @@ where
 /// minimising `∫ ([x; z]ᵀ Q [x; z] + uᵀ R u) dt`. The control law is
 /// `u = −K_x x − K_z z` with `z' = r − y`.
 ///
+/// Either model size ([`IntegralAction`]): for a `StateSpace<N, M, P, _>`,
+/// `Q` is an `SMatrix<f64, NA, NA>` with `NA = N + P` (checked at compile
+/// time) and the result an `Lqr<Const<NA>, Const<M>>`; for a
+/// `DynStateSpace`, `Q` is an `(n + p) × (n + p)` `DMatrix` (checked when
+/// called) and the result a [`DynLqr`](super::DynLqr).
+///
 /// # Errors
 ///
-/// As [`augment_integral`] and [`lqr`] ([`Error::Unstable`] when, for
+/// [`Error::DimensionMismatch`] named `"Q"` or `"R"` for a weight of the
+/// wrong size (a run-time-sized model); as [`augment_integral`] and
+/// [`lqr`] ([`Error::Unstable`] when, for
 /// instance, the plant has a zero at `s = 0`, which an integrator cannot
 /// get past).
 ///
@@ -117,24 +128,29 @@ where
 /// // The integrator's gain has the sign that pushes x2 up to r: K_z < 0.
 /// assert!(sol.gain[4] < 0.0);
 /// assert!(sol.poles.iter().all(|p| p.re < 0.0) && sol.residual < 1e-9);
+///
+/// // Sized at run time: the same gain.
+/// let dynamic = ctrlab::DynStateSpace::from(&plant);
+/// let qd = nalgebra::DMatrix::from_column_slice(5, 5, q.as_slice());
+/// assert_eq!(lqi(&dynamic, &qd, &nalgebra::dmatrix![1.0])?.gain.as_slice(), sol.gain.as_slice());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn lqi<const N: usize, const M: usize, const P: usize, const NA: usize>(
-    sys: &StateSpace<N, M, P, Continuous>,
-    q: &SMatrix<f64, NA, NA>,
-    r: &SMatrix<f64, M, M>,
-) -> Result<Lqr<NA, M>, Error> {
-    lqr(&augment_integral(sys)?, q, r)
+pub fn lqi<S, Q>(sys: &S, q: &Q, r: &S::InputWeight) -> Result<S::Lqi, Error>
+where
+    S: IntegralAction<Q, Domain = Continuous>,
+{
+    sys.integral_regulator(Token(()), q, r)
 }
 
 /// Discrete-time linear-quadratic-integral design (MATLAB's `lqi` on a
 /// discrete model): the [`dlqr`] gain of the plant augmented with the
 /// forward-Euler integrators `z[k+1] = z[k] + T (r[k] − y[k])`
 /// ([`augment_integral`]), minimising `Σ ([x; z]ᵀ Q [x; z] + uᵀ R u)`.
+/// Either model size, as [`lqi`].
 ///
 /// # Errors
 ///
-/// As [`augment_integral`] and [`dlqr`].
+/// As [`lqi`], with [`dlqr`]'s.
 ///
 /// # Examples
 ///
@@ -146,14 +162,16 @@ pub fn lqi<const N: usize, const M: usize, const P: usize, const NA: usize>(
 /// let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
 /// let sol = dlqi(&plant, &q, &matrix![1.0])?;
 /// assert!(sol.poles.iter().all(|z| z.norm() < 1.0));
+/// let dynamic = ctrlab::DynStateSpace::from(&plant);
+/// let qd = nalgebra::DMatrix::from_column_slice(5, 5, q.as_slice());
+/// assert_eq!(dlqi(&dynamic, &qd, &nalgebra::dmatrix![1.0])?.gain.as_slice(), sol.gain.as_slice());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn dlqi<const N: usize, const M: usize, const P: usize, const NA: usize>(
-    sys: &StateSpace<N, M, P, Discrete>,
-    q: &SMatrix<f64, NA, NA>,
-    r: &SMatrix<f64, M, M>,
-) -> Result<Lqr<NA, M>, Error> {
-    dlqr(&augment_integral(sys)?, q, r)
+pub fn dlqi<S, Q>(sys: &S, q: &Q, r: &S::InputWeight) -> Result<S::Lqi, Error>
+where
+    S: IntegralAction<Q, Domain = Discrete>,
+{
+    sys.integral_regulator(Token(()), q, r)
 }
 
 /// What an integral controller does when the drive applies less than it

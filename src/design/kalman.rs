@@ -1,12 +1,18 @@
 //! Steady-state Kalman filters, [`lqe`] and [`dlqe`]: the dual of the
 //! linear-quadratic regulator, solved by the same Riccati solvers.
 
-use nalgebra::{Complex, SMatrix};
+use nalgebra::{
+    Complex, Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, allocator::Allocator,
+};
 
-use super::lqr::{Lqr, check_weights, dlqr, lqr, symmetric};
-use crate::error::Error;
-use crate::kernels::linalg::Lu;
-use crate::model::{Continuous, Discrete, Domain, StateSpace};
+use super::Kalman;
+use super::lqr::{Lqr, regulator};
+use super::riccati::{Weights, check_weights};
+use crate::error::{Error, check_finite_dyn, check_shape};
+use crate::kernels::linalg::{Lu, SystemAlloc};
+use crate::model::{Continuous, Discrete, Token};
+#[cfg(doc)]
+use crate::model::{DynStateSpace, StateSpace};
 
 /// A solved steady-state Kalman filter (linear-quadratic estimator): the
 /// gain, the error covariance, the estimator's poles, and how well its
@@ -41,8 +47,12 @@ use crate::model::{Continuous, Discrete, Domain, StateSpace};
 /// `poles` are the eigenvalues of `A − L C` (the estimation error's
 /// dynamics in both forms). The Riccati equation is solved as the LQR
 /// problem of the dual system `(Aᵀ, Cᵀ)` with weights `G QN Gᵀ` and `RN`
-/// (see [`Lqr`] for the method); `residual` and `iterations` are that
-/// solver's.
+/// (see [`Lqr`](Lqr#algorithm) for the method); `residual` and
+/// `iterations` are that solver's.
+///
+/// One type for both model sizes, as [`Lqr`]: `Lqe<Const<N>, Const<P>>`
+/// (stack matrices, `Copy`) for a `StateSpace<N, M, P, _>`, [`DynLqe`]
+/// for a `DynStateSpace`.
 ///
 /// # Examples
 ///
@@ -62,34 +72,61 @@ use crate::model::{Continuous, Discrete, Domain, StateSpace};
 /// assert!(kf.current_gain.is_none());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lqe<const N: usize, const P: usize> {
-    /// The estimator gain `L` (N × P): continuous filter gain, or the
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lqe<N: Dim, P: Dim>
+where
+    DefaultAllocator: Allocator<N, P> + Allocator<N, N> + Allocator<N>,
+{
+    /// The estimator gain `L` (`n × p`): continuous filter gain, or the
     /// discrete predictor gain (python-control's convention).
-    pub gain: SMatrix<f64, N, P>,
+    pub gain: OMatrix<f64, N, P>,
     /// The stabilising Riccati solution `P`: the steady-state estimation
     /// error covariance (discrete: *a priori*, before the measurement).
-    pub covariance: SMatrix<f64, N, N>,
+    pub covariance: OMatrix<f64, N, N>,
     /// Discrete only: the current-estimator gain `M` (MATLAB's `dlqe` `M`),
     /// `L = A M`.
-    pub current_gain: Option<SMatrix<f64, N, P>>,
+    pub current_gain: Option<OMatrix<f64, N, P>>,
     /// Poles of the estimation error, eigenvalues of `A − L C`, sorted as
     /// [`StateSpace::poles`].
-    pub poles: [Complex<f64>; N],
+    pub poles: OVector<Complex<f64>, N>,
     /// Relative residual of the Riccati equation at `P` (see [`Lqr`]).
     pub residual: f64,
     /// Doubling steps the Riccati solver took.
     pub iterations: usize,
 }
 
+/// The [`Lqe`] of a model sized at run time, its matrices `DMatrix`es.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{DynStateSpace, design::{DynLqe, lqe}};
+/// use nalgebra::dmatrix;
+///
+/// let sys = DynStateSpace::continuous(dmatrix![0.0], dmatrix![0.1], dmatrix![1.0], dmatrix![0.0])?;
+/// let kf: DynLqe = lqe(&sys, &dmatrix![0.1], &dmatrix![10.0], &dmatrix![2.0])?;
+/// assert_eq!(kf.gain.shape(), (1, 1));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub type DynLqe = Lqe<Dyn, Dyn>;
+
+impl<const N: usize, const P: usize> Copy for Lqe<Const<N>, Const<P>> {}
+
 /// Continuous-time steady-state Kalman filter (linear-quadratic
 /// estimator): python-control's `lqe(A, G, C, QN, RN)` with `A`, `C` from
 /// `sys` (its outputs are the measurements) and the process noise entering
-/// through `g` (`N × W`; pass `sys.b()` for noise on the input). See [`Lqe`]
+/// through `g` (`n × w`; pass `sys.b()` for noise on the input). See [`Lqe`]
 /// for the conventions.
+///
+/// Either model size ([`Kalman`]): `G`, `QN` (`w × w`) and `RN` (`p × p`)
+/// are `SMatrix`es for a fixed-size model, `DMatrix`es for a
+/// `DynStateSpace` (their shapes checked when called); the result is an
+/// [`Lqe`] of the model's sizes.
 ///
 /// # Errors
 ///
+/// [`Error::DimensionMismatch`] naming `"G"`, `"QN"` or `"RN"` for a
+/// matrix of the wrong shape (a run-time-sized model);
 /// [`Error::NonFinite`] for a non-finite `G`, `QN` or `RN`;
 /// [`Error::InvalidMatrix`] named `"QN"` unless it is symmetric positive
 /// semidefinite, `"RN"` unless symmetric positive definite;
@@ -114,23 +151,31 @@ pub struct Lqe<const N: usize, const P: usize> {
 /// let kf = lqe(&plant, plant.b(), &matrix![1.0], &rn)?;
 /// assert!(kf.poles.iter().all(|p| p.re < 0.0));
 /// assert!(kf.residual < 1e-9);
+///
+/// // The same filter for the model sized at run time.
+/// let dynamic = ctrlab::DynStateSpace::from(&plant);
+/// let heap = |m: &[f64], r, c| nalgebra::DMatrix::from_column_slice(r, c, m);
+/// let d = lqe(&dynamic, dynamic.b(), &nalgebra::dmatrix![1.0], &heap(rn.as_slice(), 2, 2))?;
+/// assert_eq!(d.gain.as_slice(), kf.gain.as_slice());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn lqe<const N: usize, const M: usize, const P: usize, const W: usize>(
-    sys: &StateSpace<N, M, P, Continuous>,
-    g: &SMatrix<f64, N, W>,
-    qn: &SMatrix<f64, W, W>,
-    rn: &SMatrix<f64, P, P>,
-) -> Result<Lqe<N, P>, Error> {
-    let q = noise_weight(g, qn, rn)?;
-    let sol = lqr(&dual(sys), &q, rn).map_err(estimator_error)?;
-    Ok(from_dual(&sol, None))
+pub fn lqe<S, G>(
+    sys: &S,
+    g: &G,
+    qn: &S::NoiseCovariance,
+    rn: &S::OutputWeight,
+) -> Result<S::Lqe, Error>
+where
+    S: Kalman<G, Domain = Continuous>,
+{
+    sys.estimator(Token(()), g, qn, rn)
 }
 
 /// Discrete-time steady-state Kalman filter: python-control's
 /// `dlqe(A, G, C, QN, RN)`, with `gain` the predictor gain
 /// `L = A P Cᵀ (C P Cᵀ + RN)⁻¹` and `current_gain` the current-estimator
 /// gain `M = P Cᵀ (C P Cᵀ + RN)⁻¹` (MATLAB's `dlqe`); see [`Lqe`].
+/// Either model size, as [`lqe`].
 ///
 /// # Errors
 ///
@@ -154,35 +199,69 @@ pub fn lqe<const N: usize, const M: usize, const P: usize, const W: usize>(
 /// assert!((plant.a() * m - kf.gain).norm() <= 1e-12 * kf.gain.norm());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn dlqe<const N: usize, const M: usize, const P: usize, const W: usize>(
-    sys: &StateSpace<N, M, P, Discrete>,
-    g: &SMatrix<f64, N, W>,
-    qn: &SMatrix<f64, W, W>,
-    rn: &SMatrix<f64, P, P>,
-) -> Result<Lqe<N, P>, Error> {
+pub fn dlqe<S, G>(
+    sys: &S,
+    g: &G,
+    qn: &S::NoiseCovariance,
+    rn: &S::OutputWeight,
+) -> Result<S::Lqe, Error>
+where
+    S: Kalman<G, Domain = Discrete>,
+{
+    sys.estimator(Token(()), g, qn, rn)
+}
+
+/// The steady-state filter of `(A, C)` with noise `G`, `QN`, `RN` and
+/// sampling period `period` (`None`: continuous): the one implementation
+/// behind [`lqe`] and [`dlqe`] for both model sizes, as the regulator of
+/// the dual `(Aᵀ, Cᵀ)`.
+pub(super) fn estimator<N: Dim, P: Dim, W: Dim>(
+    a: &OMatrix<f64, N, N>,
+    c: &OMatrix<f64, P, N>,
+    g: &OMatrix<f64, N, W>,
+    qn: &OMatrix<f64, W, W>,
+    rn: &OMatrix<f64, P, P>,
+    period: Option<f64>,
+) -> Result<Lqe<N, P>, Error>
+where
+    DefaultAllocator: SystemAlloc<N, P> + SystemAlloc<N, W> + Allocator<P, P> + Allocator<P, N>,
+{
+    let (n, p, w) = (a.nrows(), c.nrows(), g.ncols());
+    check_shape("G", g, n, w)?;
+    check_shape("QN", qn, w, w)?;
+    check_shape("RN", rn, p, p)?;
     let q = noise_weight(g, qn, rn)?;
-    let sol = dlqr(&dual(sys), &q, rn).map_err(estimator_error)?;
-    let (c, p) = (sys.c(), &sol.riccati);
-    let pct = p * c.transpose();
-    // M = P Cᵀ (C P Cᵀ + RN)⁻¹, by a right solve.
-    let current = Lu::solve_right(&(c * pct + rn), &pct, "DLQE (C P Cᵀ + RN)")?;
-    if current.iter().any(|v| !v.is_finite()) {
-        return Err(Error::Overflow {
-            operation: "DLQE gain",
-        });
-    }
-    Ok(from_dual(&sol, Some(current)))
+    let sol = regulator(&a.transpose(), &c.transpose(), &q, rn, period).map_err(estimator_error)?;
+    let current = match period {
+        None => None,
+        Some(_) => {
+            let pct = &sol.riccati * c.transpose();
+            // M = P Cᵀ (C P Cᵀ + RN)⁻¹, by a right solve.
+            let current = Lu::solve_right(&(c * &pct + rn), &pct, "DLQE (C P Cᵀ + RN)")?;
+            if current.iter().any(|v| !v.is_finite()) {
+                return Err(Error::Overflow {
+                    operation: "DLQE gain",
+                });
+            }
+            Some(current)
+        }
+    };
+    Ok(from_dual(sol, current))
 }
 
 /// Checks the noise covariances and returns `G QN Gᵀ`, symmetrised.
-fn noise_weight<const N: usize, const W: usize, const P: usize>(
-    g: &SMatrix<f64, N, W>,
-    qn: &SMatrix<f64, W, W>,
-    rn: &SMatrix<f64, P, P>,
-) -> Result<SMatrix<f64, N, N>, Error> {
-    crate::error::check_finite("G", g)?;
-    check_weights(qn, rn, ["QN", "RN"])?;
-    let q = symmetric(&(g * qn * g.transpose()));
+fn noise_weight<N: Dim, W: Dim, P: Dim>(
+    g: &OMatrix<f64, N, W>,
+    qn: &OMatrix<f64, W, W>,
+    rn: &OMatrix<f64, P, P>,
+) -> Result<OMatrix<f64, N, N>, Error>
+where
+    DefaultAllocator: SystemAlloc<N, W> + Allocator<P, P>,
+{
+    check_finite_dyn("G", g)?;
+    check_weights(qn, rn, Weights::Regulator(["QN", "RN"]), true)?;
+    let gqg = g * qn * g.transpose();
+    let q = (&gqg + gqg.transpose()) * 0.5;
     if q.iter().any(|v| !v.is_finite()) {
         return Err(Error::Overflow {
             operation: "G QN Gᵀ",
@@ -191,23 +270,11 @@ fn noise_weight<const N: usize, const W: usize, const P: usize>(
     Ok(q)
 }
 
-/// The dual system `(Aᵀ, Cᵀ, Bᵀ, Dᵀ)`: its LQR problem is the estimator's.
-fn dual<const N: usize, const M: usize, const P: usize, D: Domain>(
-    sys: &StateSpace<N, M, P, D>,
-) -> StateSpace<N, P, M, D> {
-    StateSpace::from_parts_unchecked(
-        sys.a().transpose(),
-        sys.c().transpose(),
-        sys.b().transpose(),
-        sys.d().transpose(),
-        sys.domain(),
-    )
-}
-
-fn from_dual<const N: usize, const P: usize>(
-    sol: &Lqr<N, P>,
-    current_gain: Option<SMatrix<f64, N, P>>,
-) -> Lqe<N, P> {
+/// The estimator from the dual regulator.
+fn from_dual<N: Dim, P: Dim>(sol: Lqr<N, P>, current_gain: Option<OMatrix<f64, N, P>>) -> Lqe<N, P>
+where
+    DefaultAllocator: SystemAlloc<N, P>,
+{
     Lqe {
         gain: sol.gain.transpose(),
         covariance: sol.riccati,

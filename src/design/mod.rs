@@ -1,9 +1,17 @@
 //! Controllers and their design: the [`Controller`] trait that simulation and
 //! hardware both drive, [`OpenLoop`], [`StateFeedback`] (`u = N r − K x`),
 //! pole placement by [`acker`] (one input) and [`place`] (any number of
-//! inputs, robust), and optimal gains by [`lqr`] / [`dlqr`] — on run-time
-//! models by `DynStateSpace::lqr`, and the bare Riccati equations by
-//! [`care`] / [`dare`] (all `O(N³)`, one implementation; see [`DynLqr`]).
+//! inputs, robust), and optimal gains by [`lqr`] / [`dlqr`], with the bare
+//! Riccati equations by [`care`] / [`dare`] (all `O(N³)`, one
+//! implementation; see [`Lqr`](Lqr#algorithm)).
+//!
+//! Every design takes a model of either size, `StateSpace` or
+//! `DynStateSpace`, through the sealed trait [`Design`] (its table lists
+//! the argument and result types of each size), and returns one result
+//! type written over nalgebra's dimensions ([`Lqr`], [`Lqe`], with the
+//! aliases [`DynLqr`], [`DynLqe`] for run-time sizes). Target poles are any
+//! [`PoleTargets`]: real ones as plain `f64`, complex ones as
+//! `Complex<f64>`.
 //!
 //! Beyond static state feedback:
 //!
@@ -49,14 +57,16 @@ mod observer_controller;
 mod place;
 mod riccati;
 mod robust_place;
+mod system;
 
 pub use controller::{Controller, OpenLoop};
 pub use feedback::StateFeedback;
 pub use integral::{AntiWindup, IntegralFeedback, augment_integral, dlqi, lqi};
-pub use kalman::{Lqe, dlqe, lqe};
-pub use lqr::{Lqr, dlqr, lqr};
+pub use kalman::{DynLqe, Lqe, dlqe, lqe};
+pub use lqr::{DynLqr, Lqr, dlqr, lqr};
 pub use observer::{EstimatorForm, Observer};
 pub use observer_controller::{ObserverController, SelectOutputs};
 pub use place::acker;
-pub use riccati::{DynLqr, care, dare};
+pub use riccati::{care, dare};
 pub use robust_place::{place, place_observer};
+pub use system::{Design, IntegralAction, Kalman, PoleTargets};

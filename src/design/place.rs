@@ -1,16 +1,18 @@
 //! Pole placement for single-input systems, Ackermann's formula, and the
 //! validation of target poles that [`place`](super::place) shares.
 
-use nalgebra::{
-    Complex, DMatrix, DefaultAllocator, Dim, OMatrix, SMatrix, U1, allocator::Allocator,
-};
+use nalgebra::{Complex, DMatrix, DefaultAllocator, Dim, OMatrix, U1, allocator::Allocator};
 
+use super::Design;
+use super::system::{PoleTargets, targets};
 use crate::analysis::{eigenvalues_near, scaled_krylov_rank};
 use crate::error::Error;
 use crate::kernels::eigen::SMALL;
 use crate::kernels::linalg::Lu;
 use crate::kernels::reduce::pow2_floor;
-use crate::model::{Domain, DynStateSpace, StateSpace};
+#[cfg(doc)]
+use crate::model::{DynStateSpace, StateSpace};
+use crate::model::{SingleInput, Token};
 
 /// Relative distance within which two targets count as a conjugate pair.
 const CONJUGATE_RTOL: f64 = 1e-10;
@@ -19,8 +21,11 @@ const CONJUGATE_RTOL: f64 = 1e-10;
 /// Ackermann's formula `K = [0 … 0 1] 𝒞⁻¹ φ(A)` with `𝒞` the
 /// controllability matrix and `φ` the target characteristic polynomial.
 ///
-/// Works for continuous (`s`, rad/s) and discrete (`z`) models alike.
-/// Complex targets must come in conjugate pairs (matched to 1e-10 relative;
+/// Works for continuous (`s`, rad/s) and discrete (`z`) models alike, of
+/// either size ([`SingleInput`]: a fixed-size model with one input and an
+/// array of `N` targets, or a [`DynStateSpace`] with one input, checked
+/// when called); targets are any [`PoleTargets`], so real ones are plain
+/// `f64`. Complex targets must come in conjugate pairs (matched to 1e-10 relative;
 /// the pair is then used as exactly conjugate), so the gain is real. Like
 /// python-control's `acker`, the formula is numerically fragile for large
 /// `N` or a poorly conditioned `𝒞`; it is exact enough for the lab's four
@@ -28,7 +33,9 @@ const CONJUGATE_RTOL: f64 = 1e-10;
 ///
 /// # Errors
 ///
-/// [`Error::Uncontrollable`] with the numerical rank when `(A, B)` is not
+/// For a run-time-sized model, [`Error::DimensionMismatch`] named `"B"`
+/// unless it has one input and [`Error::LengthMismatch`] named `"poles"`
+/// unless there are `n` targets; [`Error::Uncontrollable`] with the numerical rank when `(A, B)` is not
 /// controllable (the test of [`is_controllable`](StateSpace::is_controllable),
 /// independent of units); [`Error::InvalidPole`] naming a non-finite target
 /// or one without its conjugate; [`Error::IllConditioned`] when the poles of
@@ -52,60 +59,23 @@ const CONJUGATE_RTOL: f64 = 1e-10;
 /// let p = cl.poles()?;
 /// assert!((p[0] - Complex::new(-50.0, 0.0)).norm() < 1e-8);
 /// assert!((p[3] - Complex::new(-30.0, 30.0)).norm() < 1e-8);
+///
+/// // Real targets as plain numbers, and the model sized at run time.
+/// let k = acker(&plant, [-40.0, -45.0, -50.0, -55.0])?;
+/// let dynamic = ctrlab::DynStateSpace::from(&plant);
+/// assert_eq!(acker(&dynamic, [-40.0, -45.0, -50.0, -55.0])?.as_slice(), k.as_slice());
+/// assert!(acker(&dynamic, [-40.0, -45.0]).is_err()); // two targets for four states
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn acker<const N: usize, const P: usize, D: Domain>(
-    sys: &StateSpace<N, 1, P, D>,
-    poles: &[Complex<f64>; N],
-) -> Result<SMatrix<f64, 1, N>, Error> {
-    acker_pair(sys.a(), sys.b(), poles)
-}
-
-impl<D: Domain> DynStateSpace<D> {
-    /// The state gain `K` (`1 × n`) that puts the poles of `A − B K` at
-    /// `poles` (`n` of them; `s` in rad/s or `z`) by Ackermann's formula:
-    /// [`acker`], the same code, for a single-input model sized at run
-    /// time.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::DimensionMismatch`] named `"B"` unless the model has one
-    /// input; [`Error::LengthMismatch`] named `"poles"` unless there are
-    /// `n` targets; as [`acker`] otherwise.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::DynStateSpace;
-    /// use nalgebra::{Complex, dmatrix};
-    ///
-    /// // A double integrator: poles at −1 ± i need K = [2, 2].
-    /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; 0.0, 0.0], dmatrix![0.0; 1.0],
-    ///                                     dmatrix![1.0, 0.0], dmatrix![0.0])?;
-    /// let k = sys.acker(&[Complex::new(-1.0, 1.0), Complex::new(-1.0, -1.0)])?;
-    /// assert!((k[(0, 0)] - 2.0).abs() < 1e-12 && (k[(0, 1)] - 2.0).abs() < 1e-12);
-    /// assert!(sys.acker(&[Complex::new(-1.0, 0.0)]).is_err());
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn acker(&self, poles: &[Complex<f64>]) -> Result<DMatrix<f64>, Error> {
-        let (n, m) = (self.states(), self.inputs());
-        if m != 1 {
-            return Err(Error::DimensionMismatch {
-                matrix: "B",
-                expected_rows: n,
-                expected_cols: 1,
-                found_rows: n,
-                found_cols: m,
-            });
-        }
-        check_targets(poles, n)?;
-        let k = acker_pair(self.a(), self.b(), poles)?;
-        Ok(DMatrix::from_row_slice(1, n, k.as_slice()))
-    }
+pub fn acker<S: Design + SingleInput>(
+    sys: &S,
+    poles: impl PoleTargets<S::States>,
+) -> Result<S::Gain, Error> {
+    sys.acker_gain(Token(()), &targets(&poles))
 }
 
 /// One target per state, or [`Error::LengthMismatch`] named `"poles"`.
-pub(crate) fn check_targets(poles: &[Complex<f64>], states: usize) -> Result<(), Error> {
+pub(super) fn check_targets(poles: &[Complex<f64>], states: usize) -> Result<(), Error> {
     if poles.len() == states {
         Ok(())
     } else {
@@ -118,17 +88,28 @@ pub(crate) fn check_targets(poles: &[Complex<f64>], states: usize) -> Result<(),
 }
 
 /// [`acker`] on a bare pair `(A, b)`, `b` one column, one target per state
-/// (the callers' checks): the gain as a `1 × n` row. Written once over
-/// nalgebra's dimensions, so a fixed-size model's runs on the stack.
-fn acker_pair<N: Dim, M: Dim>(
+/// (the callers' checks): the gain as the `1 × n` row of the model's gain
+/// type. Written once over nalgebra's dimensions, so a fixed-size model's
+/// runs on the stack.
+pub(super) fn acker_pair<N: Dim, M: Dim>(
     a: &OMatrix<f64, N, N>,
     b: &OMatrix<f64, N, M>,
     poles: &[Complex<f64>],
-) -> Result<OMatrix<f64, U1, N>, Error>
+) -> Result<OMatrix<f64, M, N>, Error>
 where
-    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N> + Allocator<U1, N>,
+    DefaultAllocator:
+        Allocator<N, N> + Allocator<N, M> + Allocator<M, N> + Allocator<N> + Allocator<U1, N>,
 {
-    let (dim, _) = a.shape_generic();
+    let (dim, dim_m) = b.shape_generic();
+    if dim_m.value() != 1 {
+        return Err(Error::DimensionMismatch {
+            matrix: "B",
+            expected_rows: dim.value(),
+            expected_cols: 1,
+            found_rows: dim.value(),
+            found_cols: dim_m.value(),
+        });
+    }
     let n = dim.value();
     let coeffs = real_polynomial(poles)?;
     // Controllability matrix [B, A B, …, A^(N−1) B], each new column
@@ -189,7 +170,7 @@ where
     // A − b K, with b's one column (on the stack for a fixed size).
     let a_cl = OMatrix::<f64, N, N>::from_fn_generic(dim, dim, |i, j| a[(i, j)] - b[(i, 0)] * k[j]);
     check_placement(a_cl.as_slice(), n, poles)?;
-    Ok(k)
+    Ok(OMatrix::from_row_slice_generic(dim_m, dim, k.as_slice()))
 }
 
 /// A copy on the heap, for the code written for run-time-sized matrices.

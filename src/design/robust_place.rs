@@ -2,14 +2,18 @@
 //! Nichols and Van Dooren (method 0), and its dual for observers.
 
 use nalgebra::{
-    Complex, DMatrix, DefaultAllocator, Dim, OMatrix, OVector, SMatrix, U1, allocator::Allocator,
+    Complex, DMatrix, DefaultAllocator, Dim, OMatrix, OVector, U1, allocator::Allocator,
 };
 
-use super::place::{check_targets, conjugate_pairs, heap};
+use super::Design;
+use super::place::{conjugate_pairs, heap};
+use super::system::{PoleTargets, targets};
 use crate::analysis::{eigenvalues_near, krylov, rank};
 use crate::error::Error;
 use crate::kernels::linalg::{Lu, SystemAlloc, dotc, householder_q, mul, norm};
-use crate::model::{Domain, DynStateSpace, StateSpace};
+use crate::model::Token;
+#[cfg(doc)]
+use crate::model::{DynStateSpace, StateSpace};
 
 /// Sweeps over all eigenvectors at most (SciPy's `place_poles` default).
 const MAX_SWEEPS: usize = 30;
@@ -34,7 +38,7 @@ type CVector<R> = OVector<Complex<f64>, R>;
 /// MATLAB's and python-control's `place` (python-control through SciPy's
 /// `place_poles`, which uses the Tits–Yang refinement of the same idea).
 ///
-/// # Discretization
+/// # Algorithm
 ///
 /// With `B = [U₀ U₁] [Z; 0]` (QR, `B` of full column rank `M`), the
 /// eigenvector `x_j` of a target `λ_j` can be any vector of
@@ -53,12 +57,18 @@ type CVector<R> = OVector<Complex<f64>, R>;
 /// The achieved poles (eigenvalues of `A − B K`) are then checked: each
 /// must be within `1e-6 · max(1, |target|)` of its target (python-control's
 /// tests check six decimals). Works for continuous (`s`) and discrete (`z`)
-/// models alike. For a single input, [`acker`](crate::design::acker) gives
-/// the same gain by Ackermann's formula.
+/// models alike, of either size ([`Design`]): a fixed-size model takes an
+/// array of exactly `N` targets and returns an `SMatrix<f64, M, N>`, a
+/// [`DynStateSpace`] any list of `n` targets (counted when called) and
+/// returns a `DMatrix`. Targets are any [`PoleTargets`]: real ones as plain
+/// `f64`, complex ones as `Complex<f64>`. For a single input,
+/// [`acker`](crate::design::acker) gives the same gain by Ackermann's
+/// formula.
 ///
 /// # Errors
 ///
-/// [`Error::InvalidParameter`] named `"poles"` for a non-finite target,
+/// [`Error::LengthMismatch`] named `"poles"` unless there are `n` targets
+/// (a run-time-sized model); [`Error::InvalidParameter`] named `"poles"` for a non-finite target,
 /// targets not closed under conjugation, or a target repeated more than
 /// `M` times (a closed loop with more equal poles than inputs is defective:
 /// no eigenvector basis exists); [`Error::InvalidMatrix`] named `"B"`
@@ -88,14 +98,18 @@ type CVector<R> = OVector<Complex<f64>, R>;
 /// let achieved = StateSpace::continuous(a - b * k, b, sys.c().clone_owned(), *sys.d())?.poles()?;
 /// assert!((achieved[0] - Complex::new(-40.0, 0.0)).norm() < 1e-6 * 40.0);
 /// assert!((achieved[3] - Complex::new(-20.0, 20.0)).norm() < 1e-6 * 40.0);
+///
+/// // Real targets as plain numbers; the model sized at run time gives the
+/// // same gain.
+/// let k = place(&sys, [-5.0, -6.0, -7.0, -8.0])?;
+/// let dynamic = ctrlab::DynStateSpace::from(&sys);
+/// assert_eq!(place(&dynamic, [-5.0, -6.0, -7.0, -8.0])?.as_slice(), k.as_slice());
+/// assert!(place(&dynamic, &[-5.0, -6.0, -7.0][..]).is_err()); // three targets, four states
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[doc(alias = "place_poles")]
-pub fn place<const N: usize, const M: usize, const P: usize, D: Domain>(
-    sys: &StateSpace<N, M, P, D>,
-    poles: &[Complex<f64>; N],
-) -> Result<SMatrix<f64, M, N>, Error> {
-    place_pair(sys.a(), sys.b(), poles)
+pub fn place<S: Design>(sys: &S, poles: impl PoleTargets<S::States>) -> Result<S::Gain, Error> {
+    sys.place_gain(Token(()), &targets(&poles))
 }
 
 /// The observer gain `L` that puts the poles of `A − L C` at `poles`: a
@@ -104,6 +118,7 @@ pub fn place<const N: usize, const M: usize, const P: usize, D: Domain>(
 /// do it. For a discrete model this is the gain of the predictor form
 /// `x̂[k+1] = A x̂[k] + B u[k] + L (y[k] − C x̂[k] − D u[k])`; an
 /// [`Observer`](crate::design::Observer) can run it in either form.
+/// Either model size and any [`PoleTargets`], as [`place`].
 ///
 /// # Errors
 ///
@@ -121,89 +136,27 @@ pub fn place<const N: usize, const M: usize, const P: usize, D: Domain>(
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
 ///     .with_output(ctrlab::lab::position_output_matrix(), matrix![0.0; 0.0])?;
-/// let targets = [-100.0, -100.0, -150.0, -150.0].map(|re| Complex::new(re, 0.0));
-/// let l = place_observer(&plant, &targets)?;
+/// let l = place_observer(&plant, [-100.0, -100.0, -150.0, -150.0])?;
 /// let error_dynamics = plant.a() - l * plant.c();
 /// let trace: f64 = error_dynamics.trace();
 /// assert!((trace + 500.0).abs() < 1e-6); // the sum of the poles
+///
+/// // Complex targets, and the model sized at run time: the same gain.
+/// let targets = [-100.0, -100.0, -150.0, -150.0].map(|re| Complex::new(re, 0.0));
+/// let dynamic = ctrlab::DynStateSpace::from(&plant);
+/// assert_eq!(place_observer(&dynamic, &targets)?.as_slice(), l.as_slice());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[doc(alias = "luenberger")]
-pub fn place_observer<const N: usize, const M: usize, const P: usize, D: Domain>(
-    sys: &StateSpace<N, M, P, D>,
-    poles: &[Complex<f64>; N],
-) -> Result<SMatrix<f64, N, P>, Error> {
-    observer_pair(sys.a(), sys.c(), poles)
-}
-
-impl<D: Domain> DynStateSpace<D> {
-    /// The state gain `K` (`m × n`) that puts the poles of `A − B K` at
-    /// `poles` (`n` of them; `s` in rad/s or `z`), by the robust method of
-    /// [`place`], the same code: of all gains that place the poles, one with
-    /// well-conditioned closed-loop eigenvectors.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::LengthMismatch`] named `"poles"` unless there are `n`
-    /// targets; as [`place`] otherwise.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{DynStateSpace, MassSpring, Cart};
-    /// use nalgebra::Complex;
-    ///
-    /// let plant = DynStateSpace::from(MassSpring::nominal().state_space(Cart::Two)?);
-    /// let targets = [Complex::new(-30.0, 30.0), Complex::new(-30.0, -30.0),
-    ///                Complex::new(-40.0, 0.0), Complex::new(-50.0, 0.0)];
-    /// let k = plant.place(&targets)?;
-    /// assert_eq!(k.shape(), (1, 4));
-    /// let closed = DynStateSpace::continuous(plant.a() - plant.b() * &k, plant.b().clone(),
-    ///                                        plant.c().clone(), plant.d().clone())?;
-    /// let p = closed.poles()?;
-    /// assert!((p[0] - Complex::new(-50.0, 0.0)).norm() < 1e-6 * 50.0);
-    /// assert!((p[3] - Complex::new(-30.0, 30.0)).norm() < 1e-6 * 50.0);
-    /// assert!(plant.place(&targets[..3]).is_err());
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    #[doc(alias = "place_poles")]
-    pub fn place(&self, poles: &[Complex<f64>]) -> Result<DMatrix<f64>, Error> {
-        check_targets(poles, self.states())?;
-        place_pair(self.a(), self.b(), poles)
-    }
-
-    /// The observer gain `L` (`n × p`) that puts the poles of `A − L C` at
-    /// `poles`: [`place_observer`], the same code (placement on the dual
-    /// `(Aᵀ, Cᵀ)`).
-    ///
-    /// # Errors
-    ///
-    /// [`Error::LengthMismatch`] named `"poles"` unless there are `n`
-    /// targets; as [`place_observer`] otherwise.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::DynStateSpace;
-    /// use nalgebra::{Complex, dmatrix};
-    ///
-    /// // A double integrator, position measured; error poles at −10, −20.
-    /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; 0.0, 0.0], dmatrix![0.0; 1.0],
-    ///                                     dmatrix![1.0, 0.0], dmatrix![0.0])?;
-    /// let l = sys.place_observer(&[Complex::new(-10.0, 0.0), Complex::new(-20.0, 0.0)])?;
-    /// // (s + 10)(s + 20) = s² + 30 s + 200: L = [30; 200].
-    /// assert!((l[(0, 0)] - 30.0).abs() < 1e-9 && (l[(1, 0)] - 200.0).abs() < 1e-9);
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    #[doc(alias = "luenberger")]
-    pub fn place_observer(&self, poles: &[Complex<f64>]) -> Result<DMatrix<f64>, Error> {
-        check_targets(poles, self.states())?;
-        observer_pair(self.a(), self.c(), poles)
-    }
+pub fn place_observer<S: Design>(
+    sys: &S,
+    poles: impl PoleTargets<S::States>,
+) -> Result<S::ObserverGain, Error> {
+    sys.observer_gain(Token(()), &targets(&poles))
 }
 
 /// [`place_observer`] on a bare pair `(A, C)`.
-fn observer_pair<N: Dim, P: Dim>(
+pub(super) fn observer_pair<N: Dim, P: Dim>(
     a: &OMatrix<f64, N, N>,
     c: &OMatrix<f64, P, N>,
     poles: &[Complex<f64>],
@@ -226,7 +179,7 @@ where
 /// [`place`] on a bare pair `(A, B)` with one target per state (the
 /// callers' check). Written once over nalgebra's dimensions, so a
 /// fixed-size model's sweeps run on stack matrices.
-fn place_pair<N: Dim, M: Dim>(
+pub(super) fn place_pair<N: Dim, M: Dim>(
     a: &OMatrix<f64, N, N>,
     b: &OMatrix<f64, N, M>,
     poles: &[Complex<f64>],

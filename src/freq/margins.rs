@@ -7,7 +7,7 @@
 use std::f64::consts::PI;
 
 use super::poly;
-use super::response::point;
+use super::response::{FrequencyDomain, point, siso_transfer_function};
 use super::tf::TransferFunction;
 use crate::error::Error;
 use crate::model::{Domain, period_of};
@@ -233,6 +233,12 @@ pub struct DelayMargin {
 /// is closed with negative feedback, `1 + L = 0` at instability).
 /// Each is `None` where its crossing does not exist.
 ///
+/// `L` is any [`FrequencyDomain`] model: a [`TransferFunction`], a
+/// [`Zpk`](super::Zpk), a 1 × 1 [`TransferMatrix`](super::TransferMatrix),
+/// or a `StateSpace` / `DynStateSpace` with one input and one output, which
+/// is converted by [`TransferFunction::from_state_space`] first (the same
+/// numbers as converting it yourself).
+///
 /// Definitions (frequencies in rad/s; a discrete `L` is evaluated at
 /// `z = e^(jω dt)`, `0 ≤ ω ≤ π/dt`):
 ///
@@ -258,7 +264,10 @@ pub struct DelayMargin {
 ///
 /// # Errors
 ///
-/// The errors of the polynomial root computations ([`Error::Overflow`],
+/// [`Error::DimensionMismatch`] named `"D"` (expected 1 × 1) for a model
+/// with several inputs or outputs; the errors of
+/// [`TransferFunction::from_state_space`] for a state-space model; the
+/// errors of the polynomial root computations ([`Error::Overflow`],
 /// [`Error::NoConvergence`]).
 ///
 /// # Examples
@@ -274,11 +283,25 @@ pub struct DelayMargin {
 /// // A stable first-order lag with gain below 1: no crossing at all.
 /// let m = stability_margins(&TransferFunction::continuous(&[0.5], &[1.0, 1.0])?)?;
 /// assert!(m.gain.is_none() && m.phase.is_none() && m.delay.is_none());
+///
+/// // A state-space loop directly: the lab's plant under 2000 N/m of
+/// // position feedback, the same margins as through its transfer function.
+/// use ctrlab::{Cart, MassSpring};
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+/// let loop_ss = ctrlab::StateSpace::continuous(*plant.a(), *plant.b(), plant.c() * 2000.0, *plant.d())?;
+/// let m = stability_margins(&loop_ss)?;
+/// assert_eq!(m, stability_margins(&TransferFunction::try_from(&loop_ss)?)?);
+/// assert!(m.phase.is_some());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[doc(alias = "margin")]
 #[doc(alias = "allmargin")]
-pub fn stability_margins<D: Domain>(l: &TransferFunction<D>) -> Result<Margins, Error> {
+pub fn stability_margins(l: &impl FrequencyDomain) -> Result<Margins, Error> {
+    margins(siso_transfer_function(l)?.as_ref())
+}
+
+/// [`stability_margins`] of a transfer function.
+fn margins<D: Domain>(l: &TransferFunction<D>) -> Result<Margins, Error> {
     let period = period_of(&l.domain());
     let at = |w: f64| l.evaluate(point(period, w));
     let mut gain: Option<GainMargin> = None;
@@ -343,7 +366,8 @@ pub struct Margins {
     pub delay: Option<DelayMargin>,
 }
 
-/// The bandwidth of a SISO model: the first frequency (rad/s) at which
+/// The bandwidth of a SISO model of any type ([`FrequencyDomain`], as
+/// [`stability_margins`]): the first frequency (rad/s) at which
 /// `|G|` falls `|dbdrop|` dB below the DC gain `|G(0)|` (`|G(1)|` for a
 /// discrete model), python-control's `bandwidth(sys, dbdrop)`;
 /// `dbdrop = −3.0` is the usual choice. `None` if it never does (for a
@@ -357,8 +381,10 @@ pub struct Margins {
 /// # Errors
 ///
 /// [`Error::InvalidParameter`] (`"dbdrop"`) unless it is finite and
-/// negative; [`Error::Singular`] for an infinite DC gain (python-control
-/// returns `nan`); the errors of the root computations.
+/// negative; [`Error::DimensionMismatch`] named `"D"` for a model with
+/// several inputs or outputs; [`Error::Singular`] for an infinite DC gain
+/// (python-control returns `nan`); the errors of
+/// [`TransferFunction::from_state_space`] and of the root computations.
 ///
 /// # Examples
 ///
@@ -370,9 +396,14 @@ pub struct Margins {
 /// let wb = bandwidth(&g, -20.0 * 2f64.sqrt().log10())?.unwrap();
 /// assert!((wb - 10.0).abs() < 1e-12);
 /// assert!(bandwidth(&g, 0.0).is_err());
+///
+/// // The same lag as a state-space model: the same bandwidth.
+/// let sys = ctrlab::StateSpace::continuous(nalgebra::matrix![-10.0], nalgebra::matrix![10.0],
+///                                          nalgebra::matrix![1.0], nalgebra::matrix![0.0])?;
+/// assert_eq!(bandwidth(&sys, -3.0)?, bandwidth(&TransferFunction::try_from(&sys)?, -3.0)?);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn bandwidth<D: Domain>(g: &TransferFunction<D>, dbdrop: f64) -> Result<Option<f64>, Error> {
+pub fn bandwidth(g: &impl FrequencyDomain, dbdrop: f64) -> Result<Option<f64>, Error> {
     if !(dbdrop.is_finite() && dbdrop < 0.0) {
         return Err(Error::InvalidParameter {
             name: "dbdrop",
@@ -380,6 +411,14 @@ pub fn bandwidth<D: Domain>(g: &TransferFunction<D>, dbdrop: f64) -> Result<Opti
             reason: "the drop must be finite and negative (dB)",
         });
     }
+    crossing_below_dc(siso_transfer_function(g)?.as_ref(), dbdrop)
+}
+
+/// [`bandwidth`] of a transfer function, `dbdrop` checked.
+fn crossing_below_dc<D: Domain>(
+    g: &TransferFunction<D>,
+    dbdrop: f64,
+) -> Result<Option<f64>, Error> {
     let dc = g.dc_gain()?.abs();
     let level = dc * 10f64.powf(dbdrop / 20.0);
     if level == 0.0 {

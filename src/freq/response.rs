@@ -2,6 +2,7 @@
 //! views [`Bode`] and [`Nyquist`], for every model type through
 //! [`FrequencyDomain`].
 
+use std::borrow::Cow;
 use std::f64::consts::PI;
 
 use nalgebra::Complex;
@@ -61,12 +62,44 @@ pub(crate) fn point(period: Option<f64>, w: f64) -> C64 {
 }
 
 mod sealed {
-    pub trait Sealed {}
+    use std::borrow::Cow;
+
+    use super::TransferFunction;
+    use crate::error::Error;
+    use crate::model::Domain;
+
+    /// Seals [`FrequencyDomain`](super::FrequencyDomain) and gives the
+    /// margin and bandwidth code each model's transfer function.
+    pub trait Sealed {
+        /// The model's time domain.
+        type Domain: Domain;
+
+        /// The model as one SISO transfer function;
+        /// [`Error::DimensionMismatch`] named `"D"` (expected 1 × 1) for a
+        /// model with several inputs or outputs.
+        fn siso_transfer_function(&self) -> Result<Cow<'_, TransferFunction<Self::Domain>>, Error>;
+    }
+}
+
+/// [`Error::DimensionMismatch`] named `"D"` for a `outputs × inputs` model
+/// where a SISO one is needed.
+fn not_siso(outputs: usize, inputs: usize) -> Error {
+    Error::DimensionMismatch {
+        matrix: "D",
+        expected_rows: 1,
+        expected_cols: 1,
+        found_rows: outputs,
+        found_cols: inputs,
+    }
 }
 
 /// A linear model whose frequency response can be evaluated:
 /// [`StateSpace`], [`DynStateSpace`], [`TransferFunction`],
-/// [`TransferMatrix`] and [`Zpk`], continuous or discrete.
+/// [`TransferMatrix`] and [`Zpk`], continuous or discrete. [`bode`],
+/// [`nyquist`], [`frequency_response`],
+/// [`stability_margins`](super::stability_margins) and
+/// [`bandwidth`](super::bandwidth) take any of them (the last two a SISO
+/// one, checked when called).
 ///
 /// Continuous models are evaluated at `s = jω`, discrete ones at
 /// `z = e^(jω dt)`, for `ω` in rad/s. Discrete responses are periodic in
@@ -523,14 +556,16 @@ fn siso(r: FrequencyResponse) -> Result<FrequencyResponse, Error> {
     if r.outputs == 1 && r.inputs == 1 {
         Ok(r)
     } else {
-        Err(Error::DimensionMismatch {
-            matrix: "D",
-            expected_rows: 1,
-            expected_cols: 1,
-            found_rows: r.outputs,
-            found_cols: r.inputs,
-        })
+        Err(not_siso(r.outputs, r.inputs))
     }
+}
+
+/// The model as one SISO transfer function, for the margins and the
+/// bandwidth.
+pub(crate) fn siso_transfer_function<S: FrequencyDomain>(
+    sys: &S,
+) -> Result<Cow<'_, TransferFunction<<S as sealed::Sealed>::Domain>>, Error> {
+    sys.siso_transfer_function()
 }
 
 /// The state-space response through the Hessenberg kernel.
@@ -553,7 +588,13 @@ fn state_space_response<D: Domain>(
     })
 }
 
-impl<D: Domain> sealed::Sealed for DynStateSpace<D> {}
+impl<D: Domain> sealed::Sealed for DynStateSpace<D> {
+    type Domain = D;
+
+    fn siso_transfer_function(&self) -> Result<Cow<'_, TransferFunction<D>>, Error> {
+        TransferFunction::from_state_space(self).map(Cow::Owned)
+    }
+}
 impl<D: Domain> FrequencyDomain for DynStateSpace<D> {
     fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
         state_space_response(self, omega)
@@ -563,6 +604,14 @@ impl<D: Domain> FrequencyDomain for DynStateSpace<D> {
 impl<const N: usize, const M: usize, const P: usize, D: Domain> sealed::Sealed
     for StateSpace<N, M, P, D>
 {
+    type Domain = D;
+
+    fn siso_transfer_function(&self) -> Result<Cow<'_, TransferFunction<D>>, Error> {
+        if (M, P) != (1, 1) {
+            return Err(not_siso(P, M));
+        }
+        TransferFunction::from_state_space(&DynStateSpace::from(self)).map(Cow::Owned)
+    }
 }
 impl<const N: usize, const M: usize, const P: usize, D: Domain> FrequencyDomain
     for StateSpace<N, M, P, D>
@@ -602,14 +651,29 @@ fn pointwise<D: Domain>(
     })
 }
 
-impl<D: Domain> sealed::Sealed for TransferFunction<D> {}
+impl<D: Domain> sealed::Sealed for TransferFunction<D> {
+    type Domain = D;
+
+    fn siso_transfer_function(&self) -> Result<Cow<'_, TransferFunction<D>>, Error> {
+        Ok(Cow::Borrowed(self))
+    }
+}
 impl<D: Domain> FrequencyDomain for TransferFunction<D> {
     fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
         pointwise(1, 1, self.domain(), omega, |_, s| self.evaluate(s))
     }
 }
 
-impl<D: Domain> sealed::Sealed for TransferMatrix<D> {}
+impl<D: Domain> sealed::Sealed for TransferMatrix<D> {
+    type Domain = D;
+
+    fn siso_transfer_function(&self) -> Result<Cow<'_, TransferFunction<D>>, Error> {
+        match self.entries() {
+            [g] => Ok(Cow::Borrowed(g)),
+            _ => Err(not_siso(self.outputs(), self.inputs())),
+        }
+    }
+}
 impl<D: Domain> FrequencyDomain for TransferMatrix<D> {
     fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
         let domain = self.entries()[0].domain();
@@ -619,7 +683,13 @@ impl<D: Domain> FrequencyDomain for TransferMatrix<D> {
     }
 }
 
-impl<D: Domain> sealed::Sealed for Zpk<D> {}
+impl<D: Domain> sealed::Sealed for Zpk<D> {
+    type Domain = D;
+
+    fn siso_transfer_function(&self) -> Result<Cow<'_, TransferFunction<D>>, Error> {
+        self.to_transfer_function().map(Cow::Owned)
+    }
+}
 impl<D: Domain> FrequencyDomain for Zpk<D> {
     fn frequency_response(&self, omega: &[f64]) -> Result<FrequencyResponse, Error> {
         pointwise(1, 1, self.domain(), omega, |_, s| self.evaluate(s))

@@ -145,6 +145,65 @@ pub struct StepInfo {
     pub steady_state_error: Option<f64>,
 }
 
+impl std::fmt::Display for StepInfo {
+    /// One figure per line, with its unit: times in s, overshoot and
+    /// undershoot in %, values in the units of `y` (none printed). Numbers
+    /// to five significant digits (`{}`), to a number of decimals
+    /// (`{:.3}`), or exactly (`{:#}`); the steady-state error only when a
+    /// reference was given.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{StateSpace, StepInfoOptions, step_info_of};
+    /// use nalgebra::matrix;
+    ///
+    /// // ωn = 10 rad/s, ζ = 0.5: about 16 % overshoot.
+    /// let sys = StateSpace::continuous(matrix![0.0, 1.0; -100.0, -10.0], matrix![0.0; 100.0],
+    ///                                  matrix![1.0, 0.0], matrix![0.0])?;
+    /// let info = step_info_of(&sys, 3.0, 0.001, &StepInfoOptions { reference: Some(1.0), ..Default::default() })?;
+    /// assert_eq!(format!("{info:.3}"), "\
+    /// rise time           0.164 s
+    /// settling time       0.808 s
+    /// transient time      0.808 s
+    /// overshoot           16.303 %
+    /// undershoot          0.000 %
+    /// peak                1.163 at 0.363 s
+    /// settling min        0.902
+    /// settling max        1.163
+    /// steady-state value  1.000
+    /// steady-state error  0.000
+    /// ");
+    /// assert!(info.to_string().starts_with("rise time           0.16"));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use crate::model::display::number;
+        let n = |v: f64| number(v, f);
+        let mut rows = vec![
+            ("rise time", format!("{} s", n(self.rise_time))),
+            ("settling time", format!("{} s", n(self.settling_time))),
+            ("transient time", format!("{} s", n(self.transient_time))),
+            ("overshoot", format!("{} %", n(self.overshoot))),
+            ("undershoot", format!("{} %", n(self.undershoot))),
+            (
+                "peak",
+                format!("{} at {} s", n(self.peak), n(self.peak_time)),
+            ),
+            ("settling min", n(self.settling_min)),
+            ("settling max", n(self.settling_max)),
+            ("steady-state value", n(self.steady_state_value)),
+        ];
+        if let Some(e) = self.steady_state_error {
+            rows.push(("steady-state error", n(e)));
+        }
+        for (label, value) in rows {
+            writeln!(f, "{label:<20}{value}")?;
+        }
+        Ok(())
+    }
+}
+
 /// Options for [`step_info`] and the model variants. `Default` gives the
 /// crate's definitions with a 2 % band, 10–90 % rise, initial value from the
 /// first sample, final value from the last 5 % of the record, no reference;

@@ -5,8 +5,9 @@ use super::step_info::{Crossings, measure};
 use super::{StepInfo, StepInfoOptions, step_info};
 use crate::data::Recording;
 use crate::error::Error;
-use crate::model::{Domain, DynStateSpace, StateSpace, period_of};
 #[cfg(doc)]
+use crate::model::StateSpace;
+use crate::model::{Domain, DynStateSpace, LinearSystem, Siso, Token, period_of};
 use crate::sim::step_response;
 
 /// Step-response figures of a stable single-input single-output model,
@@ -19,8 +20,14 @@ use crate::sim::step_response;
 /// the step) under MATLAB's. A discrete model's crossing times are sample
 /// times (see the [module docs](super#definitions)).
 ///
+/// Either model size ([`Siso`]: a fixed-size model with one input and one
+/// output, or a `DynStateSpace`, whose sizes are checked when called); the
+/// same code and numbers for both.
+///
 /// # Errors
 ///
+/// [`Error::DimensionMismatch`] unless a run-time-sized model has one
+/// input (named `"B"`) and one output (named `"C"`);
 /// [`Error::Unstable`] naming the first unstable pole; errors of
 /// [`dc_gain`](StateSpace::dc_gain), [`step_response`] and [`step_info`]
 /// (in particular [`Error::NotSettled`] if `t_end` is too short).
@@ -41,16 +48,43 @@ use crate::sim::step_response;
 /// let di = step_info_of(&d, 2.0, d.dt(), &StepInfoOptions::default())?;
 /// assert!((di.settling_time / 0.002 - (di.settling_time / 0.002).round()).abs() < 1e-9);
 /// assert!((di.settling_time - info.settling_time).abs() <= 0.002);
+///
+/// // The loop sized at run time: the same figures.
+/// let dynamic = step_info_of(&ctrlab::DynStateSpace::from(&cl), 2.0, 0.0005,
+///                            &StepInfoOptions { reference: Some(1.0), ..Default::default() })?;
+/// assert_eq!(dynamic, info);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn step_info_of<const N: usize, D: Domain>(
-    sys: &StateSpace<N, 1, 1, D>,
+#[doc(alias = "stepinfo")]
+pub fn step_info_of<S: Siso>(
+    sys: &S,
     t_end: f64,
     dt: f64,
     options: &StepInfoOptions,
 ) -> Result<StepInfo, Error> {
-    let [[info]] = channels(sys, t_end, dt, options)?;
-    info
+    let (n, m, p) = (sys.states(), sys.inputs(), sys.outputs());
+    if m != 1 || p != 1 {
+        let (matrix, rows, cols, found_rows, found_cols) = if m != 1 {
+            ("B", n, 1, n, m)
+        } else {
+            ("C", 1, n, p, n)
+        };
+        return Err(Error::DimensionMismatch {
+            matrix,
+            expected_rows: rows,
+            expected_cols: cols,
+            found_rows,
+            found_cols,
+        });
+    }
+    channels(&sys.to_dyn(Token(())), t_end, dt, options)?
+        .pop()
+        .and_then(|mut row| row.pop())
+        .unwrap_or(Err(Error::OutOfRange {
+            what: "channel",
+            index: 0,
+            len: 0,
+        }))
 }
 
 /// Refuses the options that name one number for every channel.
@@ -72,11 +106,12 @@ fn check_mimo_options(options: &StepInfoOptions) -> Result<(), Error> {
     Ok(())
 }
 
-/// Step-response figures of every channel of a stable model with `M`
-/// inputs and `P` outputs, continuous or discrete (MATLAB's `stepinfo` and
-/// python-control's `step_info` of a MIMO model): `[output][input]`, the
-/// figures of output `i` for a unit step on input `j` alone, from rest,
-/// each against its own DC gain, as [`step_info_of`] computes them.
+/// Step-response figures of every channel of a stable model with `m`
+/// inputs and `p` outputs, continuous or discrete, of either size (MATLAB's
+/// `stepinfo` and python-control's `step_info` of a MIMO model):
+/// `[output][input]` (`p` rows of `m`), the figures of output `i` for a
+/// unit step on input `j` alone, from rest, each against its own DC gain,
+/// as [`step_info_of`] computes them.
 ///
 /// Each channel has its own `Result`: a channel with no step (a zero DC
 /// gain, as between the blocks of a block-diagonal model) is
@@ -107,45 +142,27 @@ fn check_mimo_options(options: &StepInfoOptions) -> Result<(), Error> {
 /// assert!((slow.rise_time - 9f64.ln()).abs() < 1e-6);
 /// // Input 2 does not reach output 1.
 /// assert!(matches!(info[0][1], Err(Error::InvalidData { .. })));
+/// // The same figures for the model sized at run time.
+/// let dynamic = step_info_mimo(&ctrlab::DynStateSpace::from(&sys), 10.0, 0.001, &StepInfoOptions::default())?;
+/// assert_eq!(dynamic, info);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn step_info_mimo<const N: usize, const M: usize, const P: usize, D: Domain>(
-    sys: &StateSpace<N, M, P, D>,
+pub fn step_info_mimo<S: LinearSystem>(
+    sys: &S,
     t_end: f64,
     dt: f64,
     options: &StepInfoOptions,
-) -> Result<[[Result<StepInfo, Error>; M]; P], Error> {
+) -> Result<Vec<Vec<Result<StepInfo, Error>>>, Error> {
     check_mimo_options(options)?;
-    channels(sys, t_end, dt, options)
-}
-
-/// The figures of every channel of a fixed-size model, by
-/// [`channels_dyn`] (the one implementation).
-fn channels<const N: usize, const M: usize, const P: usize, D: Domain>(
-    sys: &StateSpace<N, M, P, D>,
-    t_end: f64,
-    dt: f64,
-    options: &StepInfoOptions,
-) -> Result<[[Result<StepInfo, Error>; M]; P], Error> {
-    let mut rows = channels_dyn(&DynStateSpace::from(sys), t_end, dt, options)?.into_iter();
-    // `channels_dyn` returns P rows of M figures; the fallbacks are never
-    // taken, and are errors rather than panics.
-    let missing = |index| {
-        Err(Error::OutOfRange {
-            what: "channel",
-            index,
-            len: M * P,
-        })
-    };
-    Ok(core::array::from_fn(|i| {
-        let mut row = rows.next().unwrap_or_default().into_iter();
-        core::array::from_fn(|j| row.next().unwrap_or_else(|| missing(i * M + j)))
-    }))
+    channels(&sys.to_dyn(Token(())), t_end, dt, options)
 }
 
 /// The figures of every channel, `[output][input]`; `options.final_value`,
 /// when given, serves them all (the callers allow it for one channel only).
-fn channels_dyn<D: Domain>(
+/// Written once, on the model sized at run time (a fixed-size model is
+/// copied to the heap: one copy, for a computation that allocates its
+/// responses anyway).
+fn channels<D: Domain>(
     sys: &DynStateSpace<D>,
     t_end: f64,
     dt: f64,
@@ -169,7 +186,7 @@ fn channels_dyn<D: Domain>(
     };
     let mut responses = Vec::with_capacity(sys.inputs());
     for j in 0..sys.inputs() {
-        responses.push(sys.select_input(j)?.step_response(t_end, dt)?);
+        responses.push(step_response(&sys.select_input(j)?, t_end, dt)?);
     }
     Ok((0..sys.outputs())
         .map(|i| {
@@ -192,95 +209,6 @@ fn channels_dyn<D: Domain>(
                 .collect()
         })
         .collect())
-}
-
-impl<D: Domain> DynStateSpace<D> {
-    /// Step-response figures of a stable single-input single-output model,
-    /// continuous or discrete: [`step_info_of`] for a model sized at run
-    /// time, the same code (its unit step response on
-    /// [`time_grid`](crate::sim::time_grid)`(t_end, dt)`, s, against its DC
-    /// gain unless `options.final_value` says otherwise).
-    ///
-    /// # Errors
-    ///
-    /// [`Error::DimensionMismatch`] unless the model has one input (named
-    /// `"B"`) and one output (named `"C"`); as [`step_info_of`] otherwise.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{DynStateSpace, StepInfoOptions};
-    /// use nalgebra::dmatrix;
-    ///
-    /// // A first-order lag, τ = 0.1 s: rise time τ ln 9, 2 % settling τ ln 50.
-    /// let lag = DynStateSpace::continuous(dmatrix![-10.0], dmatrix![10.0], dmatrix![1.0], dmatrix![0.0])?;
-    /// let info = lag.step_info(2.0, 0.01, &StepInfoOptions::default())?;
-    /// assert!((info.rise_time - 0.1 * 9f64.ln()).abs() < 1e-3);
-    /// assert!((info.settling_time - 0.1 * 50f64.ln()).abs() < 1e-3);
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    #[doc(alias = "stepinfo")]
-    pub fn step_info(
-        &self,
-        t_end: f64,
-        dt: f64,
-        options: &StepInfoOptions,
-    ) -> Result<StepInfo, Error> {
-        let (n, m, p) = (self.states(), self.inputs(), self.outputs());
-        if m != 1 || p != 1 {
-            let (matrix, rows, cols, found_rows, found_cols) = if m != 1 {
-                ("B", n, 1, n, m)
-            } else {
-                ("C", 1, n, p, n)
-            };
-            return Err(Error::DimensionMismatch {
-                matrix,
-                expected_rows: rows,
-                expected_cols: cols,
-                found_rows,
-                found_cols,
-            });
-        }
-        channels_dyn(self, t_end, dt, options)?
-            .pop()
-            .and_then(|mut row| row.pop())
-            .unwrap_or(Err(Error::OutOfRange {
-                what: "channel",
-                index: 0,
-                len: 0,
-            }))
-    }
-
-    /// Step-response figures of every channel, `[output][input]`:
-    /// [`step_info_mimo`] for a model sized at run time, the same code.
-    ///
-    /// # Errors
-    ///
-    /// As [`step_info_mimo`].
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{DynStateSpace, Error, StepInfoOptions};
-    /// use nalgebra::dmatrix;
-    ///
-    /// // Two lags, τ = 0.1 s and 1 s, one per input and output.
-    /// let sys = DynStateSpace::continuous(dmatrix![-10.0, 0.0; 0.0, -1.0], dmatrix![10.0, 0.0; 0.0, 1.0],
-    ///                                     dmatrix![1.0, 0.0; 0.0, 1.0], dmatrix![0.0, 0.0; 0.0, 0.0])?;
-    /// let info = sys.step_info_mimo(10.0, 0.001, &StepInfoOptions::default())?;
-    /// assert!((info[1][1].as_ref().unwrap().rise_time - 9f64.ln()).abs() < 1e-6);
-    /// assert!(matches!(info[0][1], Err(Error::InvalidData { .. })));
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn step_info_mimo(
-        &self,
-        t_end: f64,
-        dt: f64,
-        options: &StepInfoOptions,
-    ) -> Result<Vec<Vec<Result<StepInfo, Error>>>, Error> {
-        check_mimo_options(options)?;
-        channels_dyn(self, t_end, dt, options)
-    }
 }
 
 /// [`step_info`] of channel `channel` of a recording (from the rig's loop or

@@ -14,13 +14,17 @@ use crate::model::{Continuous, Discrete, Domain, StateSpace};
 /// `y = C x + D u` in continuous time, `x[k+1] = A x[k] + B u[k]` with period
 /// `dt` s in discrete time. The matrices are nalgebra [`DMatrix`]es on the
 /// heap; the design-time algorithms (poles, Riccati equations, frequency
-/// responses) run on them through faer. Analysis (`poles`, `is_stable`,
-/// `dc_gain`, `controllability`, `damping`, …), `discretize`, the standard
-/// responses (`step_response`, …, returning a
-/// [`DynResponse`](crate::sim::DynResponse)), `step_info` and pole placement
-/// (`place`, `place_observer`, `acker`) are methods, running the same code
-/// as the fixed-size functions. Convert from a fixed-size model with
-/// `From`, and back with `TryFrom`, which checks the sizes:
+/// responses) run on them through faer. Its properties are methods, as on
+/// [`StateSpace`]: analysis (`poles`, `is_stable`, `dc_gain`,
+/// `controllability`, `damping`, …), `discretize`, `zeros`, the
+/// interconnections (`series`, `parallel`, `feedback`, `append`) and input
+/// and output selection. What is computed *from* a model (a design, a
+/// response, step figures, a frequency response) is a free function that
+/// takes either model type (`lqr(&sys, ..)`, `place(&sys, ..)`,
+/// `step_response(&sys, ..)`, `step_info_of(&sys, ..)`, `bode(&sys, ..)`;
+/// see [`LinearSystem`](crate::LinearSystem)), running the same code as
+/// for a fixed-size model. Convert from a fixed-size model with `From`,
+/// and back with `TryFrom`, which checks the sizes:
 ///
 /// # Examples
 ///

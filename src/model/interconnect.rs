@@ -10,7 +10,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::error::Error;
+use crate::error::{Error, check_len};
 use crate::kernels::reduce::pow2_floor;
 use crate::model::{Domain, DynStateSpace, period_of};
 
@@ -68,15 +68,7 @@ impl<D: Domain> DynStateSpace<D> {
 
     /// A size check between the two sides of a connection.
     fn conforming(what: &'static str, expected: usize, found: usize) -> Result<(), Error> {
-        if expected == found {
-            Ok(())
-        } else {
-            Err(Error::LengthMismatch {
-                what,
-                expected,
-                found,
-            })
-        }
+        check_len(what, expected, found)
     }
 
     /// `self` followed by `next`: `next`'s input is `self`'s output, the
@@ -294,6 +286,32 @@ impl<D: Domain> DynStateSpace<D> {
             block_diag(self.d(), other.d()),
             self.domain(),
         ))
+    }
+
+    /// The model with input `j` alone (`B`'s and `D`'s column `j`), e.g. to
+    /// take the step response of one input of a multi-input model:
+    /// [`StateSpace::select_input`](crate::StateSpace::select_input) for a
+    /// model sized at run time.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::OutOfRange`] (`"input"`) unless `j` is below the number of
+    /// inputs.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::DynStateSpace;
+    /// use nalgebra::dmatrix;
+    ///
+    /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0, 2.0], dmatrix![1.0], dmatrix![0.0, 0.5])?;
+    /// let second = sys.select_input(1)?;
+    /// assert_eq!((second.b(), second.d()), (&dmatrix![2.0], &dmatrix![0.5]));
+    /// assert!(sys.select_input(2).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn select_input(&self, j: usize) -> Result<Self, Error> {
+        self.select_inputs(&[j])
     }
 
     /// The model seen from the listed inputs only, in the order given

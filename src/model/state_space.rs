@@ -268,6 +268,53 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
 }
 
 impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M, P, D> {
+    /// The number of states `N`, as [`DynStateSpace::states`](crate::DynStateSpace::states).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::MassSpring;
+    /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::Two)?;
+    /// assert_eq!((sys.states(), sys.inputs(), sys.outputs()), (4, 1, 1));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[inline]
+    pub const fn states(&self) -> usize {
+        N
+    }
+
+    /// The number of inputs `M`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::StateSpace;
+    /// # use nalgebra::matrix;
+    /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0, 2.0], matrix![1.0], matrix![0.0, 0.0])?;
+    /// assert_eq!(sys.inputs(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[inline]
+    pub const fn inputs(&self) -> usize {
+        M
+    }
+
+    /// The number of outputs `P`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::StateSpace;
+    /// # use nalgebra::matrix;
+    /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0; 2.0], matrix![0.0; 0.0])?;
+    /// assert_eq!(sys.outputs(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    #[inline]
+    pub const fn outputs(&self) -> usize {
+        P
+    }
+
     /// The state matrix `A` (N×N).
     ///
     /// # Examples

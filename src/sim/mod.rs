@@ -7,31 +7,49 @@
 //! delay, saturation and measurement quantisation and noise, producing the
 //! same [`Recording`](crate::Recording) as the rig's loop.
 //!
-//! A model sized at run time ([`DynStateSpace`](crate::DynStateSpace)) has
-//! the same simulations as methods (`sys.step_response(t_end, dt)`, …),
-//! returning a [`DynResponse`]; they run the same loops, generic over the
-//! matrices' dimensions.
+//! Every simulation of a linear model takes either model type through the
+//! sealed trait [`Simulate`] (see [`LinearSystem`] for the calling style)
+//! and returns one [`Response`] type, written over nalgebra's dimensions:
+//! `Response<Const<N>, Const<P>>` with `SVector`s for a `StateSpace`,
+//! [`DynResponse`] (`Response<Dyn, Dyn>`) with `DVector`s for a
+//! `DynStateSpace`. Both run the same loops, generic over the matrices'
+//! dimensions.
 //!
 //! For a fixed-size model the inner loops (the recursion
-//! `x ← A x + B u` of [`StateSpace::advance_mut`], and
-//! [`Integrator::step_mut`]) allocate nothing; the functions here allocate
-//! only their output, once, up front.
+//! `x ← A x + B u` of [`StateSpace::advance_mut`], and the RK4 step of
+//! [`Integrator::step_mut`](crate::integrate::Integrator::step_mut)) allocate
+//! nothing; the functions here allocate only their output, once, up front.
+//!
+//! # Examples
+//!
+//! ```
+//! use ctrlab::{DynStateSpace, StateSpace, sim::step_response};
+//! use nalgebra::matrix;
+//!
+//! // A first-order lag, τ = 0.5 s, as either model type: one call, one result type.
+//! let fixed = StateSpace::continuous(matrix![-2.0], matrix![2.0], matrix![1.0], matrix![0.0])?;
+//! let dynamic = DynStateSpace::from(&fixed);
+//! let (f, d) = (step_response(&fixed, 1.0, 0.5)?, step_response(&dynamic, 1.0, 0.5)?);
+//! assert_eq!(f.t, d.t);
+//! assert_eq!(f.output(0)?, d.output(0)?);
+//! # Ok::<(), ctrlab::Error>(())
+//! ```
 
-use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, SVector, allocator::Allocator};
+use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, allocator::Allocator};
 
-mod dynamic;
 mod responses;
 mod sampled;
 
-pub use dynamic::DynResponse;
 pub use responses::{impulse_response, initial_response, step_response};
 pub use sampled::{SampledConfig, Sensor, run_sampled};
 
 use crate::discretize::{Held, zoh};
-use crate::error::{Error, check_dt};
-use crate::integrate::{Integrator, Rk4};
+use crate::error::{Error, check_dt, check_finite_dyn, check_len};
 use crate::kernels::reduce::max_step_deviation;
-use crate::model::{Continuous, Discrete, StateSpace};
+use crate::model::{
+    Continuous, Discrete, Domain, DynStateSpace, LinearSystem, StateSpace, Token, period_of,
+};
+use responses::Test;
 
 /// Largest number of samples a simulation will allocate for (10⁷, about
 /// 0.5 GB for the lab's 4-state plant); a longer request is almost certainly
@@ -59,25 +77,59 @@ pub const MAX_RK4_STEPS: usize = 100_000_000;
 /// A simulated time response: sample times (s), states and outputs, in the
 /// model's units (SI for the crate's own models). All three have one entry
 /// per sample.
+///
+/// One type for both model sizes, written over nalgebra's dimensions: the
+/// states and outputs of a `StateSpace<N, M, P, _>` are `SVector`s
+/// (`Response<Const<N>, Const<P>>`), those of a `DynStateSpace` `DVector`s
+/// ([`DynResponse`], `Response<Dyn, Dyn>`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{StateSpace, StepInfoOptions, step_info, sim::step_response};
+/// use nalgebra::{Const, matrix};
+///
+/// // A lag, τ = 0.1 s: its step response and the figures of it.
+/// let sys = StateSpace::continuous(matrix![-10.0], matrix![10.0], matrix![1.0], matrix![0.0])?;
+/// let r: ctrlab::sim::Response<Const<1>, Const<1>> = step_response(&sys, 2.0, 0.001)?;
+/// assert_eq!((r.len(), r.x[0].len(), r.y[0].len()), (2001, 1, 1));
+/// let info = step_info(&r.t, &r.output(0)?, &StepInfoOptions::default())?;
+/// assert!((info.rise_time - 0.1 * 9f64.ln()).abs() < 1e-6);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
-pub struct Response<const N: usize, const P: usize> {
+pub struct Response<N: Dim, P: Dim>
+where
+    DefaultAllocator: Allocator<N> + Allocator<P>,
+{
     /// Sample times, s.
     pub t: Vec<f64>,
-    /// State at each sample.
-    pub x: Vec<SVector<f64, N>>,
-    /// Output at each sample.
-    pub y: Vec<SVector<f64, P>>,
+    /// State at each sample (`n` entries each).
+    pub x: Vec<OVector<f64, N>>,
+    /// Output at each sample (`p` entries each).
+    pub y: Vec<OVector<f64, P>>,
 }
 
-impl<const N: usize, const P: usize> Response<N, P> {
-    fn with_capacity(n: usize) -> Self {
-        Self {
-            t: Vec::with_capacity(n),
-            x: Vec::with_capacity(n),
-            y: Vec::with_capacity(n),
-        }
-    }
+/// The [`Response`] of a model sized at run time, its states and outputs
+/// `DVector`s.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{DynStateSpace, sim::{DynResponse, step_response}};
+/// use nalgebra::dmatrix;
+///
+/// let sys = DynStateSpace::continuous(dmatrix![-10.0], dmatrix![10.0], dmatrix![1.0], dmatrix![0.0])?;
+/// let r: DynResponse = step_response(&sys, 1.0, 0.01)?;
+/// assert_eq!((r.len(), r.x[0].len()), (101, 1));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub type DynResponse = Response<Dyn, Dyn>;
 
+impl<N: Dim, P: Dim> Response<N, P>
+where
+    DefaultAllocator: Allocator<N> + Allocator<P>,
+{
     /// Number of samples.
     ///
     /// # Examples
@@ -110,43 +162,147 @@ impl<const N: usize, const P: usize> Response<N, P> {
     ///
     /// # Errors
     ///
-    /// [`Error::OutOfRange`] unless `i < P`.
+    /// [`Error::OutOfRange`] unless `i` is below the number of outputs (`P`
+    /// for a fixed-size model; for a run-time-sized one, the first
+    /// sample's, so an empty response has none).
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::{Error, MassSpring, Cart, sim::step_response};
-    /// let r = step_response(&MassSpring::nominal().state_space(Cart::Two)?, 1.0, 0.01)?;
+    /// # use ctrlab::{DynStateSpace, Error, MassSpring, Cart, sim::step_response};
+    /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+    /// let r = step_response(&plant, 1.0, 0.01)?;
     /// assert_eq!(r.output(0)?.len(), r.len());
     /// assert!(matches!(r.output(1), Err(Error::OutOfRange { index: 1, len: 1, .. })));
+    /// // The same for the model sized at run time.
+    /// let d = step_response(&DynStateSpace::from(&plant), 1.0, 0.01)?;
+    /// assert_eq!(d.output(0)?, r.output(0)?);
+    /// assert!(matches!(d.output(1), Err(Error::OutOfRange { index: 1, len: 1, .. })));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn output(&self, i: usize) -> Result<Vec<f64>, Error> {
-        if i >= P {
+        let outputs = P::try_to_usize().unwrap_or_else(|| self.y.first().map_or(0, |y| y.len()));
+        if i >= outputs {
             return Err(Error::OutOfRange {
                 what: "output",
                 index: i,
-                len: P,
+                len: outputs,
             });
         }
         Ok(self.y.iter().map(|y| y[i]).collect())
     }
+}
 
-    /// The first sample with a non-finite state or output, as the error a
-    /// simulation reports for it.
-    fn check_finite(&self, operation: &'static str) -> Result<(), Error> {
-        let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
-        if self
-            .x
-            .iter()
-            .zip(&self.y)
-            .all(|(x, y)| finite(x.as_slice()) & finite(y.as_slice()))
-        {
-            Ok(())
-        } else {
-            Err(Error::Overflow { operation })
+/// A linear model that can be simulated: [`StateSpace`] and
+/// [`DynStateSpace`], in either time domain. [`simulate`],
+/// [`simulate_discrete`], [`simulate_discrete_feedback`],
+/// [`step_response`], [`impulse_response`] and [`initial_response`] take
+/// one; [`Response`](Self::Response) is what they return.
+///
+/// Sealed: implemented by the two model types only.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{DynStateSpace, StateSpace, sim::{Simulate, initial_response}};
+/// use nalgebra::matrix;
+///
+/// // Written once, for either model size.
+/// fn final_output<S: Simulate<Response = R>, R>(sys: &S, x0: S::State) -> Result<R, ctrlab::Error> {
+///     initial_response(sys, 1.0, 0.5, x0)
+/// }
+/// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+/// let r = final_output(&sys, matrix![1.0])?;
+/// assert!((r.y[2][0] - (-1.0f64).exp()).abs() < 1e-15);
+/// let d = final_output(&DynStateSpace::from(&sys), nalgebra::dvector![1.0])?;
+/// assert_eq!(d.y[2][0], r.y[2][0]);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub trait Simulate: LinearSystem {
+    /// The response: [`Response<Const<N>, Const<P>>`](Response) for a
+    /// `StateSpace<N, M, P, _>`, [`DynResponse`] for a `DynStateSpace`.
+    type Response: std::fmt::Debug + Clone;
+
+    /// A standard test response on the grid of `(t_end, dt)`.
+    #[doc(hidden)]
+    fn respond(
+        &self,
+        _: Token,
+        test: Test<Self::State>,
+        t_end: f64,
+        dt: f64,
+    ) -> Result<Self::Response, Error>;
+
+    /// A continuous simulation over the grid `t`.
+    #[doc(hidden)]
+    fn lsim<F: FnMut(f64) -> Self::Input>(
+        &self,
+        _: Token,
+        t: &[f64],
+        x0: Self::State,
+        input: F,
+        solver: Solver,
+    ) -> Result<Self::Response, Error>;
+
+    /// A discrete simulation of `steps` samples, closed loop.
+    #[doc(hidden)]
+    fn dsim<F: FnMut(usize, &Self::State) -> Self::Input>(
+        &self,
+        _: Token,
+        x0: Self::State,
+        steps: usize,
+        control: F,
+    ) -> Result<Self::Response, Error>;
+}
+
+/// The simulations of both model types: the same code, each on its own
+/// matrices (the types are all that differ).
+macro_rules! simulate_for {
+    ($([$($generics:tt)*] $model:ty => $response:ty),* $(,)?) => {$(
+        impl<$($generics)*> Simulate for $model {
+            type Response = $response;
+
+            fn respond(
+                &self,
+                _: Token,
+                test: Test<Self::State>,
+                t_end: f64,
+                dt: f64,
+            ) -> Result<Self::Response, Error> {
+                let abcd = (self.a(), self.b(), self.c(), self.d());
+                responses::respond(abcd, self.domain(), test, t_end, dt)
+            }
+
+            fn lsim<F: FnMut(f64) -> Self::Input>(
+                &self,
+                _: Token,
+                t: &[f64],
+                x0: Self::State,
+                input: F,
+                solver: Solver,
+            ) -> Result<Self::Response, Error> {
+                let abcd = (self.a(), self.b(), self.c(), self.d());
+                lsim(abcd, period_of(&self.domain()), t, x0, input, solver)
+            }
+
+            fn dsim<F: FnMut(usize, &Self::State) -> Self::Input>(
+                &self,
+                _: Token,
+                x0: Self::State,
+                steps: usize,
+                control: F,
+            ) -> Result<Self::Response, Error> {
+                let abcd = (self.a(), self.b(), self.c(), self.d());
+                dsim(abcd, period_of(&self.domain()), x0, steps, control)
+            }
         }
-    }
+    )*};
+}
+
+simulate_for! {
+    [const N: usize, const M: usize, const P: usize, D: Domain] StateSpace<N, M, P, D>
+        => Response<Const<N>, Const<P>>,
+    [D: Domain] DynStateSpace<D> => DynResponse,
 }
 
 /// How [`simulate`] advances a continuous model between grid points.
@@ -223,33 +379,61 @@ pub fn time_grid(t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
 /// [`Error::InvalidParameter`] named `"t"` for an empty, non-finite or
 /// non-increasing grid (or more than [`MAX_SAMPLES`] points), named
 /// `"substeps"` for zero RK4 sub-steps or more than [`MAX_RK4_STEPS`] in all,
-/// named `"input"` for a non-finite input sample; [`Error::Overflow`] when
-/// the response diverges past `f64::MAX`; errors of
-/// [`discretize`](StateSpace::discretize).
+/// named `"input"` for a non-finite input sample; [`Error::NonFinite`] named
+/// `"x0"` for a non-finite initial state; [`Error::LengthMismatch`] named
+/// `"x0"` or `"input"` for a vector of the wrong length (a run-time-sized
+/// model); [`Error::Overflow`] when the response diverges past `f64::MAX`;
+/// errors of [`discretize`](StateSpace::discretize).
 ///
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Cart, sim::{simulate, time_grid, Solver}};
-/// use nalgebra::vector;
+/// use ctrlab::{DynStateSpace, MassSpring, Cart, sim::{simulate, time_grid, Solver}};
+/// use nalgebra::{DVector, dvector, vector};
 ///
 /// let sys = MassSpring::nominal().state_space(Cart::Two)?;
 /// let t = time_grid(10.0, 0.002)?;
 /// let r = simulate(&sys, &t, vector![0.0, 0.0, 0.0, 0.0], |_t| vector![10.0], Solver::Zoh)?;
 /// // 10 N on cart 2 settles at 20 mm.
 /// assert!((r.y.last().unwrap()[0] - 0.020).abs() < 1e-9);
+///
+/// // The same model sized at run time.
+/// let dynamic = DynStateSpace::from(&sys);
+/// let d = simulate(&dynamic, &t, DVector::zeros(4), |_t| dvector![10.0], Solver::Zoh)?;
+/// assert_eq!(d.output(0)?, r.output(0)?);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[doc(alias = "lsim")]
-pub fn simulate<const N: usize, const M: usize, const P: usize>(
-    sys: &StateSpace<N, M, P, Continuous>,
+pub fn simulate<S: Simulate<Domain = Continuous>>(
+    sys: &S,
     t: &[f64],
-    x0: SVector<f64, N>,
-    mut input: impl FnMut(f64) -> SVector<f64, M>,
+    x0: S::State,
+    input: impl FnMut(f64) -> S::Input,
     solver: Solver,
-) -> Result<Response<N, P>, Error> {
+) -> Result<S::Response, Error> {
+    sys.lsim(Token(()), t, x0, input, solver)
+}
+
+/// [`simulate`] on the matrices of a continuous model (`period` is `None`).
+fn lsim<N: Dim, M: Dim, P: Dim>(
+    (a, b, c, d): Abcd<'_, N, M, P>,
+    period: Option<f64>,
+    t: &[f64],
+    x0: OVector<f64, N>,
+    mut input: impl FnMut(f64) -> OVector<f64, M>,
+    solver: Solver,
+) -> Result<Response<N, P>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
+    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
+{
+    if period.is_some() {
+        return Err(wrong_domain(
+            "a discrete model is simulated by simulate_discrete",
+        ));
+    }
     check_grid(t)?;
-    crate::error::check_finite("x0", &x0)?;
+    check_state(&x0, a.nrows())?;
     if let Solver::Rk4 { substeps } = solver {
         let bad = |reason| Error::InvalidParameter {
             name: "substeps",
@@ -265,31 +449,85 @@ pub fn simulate<const N: usize, const M: usize, const P: usize>(
         }
     }
     let Solver::Rk4 { substeps } = solver else {
-        let (x, y) = lsim_zoh(sys.a(), sys.b(), sys.c(), sys.d(), t, x0, input)?;
+        let (x, y) = lsim_zoh(a, b, c, d, t, x0, input)?;
         return Ok(Response {
             t: t.to_vec(),
             x,
             y,
         });
     };
-    let mut out = Response::with_capacity(t.len());
+    let mut xs = Vec::with_capacity(t.len());
+    let mut ys = Vec::with_capacity(t.len());
     let mut x = x0;
     let uniform = uniform_step(t, grid_rounding(t));
     for (k, &tk) in t.iter().enumerate() {
         let u = input(tk);
-        check_input(&u, M)?;
-        out.t.push(tk);
-        out.x.push(x);
-        out.y.push(sys.output(&x, &u));
+        check_input(&u, b.ncols())?;
+        ys.push(c * &x + d * &u);
+        xs.push(x.clone());
         let Some(&next) = t.get(k + 1) else { break };
         let h = uniform.unwrap_or(next - tk);
         let hs = h / substeps as f64;
-        for s in 0..substeps {
-            Rk4.step_mut(sys, tk + s as f64 * hs, hs, &mut x, &u);
+        for _ in 0..substeps {
+            rk4_step(a, b, hs, &mut x, &u);
         }
     }
-    out.check_finite("simulation (the response diverged past f64::MAX)")?;
-    Ok(out)
+    let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
+    if !xs
+        .iter()
+        .zip(&ys)
+        .all(|(x, y)| finite(x.as_slice()) & finite(y.as_slice()))
+    {
+        return Err(Error::Overflow {
+            operation: DIVERGED_CONTINUOUS,
+        });
+    }
+    Ok(Response {
+        t: t.to_vec(),
+        x: xs,
+        y: ys,
+    })
+}
+
+/// One classical RK4 step of `x' = A x + B u` with `u` held: the
+/// arithmetic of [`Rk4`](crate::integrate::Rk4) on a linear model, for
+/// matrices of either size (nothing allocated for fixed sizes).
+fn rk4_step<N: Dim, M: Dim>(
+    a: &OMatrix<f64, N, N>,
+    b: &OMatrix<f64, N, M>,
+    h: f64,
+    x: &mut OVector<f64, N>,
+    u: &OVector<f64, M>,
+) where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N> + Allocator<M>,
+{
+    let half = 0.5 * h;
+    let f = |x: &OVector<f64, N>| a * x + b * u;
+    let k1 = f(x);
+    let k2 = f(&(&*x + &k1 * half));
+    let k3 = f(&(&*x + &k2 * half));
+    let k4 = f(&(&*x + &k3 * h));
+    *x += (k1 + (k2 + k3) * 2.0 + k4) * (h / 6.0);
+}
+
+/// The error of a simulation asked of a model in the other time domain
+/// (the public functions' bounds make it unreachable).
+fn wrong_domain(reason: &'static str) -> Error {
+    Error::InvalidParameter {
+        name: "dt",
+        value: f64::NAN,
+        reason,
+    }
+}
+
+/// [`Error::LengthMismatch`] unless `x0` has `states` entries,
+/// [`Error::NonFinite`] named `"x0"` for its first non-finite entry.
+fn check_state<N: Dim>(x0: &OVector<f64, N>, states: usize) -> Result<(), Error>
+where
+    DefaultAllocator: Allocator<N>,
+{
+    check_len("x0", states, x0.len())?;
+    check_finite_dyn("x0", x0)
 }
 
 /// What a continuous simulation that overflows reports.
@@ -297,9 +535,9 @@ const DIVERGED_CONTINUOUS: &str = "simulation (the response diverged past f64::M
 
 /// The states and outputs of `(A, B, C, D)` over the grid `t` (checked)
 /// from `x0` (checked) under the input `input(t)` held between grid times,
-/// by exact ZOH steps: the one implementation behind [`simulate`] and
-/// [`DynStateSpace::simulate`](crate::DynStateSpace::simulate). For
-/// fixed-size matrices nothing in the loop allocates.
+/// by exact ZOH steps: the one implementation behind [`simulate`] (both
+/// model sizes) and the continuous standard responses. For fixed-size
+/// matrices nothing in the loop allocates.
 pub(crate) fn lsim_zoh<N: Dim, M: Dim, P: Dim>(
     a: &OMatrix<f64, N, N>,
     b: &OMatrix<f64, N, M>,
@@ -450,13 +688,7 @@ fn check_input<M: Dim>(u: &OVector<f64, M>, inputs: usize) -> Result<(), Error>
 where
     DefaultAllocator: Allocator<M>,
 {
-    if u.len() != inputs {
-        return Err(Error::LengthMismatch {
-            what: "input",
-            expected: inputs,
-            found: u.len(),
-        });
-    }
+    check_len("input", inputs, u.len())?;
     match u.iter().find(|v| !v.is_finite()) {
         Some(&value) => Err(Error::InvalidParameter {
             name: "input",
@@ -477,20 +709,22 @@ where
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{StateSpace, sim::simulate_discrete};
-/// use nalgebra::{matrix, vector};
+/// use ctrlab::{DynStateSpace, StateSpace, sim::simulate_discrete};
+/// use nalgebra::{dvector, matrix, vector};
 ///
 /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
 /// let r = simulate_discrete(&sys, vector![0.0], &[vector![1.0]; 3])?;
 /// assert_eq!(r.output(0)?, vec![0.0, 1.0, 1.5]);
+/// let d = simulate_discrete(&DynStateSpace::from(&sys), dvector![0.0], &vec![dvector![1.0]; 3])?;
+/// assert_eq!(d.output(0)?, vec![0.0, 1.0, 1.5]);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
-    sys: &StateSpace<N, M, P, Discrete>,
-    x0: SVector<f64, N>,
-    inputs: &[SVector<f64, M>],
-) -> Result<Response<N, P>, Error> {
-    simulate_discrete_feedback(sys, x0, inputs.len(), |k, _x| inputs[k])
+pub fn simulate_discrete<S: Simulate<Domain = Discrete>>(
+    sys: &S,
+    x0: S::State,
+    inputs: &[S::Input],
+) -> Result<S::Response, Error> {
+    sys.dsim(Token(()), x0, inputs.len(), |k, _x| inputs[k].clone())
 }
 
 /// Simulates a discrete model for `steps` samples with the input computed
@@ -501,14 +735,15 @@ pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
 ///
 /// [`Error::InvalidParameter`] named `"steps"` for more than
 /// [`MAX_SAMPLES`] samples, `"x0"` for a non-finite initial state, `"input"`
-/// for a non-finite input sample; [`Error::Overflow`] when the response
-/// diverges past `f64::MAX`.
+/// for a non-finite input sample; [`Error::LengthMismatch`] named `"x0"` or
+/// `"input"` for a vector of the wrong length (a run-time-sized model);
+/// [`Error::Overflow`] when the response diverges past `f64::MAX`.
 ///
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{Error, StateSpace, sim::simulate_discrete_feedback};
-/// use nalgebra::{matrix, vector};
+/// use ctrlab::{DynStateSpace, Error, StateSpace, sim::simulate_discrete_feedback};
+/// use nalgebra::{dvector, matrix, vector};
 ///
 /// // x[k+1] = x + u with u = -0.5 x halves the state every sample.
 /// let sys = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
@@ -518,14 +753,38 @@ pub fn simulate_discrete<const N: usize, const M: usize, const P: usize>(
 /// // from 1e300, an error, not infinities.
 /// let diverging = simulate_discrete_feedback(&sys, vector![1e300], 40, |_k, x| *x);
 /// assert!(matches!(diverging, Err(Error::Overflow { .. })));
+///
+/// // The same loop on the model sized at run time.
+/// let d = simulate_discrete_feedback(&DynStateSpace::from(&sys), dvector![8.0], 4, |_k, x| -0.5 * x)?;
+/// assert_eq!(d.output(0)?, r.output(0)?);
+/// assert!((d.t[3] - 0.3).abs() < 1e-15);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
-pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize>(
-    sys: &StateSpace<N, M, P, Discrete>,
-    x0: SVector<f64, N>,
+pub fn simulate_discrete_feedback<S: Simulate<Domain = Discrete>>(
+    sys: &S,
+    x0: S::State,
     steps: usize,
-    control: impl FnMut(usize, &SVector<f64, N>) -> SVector<f64, M>,
-) -> Result<Response<N, P>, Error> {
+    control: impl FnMut(usize, &S::State) -> S::Input,
+) -> Result<S::Response, Error> {
+    sys.dsim(Token(()), x0, steps, control)
+}
+
+/// [`simulate_discrete_feedback`] on the matrices of a discrete model
+/// (`period` is its period).
+fn dsim<N: Dim, M: Dim, P: Dim>(
+    abcd: Abcd<'_, N, M, P>,
+    period: Option<f64>,
+    x0: OVector<f64, N>,
+    steps: usize,
+    control: impl FnMut(usize, &OVector<f64, N>) -> OVector<f64, M>,
+) -> Result<Response<N, P>, Error>
+where
+    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
+    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
+{
+    let Some(dt) = period else {
+        return Err(wrong_domain("a continuous model is simulated by simulate"));
+    };
     if steps > MAX_SAMPLES {
         return Err(Error::InvalidParameter {
             name: "steps",
@@ -533,6 +792,7 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
             reason: "more samples than MAX_SAMPLES",
         });
     }
+    check_len("x0", abcd.0.nrows(), x0.len())?;
     if let Some(&value) = x0.iter().find(|v| !v.is_finite()) {
         return Err(Error::InvalidParameter {
             name: "x0",
@@ -540,22 +800,16 @@ pub fn simulate_discrete_feedback<const N: usize, const M: usize, const P: usize
             reason: "the initial state must be finite",
         });
     }
-    let (t, x, y) = discrete_feedback(
-        (sys.a(), sys.b(), sys.c(), sys.d()),
-        sys.dt(),
-        x0,
-        steps,
-        control,
-    )?;
+    let (t, x, y) = discrete_feedback(abcd, dt, x0, steps, control)?;
     Ok(Response { t, x, y })
 }
 
 /// The times (`k dt`), states and outputs of the discrete `(A, B, C, D)`
 /// with period `dt` for `steps` samples from `x0` under
-/// `u[k] = control(k, &x[k])`: the one
-/// implementation behind [`simulate_discrete_feedback`] and the discrete
-/// simulations of [`DynStateSpace`](crate::DynStateSpace). `steps` and
-/// `x0` are the caller's to check. For fixed-size matrices nothing in the
+/// `u[k] = control(k, &x[k])`: the one implementation behind
+/// [`simulate_discrete`], [`simulate_discrete_feedback`] and the discrete
+/// standard responses, for both model sizes. `steps` and `x0` are the
+/// caller's to check. For fixed-size matrices nothing in the
 /// loop allocates.
 pub(crate) fn discrete_feedback<N: Dim, M: Dim, P: Dim>(
     (a, b, c, d): Abcd<'_, N, M, P>,

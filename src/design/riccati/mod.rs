@@ -1,106 +1,18 @@
-//! Algebraic Riccati equations and linear-quadratic regulators sized at run
-//! time: [`care`], [`dare`] and `DynStateSpace::lqr`, the one
-//! implementation behind the fixed-size [`lqr`](super::lqr) and
-//! [`dlqr`](super::dlqr) too. The method is documented on [`DynLqr`].
+//! Algebraic Riccati equations sized at run time, [`care`] and [`dare`]:
+//! the one implementation behind [`lqr`](super::lqr) and
+//! [`dlqr`](super::dlqr) too, for both model sizes. The method is
+//! documented on [`Lqr`](super::Lqr#algorithm).
 
 mod kernels;
 mod solver;
 
 use nalgebra::allocator::Allocator;
-use nalgebra::{Cholesky, Complex, DMatrix, DefaultAllocator, Dim, OMatrix};
+use nalgebra::{Cholesky, DMatrix, DefaultAllocator, Dim, OMatrix};
 
+use super::lqr::{DynLqr, Lqr};
 use crate::error::{Error, check_finite_dyn, check_shape};
 use crate::kernels::reduce::pow2_floor;
-use crate::model::{Continuous, Discrete, DynStateSpace};
 pub(crate) use solver::{Solution, continuous, discrete};
-
-/// A solved algebraic Riccati equation, or linear-quadratic regulator, sized
-/// at run time: the gain, the stabilising solution, the closed-loop poles,
-/// and how well the equation is satisfied. The run-time counterpart of
-/// [`Lqr`](super::Lqr), returned by [`care`], [`dare`] and
-/// [`DynStateSpace::lqr`].
-///
-/// # Discretization
-///
-/// The discrete equation
-/// `X = Aᵀ X A − Aᵀ X B (R + Bᵀ X B)⁻¹ Bᵀ X A + Q` is the fixed point of the
-/// structure-preserving doubling algorithm (SDA) of Chu, Fan and Lin (2005):
-/// with `E₀ = A`, `G₀ = B R⁻¹ Bᵀ`, `H₀ = Q`,
-///
-/// ```text
-/// W = I + G H,  E ← E W⁻¹ E,  G ← G + E W⁻¹ G Eᵀ,  H ← H + Eᵀ H W⁻¹ E
-/// ```
-///
-/// and `H → X` quadratically. The continuous equation
-/// `Aᵀ X + X A − X B R⁻¹ Bᵀ X + Q = 0` is first mapped to that form by the
-/// Cayley transform of its Hamiltonian with a shift `γ > 0`
-/// (`A_γ = A − γ I`, `W_γ = A_γᵀ + Q A_γ⁻¹ G`, `E₀ = I + 2γ W_γ⁻ᵀ`,
-/// `G₀ = 2γ A_γ⁻¹ G W_γ⁻¹`, `H₀ = 2γ W_γ⁻¹ Q A_γ⁻¹`; Chu, Fan, Lin and Weng,
-/// 2004). Neither needs a stable or invertible `A`, so both converge for
-/// unstable plants: the only requirements are the usual LQR ones, `(A, B)`
-/// stabilisable and `(A, Q)` detectable, with no closed-loop pole on the
-/// stability boundary. The shift starts at
-/// `γ = max(‖A‖_F, √(‖G‖_F ‖Q‖_F))`, the scale of the Hamiltonian's
-/// eigenvalues; if the residual stays above 1e-13 and the Newton steps
-/// below could still lower it, a few other shifts (γ/2, 2γ, γ/4, 4γ,
-/// γ/10, 10γ) are tried and the best solution kept.
-///
-/// On an ill-conditioned problem (a large `X` from nearly cancelling terms)
-/// the doubling alone can stop at a relative residual of about 1e-9. Up to
-/// three Newton steps follow it (while the residual is above 4ε), each
-/// kept only if it lowers the residual:
-/// a Lyapunov equation of the closed loop for the continuous case (solved
-/// by the matrix-sign-function iteration), a Stein equation for the
-/// discrete one (squared Smith). Every step of every part costs `O(N³)`:
-/// LU solves, products and inverses, no `N² × N²` system. The code is
-/// generic over nalgebra's dimensions, so the fixed-size [`lqr`](super::lqr)
-/// runs it on stack matrices and `DynStateSpace::lqr` on heap ones, with
-/// cache-blocked products (matrixmultiply) at large `N`.
-///
-/// A discrete equation with a singular (positive semidefinite) `R`, which
-/// only [`dare`] accepts, is first solved with `R + δ I`
-/// (`δ = 10⁻⁸ (‖R‖ + ‖B‖² ‖Q‖)`), and Newton's method on the true equation
-/// (it needs only `R + Bᵀ X B` invertible) takes it from there.
-///
-/// Every solution's closed loop is checked: one that is not stable is
-/// refused with [`Error::Unstable`]. The relative residual of the Riccati
-/// equation is returned in [`DynLqr::residual`] and is not a refusal
-/// criterion: callers that need a bound check it.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::design::care;
-/// use nalgebra::dmatrix;
-///
-/// // x' = x + u (unstable), q = r = 1: X = 1 + √2, K = X.
-/// let sol = care(&dmatrix![1.0], &dmatrix![1.0], &dmatrix![1.0], &dmatrix![1.0])?;
-/// assert!((sol.riccati[(0, 0)] - (1.0 + 2f64.sqrt())).abs() < 1e-12);
-/// assert!((sol.gain[(0, 0)] - (1.0 + 2f64.sqrt())).abs() < 1e-12);
-/// assert!((sol.poles[0].re + 2f64.sqrt()).abs() < 1e-12);
-/// assert!(sol.residual < 1e-12);
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-#[derive(Debug, Clone, PartialEq)]
-pub struct DynLqr {
-    /// The optimal state gain `K` (`m × n`) of `u = −K x` (SI: input unit
-    /// per state unit): `R⁻¹ Bᵀ X` in continuous time,
-    /// `(R + Bᵀ X B)⁻¹ Bᵀ X A` in discrete time.
-    pub gain: DMatrix<f64>,
-    /// The stabilising solution `X` (`n × n`, symmetric) of the Riccati
-    /// equation; for a regulator the optimal cost from `x₀` is `x₀ᵀ X x₀`
-    /// (units of the cost per squared state unit).
-    pub riccati: DMatrix<f64>,
-    /// Poles of the closed loop `A − B K` (s-plane in rad/s, or z-plane),
-    /// sorted as [`DynStateSpace::poles`].
-    pub poles: Vec<Complex<f64>>,
-    /// Relative residual of the Riccati equation at `X`: the Frobenius norm
-    /// of the equation's left side minus its right, over the sum of the
-    /// norms of its terms (dimensionless).
-    pub residual: f64,
-    /// Doubling steps the solver took.
-    pub iterations: usize,
-}
 
 /// Which weights a caller accepts.
 #[derive(Debug, Clone, Copy)]
@@ -121,9 +33,9 @@ pub(crate) enum Weights {
 /// `K = R⁻¹ Bᵀ X`; SciPy's `solve_continuous_are(a, b, q, r)`, MATLAB's
 /// `icare(A, B, Q, R)`. Sizes are taken from the matrices: `A` and `Q` are
 /// `n × n`, `B` is `n × m`, `R` is `m × m`. The method is described on
-/// [`DynLqr`]; `O(n³)` per step.
+/// [`Lqr`](super::Lqr#algorithm); `O(n³)` per step.
 ///
-/// Unlike [`DynStateSpace::lqr`], `Q` may be indefinite (only symmetric), as
+/// Unlike [`lqr`](super::lqr), `Q` may be indefinite (only symmetric), as
 /// SciPy allows; the solution is then not necessarily positive
 /// semidefinite.
 ///
@@ -161,7 +73,7 @@ pub fn care(
     r: &DMatrix<f64>,
 ) -> Result<DynLqr, Error> {
     check_problem(a, b, q, r)?;
-    continuous(a, b, q, r, Weights::Equation).map(DynLqr::from)
+    continuous(a, b, q, r, Weights::Equation).map(Lqr::from)
 }
 
 /// Discrete-time algebraic Riccati equation
@@ -169,7 +81,7 @@ pub fn care(
 /// `X` (the one that puts the poles of `A − B K` inside the unit circle),
 /// with the gain `K = (R + Bᵀ X B)⁻¹ Bᵀ X A`; SciPy's
 /// `solve_discrete_are(a, b, q, r)`, MATLAB's `idare(A, B, Q, R)`. Sizes as
-/// [`care`]; the method is described on [`DynLqr`].
+/// [`care`]; the method is described on [`Lqr`](super::Lqr#algorithm).
 ///
 /// `Q` may be indefinite and `R` singular (positive semidefinite), as SciPy
 /// allows, as long as `R + Bᵀ X B` is invertible at the solution.
@@ -210,86 +122,7 @@ pub fn dare(
     r: &DMatrix<f64>,
 ) -> Result<DynLqr, Error> {
     check_problem(a, b, q, r)?;
-    discrete(a, b, q, r, Weights::Equation, None).map(DynLqr::from)
-}
-
-impl DynStateSpace<Continuous> {
-    /// Continuous-time LQR: the gain `K = R⁻¹ Bᵀ X` (`m × n`) minimising
-    /// `∫ (xᵀ Q x + uᵀ R u) dt` for `u = −K x`, with `X` the stabilising
-    /// solution of the continuous algebraic Riccati equation (see
-    /// [`DynLqr`]). MATLAB's and python-control's `lqr(sys, Q, R)`; the
-    /// run-time counterpart of [`lqr`](crate::design::lqr).
-    ///
-    /// # Errors
-    ///
-    /// [`Error::DimensionMismatch`] unless `Q` is `n × n` and `R` `m × m`;
-    /// [`Error::NonFinite`] for a non-finite weight;
-    /// [`Error::InvalidMatrix`] unless `Q` is symmetric positive
-    /// semidefinite and `R` symmetric positive definite;
-    /// [`Error::NoConvergence`] if the doubling does not converge;
-    /// [`Error::Unstable`] if the solution does not stabilise the loop (the
-    /// plant is not stabilisable, or `(A, Q)` not detectable).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{Cart, DynStateSpace, MassSpring};
-    /// use nalgebra::{DMatrix, dmatrix, dvector};
-    ///
-    /// let plant = DynStateSpace::from(MassSpring::nominal().state_space(Cart::Two)?);
-    /// let q = DMatrix::from_diagonal(&dvector![0.0, 0.0, 1e6, 0.0]);
-    /// let sol = plant.lqr(&q, &dmatrix![1.0])?;
-    /// assert_eq!(sol.gain.shape(), (1, 4));
-    /// assert!(sol.poles.iter().all(|p| p.re < 0.0));
-    /// assert!(sol.residual < 1e-12);
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn lqr(&self, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<DynLqr, Error> {
-        check_weight_shapes(self.states(), self.inputs(), q, r)?;
-        continuous(self.a(), self.b(), q, r, Weights::Regulator(["Q", "R"])).map(DynLqr::from)
-    }
-}
-
-impl DynStateSpace<Discrete> {
-    /// Discrete-time LQR: the gain `K = (R + Bᵀ X B)⁻¹ Bᵀ X A` (`m × n`)
-    /// minimising `Σ (xᵀ Q x + uᵀ R u)` for `u[k] = −K x[k]`, with `X` the
-    /// stabilising solution of the discrete algebraic Riccati equation (see
-    /// [`DynLqr`]). MATLAB's `lqr(sys, Q, R)` on a discrete model,
-    /// python-control's `dlqr`; the run-time counterpart of
-    /// [`dlqr`](crate::design::dlqr).
-    ///
-    /// # Errors
-    ///
-    /// As [`DynStateSpace::<Continuous>::lqr`]; [`Error::Unstable`] means a
-    /// closed-loop pole on or outside the unit circle.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::{Cart, DynStateSpace, MassSpring, Discretization};
-    /// use nalgebra::{DMatrix, dmatrix, dvector};
-    ///
-    /// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
-    /// let plant = DynStateSpace::from(d);
-    /// let q = DMatrix::from_diagonal(&dvector![1e4, 0.0, 1e6, 0.0]);
-    /// let sol = plant.lqr(&q, &dmatrix![1.0])?;
-    /// assert!(sol.poles.iter().all(|z| z.norm() < 1.0));
-    /// assert!(sol.residual < 1e-12);
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    #[doc(alias = "dlqr")]
-    pub fn lqr(&self, q: &DMatrix<f64>, r: &DMatrix<f64>) -> Result<DynLqr, Error> {
-        check_weight_shapes(self.states(), self.inputs(), q, r)?;
-        discrete(
-            self.a(),
-            self.b(),
-            q,
-            r,
-            Weights::Regulator(["Q", "R"]),
-            Some(self.dt()),
-        )
-        .map(DynLqr::from)
-    }
+    discrete(a, b, q, r, Weights::Equation, None).map(Lqr::from)
 }
 
 fn check_weight_shapes(

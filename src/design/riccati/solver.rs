@@ -1,13 +1,13 @@
 //! The solvers themselves, written once over nalgebra's dimensions: the
 //! Cayley transform and doubling, Newton refinement, the residuals, and the
-//! closed-loop check. [`DynLqr`] documents the method.
+//! closed-loop check. [`Lqr`](crate::design::Lqr#algorithm) documents the method.
 
-use nalgebra::{Complex, DMatrix, DefaultAllocator, Dim, Dyn, OMatrix, allocator::Allocator};
+use nalgebra::{Complex, DMatrix, DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
 use super::kernels::{
     MAX_ITERATIONS, Square, finite, fro, inverse, lyapunov, sda, stein, symmetrize,
 };
-use super::{DynLqr, Weights, check_weights};
+use super::{Weights, check_weights};
 use crate::analysis::{eigenvalues_dyn, first_unstable_dyn};
 use crate::error::Error;
 use crate::kernels::linalg::{Lu, SystemAlloc};
@@ -26,8 +26,8 @@ const REGULARISED_REFINE_STEPS: usize = 12;
 /// Cayley shifts tried, as multiples of the Hamiltonian's scale.
 const SHIFTS: [f64; 7] = [1.0, 0.5, 2.0, 0.25, 4.0, 0.1, 10.0];
 
-/// A solution in the caller's matrix sizes; [`DynLqr`] and the fixed-size
-/// [`Lqr`](crate::design::Lqr) are built from it.
+/// A solution in the caller's matrix sizes; [`Lqr`](crate::design::Lqr)
+/// is built from it.
 pub(crate) struct Solution<N: Dim, M: Dim>
 where
     DefaultAllocator: SystemAlloc<N, M>,
@@ -39,18 +39,6 @@ where
     pub(crate) iterations: usize,
 }
 
-impl From<Solution<Dyn, Dyn>> for DynLqr {
-    fn from(s: Solution<Dyn, Dyn>) -> Self {
-        Self {
-            gain: s.gain,
-            riccati: s.riccati,
-            poles: s.poles,
-            residual: s.residual,
-            iterations: s.iterations,
-        }
-    }
-}
-
 /// A copy on the heap, for the checks and diagnostics written for
 /// run-time-sized matrices (outside the iterations).
 fn heap<R: Dim, C: Dim>(m: &OMatrix<f64, R, C>) -> DMatrix<f64>
@@ -60,8 +48,8 @@ where
     DMatrix::from_iterator(m.nrows(), m.ncols(), m.iter().copied())
 }
 
-/// The continuous solver behind [`care`](crate::design::care), `DynStateSpace::lqr` and the
-/// fixed-size [`lqr`](crate::design::lqr); shapes already checked.
+/// The continuous solver behind [`care`](crate::design::care) and
+/// [`lqr`](crate::design::lqr); shapes already checked.
 pub(crate) fn continuous<N: Dim, M: Dim>(
     a: &Square<N>,
     b: &OMatrix<f64, N, M>,
@@ -140,9 +128,9 @@ where
     finish(a, b, gain, x, weight, residual, iterations, None)
 }
 
-/// The discrete solver behind [`dare`](crate::design::dare), `DynStateSpace::lqr` and the
-/// fixed-size [`dlqr`](crate::design::dlqr); shapes already checked. `period` is
-/// the model's (`None` for a bare equation).
+/// The discrete solver behind [`dare`](crate::design::dare) and
+/// [`dlqr`](crate::design::dlqr); shapes already checked. `period` is the
+/// model's (`None` for a bare equation).
 pub(crate) fn discrete<N: Dim, M: Dim>(
     a: &Square<N>,
     b: &OMatrix<f64, N, M>,

@@ -68,7 +68,7 @@ pub struct Lqi {
     /// V/(m·s).
     pub gain: SMatrix<f64, 1, 5>,
     /// The closed loop's poles on the model (z-plane).
-    pub poles: [Complex<f64>; 5],
+    pub poles: SVector<Complex<f64>, 5>,
 }
 
 /// The Kalman filter's process noise: a force on cart 2 through the

@@ -1,5 +1,5 @@
-//! The analysis methods of fixed-size models, each handing the model's
-//! matrices to the one run-time-sized implementation.
+//! The analysis methods of fixed-size models ([`StateSpace`]), each
+//! handing the model's matrices to the one run-time-sized implementation.
 
 use nalgebra::{Complex, DMatrix, SMatrix};
 
