@@ -60,7 +60,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     ///
     /// ```
     /// use ctrlab::{Discretization, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// // x' = -x + u held for 0.1 s: Ad = e^-0.1, Bd = 1 - e^-0.1.
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
@@ -100,7 +100,7 @@ impl DynStateSpace<Continuous> {
     ///
     /// ```
     /// use ctrlab::{DynStateSpace, Discretization};
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // x' = -x + u held for 0.1 s: Ad = e^-0.1, Bd = 1 - e^-0.1.
     /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
@@ -214,7 +214,7 @@ const PADE_Q: usize = 6;
 ///
 /// ```
 /// use ctrlab::{Error, discretize::{EXPM_MAX_ERROR, expm}};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// let r = expm(&matrix![0.0, -1e3; 1e3, 0.0])?; // error about 1e-13
 /// assert!((r[(1, 0)] - 1e3f64.sin()).abs() < 1e-10);
@@ -377,7 +377,7 @@ where
 ///
 /// ```
 /// use ctrlab::discretize::expm;
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // A rotation generator: exp([[0, -θ], [θ, 0]]) is the rotation by θ.
 /// let theta = 0.3f64;
@@ -404,7 +404,7 @@ pub fn expm<const N: usize>(a: &SMatrix<f64, N, N>) -> Result<SMatrix<f64, N, N>
 ///
 /// ```
 /// use ctrlab::discretize::expm_dyn;
-/// use nalgebra::{DMatrix, dmatrix};
+/// use ctrlab::nalgebra::{DMatrix, dmatrix};
 ///
 /// let theta = 0.3f64;
 /// let r = expm_dyn(&dmatrix![0.0, -theta; theta, 0.0])?;

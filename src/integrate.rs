@@ -31,7 +31,7 @@ pub trait Integrator {
     ///
     /// ```
     /// use ctrlab::integrate::{Euler, Integrator};
-    /// use nalgebra::{SVector, vector};
+    /// use ctrlab::nalgebra::{SVector, vector};
     /// let decay = |_t: f64, x: &SVector<f64, 1>, _u: &SVector<f64, 1>| -x;
     /// assert_eq!(Euler.step(&decay, 0.0, 0.1, &vector![1.0], &vector![0.0]), vector![0.9]);
     /// ```
@@ -58,7 +58,7 @@ pub trait Integrator {
 ///
 /// ```
 /// use ctrlab::integrate::{Integrator, Rk4};
-/// use nalgebra::{SVector, vector};
+/// use ctrlab::nalgebra::{SVector, vector};
 ///
 /// // x' = -x from 1: after 1 s, e^-1, to 1e-9 with 100 steps.
 /// let decay = |_t: f64, x: &SVector<f64, 1>, _u: &SVector<f64, 1>| -x;
@@ -97,7 +97,7 @@ impl Integrator for Rk4 {
 ///
 /// ```
 /// use ctrlab::integrate::{Euler, Integrator};
-/// use nalgebra::{SVector, vector};
+/// use ctrlab::nalgebra::{SVector, vector};
 /// let ramp = |_t: f64, _x: &SVector<f64, 1>, u: &SVector<f64, 1>| *u;
 /// let mut x = vector![0.0];
 /// Euler.step_mut(&ramp, 0.0, 0.5, &mut x, &vector![2.0]);

@@ -25,7 +25,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // x'' + 2 x' + 5 x = u: poles −1 ± 2i.
     /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; -5.0, -2.0], dmatrix![0.0; 1.0],
@@ -51,7 +51,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let lag = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
     /// let integrator = DynStateSpace::continuous(dmatrix![0.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
@@ -78,7 +78,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let sys = DynStateSpace::discrete(dmatrix![0.5, 0.0; 0.0, 1.5], dmatrix![1.0; 1.0],
     ///                                   dmatrix![1.0, 1.0], dmatrix![0.0], 0.1)?;
@@ -110,7 +110,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::{DynStateSpace, Error};
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // Two lags with gains 2 and 0.5, one per channel.
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0, 0.0; 0.0, -4.0], dmatrix![4.0, 0.0; 0.0, 2.0],
@@ -141,7 +141,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; 0.0, 0.0], dmatrix![0.0; 1.0],
     ///                                     dmatrix![1.0, 0.0], dmatrix![0.0])?;
@@ -163,7 +163,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; 0.0, 0.0], dmatrix![0.0; 1.0],
     ///                                     dmatrix![1.0, 0.0], dmatrix![0.0])?;
@@ -193,7 +193,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::{DMatrix, dmatrix};
+    /// use ctrlab::nalgebra::{DMatrix, dmatrix};
     ///
     /// // Five integrators in a chain, coupled by 10⁶: controllable from the
     /// // first, though the raw matrix spans 24 decades.
@@ -219,7 +219,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // The output sees only the first of two decoupled states.
     /// let sys = DynStateSpace::continuous(dmatrix![-1.0, 0.0; 0.0, -2.0], dmatrix![1.0; 1.0],
@@ -244,7 +244,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // ωn = 10 rad/s, ζ = 0.3.
     /// let sys = DynStateSpace::continuous(dmatrix![0.0, 1.0; -100.0, -6.0], dmatrix![0.0; 1.0],

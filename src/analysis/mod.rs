@@ -59,7 +59,7 @@ const ITERATIONS_PER_DIM: usize = 200;
 ///
 /// ```
 /// use ctrlab::StateSpace;
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // ωn = 10 rad/s, ζ = 0.3: x'' + 6 x' + 100 x = u.
 /// let sys = StateSpace::continuous(matrix![0.0, 1.0; -100.0, -6.0], matrix![0.0; 1.0],
@@ -143,7 +143,7 @@ pub(crate) fn damping_of(poles: &[Complex<f64>], period: Option<f64>) -> Vec<Dam
 ///
 /// ```
 /// use ctrlab::analysis::rank;
-/// use nalgebra::dmatrix;
+/// use ctrlab::nalgebra::dmatrix;
 ///
 /// let m = dmatrix![1.0, 2.0; 2.0, 4.0 + 1e-12];
 /// assert_eq!(rank(&m, None)?, 2);        // 1e-12 is far above ε

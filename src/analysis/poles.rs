@@ -24,7 +24,7 @@ const PAIR_RTOL: f64 = 1e-9;
 ///
 /// ```
 /// use ctrlab::{Cart, MassSpring, analysis::Poles};
-/// use nalgebra::Complex;
+/// use ctrlab::nalgebra::Complex;
 ///
 /// let p = [Complex::new(-3.71, -22.2), Complex::new(-3.71, 22.2), Complex::new(-5.0, 0.0)];
 /// assert_eq!(Poles(&p).to_string(), "-3.71 ± 22.2j, -5");
@@ -47,7 +47,7 @@ impl fmt::Display for Poles<'_> {
     ///
     /// ```
     /// use ctrlab::analysis::Poles;
-    /// use nalgebra::Complex;
+    /// use ctrlab::nalgebra::Complex;
     ///
     /// let p = [Complex::new(-1.0, 0.0), Complex::new(-0.1, 2.0), Complex::new(-0.1, -2.0)];
     /// assert_eq!(format!("{}", Poles(&p)), "-1, -0.1 ± 2j");

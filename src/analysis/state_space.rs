@@ -45,7 +45,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::StateSpace;
-    /// use nalgebra::{dmatrix, matrix};
+    /// use ctrlab::nalgebra::{dmatrix, matrix};
     ///
     /// let sys = StateSpace::continuous(matrix![0.0, 1.0; 0.0, 0.0], matrix![0.0; 1.0],
     ///                                  matrix![1.0, 0.0], matrix![0.0])?;
@@ -67,7 +67,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::StateSpace;
-    /// use nalgebra::{dmatrix, matrix};
+    /// use ctrlab::nalgebra::{dmatrix, matrix};
     ///
     /// let sys = StateSpace::continuous(matrix![0.0, 1.0; 0.0, 0.0], matrix![0.0; 1.0],
     ///                                  matrix![1.0, 0.0], matrix![0.0])?;
@@ -95,7 +95,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::StateSpace;
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// // The input drives only the first of two decoupled states.
     /// let sys = StateSpace::continuous(matrix![-1.0, 0.0; 0.0, -2.0], matrix![1.0; 0.0],
@@ -148,7 +148,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::StateSpace;
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let lag = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
     /// let integrator = StateSpace::continuous(matrix![0.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
@@ -188,7 +188,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::StateSpace;
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let sys = StateSpace::continuous(matrix![-1.0, 0.0; 0.0, 2.0], matrix![1.0; 1.0], matrix![1.0, 1.0], matrix![0.0])?;
     /// assert_eq!(sys.unstable_pole()?.map(|p| p.re), Some(2.0));
@@ -216,7 +216,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::{Cart, Error, MassSpring, Discretization, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let lag = StateSpace::continuous(matrix![-2.0], matrix![4.0], matrix![1.0], matrix![0.0])?;
     /// assert_eq!(lag.dc_gain()?, matrix![2.0]);
@@ -251,7 +251,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::{Cart, MassSpring, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let d = MassSpring::nominal().state_space(Cart::Two)?.damping()?;
     /// // Both modes of the rig are lightly damped.

@@ -299,7 +299,7 @@ impl Schema {
 ///
 /// ```
 /// use ctrlab::data::{Recording, Schema};
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 ///
 /// let mut rec = Recording::with_capacity(Schema::numbered(1, 2), 2);
 /// rec.push_vectors(0.0, &vector![1.0], &vector![0.0, 0.0])?;
@@ -634,7 +634,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// # use nalgebra::vector;
+    /// # use ctrlab::nalgebra::vector;
     /// let mut rec = Recording::with_capacity(Schema::numbered(1, 4), 1);
     /// rec.push_vectors(0.0, &vector![1.0], &vector![0.001, 0.01, 0.002, 0.02])?;
     /// assert_eq!(rec.channel("y2")?, &[0.01]);

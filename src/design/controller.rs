@@ -29,7 +29,7 @@ use nalgebra::SVector;
 ///
 /// ```
 /// use ctrlab::Controller;
-/// use nalgebra::{SVector, vector};
+/// use ctrlab::nalgebra::{SVector, vector};
 ///
 /// struct Pi { kp: f64, ki: f64, dt: f64, integral: f64 }
 /// impl Controller<1, 1, 1> for Pi {
@@ -62,7 +62,7 @@ pub trait Controller<const P: usize, const R: usize, const M: usize> {
     ///
     /// ```
     /// use ctrlab::{Controller, OpenLoop};
-    /// use nalgebra::{SVector, vector};
+    /// use ctrlab::nalgebra::{SVector, vector};
     /// let mut c = OpenLoop;
     /// let u: SVector<f64, 1> = Controller::<2, 1, 1>::update(&mut c, &vector![0.0, 0.0], &vector![30.0]);
     /// Controller::<2, 1, 1>::applied(&mut c, &vector![24.0]); // saturated: nothing to remember
@@ -78,7 +78,7 @@ pub trait Controller<const P: usize, const R: usize, const M: usize> {
     ///
     /// ```
     /// use ctrlab::{Controller, StateFeedback};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// let mut c = StateFeedback::new(matrix![1.0, 0.0], vector![1.0])?;
     /// let before = c.update(&vector![0.01, 0.0], &vector![0.02]);
@@ -97,7 +97,7 @@ pub trait Controller<const P: usize, const R: usize, const M: usize> {
     ///
     /// ```
     /// use ctrlab::{Controller, StateFeedback};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     /// let c = StateFeedback::new(matrix![1.0], vector![1.0])?;
     /// assert_eq!(c.period(), None);
     /// # Ok::<(), ctrlab::Error>(())
@@ -145,7 +145,7 @@ where
 ///
 /// ```
 /// use ctrlab::{Controller, OpenLoop};
-/// use nalgebra::{SVector, vector};
+/// use ctrlab::nalgebra::{SVector, vector};
 ///
 /// let mut open = OpenLoop;
 /// let u: SVector<f64, 1> = open.update(&vector![0.1, 0.0, 0.2, 0.0], &vector![2.0]);

@@ -25,7 +25,7 @@ use crate::model::{Domain, StateSpace};
 ///
 /// ```
 /// use ctrlab::{Controller, design::StateFeedback};
-/// use nalgebra::{matrix, vector};
+/// use ctrlab::nalgebra::{matrix, vector};
 ///
 /// let mut c = StateFeedback::new(matrix![2.0, 0.5], vector![3.0])?;
 /// assert_eq!(c.update(&vector![1.0, 2.0], &vector![1.0]), vector![3.0 - 2.0 - 1.0]);
@@ -48,7 +48,7 @@ impl<const N: usize, const M: usize, const R: usize> StateFeedback<N, M, R> {
     ///
     /// ```
     /// use ctrlab::{Error, design::StateFeedback};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// let err = StateFeedback::new(matrix![f64::NAN], vector![1.0]).unwrap_err();
     /// assert!(matches!(err, Error::NonFinite { matrix: "K", .. }));
@@ -65,7 +65,7 @@ impl<const N: usize, const M: usize, const R: usize> StateFeedback<N, M, R> {
     ///
     /// ```
     /// use ctrlab::design::StateFeedback;
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// let c = StateFeedback::new(matrix![10.0, 0.1], vector![10.0])?;
     /// assert_eq!(*c.gain(), matrix![10.0, 0.1]);
@@ -81,7 +81,7 @@ impl<const N: usize, const M: usize, const R: usize> StateFeedback<N, M, R> {
     ///
     /// ```
     /// use ctrlab::design::StateFeedback;
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// let c = StateFeedback::new(matrix![10.0, 0.1], vector![10.0])?;
     /// assert_eq!(*c.reference_gain(), vector![10.0]);
@@ -104,7 +104,7 @@ impl<const N: usize, const M: usize, const R: usize> StateFeedback<N, M, R> {
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::StateFeedback};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// // A lag x' = −x + u under u = r − 3x: x' = −4x + r, DC gain 1/4.
     /// let plant = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
@@ -152,7 +152,7 @@ impl<const N: usize> StateFeedback<N, 1, 1> {
     ///
     /// ```
     /// use ctrlab::{Cart, MassSpring, Discretization, StateSpace, design::StateFeedback};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
     /// let c = StateFeedback::with_prefilter(&plant, matrix![0.0, 0.0, 100.0, 0.0])?;

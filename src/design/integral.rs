@@ -120,7 +120,7 @@ pub(super) fn augmented<D: Domain>(sys: &DynStateSpace<D>) -> Result<DynStateSpa
 ///
 /// ```
 /// use ctrlab::{MassSpring, Cart, design::lqi};
-/// use nalgebra::{SMatrix, matrix, vector};
+/// use ctrlab::nalgebra::{SMatrix, matrix, vector};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
@@ -131,8 +131,8 @@ pub(super) fn augmented<D: Domain>(sys: &DynStateSpace<D>) -> Result<DynStateSpa
 ///
 /// // Sized at run time: the same gain.
 /// let dynamic = ctrlab::DynStateSpace::from(&plant);
-/// let qd = nalgebra::DMatrix::from_column_slice(5, 5, q.as_slice());
-/// assert_eq!(lqi(&dynamic, &qd, &nalgebra::dmatrix![1.0])?.gain.as_slice(), sol.gain.as_slice());
+/// let qd = ctrlab::nalgebra::DMatrix::from_column_slice(5, 5, q.as_slice());
+/// assert_eq!(lqi(&dynamic, &qd, &ctrlab::nalgebra::dmatrix![1.0])?.gain.as_slice(), sol.gain.as_slice());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn lqi<S, Q>(sys: &S, q: &Q, r: &S::InputWeight) -> Result<S::Lqi, Error>
@@ -156,15 +156,15 @@ where
 ///
 /// ```
 /// use ctrlab::{MassSpring, Cart, Discretization, design::dlqi};
-/// use nalgebra::{SMatrix, matrix, vector};
+/// use ctrlab::nalgebra::{SMatrix, matrix, vector};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
 /// let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
 /// let sol = dlqi(&plant, &q, &matrix![1.0])?;
 /// assert!(sol.poles.iter().all(|z| z.norm() < 1.0));
 /// let dynamic = ctrlab::DynStateSpace::from(&plant);
-/// let qd = nalgebra::DMatrix::from_column_slice(5, 5, q.as_slice());
-/// assert_eq!(dlqi(&dynamic, &qd, &nalgebra::dmatrix![1.0])?.gain.as_slice(), sol.gain.as_slice());
+/// let qd = ctrlab::nalgebra::DMatrix::from_column_slice(5, 5, q.as_slice());
+/// assert_eq!(dlqi(&dynamic, &qd, &ctrlab::nalgebra::dmatrix![1.0])?.gain.as_slice(), sol.gain.as_slice());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn dlqi<S, Q>(sys: &S, q: &Q, r: &S::InputWeight) -> Result<S::Lqi, Error>
@@ -354,7 +354,7 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
 /// ```
 /// use ctrlab::{Controller, MassSpring, Cart, Discretization};
 /// use ctrlab::design::{AntiWindup, IntegralFeedback, dlqi};
-/// use nalgebra::{SMatrix, matrix, vector};
+/// use ctrlab::nalgebra::{SMatrix, matrix, vector};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
 /// let q = SMatrix::<f64, 5, 5>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0, 1e8]);
@@ -394,7 +394,7 @@ impl<const N: usize, const M: usize, const I: usize> IntegralFeedback<N, M, I> {
     ///
     /// ```
     /// use ctrlab::{Controller, StateSpace, design::{AntiWindup, IntegralFeedback}};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// let plant = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
     /// let mut c = IntegralFeedback::new(&plant, &matrix![0.2, -3.0], AntiWindup::None)?;
@@ -421,7 +421,7 @@ impl<const N: usize, const M: usize, const I: usize> IntegralFeedback<N, M, I> {
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{AntiWindup, IntegralFeedback}};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     /// let plant = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
     /// let c = IntegralFeedback::new(&plant, &matrix![0.2, -3.0], AntiWindup::None)?;
     /// assert_eq!(c.integrators()[0], 0.0);

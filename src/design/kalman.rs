@@ -61,7 +61,7 @@ use crate::model::{DynStateSpace, StateSpace};
 ///
 /// ```
 /// use ctrlab::{StateSpace, design::lqe};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// let sys = StateSpace::continuous(matrix![0.0], matrix![0.1], matrix![1.0], matrix![0.0])?;
 /// let kf = lqe(&sys, &matrix![0.1], &matrix![10.0], &matrix![2.0])?;
@@ -101,7 +101,7 @@ where
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, design::{DynLqe, lqe}};
-/// use nalgebra::dmatrix;
+/// use ctrlab::nalgebra::dmatrix;
 ///
 /// let sys = DynStateSpace::continuous(dmatrix![0.0], dmatrix![0.1], dmatrix![1.0], dmatrix![0.0])?;
 /// let kf: DynLqe = lqe(&sys, &dmatrix![0.1], &dmatrix![10.0], &dmatrix![2.0])?;
@@ -142,7 +142,7 @@ impl<const N: usize, const P: usize> Copy for Lqe<Const<N>, Const<P>> {}
 ///
 /// ```
 /// use ctrlab::{MassSpring, Cart, design::lqe, lab};
-/// use nalgebra::{matrix, SMatrix};
+/// use ctrlab::nalgebra::{matrix, SMatrix};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
 ///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?;
@@ -154,8 +154,8 @@ impl<const N: usize, const P: usize> Copy for Lqe<Const<N>, Const<P>> {}
 ///
 /// // The same filter for the model sized at run time.
 /// let dynamic = ctrlab::DynStateSpace::from(&plant);
-/// let heap = |m: &[f64], r, c| nalgebra::DMatrix::from_column_slice(r, c, m);
-/// let d = lqe(&dynamic, dynamic.b(), &nalgebra::dmatrix![1.0], &heap(rn.as_slice(), 2, 2))?;
+/// let heap = |m: &[f64], r, c| ctrlab::nalgebra::DMatrix::from_column_slice(r, c, m);
+/// let d = lqe(&dynamic, dynamic.b(), &ctrlab::nalgebra::dmatrix![1.0], &heap(rn.as_slice(), 2, 2))?;
 /// assert_eq!(d.gain.as_slice(), kf.gain.as_slice());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
@@ -186,7 +186,7 @@ where
 ///
 /// ```
 /// use ctrlab::{MassSpring, Cart, Discretization, design::dlqe, lab};
-/// use nalgebra::{matrix, SMatrix};
+/// use ctrlab::nalgebra::{matrix, SMatrix};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
 ///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?

@@ -79,7 +79,7 @@ use crate::model::{Continuous, Discrete, Token, display};
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace, design::lqr};
-/// use nalgebra::{dmatrix, matrix};
+/// use ctrlab::nalgebra::{dmatrix, matrix};
 ///
 /// // x' = x + u (unstable), q = r = 1: X = 1 + √2, K = X.
 /// let sys = StateSpace::continuous(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
@@ -125,7 +125,7 @@ where
 ///
 /// ```
 /// use ctrlab::design::{DynLqr, care};
-/// use nalgebra::dmatrix;
+/// use ctrlab::nalgebra::dmatrix;
 ///
 /// let sol: DynLqr = care(&dmatrix![1.0], &dmatrix![1.0], &dmatrix![1.0], &dmatrix![1.0])?;
 /// assert_eq!(sol.gain.shape(), (1, 1));
@@ -164,7 +164,7 @@ where
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::lqr};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// // A double integrator, q = diag(1, 0), r = 1: K = [1, √2].
     /// let sys = StateSpace::continuous(matrix![0.0, 1.0; 0.0, 0.0], matrix![0.0; 1.0],
@@ -207,7 +207,7 @@ where
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, MassSpring, Cart, design::lqr};
-/// use nalgebra::{DMatrix, SMatrix, dmatrix, dvector, matrix, vector};
+/// use ctrlab::nalgebra::{DMatrix, SMatrix, dmatrix, dvector, matrix, vector};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0]);
@@ -246,7 +246,7 @@ pub fn lqr<S: Design<Domain = Continuous>>(
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, MassSpring, Discretization, Cart, design::dlqr};
-/// use nalgebra::{DMatrix, SMatrix, dmatrix, matrix, vector};
+/// use ctrlab::nalgebra::{DMatrix, SMatrix, dmatrix, matrix, vector};
 ///
 /// let d = MassSpring::nominal().state_space(Cart::Two)?.discretize(0.002, Discretization::Zoh)?;
 /// let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e4, 0.0, 1e6, 0.0]);

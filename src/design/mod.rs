@@ -33,7 +33,7 @@
 //!
 //! ```
 //! use ctrlab::{Controller, StateSpace, design::{StateFeedback, lqr}};
-//! use nalgebra::{matrix, vector};
+//! use ctrlab::nalgebra::{matrix, vector};
 //!
 //! // A double integrator (position, speed), force input, position output.
 //! let plant = StateSpace::continuous(

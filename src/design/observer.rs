@@ -57,7 +57,7 @@ pub enum EstimatorForm {
 /// ```
 /// use ctrlab::{MassSpring, Cart, Discretization, lab};
 /// use ctrlab::design::{EstimatorForm, Observer, place_observer};
-/// use nalgebra::{Complex, matrix, vector};
+/// use ctrlab::nalgebra::{Complex, matrix, vector};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
 ///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?
@@ -114,7 +114,7 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     ///
     /// ```
     /// use ctrlab::{Error, StateSpace, design::{EstimatorForm, Observer}};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let model = StateSpace::discrete(matrix![1.0], matrix![0.1], matrix![1.0], matrix![0.0], 0.1)?;
     /// assert!(Observer::new(&model, matrix![0.5], EstimatorForm::Predictor).is_ok());
@@ -171,7 +171,7 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{EstimatorForm, Observer}};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     /// let model = StateSpace::discrete(matrix![1.0], matrix![0.1], matrix![1.0], matrix![0.0], 0.1)?;
     /// let mut obs = Observer::new(&model, matrix![0.5], EstimatorForm::Current)?;
     /// // x̂[0|−1] = 0; corrected by A⁻¹ L (2 − 0) = 1.
@@ -199,7 +199,7 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{EstimatorForm, Observer}};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     /// let model = StateSpace::discrete(matrix![1.0], matrix![0.1], matrix![1.0], matrix![0.0], 0.1)?;
     /// let mut obs = Observer::new(&model, matrix![0.5], EstimatorForm::Predictor)?;
     /// obs.correct(&vector![2.0]);
@@ -227,7 +227,7 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{EstimatorForm, Observer}};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     /// let model = StateSpace::discrete(matrix![1.0], matrix![0.1], matrix![1.0], matrix![0.0], 0.1)?;
     /// let obs = Observer::new(&model, matrix![0.5], EstimatorForm::Current)?;
     /// assert_eq!(obs.estimate(), vector![0.0]);
@@ -250,7 +250,7 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{EstimatorForm, Observer}};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     /// let model = StateSpace::discrete(matrix![1.0], matrix![0.1], matrix![1.0], matrix![0.0], 0.1)?;
     /// let obs = Observer::new(&model, matrix![0.5], EstimatorForm::Current)?;
     /// assert_eq!(obs.model().dt(), 0.1);
@@ -266,7 +266,7 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{EstimatorForm, Observer}};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     /// let model = StateSpace::discrete(matrix![1.0], matrix![0.1], matrix![1.0], matrix![0.0], 0.1)?;
     /// let mut obs = Observer::new(&model, matrix![0.5], EstimatorForm::Current)?;
     /// obs.correct(&vector![2.0]);

@@ -46,7 +46,7 @@ use crate::error::{Error, check_finite};
 /// ```
 /// use ctrlab::{Controller, MassSpring, Cart, Discretization, lab};
 /// use ctrlab::design::{AntiWindup, EstimatorForm, Observer, ObserverController, dlqe, dlqi};
-/// use nalgebra::{SMatrix, matrix, vector};
+/// use ctrlab::nalgebra::{SMatrix, matrix, vector};
 ///
 /// let model = MassSpring::nominal().state_space(Cart::Two)?
 ///     .with_output(lab::position_output_matrix(), matrix![0.0; 0.0])?
@@ -99,7 +99,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize>
     /// ```
     /// use ctrlab::{Controller, StateSpace};
     /// use ctrlab::design::{AntiWindup, EstimatorForm, Observer, ObserverController};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// // A double integrator at 0.1 s, position measured.
     /// let model = StateSpace::discrete(matrix![1.0, 0.1; 0.0, 1.0], matrix![0.005; 0.1],
@@ -139,7 +139,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize>
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{AntiWindup, EstimatorForm, Observer, ObserverController}};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     /// let model = StateSpace::discrete(matrix![1.0, 0.1; 0.0, 1.0], matrix![0.005; 0.1],
     ///                                  matrix![1.0, 0.0], matrix![0.0], 0.1)?;
     /// let observer = Observer::new(&model, matrix![1.0; 2.0], EstimatorForm::Predictor)?;
@@ -157,7 +157,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize>
     ///
     /// ```
     /// use ctrlab::{StateSpace, design::{AntiWindup, EstimatorForm, Observer, ObserverController}};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     /// let model = StateSpace::discrete(matrix![1.0, 0.1; 0.0, 1.0], matrix![0.005; 0.1],
     ///                                  matrix![1.0, 0.0], matrix![0.0], 0.1)?;
     /// let observer = Observer::new(&model, matrix![1.0; 2.0], EstimatorForm::Predictor)?;
@@ -215,7 +215,7 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize> Controller<
 ///
 /// ```
 /// use ctrlab::{Controller, StateFeedback, design::SelectOutputs};
-/// use nalgebra::{matrix, vector};
+/// use ctrlab::nalgebra::{matrix, vector};
 ///
 /// // A law on [x1, x2] only, given the rig's four measurements.
 /// let law = StateFeedback::new(matrix![1.0, 2.0], vector![0.0])?;
@@ -241,7 +241,7 @@ impl<C, const P: usize, const Q: usize> SelectOutputs<C, P, Q> {
     ///
     /// ```
     /// use ctrlab::{OpenLoop, design::SelectOutputs};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     /// let err = SelectOutputs::new(OpenLoop, matrix![f64::NAN, 0.0]).unwrap_err();
     /// assert!(matches!(err, ctrlab::Error::NonFinite { matrix: "S", .. }));
     /// ```

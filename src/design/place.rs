@@ -47,7 +47,7 @@ const CONJUGATE_RTOL: f64 = 1e-10;
 ///
 /// ```
 /// use ctrlab::{MassSpring, Cart, design::{StateFeedback, acker}};
-/// use nalgebra::Complex;
+/// use ctrlab::nalgebra::Complex;
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let targets = [

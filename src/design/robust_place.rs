@@ -83,7 +83,7 @@ type CVector<R> = OVector<Complex<f64>, R>;
 ///
 /// ```
 /// use ctrlab::{StateSpace, design::place};
-/// use nalgebra::{Complex, matrix};
+/// use ctrlab::nalgebra::{Complex, matrix};
 ///
 /// let (m1, m2, k1, k2) = (1.3, 0.7, 1000.0, 1000.0);
 /// let a = matrix![0.0, 1.0, 0.0, 0.0;
@@ -132,7 +132,7 @@ pub fn place<S: Design>(sys: &S, poles: impl PoleTargets<S::States>) -> Result<S
 ///
 /// ```
 /// use ctrlab::{MassSpring, Cart, design::place_observer};
-/// use nalgebra::{Complex, matrix};
+/// use ctrlab::nalgebra::{Complex, matrix};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?
 ///     .with_output(ctrlab::lab::position_output_matrix(), matrix![0.0; 0.0])?;

@@ -42,7 +42,7 @@ use crate::model::{Domain, DynStateSpace, LinearSystem, StateSpace, Token, perio
 ///
 /// ```
 /// use ctrlab::{Continuous, DynStateSpace, StateSpace, design::{Design, lqr}};
-/// use nalgebra::{dmatrix, matrix};
+/// use ctrlab::nalgebra::{dmatrix, matrix};
 ///
 /// fn report<S: Design<Domain = Continuous>>(sys: &S, q: &S::StateWeight, r: &S::InputWeight)
 ///     -> Result<String, ctrlab::Error>
@@ -109,7 +109,7 @@ pub trait Design: LinearSystem {
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace, design::lqe};
-/// use nalgebra::{dmatrix, matrix};
+/// use ctrlab::nalgebra::{dmatrix, matrix};
 ///
 /// // A random walk measured directly: the same filter for either size.
 /// let sys = StateSpace::continuous(matrix![0.0], matrix![0.1], matrix![1.0], matrix![0.0])?;
@@ -146,7 +146,7 @@ pub trait Kalman<G>: Design {
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace, design::lqi};
-/// use nalgebra::{dmatrix, matrix};
+/// use ctrlab::nalgebra::{dmatrix, matrix};
 ///
 /// // A lag with an integrator on its output.
 /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
@@ -321,7 +321,7 @@ mod sealed {
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace, design::place};
-/// use nalgebra::{Complex, matrix};
+/// use ctrlab::nalgebra::{Complex, matrix};
 ///
 /// // A double integrator.
 /// let sys = StateSpace::continuous(matrix![0.0, 1.0; 0.0, 0.0], matrix![0.0; 1.0],

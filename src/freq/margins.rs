@@ -398,8 +398,8 @@ pub struct Margins {
 /// assert!(bandwidth(&g, 0.0).is_err());
 ///
 /// // The same lag as a state-space model: the same bandwidth.
-/// let sys = ctrlab::StateSpace::continuous(nalgebra::matrix![-10.0], nalgebra::matrix![10.0],
-///                                          nalgebra::matrix![1.0], nalgebra::matrix![0.0])?;
+/// let sys = ctrlab::StateSpace::continuous(ctrlab::nalgebra::matrix![-10.0], ctrlab::nalgebra::matrix![10.0],
+///                                          ctrlab::nalgebra::matrix![1.0], ctrlab::nalgebra::matrix![0.0])?;
 /// assert_eq!(bandwidth(&sys, -3.0)?, bandwidth(&TransferFunction::try_from(&sys)?, -3.0)?);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```

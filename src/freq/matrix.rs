@@ -15,7 +15,7 @@ use crate::model::{Continuous, Domain, DynStateSpace, StateSpace};
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, freq::TransferMatrix};
-/// use nalgebra::dmatrix;
+/// use ctrlab::nalgebra::dmatrix;
 ///
 /// // Two decoupled lags: 1/(s + 1) and 2/(s + 2).
 /// let sys = DynStateSpace::continuous(dmatrix![-1.0, 0.0; 0.0, -2.0], dmatrix![1.0, 0.0; 0.0, 2.0],
@@ -190,7 +190,7 @@ impl<D: Domain> TransferMatrix<D> {
     ///
     /// ```
     /// # use ctrlab::freq::{TransferFunction, TransferMatrix};
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
     /// let m = TransferMatrix::new(vec![vec![g.clone(), g]])?;
     /// assert_eq!(m.evaluate(Complex::new(1.0, 0.0))?[(0, 1)], Complex::new(0.5, 0.0));

@@ -80,7 +80,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::{Complex, dmatrix};
+    /// use ctrlab::nalgebra::{Complex, dmatrix};
     ///
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![1.0], dmatrix![0.0])?;
     /// assert_eq!(sys.evaluate(Complex::new(2.0, 0.0))?[(0, 0)], Complex::new(1.0, 0.0));
@@ -105,7 +105,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::{Cart, MassSpring};
-    /// use nalgebra::Complex;
+    /// use ctrlab::nalgebra::Complex;
     ///
     /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
     /// assert!((plant.evaluate(Complex::new(0.0, 0.0))?[(0, 0)].re - 0.002).abs() < 1e-15);
@@ -127,7 +127,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// use ctrlab::StateSpace;
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// // (s + 3) / ((s + 1)(s + 2)) with a feedthrough of 1: zeros of
     /// // s² + 4 s + 5 = (s + 2)² + 1.

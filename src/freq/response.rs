@@ -239,7 +239,7 @@ impl FrequencyResponse {
     ///
     /// ```
     /// # use ctrlab::freq::{FrequencyDomain, TransferFunction};
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// let r = TransferFunction::continuous(&[1.0], &[1.0, 0.0])?.frequency_response(&[2.0])?;
     /// assert_eq!(r.response(0, 0)?, &[Complex::new(0.0, -0.5)]);
     /// assert!(r.response(1, 0).is_err());
@@ -385,7 +385,7 @@ impl Bode {
     ///
     /// ```
     /// use ctrlab::freq::Bode;
-    /// use nalgebra::Complex;
+    /// use ctrlab::nalgebra::Complex;
     ///
     /// // Three points going once around the origin: the phase keeps falling.
     /// let g = [Complex::new(0.0, -1.0), Complex::new(-1.0, 0.0), Complex::new(0.0, 1.0)];

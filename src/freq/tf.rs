@@ -66,7 +66,7 @@ pub(crate) fn check_poly(what: &'static str, p: &[f64]) -> Result<Vec<f64>, Erro
 ///
 /// ```
 /// use ctrlab::freq::TransferFunction;
-/// use nalgebra::Complex;
+/// use ctrlab::nalgebra::Complex;
 ///
 /// // 10 / (s² + 2 s + 10): ωn = √10 rad/s, ζ ≈ 0.32, DC gain 1.
 /// let g = TransferFunction::continuous(&[10.0], &[1.0, 2.0, 10.0])?;
@@ -229,7 +229,7 @@ impl<D: Domain> TransferFunction<D> {
     ///
     /// ```
     /// use ctrlab::{Error, freq::TransferFunction};
-    /// use nalgebra::Complex;
+    /// use ctrlab::nalgebra::Complex;
     ///
     /// let g = TransferFunction::continuous(&[1.0], &[1.0, 0.0])?; // 1/s
     /// assert_eq!(g.evaluate(Complex::new(0.0, 2.0))?, Complex::new(0.0, -0.5));
@@ -333,7 +333,7 @@ impl<D: Domain> TransferFunction<D> {
     ///
     /// ```
     /// use ctrlab::freq::TransferFunction;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let g = TransferFunction::continuous(&[1.0, 3.0], &[1.0, 3.0, 2.0])?;
     /// let sys = g.to_state_space()?;
@@ -394,7 +394,7 @@ impl<D: Domain> TransferFunction<D> {
     ///
     /// ```
     /// use ctrlab::{DynStateSpace, freq::TransferFunction};
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let sys = DynStateSpace::continuous(dmatrix![-3.0, -2.0; 1.0, 0.0], dmatrix![1.0; 0.0],
     ///                                     dmatrix![1.0, 3.0], dmatrix![0.0])?;

@@ -18,7 +18,7 @@ use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace};
 ///
 /// ```
 /// use ctrlab::freq::Zpk;
-/// use nalgebra::Complex;
+/// use ctrlab::nalgebra::Complex;
 ///
 /// // 2 (s + 3) / ((s + 1)(s + 2))
 /// let g = Zpk::continuous(&[Complex::new(-3.0, 0.0)],
@@ -81,7 +81,7 @@ impl Zpk<Continuous> {
     ///
     /// ```
     /// use ctrlab::freq::Zpk;
-    /// use nalgebra::Complex;
+    /// use ctrlab::nalgebra::Complex;
     ///
     /// assert!(Zpk::continuous(&[], &[Complex::new(-1.0, 1.0)], 1.0).is_err()); // no conjugate
     /// assert!(Zpk::continuous(&[], &[Complex::new(-1.0, 1.0), Complex::new(-1.0, -1.0)], 1.0).is_ok());
@@ -107,7 +107,7 @@ impl Zpk<Discrete> {
     ///
     /// ```
     /// use ctrlab::freq::Zpk;
-    /// use nalgebra::Complex;
+    /// use ctrlab::nalgebra::Complex;
     ///
     /// let g = Zpk::discrete(&[], &[Complex::new(0.5, 0.0)], 0.5, 0.1)?;
     /// assert_eq!(g.dc_gain()?, 1.0);
@@ -154,7 +154,7 @@ impl<D: Domain> Zpk<D> {
     ///
     /// ```
     /// # use ctrlab::freq::Zpk;
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// let z = [Complex::new(-3.0, 0.0)];
     /// assert_eq!(Zpk::continuous(&z, &[], 1.0)?.zeros(), &z);
     /// # Ok::<(), ctrlab::Error>(())
@@ -169,7 +169,7 @@ impl<D: Domain> Zpk<D> {
     ///
     /// ```
     /// # use ctrlab::freq::Zpk;
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// let p = [Complex::new(-1.0, 0.0)];
     /// assert_eq!(Zpk::continuous(&[], &p, 1.0)?.poles(), &p);
     /// # Ok::<(), ctrlab::Error>(())
@@ -216,7 +216,7 @@ impl<D: Domain> Zpk<D> {
     ///
     /// ```
     /// # use ctrlab::freq::Zpk;
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// let g = Zpk::continuous(&[], &[Complex::new(-1.0, 0.0)], 1.0)?;
     /// assert_eq!(g.evaluate(Complex::new(1.0, 0.0))?, Complex::new(0.5, 0.0));
     /// assert!(g.evaluate(Complex::new(-1.0, 0.0)).is_err());
@@ -256,7 +256,7 @@ impl<D: Domain> Zpk<D> {
     ///
     /// ```
     /// # use ctrlab::freq::Zpk;
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// assert!(Zpk::continuous(&[], &[Complex::new(0.0, 0.0)], 1.0)?.dc_gain().is_err());
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
@@ -277,7 +277,7 @@ impl<D: Domain> Zpk<D> {
     ///
     /// ```
     /// # use ctrlab::freq::Zpk;
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// let g = Zpk::continuous(&[], &[Complex::new(-1.0, 2.0), Complex::new(-1.0, -2.0)], 5.0)?;
     /// assert_eq!(g.to_transfer_function()?.den(), &[1.0, 2.0, 5.0]);
     /// # Ok::<(), ctrlab::Error>(())

@@ -22,7 +22,7 @@ use crate::data::Schema;
 ///
 /// ```
 /// use ctrlab::hw::{Rig, RigError};
-/// use nalgebra::{SVector, vector};
+/// use ctrlab::nalgebra::{SVector, vector};
 ///
 /// struct Heater { temperature: f64, power: f64 }
 /// impl Rig<1, 1> for Heater {

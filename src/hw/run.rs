@@ -147,7 +147,7 @@ impl std::fmt::Display for LoopStats {
 /// ```
 /// use ctrlab::hw::{Clock, LoopConfig, LoopFaultKind, VirtualClock, run};
 /// use ctrlab::{OpenLoop, lab::SimulatedRig};
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
 /// let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
@@ -195,7 +195,7 @@ impl std::error::Error for RunError {
 /// ```
 /// use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
 /// use ctrlab::{OpenLoop, lab::SimulatedRig};
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
 /// let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone()))?;
@@ -268,7 +268,7 @@ const SPIN: Duration = Duration::from_micros(200);
 /// ```
 /// use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
 /// use ctrlab::lab::{Cart, LabGains, MassSpring, SimulatedRig};
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 ///
 /// let clock = VirtualClock::new();
 /// let mut rig = SimulatedRig::ideal(MassSpring::nominal())

@@ -72,7 +72,7 @@ enum Time {
 ///
 /// ```
 /// use ctrlab::hw::{Clock, Pc104, SimulatedCard, SimulatedCardConfig, VirtualClock};
-/// use nalgebra::{SVector, vector};
+/// use ctrlab::nalgebra::{SVector, vector};
 ///
 /// let lag = |_t: f64, x: &SVector<f64, 1>, u: &SVector<f64, 1>| vector![-10.0 * x[0] + 10.0 * u[0]];
 /// let mut config = SimulatedCardConfig::<1>::default();
@@ -131,7 +131,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     ///
     /// ```
     /// use ctrlab::hw::{Clock, SimulatedCard, SimulatedCardConfig};
-    /// use nalgebra::SVector;
+    /// use ctrlab::nalgebra::SVector;
     /// let still = |_t: f64, _x: &SVector<f64, 1>, _u: &SVector<f64, 1>| SVector::<f64, 1>::zeros();
     /// let card = SimulatedCard::new(still, SimulatedCardConfig::default(), Clock::RealTime)?;
     /// assert!(card.clock().is_none());
@@ -351,7 +351,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     ///
     /// ```
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
-    /// use nalgebra::vector;
+    /// use ctrlab::nalgebra::vector;
     /// let mut card = SimulatedRig::default().card(&Clock::RealTime)?;
     /// card.set_true_state(vector![0.02, 0.0, 0.0, 0.0])?;
     /// assert_eq!(card.true_state()[0], 0.02);
@@ -379,7 +379,7 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     ///
     /// ```
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
-    /// use nalgebra::vector;
+    /// use ctrlab::nalgebra::vector;
     /// let rig = SimulatedRig { initial_state: [0.01, 0.0, 0.02, 0.0], ..Default::default() };
     /// assert_eq!(rig.card(&Clock::RealTime)?.true_state()[2], 0.02);
     /// # Ok::<(), ctrlab::hw::RigError>(())

@@ -28,7 +28,7 @@ use crate::kernels::reduce::pow2_floor;
 ///
 /// ```
 /// use ctrlab::ident::Rls;
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 ///
 /// let mut rls = Rls::<2>::new(1.0, 1e6)?;
 /// for k in 0..100 {
@@ -90,7 +90,7 @@ impl<const P: usize> Rls<P> {
     ///
     /// ```
     /// # use ctrlab::ident::Rls;
-    /// # use nalgebra::{vector, matrix};
+    /// # use ctrlab::nalgebra::{vector, matrix};
     /// let rls = Rls::with_prior(1.0, vector![950.0, 12.0], matrix![1e2, 0.0; 0.0, 1e2])?;
     /// assert_eq!(rls.theta()[0], 950.0);
     /// # Ok::<(), ctrlab::Error>(())
@@ -130,7 +130,7 @@ impl<const P: usize> Rls<P> {
     ///
     /// ```
     /// # use ctrlab::ident::Rls;
-    /// # use nalgebra::vector;
+    /// # use ctrlab::nalgebra::vector;
     /// let mut rls = Rls::<1>::new(1.0, 1e8)?;
     /// let e = rls.update(&vector![2.0], 6.0)?;
     /// assert_eq!(e, 6.0); // θ₀ = 0 predicted 0
@@ -231,7 +231,7 @@ impl<const P: usize> Rls<P> {
     ///
     /// ```
     /// # use ctrlab::ident::Rls;
-    /// # use nalgebra::vector;
+    /// # use ctrlab::nalgebra::vector;
     /// let mut rls = Rls::<1>::new(1.0, 100.0)?;
     /// rls.update(&vector![1.0], 1.0)?;
     /// assert!(rls.covariance()[(0, 0)] < 1.0); // one observation shrinks it

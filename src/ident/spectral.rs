@@ -72,7 +72,7 @@ impl FrequencyEstimate {
     ///
     /// ```
     /// # use ctrlab::ident::FrequencyEstimate;
-    /// # use nalgebra::Complex;
+    /// # use ctrlab::nalgebra::Complex;
     /// let g = FrequencyEstimate { omega: vec![1.0], response: vec![Complex::new(3.0, 4.0)] };
     /// assert_eq!(g.magnitude(), vec![5.0]);
     /// ```
@@ -153,7 +153,7 @@ fn check_data(u: &[f64], y: &[f64], dt: f64) -> Result<(), Error> {
 /// let g = etfe(&u, &y, dt)?;
 /// let w = g.omega[0];
 /// assert!((w - std::f64::consts::TAU * 7.0 / (200.0 * dt)).abs() < 1e-9);
-/// assert!((g.response[0] - nalgebra::Complex::from_polar(1.0, -w * dt)).norm() < 1e-12);
+/// assert!((g.response[0] - ctrlab::nalgebra::Complex::from_polar(1.0, -w * dt)).norm() < 1e-12);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[doc(alias = "tfestimate")]
@@ -232,7 +232,7 @@ pub fn etfe(u: &[f64], y: &[f64], dt: f64) -> Result<FrequencyEstimate, Error> {
 /// let w = [10.0, 100.0];
 /// let g = spa(&u, &y, dt, None, &w)?;
 /// for (w, g) in w.iter().zip(&g.response) {
-///     let truth = 1.0 + nalgebra::Complex::from_polar(0.5, -w * dt);
+///     let truth = 1.0 + ctrlab::nalgebra::Complex::from_polar(0.5, -w * dt);
 ///     assert!((g - truth).norm() < 0.02);
 /// }
 /// # Ok::<(), ctrlab::Error>(())

@@ -83,7 +83,7 @@ pub fn modes_hz(model: &MassSpring) -> Result<Vec<f64>, Error> {
 ///
 /// ```
 /// use ctrlab::ident::FrequencyEstimate;
-/// use nalgebra::Complex;
+/// use ctrlab::nalgebra::Complex;
 /// let tau = std::f64::consts::TAU;
 /// let g = FrequencyEstimate {
 ///     omega: [1.0, 2.0, 3.0, 4.0, 5.0].map(|f| f * tau).to_vec(),
@@ -199,7 +199,7 @@ pub struct FrequencyResponse {
 /// use ctrlab::OpenLoop;
 /// use ctrlab::lab::{Calibration, SimulatedRig, frequency, lqi};
 /// use ctrlab::signal::Signal;
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 /// let sim = SimulatedRig::default();
 /// let rig = lqi::predicted_rig(sim.truth, sim.friction.coulomb, &sim.calibration, sim.period);
 /// let ms = frequency::multisine(8.0)?;

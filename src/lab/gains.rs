@@ -79,7 +79,7 @@ impl LabGains {
     ///
     /// ```
     /// use ctrlab::{Cart, Controller, MassSpring, lab::LabGains};
-    /// use nalgebra::{matrix, vector};
+    /// use ctrlab::nalgebra::{matrix, vector};
     ///
     /// let mut c = LabGains::new([0.0, 0.0, 0.1, 0.0], Cart::Two).state_feedback()?;
     /// // Setpoint 30 mm, cart 2 at 5 mm: u = 0.1 · (30 − 5) = 2.5.
@@ -129,7 +129,7 @@ impl LabGains {
     ///
     /// ```
     /// use ctrlab::{Cart, MassSpring, StateFeedback, lab::LabGains, lqr};
-    /// use nalgebra::{SMatrix, matrix, vector};
+    /// use ctrlab::nalgebra::{SMatrix, matrix, vector};
     ///
     /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
     /// let q = SMatrix::<f64, 4, 4>::from_diagonal(&vector![0.0, 0.0, 1e6, 0.0]);

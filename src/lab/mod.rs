@@ -39,7 +39,7 @@
 //! use ctrlab::hw::{self, Clock, LoopConfig, VirtualClock};
 //! use ctrlab::lab::{Cart, LabGains, MassSpring, SimulatedRig};
 //! use ctrlab::sim::run_sampled;
-//! use nalgebra::vector;
+//! use ctrlab::nalgebra::vector;
 //!
 //! let sim = SimulatedRig::ideal(MassSpring::nominal());
 //! let law = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?;
@@ -97,7 +97,7 @@ use crate::data::{Channel, Schema};
 /// # Examples
 ///
 /// ```
-/// use nalgebra::{matrix, vector};
+/// use ctrlab::nalgebra::{matrix, vector};
 /// let c = ctrlab::lab::position_output_matrix();
 /// assert_eq!(c, matrix![1.0, 0.0, 0.0, 0.0; 0.0, 0.0, 1.0, 0.0]);
 /// assert_eq!(c * vector![0.01, 0.5, 0.02, -0.1], vector![0.01, 0.02]);

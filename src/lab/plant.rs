@@ -54,7 +54,7 @@ impl Cart {
     ///
     /// ```
     /// # use ctrlab::Cart;
-    /// # use nalgebra::matrix;
+    /// # use ctrlab::nalgebra::matrix;
     /// assert_eq!(Cart::Two.selection(), matrix![0.0, 0.0, 1.0, 0.0]);
     /// ```
     pub fn selection(self) -> SMatrix<f64, 1, 4> {

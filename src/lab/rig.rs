@@ -251,7 +251,7 @@ impl<P: EppPort> MassSpringRig<P> {
     ///
     /// ```
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
-    /// use nalgebra::vector;
+    /// use ctrlab::nalgebra::vector;
     /// let mut rig = SimulatedRig { initial_state: [0.001, 0.0, 0.002, 0.0], ..Default::default() }
     ///     .rig(&Clock::RealTime)?;
     /// let x = rig.read_state()?; // the counters count from where they were cleared: 0

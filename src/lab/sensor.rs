@@ -20,7 +20,7 @@ use crate::sim::Sensor;
 /// ```
 /// use ctrlab::lab::EncoderSensor;
 /// use ctrlab::sim::Sensor;
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 ///
 /// let mut enc = EncoderSensor::new(0.080 / 8192.0, 0.002, 0.0, 1);
 /// let y0 = enc.measure(0.0, &vector![0.0, 0.0, 0.0, 0.0]);

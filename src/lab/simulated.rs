@@ -36,7 +36,7 @@ use crate::sim::SampledConfig;
 /// use ctrlab::Dynamics;
 /// use ctrlab::integrate::{Integrator, Rk4};
 /// use ctrlab::lab::{FrictionPlant, MassSpring};
-/// use nalgebra::vector;
+/// use ctrlab::nalgebra::vector;
 ///
 /// // 1 V (1 N) against 2 N of friction on cart 2: nothing moves.
 /// let mut plant = FrictionPlant::new(MassSpring::nominal(), [0.0, 2.0]);

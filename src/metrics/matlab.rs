@@ -76,7 +76,7 @@ impl StepInfoOptions {
     ///
     /// ```
     /// use ctrlab::{StateSpace, StepInfoOptions, step_info_of};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// // stepinfo(tf(1, [1 1])): a first-order lag, τ = 1 s.
     /// let lag = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;

@@ -7,7 +7,7 @@
 //!
 //! ```
 //! use ctrlab::{StateSpace, StepInfoOptions, step_info_of};
-//! use nalgebra::matrix;
+//! use ctrlab::nalgebra::matrix;
 //!
 //! // A first-order lag, τ = 0.1 s: rise time τ ln 9, 2 % settling τ ln 50.
 //! let lag = StateSpace::continuous(matrix![-10.0], matrix![10.0], matrix![1.0], matrix![0.0])?;
@@ -156,7 +156,7 @@ impl std::fmt::Display for StepInfo {
     ///
     /// ```
     /// use ctrlab::{StateSpace, StepInfoOptions, step_info_of};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// // ωn = 10 rad/s, ζ = 0.5: about 16 % overshoot.
     /// let sys = StateSpace::continuous(matrix![0.0, 1.0; -100.0, -10.0], matrix![0.0; 100.0],

@@ -129,7 +129,7 @@ fn check_mimo_options(options: &StepInfoOptions) -> Result<(), Error> {
 ///
 /// ```
 /// use ctrlab::{Error, StateSpace, StepInfoOptions, metrics::step_info_mimo};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // Two lags, τ = 0.1 s and 1 s, one per input and output.
 /// let sys = StateSpace::continuous(

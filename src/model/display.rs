@@ -102,7 +102,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> fmt::Display
     ///
     /// ```
     /// use ctrlab::{Discretization, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![2.0], matrix![0.0], 0.1)?;
     /// let text = format!("{sys:.2}");
@@ -134,7 +134,7 @@ impl<D: Domain> fmt::Display for DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::{DynStateSpace, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let sys = StateSpace::continuous(matrix![-1.0, 2.0; 0.0, -3.0], matrix![0.0; 1.0],
     ///                                  matrix![1.0, 0.0], matrix![0.0])?;

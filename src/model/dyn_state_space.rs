@@ -30,7 +30,7 @@ use crate::model::{Continuous, Discrete, Domain, StateSpace};
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace};
-/// use nalgebra::{dmatrix, matrix};
+/// use ctrlab::nalgebra::{dmatrix, matrix};
 ///
 /// // A first-order lag, time constant 0.5 s, DC gain 2, sized at run time.
 /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![1.0], dmatrix![0.0])?;
@@ -89,7 +89,7 @@ impl DynStateSpace<Continuous> {
     ///
     /// ```
     /// # use ctrlab::{DynStateSpace, Error};
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let err = DynStateSpace::continuous(dmatrix![-1.0, 0.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])
     ///     .unwrap_err();
     /// assert!(matches!(err, Error::DimensionMismatch { matrix: "A", found_rows: 1, found_cols: 2, .. }));
@@ -124,7 +124,7 @@ impl DynStateSpace<Discrete> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let sys = DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], 0.002)?;
     /// assert_eq!(sys.dt(), 0.002);
     /// assert!(DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], 0.0).is_err());
@@ -154,7 +154,7 @@ impl DynStateSpace<Discrete> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let sys = DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], 0.01)?;
     /// assert_eq!(sys.dt(), 0.01);
     /// # Ok::<(), ctrlab::Error>(())
@@ -174,7 +174,7 @@ impl DynStateSpace<Discrete> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::{dmatrix, dvector};
+    /// # use ctrlab::nalgebra::{dmatrix, dvector};
     /// let sys = DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], 0.01)?;
     /// assert_eq!(sys.advance(&dvector![2.0], &dvector![1.0])?, dvector![2.0]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -234,7 +234,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![1.0], dmatrix![0.0])?;
     /// assert_eq!(sys.a(), &dmatrix![-2.0]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -249,7 +249,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![1.0], dmatrix![0.0])?;
     /// assert_eq!(sys.b(), &dmatrix![4.0]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -264,7 +264,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![1.0], dmatrix![0.0])?;
     /// assert_eq!(sys.c(), &dmatrix![1.0]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -279,7 +279,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![1.0], dmatrix![0.5])?;
     /// assert_eq!(sys.d(), &dmatrix![0.5]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -294,7 +294,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::dmatrix;
+    /// # use ctrlab::nalgebra::dmatrix;
     /// let sys = DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], 0.002)?;
     /// assert_eq!(sys.domain().dt(), 0.002);
     /// # Ok::<(), ctrlab::Error>(())
@@ -314,7 +314,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// # use ctrlab::DynStateSpace;
-    /// # use nalgebra::{dmatrix, dvector};
+    /// # use ctrlab::nalgebra::{dmatrix, dvector};
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![3.0], dmatrix![0.5])?;
     /// assert_eq!(sys.output(&dvector![1.0], &dvector![2.0])?, dvector![4.0]);
     /// assert!(sys.output(&dvector![1.0, 0.0], &dvector![2.0]).is_err());

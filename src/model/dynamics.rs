@@ -23,7 +23,7 @@ use super::{Continuous, StateSpace};
 /// ```
 /// use ctrlab::Dynamics;
 /// use ctrlab::integrate::{Integrator, Rk4};
-/// use nalgebra::{SVector, vector};
+/// use ctrlab::nalgebra::{SVector, vector};
 ///
 /// // A pendulum, x = [angle (rad), rate (rad/s)], u = torque/inertia (rad/s²).
 /// let pendulum = |_t: f64, x: &SVector<f64, 2>, u: &SVector<f64, 1>| {
@@ -50,7 +50,7 @@ pub trait Dynamics<const N: usize, const M: usize> {
     ///
     /// ```
     /// use ctrlab::Dynamics;
-    /// use nalgebra::{SVector, vector};
+    /// use ctrlab::nalgebra::{SVector, vector};
     ///
     /// /// x' = u, but x never goes below zero (a hard stop).
     /// struct Stop;

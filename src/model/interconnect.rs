@@ -90,7 +90,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // 1/(s+1) then 2/(s+3): DC gain 1 · 2/3, poles −1 and −3.
     /// let g1 = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
@@ -148,13 +148,13 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // 1/(s+1) + 2 (a pure gain, no states).
     /// let g1 = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
     /// let k = DynStateSpace::continuous(
-    ///     nalgebra::DMatrix::zeros(0, 0), nalgebra::DMatrix::zeros(0, 1),
-    ///     nalgebra::DMatrix::zeros(1, 0), dmatrix![2.0])?;
+    ///     ctrlab::nalgebra::DMatrix::zeros(0, 0), ctrlab::nalgebra::DMatrix::zeros(0, 1),
+    ///     ctrlab::nalgebra::DMatrix::zeros(1, 0), dmatrix![2.0])?;
     /// let g = g1.parallel(&k)?;
     /// assert_eq!((g.states(), g.d()[(0, 0)]), (1, 2.0));
     /// # Ok::<(), ctrlab::Error>(())
@@ -205,13 +205,13 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::{DynStateSpace, model::Sign};
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// // 1/s under unity negative feedback: 1/(s+1).
     /// let plant = DynStateSpace::continuous(dmatrix![0.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
     /// let unity = DynStateSpace::continuous(
-    ///     nalgebra::DMatrix::zeros(0, 0), nalgebra::DMatrix::zeros(0, 1),
-    ///     nalgebra::DMatrix::zeros(1, 0), dmatrix![1.0])?;
+    ///     ctrlab::nalgebra::DMatrix::zeros(0, 0), ctrlab::nalgebra::DMatrix::zeros(0, 1),
+    ///     ctrlab::nalgebra::DMatrix::zeros(1, 0), dmatrix![1.0])?;
     /// let cl = plant.feedback(&unity, Sign::Negative)?;
     /// assert_eq!(cl.a(), &dmatrix![-1.0]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -269,7 +269,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let g1 = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
     /// let g = g1.append(&g1)?;
@@ -302,7 +302,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0, 2.0], dmatrix![1.0], dmatrix![0.0, 0.5])?;
     /// let second = sys.select_input(1)?;
@@ -325,7 +325,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0, 2.0, 3.0],
     ///                                     dmatrix![1.0], dmatrix![0.0, 0.0, 0.5])?;
@@ -358,7 +358,7 @@ impl<D: Domain> DynStateSpace<D> {
     ///
     /// ```
     /// use ctrlab::DynStateSpace;
-    /// use nalgebra::dmatrix;
+    /// use ctrlab::nalgebra::dmatrix;
     ///
     /// let sys = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0],
     ///                                     dmatrix![1.0; 2.0], dmatrix![0.0; 0.0])?;

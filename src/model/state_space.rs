@@ -47,7 +47,7 @@ impl Discrete {
     ///
     /// ```
     /// # use ctrlab::{StateSpace, Discrete};
-    /// # use nalgebra::{matrix};
+    /// # use ctrlab::nalgebra::{matrix};
     /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.002)?;
     /// assert_eq!(sys.domain().dt(), 0.002);
     /// # Ok::<(), ctrlab::Error>(())
@@ -84,7 +84,7 @@ pub(crate) fn period_of<D: Domain>(domain: &D) -> Option<f64> {
 ///
 /// ```compile_fail
 /// # use ctrlab::StateSpace;
-/// # use nalgebra::matrix;
+/// # use ctrlab::nalgebra::matrix;
 /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0]).unwrap();
 /// sys.advance(&matrix![0.0], &matrix![1.0]); // no `advance` on a continuous model
 /// ```
@@ -93,7 +93,7 @@ pub(crate) fn period_of<D: Domain>(domain: &D) -> Option<f64> {
 ///
 /// ```
 /// use ctrlab::StateSpace;
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // A first-order lag, time constant 0.5 s, DC gain 2.
 /// let sys = StateSpace::continuous(matrix![-2.0], matrix![4.0], matrix![1.0], matrix![0.0])?;
@@ -136,7 +136,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     ///
     /// ```
     /// # use ctrlab::{StateSpace, Error};
-    /// # use nalgebra::matrix;
+    /// # use ctrlab::nalgebra::matrix;
     /// let err = StateSpace::continuous(matrix![-1.0], matrix![f64::INFINITY], matrix![1.0], matrix![0.0]).unwrap_err();
     /// assert!(matches!(err, Error::NonFinite { matrix: "B", row: 0, col: 0, .. }));
     /// ```
@@ -162,7 +162,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Continu
     ///
     /// ```
     /// # use ctrlab::StateSpace;
-    /// # use nalgebra::{matrix, vector};
+    /// # use ctrlab::nalgebra::{matrix, vector};
     /// let sys = StateSpace::continuous(matrix![-2.0], matrix![4.0], matrix![1.0], matrix![0.0])?;
     /// assert_eq!(sys.derivative(&vector![1.0], &vector![0.5]), vector![0.0]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -186,7 +186,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     ///
     /// ```
     /// # use ctrlab::{StateSpace, Error};
-    /// # use nalgebra::matrix;
+    /// # use ctrlab::nalgebra::matrix;
     /// let sys = StateSpace::discrete(matrix![0.9], matrix![0.1], matrix![1.0], matrix![0.0], 0.01)?;
     /// assert_eq!(sys.dt(), 0.01);
     /// let err = StateSpace::discrete(matrix![0.9], matrix![0.1], matrix![1.0], matrix![0.0], 0.0).unwrap_err();
@@ -217,7 +217,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     ///
     /// ```
     /// # use ctrlab::StateSpace;
-    /// # use nalgebra::matrix;
+    /// # use ctrlab::nalgebra::matrix;
     /// let sys = StateSpace::discrete(matrix![1.0], matrix![0.0], matrix![1.0], matrix![0.0], 0.002)?;
     /// assert_eq!(sys.dt(), 0.002);
     /// # Ok::<(), ctrlab::Error>(())
@@ -236,7 +236,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     ///
     /// ```
     /// # use ctrlab::StateSpace;
-    /// # use nalgebra::{matrix, vector};
+    /// # use ctrlab::nalgebra::{matrix, vector};
     /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
     /// let mut x = vector![2.0];
     /// sys.advance_mut(&mut x, &vector![1.0]);
@@ -255,7 +255,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     ///
     /// ```
     /// # use ctrlab::StateSpace;
-    /// # use nalgebra::{matrix, vector};
+    /// # use ctrlab::nalgebra::{matrix, vector};
     /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
     /// assert_eq!(sys.advance(&vector![4.0], &vector![0.0]), vector![2.0]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -289,7 +289,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::StateSpace;
-    /// # use nalgebra::matrix;
+    /// # use ctrlab::nalgebra::matrix;
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0, 2.0], matrix![1.0], matrix![0.0, 0.0])?;
     /// assert_eq!(sys.inputs(), 2);
     /// # Ok::<(), ctrlab::Error>(())
@@ -305,7 +305,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::StateSpace;
-    /// # use nalgebra::matrix;
+    /// # use ctrlab::nalgebra::matrix;
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0; 2.0], matrix![0.0; 0.0])?;
     /// assert_eq!(sys.outputs(), 2);
     /// # Ok::<(), ctrlab::Error>(())
@@ -396,7 +396,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::MassSpring;
-    /// # use nalgebra::vector;
+    /// # use ctrlab::nalgebra::vector;
     /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::One)?;
     /// let y = sys.output(&vector![0.01, 0.0, 0.02, 0.0], &vector![0.0]);
     /// assert_eq!(y[0], 0.01);
@@ -418,7 +418,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::MassSpring;
-    /// # use nalgebra::{SMatrix, matrix};
+    /// # use ctrlab::nalgebra::{SMatrix, matrix};
     /// let sys = MassSpring::nominal().state_space(ctrlab::Cart::One)?;
     /// let full = sys.with_output(SMatrix::<f64, 4, 4>::identity(), SMatrix::<f64, 4, 1>::zeros())?;
     /// assert_eq!(full.c().nrows(), 4);
@@ -452,7 +452,7 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> StateSpace<N, M,
     ///
     /// ```
     /// # use ctrlab::{Error, StateSpace};
-    /// # use nalgebra::matrix;
+    /// # use ctrlab::nalgebra::matrix;
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0, 2.0], matrix![1.0], matrix![0.0, 0.5])?;
     /// let second = sys.select_input(1)?;
     /// assert_eq!((second.b()[(0, 0)], second.d()[(0, 0)]), (2.0, 0.5));

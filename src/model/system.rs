@@ -70,7 +70,7 @@ pub(crate) use sealed::Token;
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, LinearSystem, StateSpace};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// fn describe(sys: &impl LinearSystem) -> String {
 ///     format!("{} states, {} inputs, {} outputs", sys.states(), sys.inputs(), sys.outputs())
@@ -103,7 +103,7 @@ pub trait LinearSystem: sealed::Sealed {
     ///
     /// ```
     /// use ctrlab::{LinearSystem, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
     /// assert_eq!(LinearSystem::states(&sys), 1);
@@ -117,7 +117,7 @@ pub trait LinearSystem: sealed::Sealed {
     ///
     /// ```
     /// use ctrlab::{LinearSystem, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0, 0.0], matrix![1.0], matrix![0.0, 0.0])?;
     /// assert_eq!(LinearSystem::inputs(&sys), 2);
@@ -131,7 +131,7 @@ pub trait LinearSystem: sealed::Sealed {
     ///
     /// ```
     /// use ctrlab::{LinearSystem, StateSpace};
-    /// use nalgebra::matrix;
+    /// use ctrlab::nalgebra::matrix;
     ///
     /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0; 2.0], matrix![0.0; 0.0])?;
     /// assert_eq!(LinearSystem::outputs(&sys), 2);
@@ -154,7 +154,7 @@ pub trait LinearSystem: sealed::Sealed {
 ///
 /// ```compile_fail
 /// use ctrlab::{StateSpace, sim::step_response};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // Two inputs: pick one with `select_input` first.
 /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0, 2.0], matrix![1.0], matrix![0.0, 0.0]).unwrap();
@@ -163,7 +163,7 @@ pub trait LinearSystem: sealed::Sealed {
 ///
 /// ```
 /// use ctrlab::{StateSpace, sim::step_response};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0, 2.0], matrix![1.0], matrix![0.0, 0.0])?;
 /// let r = step_response(&sys.select_input(1)?, 1.0, 0.1)?;
@@ -180,7 +180,7 @@ pub trait SingleInput: LinearSystem {}
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace, StepInfoOptions, step_info_of};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// let lag = StateSpace::continuous(matrix![-10.0], matrix![10.0], matrix![1.0], matrix![0.0])?;
 /// let fixed = step_info_of(&lag, 2.0, 0.01, &StepInfoOptions::default())?;

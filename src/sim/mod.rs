@@ -24,7 +24,7 @@
 //!
 //! ```
 //! use ctrlab::{DynStateSpace, StateSpace, sim::step_response};
-//! use nalgebra::matrix;
+//! use ctrlab::nalgebra::matrix;
 //!
 //! // A first-order lag, τ = 0.5 s, as either model type: one call, one result type.
 //! let fixed = StateSpace::continuous(matrix![-2.0], matrix![2.0], matrix![1.0], matrix![0.0])?;
@@ -64,7 +64,7 @@ pub const MAX_SAMPLES: usize = 10_000_000;
 ///
 /// ```
 /// use ctrlab::{Error, StateSpace, sim::{MAX_RK4_STEPS, Solver, simulate}};
-/// use nalgebra::{matrix, vector};
+/// use ctrlab::nalgebra::{matrix, vector};
 ///
 /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
 /// let solver = Solver::Rk4 { substeps: MAX_RK4_STEPS + 1 };
@@ -87,7 +87,7 @@ pub const MAX_RK4_STEPS: usize = 100_000_000;
 ///
 /// ```
 /// use ctrlab::{StateSpace, StepInfoOptions, step_info, sim::step_response};
-/// use nalgebra::{Const, matrix};
+/// use ctrlab::nalgebra::{Const, matrix};
 ///
 /// // A lag, τ = 0.1 s: its step response and the figures of it.
 /// let sys = StateSpace::continuous(matrix![-10.0], matrix![10.0], matrix![1.0], matrix![0.0])?;
@@ -117,7 +117,7 @@ where
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, sim::{DynResponse, step_response}};
-/// use nalgebra::dmatrix;
+/// use ctrlab::nalgebra::dmatrix;
 ///
 /// let sys = DynStateSpace::continuous(dmatrix![-10.0], dmatrix![10.0], dmatrix![1.0], dmatrix![0.0])?;
 /// let r: DynResponse = step_response(&sys, 1.0, 0.01)?;
@@ -205,7 +205,7 @@ where
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace, sim::{Simulate, initial_response}};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // Written once, for either model size.
 /// fn final_output<S: Simulate<Response = R>, R>(sys: &S, x0: S::State) -> Result<R, ctrlab::Error> {
@@ -214,7 +214,7 @@ where
 /// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
 /// let r = final_output(&sys, matrix![1.0])?;
 /// assert!((r.y[2][0] - (-1.0f64).exp()).abs() < 1e-15);
-/// let d = final_output(&DynStateSpace::from(&sys), nalgebra::dvector![1.0])?;
+/// let d = final_output(&DynStateSpace::from(&sys), ctrlab::nalgebra::dvector![1.0])?;
 /// assert_eq!(d.y[2][0], r.y[2][0]);
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
@@ -389,7 +389,7 @@ pub fn time_grid(t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, MassSpring, Cart, sim::{simulate, time_grid, Solver}};
-/// use nalgebra::{DVector, dvector, vector};
+/// use ctrlab::nalgebra::{DVector, dvector, vector};
 ///
 /// let sys = MassSpring::nominal().state_space(Cart::Two)?;
 /// let t = time_grid(10.0, 0.002)?;
@@ -710,7 +710,7 @@ where
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, StateSpace, sim::simulate_discrete};
-/// use nalgebra::{dvector, matrix, vector};
+/// use ctrlab::nalgebra::{dvector, matrix, vector};
 ///
 /// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
 /// let r = simulate_discrete(&sys, vector![0.0], &[vector![1.0]; 3])?;
@@ -743,7 +743,7 @@ pub fn simulate_discrete<S: Simulate<Domain = Discrete>>(
 ///
 /// ```
 /// use ctrlab::{DynStateSpace, Error, StateSpace, sim::simulate_discrete_feedback};
-/// use nalgebra::{dvector, matrix, vector};
+/// use ctrlab::nalgebra::{dvector, matrix, vector};
 ///
 /// // x[k+1] = x + u with u = -0.5 x halves the state every sample.
 /// let sys = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;

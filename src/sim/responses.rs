@@ -147,7 +147,7 @@ where
 ///
 /// ```
 /// use ctrlab::{StateSpace, sim::step_response};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // First-order lag, τ = 0.5 s: y(τ) = 1 - e^-1.
 /// let sys = StateSpace::continuous(matrix![-2.0], matrix![2.0], matrix![1.0], matrix![0.0])?;
@@ -199,7 +199,7 @@ pub fn step_response<S: Simulate + SingleInput>(
 ///
 /// ```
 /// use ctrlab::{Discretization, StateSpace, sim::impulse_response};
-/// use nalgebra::matrix;
+/// use ctrlab::nalgebra::matrix;
 ///
 /// // A lag 1/(τ s + 1), τ = 0.5 s: g(t) = e^{−t/τ} / τ.
 /// let sys = StateSpace::continuous(matrix![-2.0], matrix![2.0], matrix![1.0], matrix![0.0])?;
@@ -239,16 +239,16 @@ pub fn impulse_response<S: Simulate + SingleInput>(
 ///
 /// ```
 /// use ctrlab::{StateSpace, sim::initial_response};
-/// use nalgebra::{matrix, vector};
+/// use ctrlab::nalgebra::{matrix, vector};
 ///
 /// // An undamped oscillator, ω = 2 rad/s, released from x = 1: cos 2t.
 /// let sys = StateSpace::continuous(matrix![0.0, 1.0; -4.0, 0.0], matrix![0.0; 1.0], matrix![1.0, 0.0], matrix![0.0])?;
 /// let r = initial_response(&sys, 1.0, 0.25, vector![1.0, 0.0])?;
 /// assert!((r.y[4][0] - 2f64.cos()).abs() < 1e-12);
 /// let dynamic = ctrlab::DynStateSpace::from(&sys);
-/// let d = initial_response(&dynamic, 1.0, 0.25, nalgebra::dvector![1.0, 0.0])?;
+/// let d = initial_response(&dynamic, 1.0, 0.25, ctrlab::nalgebra::dvector![1.0, 0.0])?;
 /// assert_eq!(d.output(0)?, r.output(0)?);
-/// assert!(initial_response(&dynamic, 1.0, 0.25, nalgebra::dvector![1.0]).is_err());
+/// assert!(initial_response(&dynamic, 1.0, 0.25, ctrlab::nalgebra::dvector![1.0]).is_err());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[doc(alias = "initial")]

@@ -25,7 +25,7 @@ use super::{MAX_RK4_STEPS, MAX_SAMPLES};
 ///
 /// ```
 /// use ctrlab::sim::Sensor;
-/// use nalgebra::{SVector, matrix, vector};
+/// use ctrlab::nalgebra::{SVector, matrix, vector};
 ///
 /// let c = matrix![1.0, 0.0];
 /// let mut position = |x: &SVector<f64, 2>| c * x;
@@ -42,7 +42,7 @@ pub trait Sensor<const N: usize, const P: usize> {
     ///
     /// ```
     /// use ctrlab::sim::Sensor;
-    /// use nalgebra::{SVector, vector};
+    /// use ctrlab::nalgebra::{SVector, vector};
     /// let mut full = |x: &SVector<f64, 1>| *x;
     /// full.reset();
     /// assert_eq!(full.measure(0.0, &vector![1.0]), vector![1.0]);
@@ -284,7 +284,7 @@ impl<const M: usize, const P: usize> SampledConfig<M, P> {
 ///
 /// ```
 /// use ctrlab::{StateFeedback, StateSpace, sim::{SampledConfig, run_sampled}};
-/// use nalgebra::{SVector, matrix, vector};
+/// use ctrlab::nalgebra::{SVector, matrix, vector};
 ///
 /// let plant = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
 /// let control = StateFeedback::new(matrix![4.0], vector![5.0])?; // u = 5 r − 4 x

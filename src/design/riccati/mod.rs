@@ -54,7 +54,7 @@ pub(crate) enum Weights {
 ///
 /// ```
 /// use ctrlab::design::care;
-/// use nalgebra::dmatrix;
+/// use ctrlab::nalgebra::dmatrix;
 ///
 /// let a = dmatrix![0.0, 1.0; 0.0, 0.0];
 /// let b = dmatrix![0.0; 1.0];
@@ -98,7 +98,7 @@ pub fn care(
 ///
 /// ```
 /// use ctrlab::design::dare;
-/// use nalgebra::dmatrix;
+/// use ctrlab::nalgebra::dmatrix;
 ///
 /// let a = dmatrix![0.0, 1.0; 0.0, 0.0];
 /// let b = dmatrix![0.0; 1.0];

@@ -422,7 +422,7 @@ pub fn refine(rec: &Recording, start: &MassSpringEstimate) -> Result<Refined, Er
 /// use ctrlab::lab::ident::{Options, SpringModel, identify_with, refine_with};
 /// use ctrlab::signal::SquareWave;
 /// # use ctrlab::{OpenLoop, hw::{self, Clock, LoopConfig, VirtualClock}};
-/// # use nalgebra::vector;
+/// # use ctrlab::nalgebra::vector;
 /// let sim = SimulatedRig::default();
 /// // A 3 s square-wave run on the simulated card (its Coulomb friction,
 /// // stiction, PWM delay and encoder noise), as `hw::run` records it.

@@ -16,7 +16,7 @@
 //! ```
 //! use ctrlab::Controller;
 //! use ctrlab::lab::{Cart, MassSpring, lqi};
-//! use nalgebra::vector;
+//! use ctrlab::nalgebra::vector;
 //!
 //! let model = lqi::position_model(&MassSpring::nominal(), 0.002)?;
 //! let design = lqi::positions_lqi(&model, Cart::Two, &lqi::weights(Cart::Two, 1e7), 9.765625e-6)?;

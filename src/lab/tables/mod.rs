@@ -289,7 +289,7 @@ impl fmt::Display for KfDisplay<'_> {
 ///
 /// ```
 /// use ctrlab::lab::tables::poles_display;
-/// use nalgebra::Complex;
+/// use ctrlab::nalgebra::Complex;
 /// let poles = [Complex::new(-1.0, 2.0), Complex::new(-1.0, -2.0), Complex::new(-3.5, 0.0)];
 /// assert_eq!(poles_display(&poles).to_string(), "-1.00 ± 2.00j, -3.50");
 /// ```

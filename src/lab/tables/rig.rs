@@ -268,7 +268,7 @@ impl RigRun {
     ///
     /// ```
     /// use ctrlab::lab::tables::{Prediction, RigOutcome, RigRun};
-    /// use nalgebra::Complex;
+    /// use ctrlab::nalgebra::Complex;
     /// let run = RigRun {
     ///     kf: [0.0, 0.0, 1.0, 0.0],
     ///     prediction: Prediction { radius: 1.01, poles: [Complex::new(0.0, 0.0); 4] },
