@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 ///
 /// ```
 /// use ctrlab::hw::{Clock, LoopConfig, LoopFaultKind, StopSignal, VirtualClock, run};
-/// use ctrlab::{OpenLoop, lab::SimulatedRig, ctrlab::nalgebra::vector};
+/// use ctrlab::{OpenLoop, lab::SimulatedRig, nalgebra::vector};
 ///
 /// let stop = StopSignal::new();
 /// let clock = VirtualClock::new();

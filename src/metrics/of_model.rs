@@ -35,7 +35,7 @@ use crate::sim::step_response;
 /// # Examples
 ///
 /// ```
-/// use ctrlab::{MassSpring, Cart, Discretization, design::StateFeedback, metrics::{StepInfoOptions, step_info_of}};
+/// use ctrlab::{MassSpring, Cart, Discretization, lab::LabGains, metrics::{StepInfoOptions, step_info_of}};
 ///
 /// let plant = MassSpring::nominal().state_space(Cart::Two)?;
 /// let cl = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two).state_feedback()?.closed_loop(&plant)?;
