@@ -77,7 +77,10 @@ pub struct VirtualClock {
 /// schedule gives the same run. The loop ([`run`](super::run)) handles a
 /// late wake-up as on the wall clock: a tick a period or more late skips
 /// the deadlines it missed ([`LoopStats::skipped`](super::LoopStats)),
-/// and the next tick keeps its own deadline, however soon that is.
+/// and the next tick keeps its own deadline, however soon that is. Skipped
+/// deadlines are timing faults there too: a schedule that skips more than
+/// [`LoopConfig::max_timing_faults`](super::LoopConfig) deadlines within
+/// its window stops the run, unless the limit is raised.
 ///
 /// # Examples
 ///
