@@ -86,7 +86,7 @@ fn one_count_over_5_us_after_a_late_tick_is_neither_a_bus_fault_nor_a_speed_spik
     let want = COUNT / (2.0 * PERIOD);
     assert!((x[3] - want).abs() < 1e-12 * want, "{} vs {want}", x[3]);
     // Differenced over the 5 µs it would have been 1.95 m/s, 800 times that.
-    assert!(x[3] < 1e-3 * COUNT / 5e-6, "{}", x[3]);
+    assert!(x[3] < 0.01 * COUNT / 5e-6, "{}", x[3]);
     // The issue's own figures: one count over 4.87 µs, 2.006 m/s.
     read_at(&mut rig, &clock, 5 * PERIOD_NS - 4_870, 1).unwrap();
     let x = read_at(&mut rig, &clock, 5 * PERIOD_NS, 2).unwrap();
