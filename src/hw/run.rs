@@ -23,6 +23,37 @@
 //! The recording's time stamps are the actual sampling (latch) instants on
 //! the monotonic clock, so a missed tick shows as a gap, never papered over;
 //! its inputs are those the rig reports as applied.
+//!
+//! # Late ticks
+//!
+//! One policy, from the loop to the analyses:
+//!
+//! - A tick keeps its absolute deadline `k T` whatever happened before it.
+//!   A tick whose sample is taken [`LATE_FRACTION`] of a period or more
+//!   after its deadline is *late* ([`LoopStats::late`]); the next tick
+//!   still samples at its own deadline, so it follows the late one by less
+//!   than `(1 − LATE_FRACTION) T` — as little as a few µs.
+//! - A tick that wakes up a whole period or more after its deadline skips
+//!   the deadlines it missed ([`LoopStats::skipped`]) and samples at once:
+//!   never two samples back to back on stale time. Too many skipped
+//!   deadlines and overruns in a window stop the run
+//!   ([`LoopFault::TimingFaults`]); an interval longer than `max_gap`
+//!   stops it too ([`LoopFault::Gap`]).
+//! - Both show in the recording, which is not resampled: its time stamps
+//!   are the actual instants (a late sample is stamped late, a skipped
+//!   deadline leaves a longer interval), with no extra column.
+//! - Nothing downstream differentiates over a short interval:
+//!   [`MassSpringRig::read_state`](crate::lab::MassSpringRig::read_state)
+//!   takes its speeds over a stored sample at least `(1 − LATE_FRACTION) T`
+//!   old (in the loop, the sample two ticks back always is), and its bus
+//!   fault check allows a change of one count over any interval; the lab's
+//!   identification splits the recording at short intervals and gaps, and
+//!   its simulation applies each input its delay after the sample's actual
+//!   instant ([`lab::ident`](crate::lab::ident)).
+//!
+//! The same policy runs on a [`VirtualClock`](super::VirtualClock) with a
+//! seeded [`Jitter`](super::Jitter) schedule, which makes ticks late and
+//! stall reproducibly for tests.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::{Duration, Instant};
@@ -79,16 +110,31 @@ impl Default for LoopConfig {
     }
 }
 
+/// A tick whose sample is taken this fraction of the period or more after
+/// its deadline is late ([`LoopStats::late`]): the next sample, taken at its
+/// own deadline, follows it by less than `1 − LATE_FRACTION` periods, too
+/// short an interval to difference over (see the module's "Late ticks").
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::LATE_FRACTION;
+/// // At the lab's 2 ms, a sample 0.5 ms late or more is late.
+/// assert_eq!(LATE_FRACTION * 0.002, 0.5e-3);
+/// ```
+pub const LATE_FRACTION: f64 = 0.25;
+
 /// Timing statistics of a run, in the spirit of cyclictest. Lateness is how
-/// long after its deadline a tick's sample was taken, s (always 0 on the
-/// virtual clock).
+/// long after its deadline a tick's sample was taken, s (always 0 on an
+/// ideal virtual clock, the [`Jitter`](super::Jitter) schedule's on a
+/// jittered one).
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::hw::LoopStats;
 /// let s = LoopStats::default();
-/// assert_eq!((s.ticks, s.overruns, s.lateness_max), (0, 0, 0.0));
+/// assert_eq!((s.ticks, s.overruns, s.late, s.lateness_max), (0, 0, 0, 0.0));
 /// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LoopStats {
@@ -97,8 +143,14 @@ pub struct LoopStats {
     /// Ticks whose work ended after the next deadline.
     pub overruns: usize,
     /// Deadlines skipped because the loop fell a whole period or more
-    /// behind (real-time clock only); they show as gaps in the recording.
+    /// behind (on the wall clock or a jittered virtual clock); they show as
+    /// gaps in the recording.
     pub skipped: usize,
+    /// Ticks whose sample was taken [`LATE_FRACTION`] of a period or more
+    /// after their deadline (the tick that samples after skipped deadlines
+    /// among them when it is that late); each shows as a late time stamp,
+    /// followed by a shorter interval.
+    pub late: usize,
     /// Longest run of consecutive overruns.
     pub max_consecutive_overruns: usize,
     /// Longest interval between two recorded samples, s.
@@ -126,12 +178,13 @@ impl std::fmt::Display for LoopStats {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "ticks {}, p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs, overruns {} (longest run {}), skipped {}, longest interval {:.3} ms",
+            "ticks {}, p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs, max {:.1} µs, late {}, overruns {} (longest run {}), skipped {}, longest interval {:.3} ms",
             self.ticks,
             self.lateness_p50 * 1e6,
             self.lateness_p99 * 1e6,
             self.lateness_p999 * 1e6,
             self.lateness_max * 1e6,
+            self.late,
             self.overruns,
             self.max_consecutive_overruns,
             self.skipped,
@@ -384,15 +437,30 @@ where
         }
         // Wait for the absolute deadline k·T; `t` is the sampling instant.
         let (t, late) = match clock {
-            Clock::Virtual(c) => {
+            Clock::Virtual(c) if c.jitter().is_none() => {
                 // Time is kept in whole nanoseconds, and so is the record.
                 let offset = (k as u64).saturating_mul(period_ns);
                 let target = virtual_start.saturating_add(offset);
                 c.advance_nanos(target.saturating_sub(c.now_nanos()));
                 (offset as f64 * 1e-9, 0.0)
             }
-            Clock::RealTime => {
-                let elapsed = wall_start.elapsed().as_secs_f64();
+            _ => {
+                // When the loop wakes up: now on the wall clock; on a
+                // jittered virtual clock, the deadline (or now, if past it)
+                // plus the schedule's lateness for this tick.
+                let elapsed = match clock {
+                    Clock::Virtual(c) => {
+                        let offset = (k as u64).saturating_mul(period_ns);
+                        let target = virtual_start.saturating_add(offset);
+                        let lateness = c.jitter().map_or(0.0, |j| j.lateness(k as u64));
+                        let wake = target
+                            .max(c.now_nanos())
+                            .saturating_add((lateness * 1e9).round() as u64);
+                        c.advance_nanos(wake.saturating_sub(c.now_nanos()));
+                        c.now_nanos().saturating_sub(virtual_start) as f64 * 1e-9
+                    }
+                    Clock::RealTime => wall_start.elapsed().as_secs_f64(),
+                };
                 if elapsed > (k + 1) as f64 * period {
                     // A whole period or more behind (the OS took the CPU):
                     // skip the missed deadlines rather than run them back
@@ -409,16 +477,27 @@ where
                         break;
                     }
                 }
-                let target = wall_start + Duration::from_secs_f64(k as f64 * period);
-                realtime::sleep_until(target, spin);
-                let now = Instant::now();
-                (
-                    (now - wall_start).as_secs_f64(),
-                    (now - target).as_secs_f64(),
-                )
+                match clock {
+                    Clock::Virtual(c) => {
+                        let t = c.now_nanos().saturating_sub(virtual_start) as f64 * 1e-9;
+                        (t, (t - k as f64 * period).max(0.0))
+                    }
+                    Clock::RealTime => {
+                        let target = wall_start + Duration::from_secs_f64(k as f64 * period);
+                        realtime::sleep_until(target, spin);
+                        let now = Instant::now();
+                        (
+                            (now - wall_start).as_secs_f64(),
+                            (now - target).as_secs_f64(),
+                        )
+                    }
+                }
             }
         };
         lateness.push(late);
+        if late >= LATE_FRACTION * period {
+            stats.late += 1;
+        }
         if let Some(previous) = previous_sample {
             let interval = t - previous;
             stats.max_interval = stats.max_interval.max(interval);

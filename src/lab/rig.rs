@@ -7,7 +7,8 @@ use crate::nalgebra::{SVector, vector};
 use super::Calibration;
 use crate::data::Schema;
 use crate::hw::{
-    Clock, ConfigError, EppPort, LoopFault, MAX_DUTY, Pc104, PortError, Rig, RigError,
+    Clock, ConfigError, EppPort, LATE_FRACTION, LoopFault, MAX_DUTY, Pc104, PortError, Rig,
+    RigError,
 };
 
 /// The lab's two-cart rig on a [`Pc104`] card: counts to metres, volts to
@@ -21,13 +22,16 @@ use crate::hw::{
 /// - [`read_state`](Self::read_state) latches both counters **and kicks the
 ///   watchdog** in one control write, reads cart 1's and cart 2's counters,
 ///   and returns `[x1, v1, x2, v2]`; each speed is the count change over
-///   the actual interval since the previous read, timed on the rig's
-///   [`Clock`] (the first read reports zero speeds).
+///   the actual interval since a stored read at least
+///   `(1 − LATE_FRACTION) T` old (never over the few µs after a late
+///   tick), timed on the rig's [`Clock`] (the first read reports zero
+///   speeds).
 /// - Every read checks the measurement is physical, halting the rig
 ///   otherwise: a cart beyond its travel limit ([`LoopFault::TravelLimit`]),
-///   a count change faster than [`Calibration::max_speed`]
-///   ([`LoopFault::BusFault`]: a flipped bit, a glitch on the bus), or a
-///   change of drive that moves no encoder ([`LoopFault::NotResponding`]).
+///   a count change of more than one count faster than
+///   [`Calibration::max_speed`] ([`LoopFault::BusFault`]: a flipped bit, a
+///   glitch on the bus), or a change of drive that moves no encoder
+///   ([`LoopFault::NotResponding`]).
 /// - [`apply_voltage`](Self::apply_voltage) saturates to
 ///   ±`volts_full_scale` and quantises to the card's 0.1 % duty steps; a
 ///   non-finite command halts the rig and returns
@@ -66,10 +70,8 @@ pub struct MassSpringRig<P: EppPort> {
     period: f64,
     clock: Clock,
     start: Instant,
-    /// Counts of the previous read, its time stamp (s on `clock`, the
-    /// middle of the instants bracketing the latch) and the earliest the
-    /// latch can have been.
-    previous: Option<([i64; 2], f64, f64)>,
+    /// The last reads, to take speeds over an interval of about a period.
+    history: History,
     /// Time of the last watchdog kick (s on `clock`).
     last_kick: Option<f64>,
     /// The voltage last applied, V.
@@ -150,7 +152,7 @@ impl<P: EppPort> MassSpringRig<P> {
             period,
             clock,
             start: Instant::now(),
-            previous: None,
+            history: History::default(),
             last_kick: None,
             volts: 0.0,
             motion: None,
@@ -240,12 +242,34 @@ impl<P: EppPort> MassSpringRig<P> {
     /// and kicks the watchdog in one control write, then reads both
     /// counters. [`Rig::read`] is this.
     ///
+    /// # Late ticks
+    ///
+    /// The rig keeps its last few reads (a fixed array: nothing is
+    /// allocated). Each speed is the count change since the latest stored
+    /// read at least `(1 − LATE_FRACTION) T` old (3/4 of the period `T`,
+    /// [`LATE_FRACTION`]), over the actual interval between the two time
+    /// stamps; only when no stored read is that old (reads faster than the
+    /// period, outside the control loop) the oldest stored one is used,
+    /// over an interval taken as `(1 − LATE_FRACTION) T` at least. In
+    /// [`hw::run`](crate::hw::run) the read two ticks back is always more
+    /// than a period old, so after a late tick the next speed is taken over
+    /// two ticks instead of over the few µs left to the next deadline: one
+    /// count of quantisation over 5 µs would read as 2 m/s, over 3/4 of a
+    /// period it stays within 4/3 of a count per period. On time, the
+    /// previous read is one period old and is the one used.
+    ///
+    /// The bus-fault check is judged over the same stored read and the
+    /// longest the interval can have been: a change of one count either
+    /// way is quantisation, never a fault, whatever the interval; more is a
+    /// [`LoopFault::BusFault`] when it is faster than
+    /// [`Calibration::max_speed`].
+    ///
     /// # Errors
     ///
     /// Port errors; after halting: [`LoopFault::TravelLimit`] when a cart is
-    /// beyond its limit, [`LoopFault::BusFault`] for a count change faster
-    /// than the carts can move, [`LoopFault::NotResponding`] for sustained
-    /// drive with no motion.
+    /// beyond its limit, [`LoopFault::BusFault`] for a count change of more
+    /// than one count faster than the carts can move,
+    /// [`LoopFault::NotResponding`] for sustained drive with no motion.
     ///
     /// # Examples
     ///
@@ -271,10 +295,29 @@ impl<P: EppPort> MassSpringRig<P> {
             self.card.read_counter(cal.encoder_channels[1])?,
         ];
         let stamp = 0.5 * (before + after);
-        let (previous, interval, longest) = match self.previous.replace((counts, stamp, before)) {
+        // A read at least 3/4 of a period old: never a speed over the µs
+        // after a late tick, and (unlike the nominal period as the interval)
+        // still the actual interval, so a skipped deadline or a stall does
+        // not inflate the speed. On time, the previous read (one period
+        // old) is the one used: the same numbers as differencing over it.
+        let min_age = (1.0 - LATE_FRACTION) * self.period;
+        let base = self.history.base(stamp, min_age);
+        self.history.push(Read {
+            counts,
+            stamp,
+            earliest: before,
+        });
+        let (previous, interval, longest) = match base {
             // Speeds over the best estimate of the interval; the bus-fault
             // check over the longest it can have been.
-            Some((c, t, earliest)) if stamp > t => (c, stamp - t, after - earliest),
+            // The speeds' interval is at least 3/4 of a period even when no
+            // stored read is that old (reads faster than the period): a
+            // speed is never a count over a few µs.
+            Some(read) if stamp > read.stamp => (
+                read.counts,
+                (stamp - read.stamp).max(min_age),
+                after - read.earliest,
+            ),
             _ => (counts, 0.0, 0.0),
         };
         let mut x = SVector::<f64, 4>::zeros();
@@ -284,9 +327,11 @@ impl<P: EppPort> MassSpringRig<P> {
             x[2 * cart] = counts[cart] as f64 * scale;
             if interval > 0.0 {
                 let fastest = moved as f64 * scale / longest;
-                if fastest.abs() > cal.max_speed {
-                    // The sample is not a measurement: forget it.
-                    self.previous = None;
+                // One count either way is quantisation (or an encoder's
+                // edge jitter), at any interval.
+                if moved.saturating_abs() > 1 && fastest.abs() > cal.max_speed {
+                    // The sample is not a measurement: forget the reads.
+                    self.history = History::default();
                     return self.fault(LoopFault::BusFault {
                         channel: cal.encoder_channels[cart],
                         counts: moved,
@@ -434,9 +479,53 @@ impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
     }
 
     fn restart(&mut self) {
-        self.previous = None;
+        self.history = History::default();
         self.motion = None;
         self.stall = None;
+    }
+}
+
+/// One read of the counters: the counts, its time stamp (s on the rig's
+/// clock, the middle of the instants bracketing the latch) and the
+/// earliest the latch can have been.
+#[derive(Debug, Clone, Copy)]
+struct Read {
+    counts: [i64; 2],
+    stamp: f64,
+    earliest: f64,
+}
+
+/// Reads kept for the speeds: the loop needs two (the read two ticks back
+/// is always over a period old); four leave room for reads between ticks.
+const HISTORY: usize = 4;
+
+/// The last [`HISTORY`] reads, newest at `newest`, in a fixed ring.
+#[derive(Debug, Clone, Copy, Default)]
+struct History {
+    reads: [Option<Read>; HISTORY],
+    newest: usize,
+}
+
+impl History {
+    fn push(&mut self, read: Read) {
+        self.newest = (self.newest + 1) % HISTORY;
+        self.reads[self.newest] = Some(read);
+    }
+
+    /// The newest read at least `min_age` older than `now`, else the
+    /// oldest read stored (`None` when there is none).
+    fn base(&self, now: f64, min_age: f64) -> Option<Read> {
+        let mut oldest = None;
+        for back in 0..HISTORY {
+            let Some(read) = self.reads[(self.newest + HISTORY - back) % HISTORY] else {
+                break;
+            };
+            if now - read.stamp >= min_age {
+                return Some(read);
+            }
+            oldest = Some(read);
+        }
+        oldest
     }
 }
 

@@ -49,6 +49,12 @@
 //! uniformly sampled recording is one segment and gives exactly the rows
 //! (and numbers) of equations (6)–(11).
 //!
+//! Validation, refinement and the bootstrap simulate the rig on the same
+//! actual instants, gaps and short intervals included: each input takes
+//! effect [`SimulationModel::input_delay`] after its own sample, so an
+//! interval of a few µs after a late sample (the loop's policy for late
+//! ticks, see [`hw::run`]) is simulated as the rig ran it, never refused.
+//!
 //! Every row is multiplied by its segment's `T²` as in the lab's code
 //! (equations (6), (9)): within a segment that scaling does not change the
 //! estimate, and across segments it keeps every row in the unit of `λ` (a

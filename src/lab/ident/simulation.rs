@@ -23,10 +23,16 @@ const MAX_SUBSTEPS_PER_SAMPLE: f64 = 1000.0;
 /// refinement: the structure of the model, which the refined parameters
 /// cannot make up for if it is wrong.
 ///
-/// Each sampling interval `[t_k, t_k+1]` holds the previous input until
-/// `t_k + input_delay`, then `u_k`; both parts are integrated in equal
-/// sub-steps of at most `max_substep`, and each cart's stick or slip is
-/// decided between sub-steps ([`FrictionPlant`]'s rules, with breakaway
+/// Each input `u_k` takes effect `input_delay` after its sample's actual
+/// instant `t_k` and holds until the next input takes effect: with a delay
+/// shorter than the interval, `[t_k, t_k+1]` holds the previous input until
+/// `t_k + input_delay`, then `u_k`; after a late sample, whose next
+/// interval can be shorter than the delay, `u_k` is replaced by `u_k+1`
+/// before taking effect (the drive keeps only its newest pending command,
+/// as the simulated card's does), and an interval holds whichever inputs
+/// take effect within it, in order. Each part
+/// is integrated in equal sub-steps of at most `max_substep`, and each
+/// cart's stick or slip is decided between sub-steps ([`FrictionPlant`]'s rules, with breakaway
 /// force `stiction_ratio × ` its Coulomb force). This is how the simulated
 /// card ([`SimulatedRig`](crate::lab::SimulatedRig)) moves its plant, so
 /// [`SimulatedRig::simulation_model`](crate::lab::SimulatedRig::simulation_model)
@@ -54,7 +60,10 @@ pub struct SimulationModel {
     /// simulated card's). Stick and slip are decided between sub-steps.
     pub max_substep: f64,
     /// Time from a sample to its input taking effect, s (≥ 0 and shorter
-    /// than every sampling interval; default 0).
+    /// than the recording's median interval; default 0). It may be longer
+    /// than some of the recording's intervals (a late sample's next
+    /// interval): each input takes effect this long after its own sample's
+    /// actual instant.
     pub input_delay: f64,
     /// Each cart's breakaway (static) friction over its Coulomb friction
     /// (≥ 1; default 1, no stiction above the Coulomb force).
@@ -73,7 +82,7 @@ impl Default for SimulationModel {
 
 impl SimulationModel {
     /// Checks the fields on their own (the delay against the recording's
-    /// intervals is checked when a recording is simulated).
+    /// median interval is checked when a recording is simulated).
     ///
     /// # Errors
     ///
@@ -153,17 +162,20 @@ impl<'a> Run<'a> {
             });
         }
         // A recording's times increase strictly (`Recording` checks).
-        let shortest = run
-            .t
-            .windows(2)
-            .map(|w| w[1] - w[0])
-            .fold(f64::INFINITY, f64::min);
         let longest = run.t.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
-        if model.input_delay >= shortest {
+        // The delay against the recording's typical interval, not its
+        // shortest: after a late sample an interval can be a few µs, and
+        // its input is then replaced before taking effect, as on the rig;
+        // a delay of a typical interval or more would replace every input.
+        let mut intervals: Vec<f64> = run.t.windows(2).map(|w| w[1] - w[0]).collect();
+        let mid = intervals.len() / 2;
+        let median = *intervals.select_nth_unstable_by(mid, f64::total_cmp).1;
+        // (To rounding: a grid of 2 ms in ns has intervals of 2 ms ± 1 ulp.)
+        if model.input_delay >= median * (1.0 - 1e-9) {
             return Err(Error::InvalidParameter {
                 name: "input_delay",
                 value: model.input_delay,
-                reason: "the input delay must be shorter than the recording's shortest interval, s",
+                reason: "the input delay must be shorter than the recording's median interval, s",
             });
         }
         if longest / model.max_substep > MAX_SUBSTEPS_PER_SAMPLE {
@@ -173,10 +185,12 @@ impl<'a> Run<'a> {
                 reason: "more than 1000 sub-steps in one of the recording's intervals",
             });
         }
-        Ok(Run {
-            uniform: uniform_step(run.t, grid_rounding(run.t)),
-            ..run
-        })
+        // The exact sub-steps of a uniform grid split each interval in two
+        // at the delay; a delay of an interval or more is simulated as on
+        // any grid.
+        let uniform =
+            uniform_step(run.t, grid_rounding(run.t)).filter(|&dt| model.input_delay < dt);
+        Ok(Run { uniform, ..run })
     }
 
     /// Simulates `plant` with Coulomb forces `coulomb` (N) from the recorded
@@ -187,10 +201,12 @@ impl<'a> Run<'a> {
     /// plant's sub-step cannot be discretised; the samples after that are
     /// not visited.
     ///
-    /// On a uniform grid each sub-step is the exact ZOH step of the
-    /// plant's linear part in its stick structure (the card's RK4 sub-steps
-    /// agree with it to about 1e-11 at 0.25 ms); otherwise RK4 sub-steps of
-    /// each interval as it is.
+    /// On a uniform grid (with a delay shorter than its interval) each
+    /// sub-step is the exact ZOH step of the plant's linear part in its
+    /// stick structure (the card's RK4 sub-steps agree with it to about
+    /// 1e-11 at 0.25 ms); otherwise RK4 sub-steps of each part of each
+    /// interval as it is, the parts split wherever an input takes effect
+    /// (`t_j + input_delay`, on the actual instants).
     pub(super) fn simulate(
         &self,
         plant: &MassSpring,
@@ -200,16 +216,12 @@ impl<'a> Run<'a> {
         let m = &self.model;
         let stiction = [0, 1].map(|c| coulomb[c] * m.stiction_ratio[c]);
         let mut model = FrictionPlant::new(*plant, coulomb).with_stiction(stiction);
-        let spans = |interval: f64| {
-            let delay = m.input_delay;
-            [(delay, 0.0), (interval - delay, delay)]
-                .map(|(span, offset)| (span, substeps(span, m.max_substep), offset))
-        };
+        let delay = m.input_delay;
         let exact = match self.uniform {
             Some(interval) => {
-                match spans(interval)
-                    .map(|(span, steps, _)| Steps::new(plant, coulomb, span, steps))
-                {
+                match [(delay, 0.0), (interval - delay, delay)].map(|(span, _)| {
+                    Steps::new(plant, coulomb, span, substeps(span, m.max_substep))
+                }) {
                     [Some(a), Some(b)] => Some([a, b]),
                     _ => return false,
                 }
@@ -217,7 +229,10 @@ impl<'a> Run<'a> {
             None => None,
         };
         let mut x: SVector<f64, 4> = vector![self.x1[0], 0.0, self.x2[0], 0.0];
+        // The input in effect, and the next sample whose input has not
+        // taken effect yet.
         let mut held = 0.0;
+        let mut pending = 0;
         for (k, &t) in self.t.iter().enumerate() {
             sample(k, x[0], x[2]);
             if !(x[0].abs() <= 1.0 && x[2].abs() <= 1.0) {
@@ -227,25 +242,55 @@ impl<'a> Run<'a> {
                 break;
             };
             let interval = self.uniform.unwrap_or(next - t);
-            for (part, (span, steps, offset)) in spans(interval).into_iter().enumerate() {
-                if span <= 0.0 {
-                    continue;
-                }
-                let u = vector![if part == 0 { held } else { self.u[k] }];
-                let h = span / steps as f64;
-                let start = t + offset;
-                // As the card: the mode first (a stuck cart may break away
-                // under the new input), then after each sub-step.
-                model.update_mode(start, &mut x, &u);
-                for s in 0..steps {
-                    match &exact {
-                        Some(exact) => exact[part].step(&model, &mut x, u[0]),
-                        None => Rk4.step_mut(&model, start + s as f64 * h, h, &mut x, &u),
+            // The parts of the interval: from `offset` (s after `t`) to the
+            // next input's taking effect, or to the interval's end. The
+            // offset of `u_j` is `t_j − t + delay`: exactly `delay` for
+            // `u_k`, as on a uniform grid.
+            let mut offset = 0.0;
+            loop {
+                // Inputs that take effect at or before this part's start,
+                // and those replaced before taking effect (the drive keeps
+                // only its newest pending command, as the card's does).
+                while pending <= k {
+                    if self.t[pending + 1] < self.t[pending] + delay {
+                        pending += 1;
+                    } else if self.t[pending] - t + delay <= offset {
+                        held = self.u[pending];
+                        pending += 1;
+                    } else {
+                        break;
                     }
-                    model.update_mode(start + (s + 1) as f64 * h, &mut x, &u);
                 }
+                let end = if pending <= k {
+                    (self.t[pending] - t + delay).min(interval)
+                } else {
+                    interval
+                };
+                let span = end - offset;
+                if span > 0.0 {
+                    let u = vector![held];
+                    let steps = substeps(span, m.max_substep);
+                    let h = span / steps as f64;
+                    let start = t + offset;
+                    // On a uniform grid: the part before `u_k` takes effect,
+                    // or the part after.
+                    let part = usize::from(pending > k);
+                    // As the card: the mode first (a stuck cart may break
+                    // away under the new input), then after each sub-step.
+                    model.update_mode(start, &mut x, &u);
+                    for s in 0..steps {
+                        match &exact {
+                            Some(exact) => exact[part].step(&model, &mut x, u[0]),
+                            None => Rk4.step_mut(&model, start + s as f64 * h, h, &mut x, &u),
+                        }
+                        model.update_mode(start + (s + 1) as f64 * h, &mut x, &u);
+                    }
+                }
+                if end >= interval {
+                    break;
+                }
+                offset = end;
             }
-            held = self.u[k];
         }
         true
     }
