@@ -211,10 +211,7 @@ fn main() {
     for note in &report.notes {
         println!("note: {note}");
     }
-    let config = RigConfig {
-        map: report.map,
-        calibration: Calibration::from_probe(&report, &args.base),
-    };
+    let config = RigConfig::new(report.map, Calibration::from_probe(&report, &args.base));
     println!(
         "not measured, taken as given: {} m per count, {} V full scale, travel limits ±{:?} m",
         config.calibration.metres_per_count,

@@ -32,11 +32,7 @@ fn the_probe_rediscovers_the_simulated_cards_map_and_calibration() {
     let calibration = Calibration::from_probe(&report, &Calibration::default());
     assert_eq!(calibration, rig.calibration);
     // The card file it writes is the one the rest of the crate loads.
-    let file = RigConfig {
-        map: report.map,
-        calibration,
-    }
-    .to_toml();
+    let file = RigConfig::new(report.map, calibration).to_toml();
     let loaded = RigConfig::from_toml(&file).unwrap();
     assert_eq!(
         (loaded.map, loaded.calibration),
