@@ -74,6 +74,28 @@ pub enum ProbeError {
         /// How far, counts (sign-corrected).
         counts: i64,
     },
+    /// The card does not answer as the given register map says (the
+    /// default probe, which confirms a map): a wrong map, or a card other
+    /// than the one the card file describes.
+    #[error(
+        "the card does not answer as the given register map says: {reason}. Check the map (the card file's [map]) against the lab's existing driver or the FPGA's sources"
+    )]
+    WrongMap {
+        /// What the card did instead.
+        reason: String,
+    },
+    /// A step of the blind scan was called without
+    /// [`ProbeOptions::scan`](super::ProbeOptions::scan). Nothing was read
+    /// or written.
+    #[error(
+        "the blind scan writes test patterns to card addresses no map describes, which on an FPGA can hit configuration registers; it runs only when asked for (ProbeOptions::scan, the probe example's --scan). Nothing was read or written"
+    )]
+    ScanNotEnabled,
+    /// A stop was requested ([`StopSignal`](crate::hw::StopSignal): Ctrl-C,
+    /// SIGTERM or code); the probe zeroed the PWM it had driven and
+    /// stopped.
+    #[error("stopped on request (Ctrl-C or a stop signal); the PWM the probe drove was zeroed")]
+    Interrupted,
     /// A step was called before the one it needs.
     #[error("{step} needs {needs} first")]
     OutOfOrder {
