@@ -277,9 +277,12 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         self.operator.tell(&format!(
             "step 3/4, drive: with the motor supply ON, the probe writes PWM duties of {d0}, \
              {d1} and {d2} per mille (of full scale) for {} s to the map's PWM channels 0-3 \
-             (low bytes {:#04x?}) in turn until a cart moves, kicking the watchdog with bit \
-             {:#04x} of register {:#04x}; the carts must be free to move",
-            self.options.pulse_time, map.pwm_low, map.watchdog_bit, map.control
+             (low bytes {}) in turn until a cart moves, kicking the watchdog with bit {:#04x} \
+             of register {:#04x}; the carts must be free to move",
+            self.options.pulse_time,
+            map.pwm_low.map(|a| format!("{a:#04x}")).join(", "),
+            map.watchdog_bit,
+            map.control
         ));
         if !self.operator.confirm(
             "Switch the motor supply ON now. Carts free, hands off, e-stop within reach: \

@@ -17,11 +17,17 @@ use crate::hw::{ConfigError, PortError};
 /// #     fn hands(&mut self, _: Hands) {}
 /// #     fn wait(&mut self, _: &mut P, _: f64) {}
 /// # }
-/// // Every address reads 0: no card.
-/// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+/// // Every address reads 0: the blind scan finds no card.
+/// let blind = ProbeOptions { scan: true, ..Default::default() };
+/// let mut probe = Probe::new(RegisterFile::new(), Nobody, blind)?;
 /// let err = probe.scan().unwrap_err();
 /// assert!(matches!(err, ProbeError::NoCard { .. }));
 /// assert!(err.to_string().contains("every address reads 0x00"));
+/// // The default probe, given a map, finds no ID where the map says.
+/// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+/// let err = probe.check_id().unwrap_err();
+/// assert!(matches!(err, ProbeError::WrongMap { .. }));
+/// assert!(err.to_string().contains("nothing was written"));
 /// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, thiserror::Error)]
