@@ -19,8 +19,8 @@
 ///   BIOS) does: Linux's `parport_pc` sets the direction bit itself before
 ///   each EPP read on such a port;
 /// - most EPP-only ports turn the lines round in hardware during an EPP
-///   read cycle (LinuxCNC's drivers for the Mesa 7i43 and the Pluto-P read
-///   EPP without touching the bit);
+///   read cycle (LinuxCNC's driver for the Mesa 7i43 reads EPP without
+///   touching the bit);
 /// - some need the direction bit (bit 5 of the control register) set by
 ///   software first, as LinuxCNC's `hal_ppmc` does before every read.
 ///

@@ -402,7 +402,8 @@ impl RigConfig {
 
 /// What the rig will use, for a person to check before anything moves: the
 /// ID it expects and where, the motor's channel, registers and voltage
-/// range, the carts' encoders, the travel limits and the watchdog.
+/// range, the carts' encoders, the travel limits, the watchdog and how the
+/// port is driven.
 ///
 /// # Examples
 ///
@@ -414,6 +415,7 @@ impl RigConfig {
 /// assert!(text.contains("PWM channel 0 (registers 0x10, 0x11), -24 V to +24 V"));
 /// assert!(text.contains("±50.0 mm"));
 /// assert!(text.contains("watchdog: 100 ms"));
+/// assert!(text.ends_with("port: EPP reads without the data-direction bit (the default)"));
 /// ```
 impl fmt::Display for RigConfig {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -464,11 +466,20 @@ impl fmt::Display for RigConfig {
                 "watchdog: none; nothing on the card stops the motor if the PC stops driving it"
             )?,
         }
-        write!(
+        writeln!(
             f,
             "plausibility: a count change faster than {} m/s is a bus fault; {} V of new drive \
              that moves no encoder {} counts within {} s is a stalled motor or encoder",
             cal.max_speed, cal.stall_volts, cal.stall_counts, cal.stall_time
+        )?;
+        write!(
+            f,
+            "port: {}",
+            if self.port.data_dir {
+                "data-direction bit set around each EPP read (PPDATADIR)"
+            } else {
+                "EPP reads without the data-direction bit (the default)"
+            }
         )
     }
 }
