@@ -103,9 +103,13 @@ fn parse() -> Result<Args, String> {
     Ok(args)
 }
 
-/// The person at the console.
+/// The person at the console. Ctrl-C at a prompt takes effect when the
+/// line ends (Enter): the answer is then "no", and the probe stops at its
+/// next wait.
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
-struct Console;
+struct Console {
+    stop: StopSignal,
+}
 
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 impl Console {
@@ -126,7 +130,8 @@ impl<P> Operator<P> for Console {
     fn confirm(&mut self, question: &str) -> bool {
         print!("{question} [yes/NO] ");
         let _ = std::io::stdout().flush();
-        matches!(Self::line().trim(), "y" | "yes" | "Y" | "YES")
+        let yes = matches!(Self::line().trim(), "y" | "yes" | "Y" | "YES");
+        yes && !self.stop.is_requested()
     }
 
     fn hands(&mut self, hands: Hands) {
@@ -195,7 +200,8 @@ fn real(
         Ok(us) => println!("  one register read (address + data cycle): {us:.2} µs"),
         Err(e) => println!("  EPP cycles fail with no answer ({e}): no card, or no EPP"),
     }
-    probe(port, Console, options, stop)
+    let console = Console { stop: stop.clone() };
+    probe(port, console, options, stop)
         .map(|(r, _)| r)
         .map_err(|e| e.to_string())
 }

@@ -89,10 +89,10 @@ pub mod ioctl {
     pub const PPGETMODES: u32 = ioc(layout::READ, 0x97, size_of::<c_uint>());
     /// `_IOW('p', 0x84, unsigned char)`: write the control register's
     /// bits 0–3 (nStrobe, nAutoFd, nInit, nSelectIn). The PC-style driver
-    /// (`parport_pc`) masks the value to those four bits: it does not write
-    /// bit 4 (the port's interrupt enable, which the kernel manages) and,
-    /// for bit 5 (data direction), calls its data-direction routine as
-    /// `PPDATADIR` does, logging that the caller should use that instead.
+    /// (`parport_pc`) masks the value to those four bits: it never writes
+    /// bit 4 (the port's interrupt enable, which the kernel manages), and a
+    /// set bit 5 only turns the data lines round (reverse, as `PPDATADIR`
+    /// 1 does, with a kernel log line saying to use that instead).
     pub const PPWCONTROL: u32 = ioc(layout::WRITE, 0x84, size_of::<c_uchar>());
     /// `_IOW('p', 0x90, int)`: data direction; non-zero turns the data
     /// lines round (reverse, the peripheral drives them: bit 5 of the
