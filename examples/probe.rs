@@ -1,16 +1,21 @@
-//! The card bring-up tool: finds a card's register map, encoder signs,
-//! motor polarity and watchdog, step by step, and writes the card file
-//! (`card.toml`) that `lab5 --port … --card card.toml` drives the rig from.
+//! The card bring-up tool: confirms a card's register map (from a card
+//! file) and finds its encoder signs, motor polarity and watchdog, step by
+//! step, and writes the card file (`card.toml`) that `lab5 --port …
+//! --card card.toml` drives the rig from. Only with `--scan` does it look
+//! for a map blind, writing test patterns to addresses no map describes
+//! (see `docs/hardware.md` for why that comes last).
 //!
 //! ```text
 //! cargo run --example probe -- --simulated                       # the simulated card, a simulated hand
-//! cargo run --example probe --features ppdev -- --port /dev/parport0 --out card.toml
+//! cargo run --example probe --features ppdev -- --port /dev/parport0 --card card.toml --out card.toml
+//! cargo run --example probe --features ppdev -- --port /dev/parport0 --scan --out card.toml
 //! ```
 //!
 //! Each step prints what it will do before doing it. The encoder step asks
 //! you to switch the motor supply off; the drive step pulses the motor only
-//! after you answer `yes`. Keep a hardware e-stop within reach: software
-//! alone must not be trusted for safety.
+//! after you answer `yes`. Ctrl-C (or SIGTERM) stops the probe at its next
+//! wait — within one pulse — with the PWM zeroed. Keep a hardware e-stop
+//! within reach: software alone must not be trusted for safety.
 
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 use std::io::{BufRead, Write};
@@ -22,29 +27,40 @@ use std::time::Instant;
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 use ctrlab::hw::probe::Hands;
 use ctrlab::hw::probe::{Operator, Probe, ProbeError, ProbeOptions, ProbeReport};
-use ctrlab::hw::{Clock, EppPort, VirtualClock};
+use ctrlab::hw::{Clock, EppPort, PpdevOptions, StopSignal, VirtualClock};
 use ctrlab::lab::{Calibration, RigConfig, SimulatedOperator, SimulatedRig};
 
-const USAGE: &str = "usage: probe (--simulated | --port /dev/parportN) [--out FILE] [--metres-per-count M] [--volts V]
+const USAGE: &str = "usage: probe (--simulated | --port /dev/parportN) (--card FILE | --scan) [--out FILE] [--metres-per-count M] [--volts V]
   --simulated           probe the simulated card, moved by a simulated hand
   --port PATH           probe the card on this parallel port (feature `ppdev`)
+  --card FILE           the card file whose register map ([map]) to confirm; its card_id,
+                        calibration and [port] keys are used too (the simulated card's own
+                        map when --simulated is given without it)
+  --scan                no map: scan blind, writing test patterns to addresses no map
+                        describes, which on an FPGA can hit configuration registers
   --out FILE            where the card file goes (default card.toml)
-  --metres-per-count M  cart travel per encoder count, m (default 80 mm / 8192)
-  --volts V             motor voltage at 100 % duty, V (default 24)";
+  --metres-per-count M  cart travel per encoder count, m (default: the card file's, or 80 mm / 8192)
+  --volts V             motor voltage at 100 % duty, V (default: the card file's, or 24)";
 
 struct Args {
     simulated: bool,
     port: Option<PathBuf>,
+    card: Option<PathBuf>,
+    scan: bool,
     out: PathBuf,
-    base: Calibration,
+    metres_per_count: Option<f64>,
+    volts: Option<f64>,
 }
 
 fn parse() -> Result<Args, String> {
     let mut args = Args {
         simulated: false,
         port: None,
+        card: None,
+        scan: false,
         out: PathBuf::from("card.toml"),
-        base: Calibration::default(),
+        metres_per_count: None,
+        volts: None,
     };
     let mut it = std::env::args().skip(1);
     let number = |v: Option<String>, name: &str| -> Result<f64, String> {
@@ -56,11 +72,13 @@ fn parse() -> Result<Args, String> {
         match arg.as_str() {
             "--simulated" => args.simulated = true,
             "--port" => args.port = Some(it.next().ok_or("--port needs a device path")?.into()),
+            "--card" => args.card = Some(it.next().ok_or("--card needs a file")?.into()),
+            "--scan" => args.scan = true,
             "--out" => args.out = it.next().ok_or("--out needs a file")?.into(),
             "--metres-per-count" => {
-                args.base.metres_per_count = number(it.next(), "--metres-per-count")?;
+                args.metres_per_count = Some(number(it.next(), "--metres-per-count")?);
             }
-            "--volts" => args.base.volts_full_scale = number(it.next(), "--volts")?,
+            "--volts" => args.volts = Some(number(it.next(), "--volts")?),
             "-h" | "--help" => return Err(USAGE.to_owned()),
             other => return Err(format!("unknown argument {other}\n{USAGE}")),
         }
@@ -70,12 +88,28 @@ fn parse() -> Result<Args, String> {
             "give exactly one of --simulated and --port\n{USAGE}"
         ));
     }
+    if args.scan && args.card.is_some() {
+        return Err(format!(
+            "give --card (confirm its map) or --scan (no map), not both\n{USAGE}"
+        ));
+    }
+    if args.port.is_some() && !args.scan && args.card.is_none() {
+        return Err(format!(
+            "a real card is probed against a map: give --card FILE with the register map \
+             taken from the lab's driver or the FPGA's sources (see docs/hardware.md), or \
+             --scan to look for one blind (writes to unknown addresses)\n{USAGE}"
+        ));
+    }
     Ok(args)
 }
 
-/// The person at the console.
+/// The person at the console. Ctrl-C at a prompt takes effect when the
+/// line ends (Enter): the answer is then "no", and the probe stops at its
+/// next wait.
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
-struct Console;
+struct Console {
+    stop: StopSignal,
+}
 
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 impl Console {
@@ -96,7 +130,8 @@ impl<P> Operator<P> for Console {
     fn confirm(&mut self, question: &str) -> bool {
         print!("{question} [yes/NO] ");
         let _ = std::io::stdout().flush();
-        matches!(Self::line().trim(), "y" | "yes" | "Y" | "YES")
+        let yes = matches!(Self::line().trim(), "y" | "yes" | "Y" | "YES");
+        yes && !self.stop.is_requested()
     }
 
     fn hands(&mut self, hands: Hands) {
@@ -131,41 +166,66 @@ fn cycle_time<P: EppPort>(port: &mut P) -> Result<f64, ctrlab::hw::PortError> {
     Ok(start.elapsed().as_secs_f64() * 1e3)
 }
 
-fn probe<P: EppPort, O: Operator<P>>(port: P, operator: O) -> Result<(ProbeReport, O), ProbeError> {
-    let mut probe = Probe::new(port, operator, ProbeOptions::default())?;
+fn probe<P: EppPort, O: Operator<P>>(
+    port: P,
+    operator: O,
+    options: ProbeOptions,
+    stop: StopSignal,
+) -> Result<(ProbeReport, O), ProbeError> {
+    let mut probe = Probe::new(port, operator, options)?.with_stop(stop);
     let report = probe.run()?;
     let (_port, operator) = probe.into_parts();
     Ok((report, operator))
 }
 
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
-fn real(path: &std::path::Path) -> Result<ProbeReport, String> {
+fn real(
+    path: &std::path::Path,
+    options: ProbeOptions,
+    port_options: PpdevOptions,
+    stop: StopSignal,
+) -> Result<ProbeReport, String> {
     println!(
         "step 0, port: opening {} (exclusive), reading its modes",
         path.display()
     );
     let modes = ctrlab::hw::Ppdev::modes_of(path).map_err(|e| e.to_string())?;
     println!("  modes: {modes}");
-    let mut port = ctrlab::hw::Ppdev::open(path).map_err(|e| e.to_string())?;
+    let mut port = ctrlab::hw::Ppdev::open_with(path, port_options).map_err(|e| e.to_string())?;
+    println!(
+        "  data-direction bit around reads (card file [port] data_dir): {}",
+        port_options.data_dir
+    );
     match cycle_time(&mut port) {
         Ok(us) => println!("  one register read (address + data cycle): {us:.2} µs"),
         Err(e) => println!("  EPP cycles fail with no answer ({e}): no card, or no EPP"),
     }
-    probe(port, Console)
+    let console = Console { stop: stop.clone() };
+    probe(port, console, options, stop)
         .map(|(r, _)| r)
         .map_err(|e| e.to_string())
 }
 
 #[cfg(not(all(feature = "ppdev", target_os = "linux")))]
-fn real(_path: &std::path::Path) -> Result<ProbeReport, String> {
+fn real(
+    _path: &std::path::Path,
+    _options: ProbeOptions,
+    _port_options: PpdevOptions,
+    _stop: StopSignal,
+) -> Result<ProbeReport, String> {
     Err("--port needs the `ppdev` feature on Linux: \
          cargo run --example probe --features ppdev -- --port /dev/parport0"
         .to_owned())
 }
 
-fn simulated() -> Result<ProbeReport, String> {
+fn simulated(mut options: ProbeOptions, stop: StopSignal) -> Result<ProbeReport, String> {
     let clock = VirtualClock::new();
     let rig = SimulatedRig::default();
+    if options.card_id.is_none() {
+        // No card file: confirm the simulated card's own map.
+        options.map = rig.card.map;
+        options.card_id = Some(rig.calibration.card_id);
+    }
     let mut card = rig
         .card(&Clock::Virtual(clock.clone()))
         .map_err(|e| e.to_string())?;
@@ -174,7 +234,8 @@ fn simulated() -> Result<ProbeReport, String> {
     println!("  one register read (address + data cycle): {us:.3} µs of computer time");
     // The simulated operator says yes to both confirmations.
     let hand = SimulatedOperator::new(clock, [true, true]);
-    let result = probe(card, hand);
+    let scan = options.scan;
+    let result = probe(card, hand, options, stop);
     let (report, hand) = result.map_err(|e| e.to_string())?;
     for line in &hand.transcript {
         println!("{line}");
@@ -185,7 +246,11 @@ fn simulated() -> Result<ProbeReport, String> {
             report.map, rig.card.map
         ));
     }
-    println!("the probe rediscovered the simulated card's register map exactly");
+    if scan {
+        println!("the blind scan rediscovered the simulated card's register map exactly");
+    } else {
+        println!("the probe confirmed the simulated card's register map");
+    }
     Ok(report)
 }
 
@@ -197,9 +262,41 @@ fn main() {
             std::process::exit(2);
         }
     };
+    let card = match args.card.as_deref().map(RigConfig::read_toml).transpose() {
+        Ok(card) => card,
+        Err(e) => {
+            eprintln!("cannot read the card file: {e}");
+            std::process::exit(1);
+        }
+    };
+    let mut base = card.map_or_else(Calibration::default, |c| c.calibration);
+    if let Some(m) = args.metres_per_count {
+        base.metres_per_count = m;
+    }
+    if let Some(v) = args.volts {
+        base.volts_full_scale = v;
+    }
+    let port_options = card.map(|c| c.port).unwrap_or_default();
+    let mut options = ProbeOptions {
+        scan: args.scan,
+        ..ProbeOptions::default()
+    };
+    if let Some(card) = &card {
+        options.map = card.map;
+        options.card_id = Some(card.calibration.card_id);
+    }
+    // Ctrl-C and SIGTERM stop the probe at its next wait, PWM zeroed,
+    // instead of killing it with a pulse's duty on.
+    let stop = match StopSignal::on_interrupt() {
+        Ok(stop) => stop,
+        Err(e) => {
+            eprintln!("cannot catch Ctrl-C, so a pulse could not be stopped safely: {e}");
+            std::process::exit(1);
+        }
+    };
     let report = match &args.port {
-        Some(path) => real(path),
-        None => simulated(),
+        Some(path) => real(path, options, port_options, stop),
+        None => simulated(options, stop),
     };
     let report = match report {
         Ok(report) => report,
@@ -212,8 +309,8 @@ fn main() {
         println!("note: {note}");
     }
     let config = RigConfig {
-        map: report.map,
-        calibration: Calibration::from_probe(&report, &args.base),
+        port: port_options,
+        ..RigConfig::new(report.map, Calibration::from_probe(&report, &base))
     };
     println!(
         "not measured, taken as given: {} m per count, {} V full scale, travel limits ±{:?} m",

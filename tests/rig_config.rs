@@ -15,10 +15,7 @@ use ctrlab::lab::{
 };
 
 fn lab() -> RigConfig {
-    RigConfig {
-        map: RegisterMap::default(),
-        calibration: Calibration::default(),
-    }
+    RigConfig::new(RegisterMap::default(), Calibration::default())
 }
 
 /// A card that differs from the defaults in every field, so a field the
@@ -47,6 +44,7 @@ fn unusual() -> RigConfig {
     cal.stall_volts = 4.5;
     cal.stall_time = 0.75;
     cal.stall_counts = 7;
+    config.port.data_dir = true;
     config
 }
 
@@ -153,8 +151,31 @@ fn the_file_is_commented_and_in_hex_where_it_helps() {
 #[test]
 fn the_file_has_every_field_of_both_structs() {
     let keys = keys(&lab().to_toml());
-    assert_eq!(keys.len(), 8 + 12, "{keys:?}");
+    assert_eq!(keys.len(), 8 + 12 + 1, "{keys:?}");
     assert!(keys.iter().filter(|k| k.starts_with("map.")).count() == 8);
+    assert_eq!(keys.last().map(String::as_str), Some("port.data_dir"));
+}
+
+#[test]
+fn the_port_table_and_its_key_default_to_no_data_direction_bit() {
+    let text = unusual().to_toml();
+    assert!(text.contains("[port]\ndata_dir = true"), "{text}");
+    // The key left out, then the whole table: the default, `false`.
+    let no_key = without(&text, "port.data_dir");
+    let no_table = &text[..text.find("\n[port]").unwrap()];
+    for cut in [no_key.as_str(), no_table] {
+        let config = RigConfig::from_toml(cut).unwrap();
+        assert!(!config.port.data_dir, "{cut}");
+        assert_eq!(
+            (config.map, config.calibration),
+            (unusual().map, unusual().calibration)
+        );
+    }
+    // A card file from before the key existed reads the same way.
+    assert_eq!(
+        RigConfig::from_toml(no_table).unwrap().port,
+        Default::default()
+    );
 }
 
 #[test]
@@ -173,7 +194,8 @@ fn a_value_of_the_wrong_type_names_its_key() {
 #[test]
 fn a_missing_key_is_refused_and_named() {
     let text = unusual().to_toml();
-    for key in keys(&text) {
+    // [port]'s keys default (the test above); every other key is required.
+    for key in keys(&text).into_iter().filter(|k| !k.starts_with("port.")) {
         let bad = without(&text, &key);
         let (named, message) = refused_key(&bad);
         assert_eq!(named.as_deref(), Some(key.as_str()), "{message}");
@@ -197,7 +219,11 @@ fn a_missing_key_is_refused_and_named() {
 #[test]
 fn an_unknown_key_is_refused_and_named() {
     let text = lab().to_toml();
-    for (section, typo) in [("map", "encoders"), ("calibration", "travel_limit")] {
+    for (section, typo) in [
+        ("map", "encoders"),
+        ("calibration", "travel_limit"),
+        ("port", "datadir"),
+    ] {
         let header = format!("\n[{section}]\n");
         let bad = text.replace(&header, &format!("{header}{typo} = 1\n"));
         let (named, message) = refused_key(&bad);

@@ -56,7 +56,7 @@ pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> S
 /// Opens the port with the file's map and reads the card's ID: the first
 /// access, and a read. Dropping the card releases the port.
 pub fn check_id(port: &Path, config: &RigConfig) -> Result<u8, RigError> {
-    let mut card = Pc104::with_map(Ppdev::open(port)?, config.map)?;
+    let mut card = Pc104::with_map(Ppdev::open_with(port, config.port)?, config.map)?;
     Ok(card.probe_id(config.calibration.card_id)?)
 }
 
@@ -64,7 +64,7 @@ pub fn check_id(port: &Path, config: &RigConfig) -> Result<u8, RigError> {
 /// probed (building the rig) before the counters are cleared, the first
 /// write.
 pub fn rig(port: &Path, config: &RigConfig, period: f64) -> Result<MassSpringRig<Ppdev>, RigError> {
-    let card = Pc104::with_map(Ppdev::open(port)?, config.map)?;
+    let card = Pc104::with_map(Ppdev::open_with(port, config.port)?, config.map)?;
     let mut rig = MassSpringRig::new(card, config.calibration, period)?;
     rig.card_mut().clear_counters()?;
     Ok(rig)

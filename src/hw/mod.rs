@@ -58,6 +58,7 @@ mod pc104;
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 mod ppdev;
+mod ppdev_options;
 pub mod probe;
 mod realtime;
 mod rig;
@@ -81,6 +82,7 @@ pub use pc104::{
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 #[cfg_attr(docsrs, doc(cfg(all(feature = "ppdev", target_os = "linux"))))]
 pub use ppdev::{PortModes, Ppdev, ioctl};
+pub use ppdev_options::PpdevOptions;
 pub use realtime::RealTime;
 pub use rig::Rig;
 pub use run::{LATE_FRACTION, LoopConfig, LoopStats, RunError, RunOutcome, run};

@@ -5,13 +5,14 @@
 //! calls. Reads and writes go through `std::fs::File`.
 #![allow(unsafe_code)]
 
+use std::ffi::{c_int, c_uchar, c_uint};
 use std::fs::{File, OpenOptions};
 use std::io::{self, Read, Write};
 use std::os::fd::AsRawFd;
 use std::os::unix::fs::OpenOptionsExt;
 use std::path::Path;
 
-use super::{CycleKind, EppPort, PortError};
+use super::{CycleKind, EppPort, PortError, PpdevOptions};
 
 mod diagnosis;
 
@@ -29,7 +30,10 @@ use diagnosis::{port_error, require_epp};
 /// use ctrlab::hw::ioctl;
 /// #[cfg(target_arch = "x86_64")]
 /// assert_eq!((ioctl::PPSETMODE, ioctl::PPWCONTROL), (0x4004_7080, 0x4001_7084));
+/// #[cfg(target_arch = "x86_64")]
+/// assert_eq!(ioctl::PPDATADIR, 0x4004_7090);
 /// assert_eq!(ioctl::IEEE1284_MODE_EPP | ioctl::IEEE1284_ADDR, 0x2040);
+/// assert_eq!(ioctl::IEEE1284_MODE_COMPAT, 0x100);
 /// assert_eq!(ioctl::EPP_CONTROL, 0x04);
 /// ```
 pub mod ioctl {
@@ -83,8 +87,17 @@ pub mod ioctl {
     pub const PPEXCL: u32 = ioc(layout::NONE, 0x8f, 0);
     /// `_IOR('p', 0x97, unsigned int)`: the port's hardware modes.
     pub const PPGETMODES: u32 = ioc(layout::READ, 0x97, size_of::<c_uint>());
-    /// `_IOW('p', 0x84, unsigned char)`: write the control register.
+    /// `_IOW('p', 0x84, unsigned char)`: write the control register's
+    /// bits 0–3 (nStrobe, nAutoFd, nInit, nSelectIn). The PC-style driver
+    /// (`parport_pc`) masks the value to those four bits: it never writes
+    /// bit 4 (the port's interrupt enable, which the kernel manages), and a
+    /// set bit 5 only turns the data lines round (reverse, as `PPDATADIR`
+    /// 1 does, with a kernel log line saying to use that instead).
     pub const PPWCONTROL: u32 = ioc(layout::WRITE, 0x84, size_of::<c_uchar>());
+    /// `_IOW('p', 0x90, int)`: data direction; non-zero turns the data
+    /// lines round (reverse, the peripheral drives them: bit 5 of the
+    /// control register set), zero sets them forward (the PC drives).
+    pub const PPDATADIR: u32 = ioc(layout::WRITE, 0x90, size_of::<c_int>());
 
     /// `PARPORT_MODE_PCSPP` in `PPGETMODES`: IBM PC registers available.
     pub const PARPORT_MODE_PCSPP: c_uint = 1 << 0;
@@ -104,14 +117,19 @@ pub mod ioctl {
     /// `PARPORT_CONTROL_INIT`, the control register's bit 2 (nInit, not
     /// inverted on the connector).
     pub const PARPORT_CONTROL_INIT: c_uchar = 0x04;
-    /// The control register for EPP cycles, written once after claiming
-    /// (`PPWCONTROL`), as LinuxCNC's EPP drivers (`hm2_7i43`) do: nInit
-    /// high (EPP's nReset, not asserted); nStrobe, nAutoFd and nSelectIn
-    /// released (bits 0, 1, 3 clear: EPP's nWrite, nDataStrobe and
-    /// nAddrStrobe, which the port's EPP hardware drives; the kernel leaves
-    /// a claimed port at `0x0c`, nSelectIn asserted); interrupts off; data
-    /// direction forward (bit 5 clear).
+    /// The control register's bits 0–3 for EPP cycles, written once after
+    /// claiming (`PPWCONTROL`, which writes only those four bits), as
+    /// LinuxCNC's EPP drivers (`hm2_7i43`) do: nInit high (bit 2 set: EPP's
+    /// nReset, not asserted); nStrobe, nAutoFd and nSelectIn high (bits 0,
+    /// 1, 3 clear: EPP's nWrite, nDataStrobe and nAddrStrobe, which the
+    /// port's EPP hardware then drives; the kernel leaves a claimed port at
+    /// `0x0c`, nSelectIn low). Bit 4 (interrupt enable) and bit 5 (data
+    /// direction) are not written by this: direction is `PPDATADIR`'s (see
+    /// [`PpdevOptions::data_dir`](crate::hw::PpdevOptions::data_dir)).
     pub const EPP_CONTROL: c_uchar = PARPORT_CONTROL_INIT;
+    /// `IEEE1284_MODE_COMPAT` for `PPSETMODE`: compatibility (printer)
+    /// mode, what the kernel expects a port to be left in.
+    pub const IEEE1284_MODE_COMPAT: c_int = 1 << 8;
     /// `IEEE1284_MODE_EPP` for `PPSETMODE`.
     pub const IEEE1284_MODE_EPP: c_int = 1 << 6;
     /// `IEEE1284_ADDR`, or'ed into the mode for address cycles.
@@ -123,11 +141,24 @@ pub mod ioctl {
 /// [`open`](Self::open) opens `/dev/parportN` non-blocking, registers
 /// exclusively (`PPEXCL`), claims the port (`PPCLAIM`), checks the hardware
 /// has EPP (`PPGETMODES`), selects EPP data cycles (`PPSETMODE`) and sets
-/// the control register for EPP ([`ioctl::EPP_CONTROL`], `PPWCONTROL`).
-/// Address cycles switch the mode to EPP | `IEEE1284_ADDR` and back (only
-/// when the cycle kind changes). There is no `PPNEGOT`: the card is not an
-/// IEEE 1284 peripheral that negotiates. Dropping the port releases it
-/// (`PPRELEASE`).
+/// the control register's bits 0–3 for EPP ([`ioctl::EPP_CONTROL`],
+/// `PPWCONTROL`). Address cycles switch the mode to EPP | `IEEE1284_ADDR`
+/// and back (only when the cycle kind changes). With
+/// [`PpdevOptions::data_dir`], each data read is bracketed by `PPDATADIR`
+/// (reverse before, forward after). There is no `PPNEGOT`: the card is not
+/// an IEEE 1284 peripheral that negotiates.
+///
+/// # Closing without a reset pulse
+///
+/// [`close`](Self::close), and dropping the port, set the mode to
+/// compatibility (`PPSETMODE` with [`ioctl::IEEE1284_MODE_COMPAT`]) and
+/// then release the port (`PPRELEASE`). Left in EPP mode, the kernel would
+/// end EPP itself when the file closes ("negotiated back to compatibility
+/// mode because user-space forgot"): the IEEE 1284 termination from EPP
+/// drives nInit — EPP's nReset, which resets the card — low for 50 µs,
+/// on every close. `PPSETMODE` only records the mode and drives no line,
+/// so the port closes with nInit high. (`PPNEGOT` to compatibility mode
+/// would not do: it runs that same termination, and its reset pulse.)
 ///
 /// # What a register access costs
 ///
@@ -138,7 +169,8 @@ pub mod ioctl {
 /// every cycle: one tick of the lab's rig
 /// ([`MassSpringRig`](crate::lab::MassSpringRig): latch and kick, two
 /// 32-bit counters, one PWM duty) is 22 EPP cycles and 22 mode switches,
-/// 44 system calls. No batching saves any without auto-increment (see
+/// 44 system calls (60 with [`PpdevOptions::data_dir`]: two `PPDATADIR`
+/// per byte read). No batching saves any without auto-increment (see
 /// `tests/hw.rs`, `one_rig_tick_costs_22_cycles_and_22_mode_switches`).
 ///
 /// Errors say what is wrong and what to do: a short read or write is
@@ -158,15 +190,12 @@ pub mod ioctl {
 /// ```
 #[derive(Debug)]
 pub struct Ppdev {
-    file: File,
-    device: String,
-    modes: PortModes,
-    /// `Some(true)` in address mode, `Some(false)` in data mode.
-    address_mode: Option<bool>,
+    port: Port<File>,
 }
 
 impl Ppdev {
-    /// Opens and claims `path` (e.g. `/dev/parport0`) in EPP mode.
+    /// Opens and claims `path` (e.g. `/dev/parport0`) in EPP mode, with the
+    /// default [`PpdevOptions`] ([`open_with`](Self::open_with)).
     ///
     /// # Errors
     ///
@@ -184,21 +213,29 @@ impl Ppdev {
     /// assert!(err.to_string().contains("PPEXCL"));
     /// ```
     pub fn open(path: impl AsRef<Path>) -> Result<Self, PortError> {
+        Self::open_with(path, PpdevOptions::default())
+    }
+
+    /// Opens and claims `path` in EPP mode, driving it as `options` says
+    /// (a card file's `[port]` table, `lab::RigConfig::port`).
+    ///
+    /// # Errors
+    ///
+    /// As [`open`](Self::open).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{PortErrorKind, Ppdev, PpdevOptions};
+    /// let options = PpdevOptions { data_dir: true };
+    /// let err = Ppdev::open_with("/dev/nonexistent", options).unwrap_err();
+    /// assert_eq!(err.kind(), PortErrorKind::NotPresent);
+    /// ```
+    pub fn open_with(path: impl AsRef<Path>, options: PpdevOptions) -> Result<Self, PortError> {
         let (file, device) = open_device(path.as_ref())?;
-        ioctl_none(&file, ioctl::PPEXCL).map_err(|e| port_error(&device, "PPEXCL", e))?;
-        ioctl_none(&file, ioctl::PPCLAIM).map_err(|e| port_error(&device, "PPCLAIM", e))?;
-        let modes = get_modes(&file).map_err(|e| port_error(&device, "PPGETMODES", e))?;
-        // Claimed: from here on, dropping `port` releases it.
-        let mut port = Self {
-            file,
-            device,
-            modes,
-            address_mode: None,
-        };
-        require_epp(&port.device, modes)?;
-        port.set_mode(false)?;
-        port.write_control(ioctl::EPP_CONTROL)?;
-        Ok(port)
+        Ok(Self {
+            port: Port::open(file, device, options)?,
+        })
     }
 
     /// The modes of the port at `path` (`PPGETMODES`), without claiming it:
@@ -217,8 +254,10 @@ impl Ppdev {
     /// assert_eq!(err.kind(), PortErrorKind::NotPresent);
     /// ```
     pub fn modes_of(path: impl AsRef<Path>) -> Result<PortModes, PortError> {
-        let (file, device) = open_device(path.as_ref())?;
-        get_modes(&file).map_err(|e| port_error(&device, "PPGETMODES", e))
+        let (mut file, device) = open_device(path.as_ref())?;
+        file.ioctl(Request::GetModes)
+            .map(PortModes::from_bits)
+            .map_err(|e| port_error(&device, Request::GetModes.name(), e))
     }
 
     /// The port's hardware modes (`PPGETMODES`, read when it was opened).
@@ -233,7 +272,21 @@ impl Ppdev {
     /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn modes(&self) -> PortModes {
-        self.modes
+        self.port.modes
+    }
+
+    /// How the port is driven (as opened).
+    ///
+    /// # Examples
+    ///
+    /// ```no_run
+    /// use ctrlab::hw::{Ppdev, PpdevOptions};
+    /// let port = Ppdev::open_with("/dev/parport0", PpdevOptions { data_dir: true })?;
+    /// assert!(port.options().data_dir);
+    /// # Ok::<(), ctrlab::hw::PortError>(())
+    /// ```
+    pub fn options(&self) -> PpdevOptions {
+        self.port.options
     }
 
     /// The device path.
@@ -247,30 +300,220 @@ impl Ppdev {
     /// # Ok::<(), ctrlab::hw::PortError>(())
     /// ```
     pub fn device(&self) -> &str {
-        &self.device
+        &self.port.device
     }
 
-    /// Writes the port's control register (`PPWCONTROL`).
-    fn write_control(&mut self, value: u8) -> Result<(), PortError> {
-        let value: libc::c_uchar = value;
-        // SAFETY: PPWCONTROL reads one `unsigned char` through its pointer
-        // argument; `value` is a live c_uchar for the whole call, and the fd
-        // is owned by `self.file`, open for the call's duration.
-        let rc = unsafe {
-            libc::ioctl(
-                self.file.as_raw_fd(),
-                ioctl::PPWCONTROL as libc::Ioctl,
-                &value as *const libc::c_uchar,
-            )
+    /// Closes the port as dropping it does — data lines forward, mode set
+    /// to compatibility (`PPSETMODE`), released (`PPRELEASE`), without the
+    /// kernel's nInit pulse (see [the type docs](Self#closing-without-a-reset-pulse))
+    /// — and says whether each step succeeded. Every step is tried, even
+    /// after one fails.
+    ///
+    /// # Errors
+    ///
+    /// The first failed step's [`PortError`], naming its ioctl.
+    ///
+    /// # Examples
+    ///
+    /// ```no_run
+    /// use ctrlab::hw::Ppdev;
+    /// let port = Ppdev::open("/dev/parport0")?;
+    /// assert!(port.close().is_ok());
+    /// # Ok::<(), ctrlab::hw::PortError>(())
+    /// ```
+    pub fn close(mut self) -> Result<(), PortError> {
+        self.port.close()
+    }
+}
+
+impl EppPort for Ppdev {
+    fn write_address(&mut self, address: u8) -> Result<(), PortError> {
+        self.port.write_address(address)
+    }
+
+    fn read_data(&mut self) -> Result<u8, PortError> {
+        self.port.read_data()
+    }
+
+    fn write_data(&mut self, value: u8) -> Result<(), PortError> {
+        self.port.write_data(value)
+    }
+}
+
+/// One `ppdev` ioctl this driver makes, with its argument.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Request {
+    /// `PPEXCL`.
+    Excl,
+    /// `PPCLAIM`.
+    Claim,
+    /// `PPGETMODES`.
+    GetModes,
+    /// `PPSETMODE` with this mode.
+    SetMode(c_int),
+    /// `PPWCONTROL` with these control bits (0–3).
+    WriteControl(c_uchar),
+    /// `PPDATADIR`: `true` reverse (the card drives the data lines),
+    /// `false` forward.
+    DataDir(bool),
+    /// `PPRELEASE`.
+    Release,
+}
+
+impl Request {
+    /// The ioctl's name, as errors name the failed step.
+    fn name(self) -> &'static str {
+        match self {
+            Self::Excl => "PPEXCL",
+            Self::Claim => "PPCLAIM",
+            Self::GetModes => "PPGETMODES",
+            Self::SetMode(_) => "PPSETMODE",
+            Self::WriteControl(_) => "PPWCONTROL",
+            Self::DataDir(_) => "PPDATADIR",
+            Self::Release => "PPRELEASE",
+        }
+    }
+}
+
+/// What the driver does to the device: ioctls, one-byte reads and writes.
+/// A `File` on `/dev/parportN`; in the unit tests a recorder, so the order
+/// of the steps is tested without a port.
+trait Device {
+    /// Makes the ioctl: `PPGETMODES`' bits, 0 for the others.
+    fn ioctl(&mut self, request: Request) -> io::Result<c_uint>;
+    /// One EPP read (data or address, as the mode says).
+    fn read_byte(&mut self, byte: &mut [u8; 1]) -> io::Result<usize>;
+    /// One EPP write (data or address, as the mode says).
+    fn write_byte(&mut self, byte: u8) -> io::Result<usize>;
+}
+
+impl Device for File {
+    fn ioctl(&mut self, request: Request) -> io::Result<c_uint> {
+        let fd = self.as_raw_fd();
+        let rc = match request {
+            Request::Excl => ioctl_none(fd, ioctl::PPEXCL),
+            Request::Claim => ioctl_none(fd, ioctl::PPCLAIM),
+            Request::Release => ioctl_none(fd, ioctl::PPRELEASE),
+            Request::GetModes => {
+                let mut modes: c_uint = 0;
+                // SAFETY: PPGETMODES writes one `unsigned int` through its
+                // pointer argument; `modes` is a live, aligned c_uint for the
+                // whole call, and `fd` is owned by `self`, open for the call.
+                let rc = unsafe {
+                    libc::ioctl(
+                        fd,
+                        ioctl::PPGETMODES as libc::Ioctl,
+                        &mut modes as *mut c_uint,
+                    )
+                };
+                return if rc < 0 {
+                    Err(io::Error::last_os_error())
+                } else {
+                    Ok(modes)
+                };
+            }
+            Request::SetMode(mode) => {
+                // SAFETY: PPSETMODE reads one `int` through its pointer
+                // argument; `mode` is a live, aligned c_int for the whole
+                // call, and `fd` is owned by `self`, open for the call.
+                unsafe { libc::ioctl(fd, ioctl::PPSETMODE as libc::Ioctl, &mode as *const c_int) }
+            }
+            Request::WriteControl(value) => {
+                // SAFETY: PPWCONTROL reads one `unsigned char` through its
+                // pointer argument; `value` is a live c_uchar for the whole
+                // call, and `fd` is owned by `self`, open for the call.
+                unsafe {
+                    libc::ioctl(
+                        fd,
+                        ioctl::PPWCONTROL as libc::Ioctl,
+                        &value as *const c_uchar,
+                    )
+                }
+            }
+            Request::DataDir(reverse) => {
+                let direction: c_int = reverse.into();
+                // SAFETY: PPDATADIR reads one `int` through its pointer
+                // argument; `direction` is a live, aligned c_int for the
+                // whole call, and `fd` is owned by `self`, open for the call.
+                unsafe {
+                    libc::ioctl(
+                        fd,
+                        ioctl::PPDATADIR as libc::Ioctl,
+                        &direction as *const c_int,
+                    )
+                }
+            }
         };
         if rc < 0 {
-            return Err(port_error(
-                &self.device,
-                "PPWCONTROL",
-                io::Error::last_os_error(),
-            ));
+            Err(io::Error::last_os_error())
+        } else {
+            Ok(0)
         }
-        Ok(())
+    }
+
+    fn read_byte(&mut self, byte: &mut [u8; 1]) -> io::Result<usize> {
+        self.read(byte)
+    }
+
+    fn write_byte(&mut self, byte: u8) -> io::Result<usize> {
+        self.write(&[byte])
+    }
+}
+
+/// An argumentless (`_IO`) ppdev ioctl; its return code.
+fn ioctl_none(fd: std::os::fd::RawFd, request: u32) -> c_int {
+    // SAFETY: `request` is one of ppdev's `_IO` requests, which take no
+    // argument and touch no user memory; `fd` is an open descriptor its
+    // caller owns for the call's duration.
+    unsafe { libc::ioctl(fd, request as libc::Ioctl) }
+}
+
+/// The driver over any [`Device`]: the mode and direction it left the port
+/// in, and whether it still holds the port.
+#[derive(Debug)]
+struct Port<D: Device> {
+    dev: D,
+    device: String,
+    modes: PortModes,
+    options: PpdevOptions,
+    /// `Some(true)` in address mode, `Some(false)` in data mode.
+    address_mode: Option<bool>,
+    /// The data lines turned round (`PPDATADIR` 1) and not yet back.
+    reversed: bool,
+    /// Claimed and not yet released: what closing has to undo.
+    claimed: bool,
+}
+
+impl<D: Device> Port<D> {
+    /// Registers exclusively, claims, checks for EPP, selects EPP data
+    /// cycles and writes the control bits. Once claimed, a failure closes
+    /// the port again (dropping it).
+    fn open(mut dev: D, device: String, options: PpdevOptions) -> Result<Self, PortError> {
+        for request in [Request::Excl, Request::Claim] {
+            dev.ioctl(request)
+                .map_err(|e| port_error(&device, request.name(), e))?;
+        }
+        let mut port = Self {
+            dev,
+            device,
+            modes: PortModes::default(),
+            options,
+            address_mode: None,
+            reversed: false,
+            claimed: true,
+        };
+        port.modes = PortModes::from_bits(port.step(Request::GetModes)?);
+        require_epp(&port.device, port.modes)?;
+        port.set_mode(false)?;
+        port.step(Request::WriteControl(ioctl::EPP_CONTROL))?;
+        Ok(port)
+    }
+
+    /// One ioctl, its failure named.
+    fn step(&mut self, request: Request) -> Result<c_uint, PortError> {
+        self.dev
+            .ioctl(request)
+            .map_err(|e| port_error(&self.device, request.name(), e))
     }
 
     /// Selects EPP address (`true`) or data (`false`) cycles, if not already.
@@ -278,69 +521,86 @@ impl Ppdev {
         if self.address_mode == Some(address) {
             return Ok(());
         }
-        let mode: libc::c_int = if address {
+        let mode = if address {
             ioctl::IEEE1284_MODE_EPP | ioctl::IEEE1284_ADDR
         } else {
             ioctl::IEEE1284_MODE_EPP
         };
-        // SAFETY: PPSETMODE reads one `int` through its pointer argument;
-        // `mode` is a live, aligned c_int for the whole call, and the fd is
-        // owned by `self.file`, open for the call's duration.
-        let rc = unsafe {
-            libc::ioctl(
-                self.file.as_raw_fd(),
-                ioctl::PPSETMODE as libc::Ioctl,
-                &mode as *const libc::c_int,
-            )
-        };
-        if rc < 0 {
-            self.address_mode = None;
-            return Err(port_error(
-                &self.device,
-                "PPSETMODE",
-                io::Error::last_os_error(),
-            ));
-        }
+        self.address_mode = None;
+        self.step(Request::SetMode(mode))?;
         self.address_mode = Some(address);
         Ok(())
     }
 
+    /// Data lines forward (the PC drives them), if a read left them
+    /// reversed.
+    fn forward(&mut self) -> Result<(), PortError> {
+        if self.reversed {
+            self.step(Request::DataDir(false))?;
+            self.reversed = false;
+        }
+        Ok(())
+    }
+
     fn write_byte(&mut self, cycle: CycleKind, byte: u8) -> Result<(), PortError> {
-        match self.file.write(&[byte]) {
+        self.forward()?;
+        match self.dev.write_byte(byte) {
             Ok(1) => Ok(()),
             Ok(_) => Err(timeout(cycle)),
             Err(e) => Err(transfer_error(&self.device, cycle, e)),
         }
     }
-}
 
-impl EppPort for Ppdev {
     fn write_address(&mut self, address: u8) -> Result<(), PortError> {
         self.set_mode(true)?;
         self.write_byte(CycleKind::AddressWrite, address)
-    }
-
-    fn read_data(&mut self) -> Result<u8, PortError> {
-        self.set_mode(false)?;
-        let mut byte = [0u8; 1];
-        match self.file.read(&mut byte) {
-            Ok(1) => Ok(byte[0]),
-            Ok(_) => Err(timeout(CycleKind::DataRead)),
-            Err(e) => Err(transfer_error(&self.device, CycleKind::DataRead, e)),
-        }
     }
 
     fn write_data(&mut self, value: u8) -> Result<(), PortError> {
         self.set_mode(false)?;
         self.write_byte(CycleKind::DataWrite, value)
     }
+
+    /// One data read; with [`PpdevOptions::data_dir`], the data lines
+    /// reversed before it and forward again after it, even when it fails.
+    fn read_data(&mut self) -> Result<u8, PortError> {
+        self.set_mode(false)?;
+        if self.options.data_dir {
+            self.reversed = true;
+            self.step(Request::DataDir(true))?;
+        }
+        let mut byte = [0u8; 1];
+        let read = match self.dev.read_byte(&mut byte) {
+            Ok(1) => Ok(byte[0]),
+            Ok(_) => Err(timeout(CycleKind::DataRead)),
+            Err(e) => Err(transfer_error(&self.device, CycleKind::DataRead, e)),
+        };
+        let forward = self.forward();
+        let byte = read?;
+        forward?;
+        Ok(byte)
+    }
+
+    /// Data lines forward, compatibility mode recorded (`PPSETMODE`, no
+    /// line driven), released: every step tried; the first failure.
+    fn close(&mut self) -> Result<(), PortError> {
+        if !self.claimed {
+            return Ok(());
+        }
+        self.claimed = false;
+        let forward = self.forward();
+        self.address_mode = None;
+        let compat = self.step(Request::SetMode(ioctl::IEEE1284_MODE_COMPAT));
+        let release = self.step(Request::Release);
+        forward.and(compat).and(release).map(drop)
+    }
 }
 
-impl Drop for Ppdev {
+impl<D: Device> Drop for Port<D> {
     fn drop(&mut self) {
-        // Nothing to do about a failed release in a destructor; closing the
+        // Nothing to do about a failed step in a destructor; closing the
         // file (which follows) releases the port in the kernel as well.
-        if ioctl_none(&self.file, ioctl::PPRELEASE).is_err() {}
+        if self.close().is_err() {}
     }
 }
 
@@ -356,39 +616,6 @@ fn open_device(path: &Path) -> Result<(File, String), PortError> {
         .open(path)
         .map_err(|e| port_error(&device, "open", e))?;
     Ok((file, device))
-}
-
-/// The port's hardware modes (`PPGETMODES`, which needs no claim).
-fn get_modes(file: &File) -> io::Result<PortModes> {
-    let mut modes: libc::c_uint = 0;
-    // SAFETY: PPGETMODES writes one `unsigned int` through its pointer
-    // argument; `modes` is a live, aligned c_uint for the whole call, and the
-    // fd is owned by `file`, open for the call's duration.
-    let rc = unsafe {
-        libc::ioctl(
-            file.as_raw_fd(),
-            ioctl::PPGETMODES as libc::Ioctl,
-            &mut modes as *mut libc::c_uint,
-        )
-    };
-    if rc < 0 {
-        Err(io::Error::last_os_error())
-    } else {
-        Ok(PortModes::from_bits(modes))
-    }
-}
-
-/// An argumentless (`_IO`) ppdev ioctl.
-fn ioctl_none(file: &File, request: u32) -> io::Result<()> {
-    // SAFETY: `request` is one of ppdev's `_IO` requests, which take no
-    // argument and touch no user memory; the fd is owned by `file`, open for
-    // the call's duration.
-    let rc = unsafe { libc::ioctl(file.as_raw_fd(), request as libc::Ioctl) };
-    if rc < 0 {
-        Err(io::Error::last_os_error())
-    } else {
-        Ok(())
-    }
 }
 
 fn timeout(cycle: CycleKind) -> PortError {
@@ -410,5 +637,214 @@ fn transfer_error(device: &str, cycle: CycleKind, e: io::Error) -> PortError {
             },
             e,
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::cell::RefCell;
+    use std::rc::Rc;
+
+    use super::*;
+    use crate::hw::PortErrorKind;
+
+    /// One step on the device, as recorded.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    enum Op {
+        Ioctl(Request),
+        Read,
+        Write(u8),
+    }
+
+    use Op::{Ioctl, Read as R, Write as W};
+    use Request::{Claim, DataDir, Excl, GetModes, Release, SetMode, WriteControl};
+
+    const EPP: c_int = ioctl::IEEE1284_MODE_EPP;
+    const ADDR: c_int = ioctl::IEEE1284_MODE_EPP | ioctl::IEEE1284_ADDR;
+    const COMPAT: c_int = ioctl::IEEE1284_MODE_COMPAT;
+
+    /// A device that records every step, shares its log with the test,
+    /// reports `modes` and reads `0xa5`; `fail` fails that ioctl, `short`
+    /// makes reads return no byte (an EPP timeout).
+    #[derive(Debug, Default)]
+    struct Recorder {
+        log: Rc<RefCell<Vec<Op>>>,
+        modes: c_uint,
+        fail: Option<Request>,
+        short: bool,
+    }
+
+    impl Device for Recorder {
+        fn ioctl(&mut self, request: Request) -> io::Result<c_uint> {
+            self.log.borrow_mut().push(Ioctl(request));
+            if self.fail == Some(request) {
+                return Err(io::Error::from_raw_os_error(libc::EIO));
+            }
+            Ok(if request == GetModes { self.modes } else { 0 })
+        }
+        fn read_byte(&mut self, byte: &mut [u8; 1]) -> io::Result<usize> {
+            self.log.borrow_mut().push(R);
+            byte[0] = 0xa5;
+            Ok(if self.short { 0 } else { 1 })
+        }
+        fn write_byte(&mut self, byte: u8) -> io::Result<usize> {
+            self.log.borrow_mut().push(W(byte));
+            Ok(1)
+        }
+    }
+
+    /// A port opened on a recorder with hardware EPP, and its log.
+    fn opened(options: PpdevOptions) -> (Port<Recorder>, Rc<RefCell<Vec<Op>>>) {
+        let dev = Recorder {
+            modes: 0x1f,
+            ..Recorder::default()
+        };
+        let log = Rc::clone(&dev.log);
+        let port = Port::open(dev, "/dev/parport0".into(), options).unwrap();
+        (port, log)
+    }
+
+    fn taken(log: &Rc<RefCell<Vec<Op>>>) -> Vec<Op> {
+        std::mem::take(&mut *log.borrow_mut())
+    }
+
+    #[test]
+    fn open_claims_checks_epp_then_selects_data_cycles_and_the_control_bits() {
+        let (_port, log) = opened(PpdevOptions::default());
+        assert_eq!(
+            taken(&log),
+            [
+                Ioctl(Excl),
+                Ioctl(Claim),
+                Ioctl(GetModes),
+                Ioctl(SetMode(EPP)),
+                Ioctl(WriteControl(0x04)),
+            ]
+        );
+    }
+
+    #[test]
+    fn by_default_a_register_read_is_two_mode_switches_and_two_cycles() {
+        let (mut port, log) = opened(PpdevOptions::default());
+        taken(&log);
+        port.write_address(0x20).unwrap();
+        assert_eq!(port.read_data().unwrap(), 0xa5);
+        port.write_address(0x10).unwrap();
+        port.write_data(0x07).unwrap();
+        assert_eq!(
+            taken(&log),
+            [
+                Ioctl(SetMode(ADDR)),
+                W(0x20),
+                Ioctl(SetMode(EPP)),
+                R,
+                Ioctl(SetMode(ADDR)),
+                W(0x10),
+                Ioctl(SetMode(EPP)),
+                W(0x07),
+            ]
+        );
+    }
+
+    #[test]
+    fn with_data_dir_every_read_is_bracketed_by_ppdatadir_and_writes_are_not() {
+        let (mut port, log) = opened(PpdevOptions { data_dir: true });
+        taken(&log);
+        port.write_address(0x20).unwrap();
+        assert_eq!(port.read_data().unwrap(), 0xa5);
+        assert_eq!(port.read_data().unwrap(), 0xa5);
+        port.write_data(0x01).unwrap();
+        assert_eq!(
+            taken(&log),
+            [
+                Ioctl(SetMode(ADDR)),
+                W(0x20),
+                Ioctl(SetMode(EPP)),
+                Ioctl(DataDir(true)),
+                R,
+                Ioctl(DataDir(false)),
+                Ioctl(DataDir(true)),
+                R,
+                Ioctl(DataDir(false)),
+                W(0x01),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_read_that_times_out_still_turns_the_data_lines_forward() {
+        let (mut port, log) = opened(PpdevOptions { data_dir: true });
+        port.dev.short = true;
+        taken(&log);
+        let err = port.read_data().unwrap_err();
+        assert_eq!(err.kind(), PortErrorKind::Timeout);
+        assert_eq!(
+            taken(&log),
+            [Ioctl(DataDir(true)), R, Ioctl(DataDir(false))]
+        );
+    }
+
+    #[test]
+    fn dropping_sets_compatibility_mode_then_releases_without_negotiating() {
+        for options in [PpdevOptions::default(), PpdevOptions { data_dir: true }] {
+            let (mut port, log) = opened(options);
+            port.write_address(0x00).unwrap();
+            port.read_data().unwrap();
+            taken(&log);
+            drop(port);
+            // PPSETMODE records the mode and drives no line; the kernel's
+            // own close then has nothing to negotiate (no nInit pulse).
+            assert_eq!(taken(&log), [Ioctl(SetMode(COMPAT)), Ioctl(Release)]);
+        }
+    }
+
+    #[test]
+    fn an_explicit_close_does_the_same_once_and_reports_a_failed_step() {
+        let (mut port, log) = opened(PpdevOptions::default());
+        port.write_address(0x00).unwrap(); // left in address mode
+        taken(&log);
+        port.close().unwrap();
+        drop(port);
+        assert_eq!(taken(&log), [Ioctl(SetMode(COMPAT)), Ioctl(Release)]);
+
+        let (mut port, log) = opened(PpdevOptions::default());
+        port.dev.fail = Some(SetMode(COMPAT));
+        taken(&log);
+        let err = port.close().unwrap_err();
+        assert!(err.to_string().contains("PPSETMODE"), "{err}");
+        // The release is tried all the same.
+        assert_eq!(taken(&log), [Ioctl(SetMode(COMPAT)), Ioctl(Release)]);
+    }
+
+    #[test]
+    fn a_port_without_epp_is_refused_and_released_in_compatibility_mode() {
+        let dev = Recorder {
+            modes: 0x1b, // PCSPP,TRISTATE,ECP,COMPAT: no EPP
+            ..Recorder::default()
+        };
+        let log = Rc::clone(&dev.log);
+        let err = Port::open(dev, "/dev/parport0".into(), PpdevOptions::default()).unwrap_err();
+        assert_eq!(err.kind(), PortErrorKind::NotPresent);
+        assert_eq!(
+            taken(&log),
+            [
+                Ioctl(Excl),
+                Ioctl(Claim),
+                Ioctl(GetModes),
+                Ioctl(SetMode(COMPAT)),
+                Ioctl(Release),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_failed_claim_has_nothing_to_release() {
+        let dev = Recorder {
+            fail: Some(Claim),
+            ..Recorder::default()
+        };
+        let log = Rc::clone(&dev.log);
+        assert!(Port::open(dev, "/dev/parport0".into(), PpdevOptions::default()).is_err());
+        assert_eq!(taken(&log), [Ioctl(Excl), Ioctl(Claim)]);
     }
 }

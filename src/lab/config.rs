@@ -8,7 +8,7 @@ use std::path::Path;
 
 use super::Calibration;
 use super::file::{self, FileError};
-use crate::hw::{ConfigError, RegisterMap};
+use crate::hw::{ConfigError, PpdevOptions, RegisterMap};
 
 /// A rig's card file (`card.toml`): where the card's registers are and how
 /// the rig's counts and volts map to SI.
@@ -21,8 +21,9 @@ use crate::hw::{ConfigError, RegisterMap};
 ///
 /// # The file
 ///
-/// Two tables, every key required. Units: m, V, s, m/s; addresses, bit
-/// masks and the ID may be written in hex (`0x20`) or decimal.
+/// Two tables, every key required, and an optional third. Units: m, V, s,
+/// m/s; addresses, bit masks and the ID may be written in hex (`0x20`) or
+/// decimal.
 ///
 /// ```
 /// use ctrlab::lab::RigConfig;
@@ -53,9 +54,14 @@ use crate::hw::{ConfigError, RegisterMap};
 ///     stall_volts = 6.0                 # V of new drive that must move an encoder
 ///     stall_time = 0.5                  # s the carts may take to answer it
 ///     stall_counts = 3                  # counts that answer it
+///
+///     ## How this PC's parallel port is driven (optional; keys default).
+///     [port]
+///     data_dir = true                   # PPDATADIR around each EPP read (default false)
 /// "#)?;
 /// assert_eq!((config.calibration.card_id, config.map.encoder[1]), (0x3c, 0x24));
 /// assert_eq!(config.calibration.sign[1], -1.0);
+/// assert!(config.port.data_dir);
 /// # Ok::<(), ctrlab::lab::FileError>(())
 /// ```
 ///
@@ -70,12 +76,18 @@ use crate::hw::{ConfigError, RegisterMap};
 /// type, and the values are checked on load: each error names the key, as
 /// `calibration.travel_limits` or `map.encoder[2]`.
 ///
+/// The `[port]` table is the exception: it describes the PC's parallel
+/// port, not the card ([`PpdevOptions`]), and its defaults are what works
+/// on most ports, so the table and each of its keys may be left out. An
+/// unknown key in it is refused all the same, and a value of the wrong type
+/// (`data_dir = "yes"`) is named `port.data_dir`.
+///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::{hw::RegisterMap, lab::{Calibration, FileError, FileErrorKind, RigConfig}};
 ///
-/// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+/// let config = RigConfig::new(RegisterMap::default(), Calibration::default());
 /// let text = config.to_toml();
 /// assert_eq!(RigConfig::from_toml(&text)?, config);
 /// // A key left out is refused, and named.
@@ -91,6 +103,10 @@ pub struct RigConfig {
     pub map: RegisterMap,
     /// How the rig's counts and volts map to SI, its channels and limits.
     pub calibration: Calibration,
+    /// How the PC's parallel port is driven (`[port]`, optional: each key
+    /// defaults, see [`PpdevOptions`]).
+    #[serde(default)]
+    pub port: PpdevOptions,
 }
 
 /// One key of the file: its dotted name, what it means (the comment
@@ -107,7 +123,7 @@ const fn field(key: &'static str, comment: &'static str, hex: bool) -> Field {
 }
 
 /// Every key of the file, in the order [`RigConfig::to_toml`] writes them.
-const FIELDS: [Field; 20] = [
+const FIELDS: [Field; 21] = [
     field("map.id", "card ID register (read)", true),
     field(
         "map.control",
@@ -180,6 +196,11 @@ const FIELDS: [Field; 20] = [
         false,
     ),
     field("calibration.stall_counts", "counts that answer it", false),
+    field(
+        "port.data_dir",
+        "PPDATADIR around each EPP read (default false)",
+        false,
+    ),
 ];
 
 /// The [`FIELDS`] entry of `name` in `section`.
@@ -214,6 +235,25 @@ fn hex(value: &str) -> String {
 }
 
 impl RigConfig {
+    /// A card file of `map` and `calibration`, its port driven the default
+    /// way ([`PpdevOptions::default`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::{PpdevOptions, RegisterMap}, lab::{Calibration, RigConfig}};
+    /// let config = RigConfig::new(RegisterMap::default(), Calibration::default());
+    /// assert_eq!(config.port, PpdevOptions::default());
+    /// assert!(!config.port.data_dir);
+    /// ```
+    pub fn new(map: RegisterMap, calibration: Calibration) -> Self {
+        Self {
+            map,
+            calibration,
+            port: PpdevOptions::default(),
+        }
+    }
+
     /// The card file's `text`, checked ([`validate`](Self::validate)).
     ///
     /// # Errors
@@ -228,7 +268,7 @@ impl RigConfig {
     ///
     /// ```
     /// use ctrlab::{hw::RegisterMap, lab::{Calibration, FileError, RigConfig}};
-    /// let good = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let good = RigConfig::new(RegisterMap::default(), Calibration::default());
     /// let bad = good.to_toml().replace("travel_limits = [0.05, 0.05]", "travel_limits = [0.05, -0.05]");
     /// match RigConfig::from_toml(&bad) {
     ///     Err(FileError::Invalid { error, line: Some(_), .. }) => {
@@ -268,7 +308,7 @@ impl RigConfig {
     ///
     /// ```
     /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
-    /// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let config = RigConfig::new(RegisterMap::default(), Calibration::default());
     /// let text = config.to_toml();
     /// assert!(text.contains("encoder = [0x20, 0x24, 0x28, 0x2c]"));
     /// assert!(text.contains("# m per encoder count"));
@@ -281,8 +321,9 @@ impl RigConfig {
         let plain = toml::to_string(self).unwrap_or_default();
         let mut out = String::from(
             "# A rig's card file (ctrlab::lab::RigConfig): where the card's registers are\n\
-             # ([map]) and how its counts and volts map to SI ([calibration]).\n\
-             # Every key is required. Units: m, V, s, m/s.\n",
+             # ([map]), how its counts and volts map to SI ([calibration]) and how\n\
+             # this PC's parallel port is driven ([port]). Every key of [map] and\n\
+             # [calibration] is required; [port]'s keys default. Units: m, V, s, m/s.\n",
         );
         let mut section = "";
         for line in plain.lines().filter(|l| !l.is_empty()) {
@@ -318,7 +359,7 @@ impl RigConfig {
     ///
     /// ```
     /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
-    /// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let config = RigConfig::new(RegisterMap::default(), Calibration::default());
     /// let path = std::env::temp_dir().join(format!("ctrlab-doc-card-{}.toml", std::process::id()));
     /// config.write_toml(&path)?;
     /// assert_eq!(RigConfig::read_toml(&path)?, config);
@@ -333,7 +374,8 @@ impl RigConfig {
     }
 
     /// Checks the map ([`RegisterMap::validate`]) and the calibration
-    /// ([`Calibration::validate`]).
+    /// ([`Calibration::validate`]). The port's one key, a boolean, has no
+    /// value to refuse: its type is checked when the file is read.
     ///
     /// # Errors
     ///
@@ -344,10 +386,10 @@ impl RigConfig {
     ///
     /// ```
     /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
-    /// let config = RigConfig {
-    ///     map: RegisterMap { encoder: [0x20, 0x24, 0x28, 0xfe], ..RegisterMap::default() },
-    ///     calibration: Calibration::default(),
-    /// };
+    /// let config = RigConfig::new(
+    ///     RegisterMap { encoder: [0x20, 0x24, 0x28, 0xfe], ..RegisterMap::default() },
+    ///     Calibration::default(),
+    /// );
     /// assert_eq!(config.validate().unwrap_err().key(), "map.encoder[3]");
     /// ```
     pub fn validate(&self) -> Result<(), ConfigError> {
@@ -360,18 +402,20 @@ impl RigConfig {
 
 /// What the rig will use, for a person to check before anything moves: the
 /// ID it expects and where, the motor's channel, registers and voltage
-/// range, the carts' encoders, the travel limits and the watchdog.
+/// range, the carts' encoders, the travel limits, the watchdog and how the
+/// port is driven.
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
-/// let config = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+/// let config = RigConfig::new(RegisterMap::default(), Calibration::default());
 /// let text = config.to_string();
 /// assert!(text.contains("register 0x00 must read 0xa5"));
 /// assert!(text.contains("PWM channel 0 (registers 0x10, 0x11), -24 V to +24 V"));
 /// assert!(text.contains("±50.0 mm"));
 /// assert!(text.contains("watchdog: 100 ms"));
+/// assert!(text.ends_with("port: EPP reads without the data-direction bit (the default)"));
 /// ```
 impl fmt::Display for RigConfig {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -422,11 +466,20 @@ impl fmt::Display for RigConfig {
                 "watchdog: none; nothing on the card stops the motor if the PC stops driving it"
             )?,
         }
-        write!(
+        writeln!(
             f,
             "plausibility: a count change faster than {} m/s is a bus fault; {} V of new drive \
              that moves no encoder {} counts within {} s is a stalled motor or encoder",
             cal.max_speed, cal.stall_volts, cal.stall_counts, cal.stall_time
+        )?;
+        write!(
+            f,
+            "port: {}",
+            if self.port.data_dir {
+                "data-direction bit set around each EPP read (PPDATADIR)"
+            } else {
+                "EPP reads without the data-direction bit (the default)"
+            }
         )
     }
 }

@@ -180,7 +180,7 @@ impl FileError {
     ///
     /// ```
     /// use ctrlab::{hw::RegisterMap, lab::{Calibration, FileErrorKind, RigConfig}};
-    /// let card = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let card = RigConfig::new(RegisterMap::default(), Calibration::default());
     /// let text = card.to_toml().replace("stall_counts = 3", "stall_counts = 0");
     /// assert_eq!(RigConfig::from_toml(&text).unwrap_err().kind(), FileErrorKind::Invalid);
     /// ```
@@ -242,7 +242,7 @@ impl FileError {
     ///
     /// ```
     /// use ctrlab::{hw::RegisterMap, lab::{Calibration, RigConfig}};
-    /// let card = RigConfig { map: RegisterMap::default(), calibration: Calibration::default() };
+    /// let card = RigConfig::new(RegisterMap::default(), Calibration::default());
     /// let text = card.to_toml().replace("travel_limits = [0.05, 0.05]", "travel_limits = [0.05, 0.0]");
     /// assert_eq!(RigConfig::from_toml(&text).unwrap_err().key(), Some("calibration.travel_limits[1]"));
     /// ```

@@ -14,7 +14,10 @@ const KICK_EVERY: f64 = 0.02;
 const RESOLUTION: f64 = 0.5e-3;
 
 impl<P: EppPort, O: Operator<P>> Probe<P, O> {
-    fn found_encoders(&self, step: &'static str) -> Result<(Latch, [Counter; 2]), ProbeError> {
+    pub(super) fn found_encoders(
+        &self,
+        step: &'static str,
+    ) -> Result<(Latch, [Counter; 2]), ProbeError> {
         match (self.latch, self.counters) {
             (Some(latch), Some(counters)) => Ok((latch, counters)),
             _ => Err(ProbeError::OutOfOrder {
@@ -24,10 +27,15 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         }
     }
 
-    /// Every control bit but the latch and the clear: one of them kicks
-    /// the watchdog.
-    fn kick_all(latch: &Latch) -> u8 {
-        !(latch.latch_bit | latch.clear_bit)
+    /// The control bits that kick the watchdog during pulses: the given
+    /// map's watchdog bit; in the blind scan, every control bit but the
+    /// latch and the clear (one of them kicks).
+    pub(super) fn kick_bits(&self, latch: &Latch) -> u8 {
+        if self.options.scan {
+            !(latch.latch_bit | latch.clear_bit)
+        } else {
+            self.options.map.watchdog_bit
+        }
     }
 
     /// Both counters now (latched), as raw 32-bit counts.
@@ -41,10 +49,14 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
 
     /// Waits until both counters stay within `min_counts` over [`SETTLE`]
     /// (the carts at rest), at most 40 looks (10 s).
-    fn settle(&mut self, latch: &Latch, counters: &[Counter; 2]) -> Result<(), ProbeError> {
+    pub(super) fn settle(
+        &mut self,
+        latch: &Latch,
+        counters: &[Counter; 2],
+    ) -> Result<(), ProbeError> {
         let mut before = self.counts(latch, counters)?;
         for _ in 0..40 {
-            self.operator.wait(&mut self.port, SETTLE);
+            self.wait(SETTLE)?;
             let now = self.counts(latch, counters)?;
             if self.moved(counters, before, now).is_none() {
                 return Ok(());
@@ -70,6 +82,10 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// [`ProbeError::ReversedMotor`] when positive duty moves it towards
     /// the wall (the PWM is zeroed first).
     pub fn find_drive(&mut self) -> Result<Drive, ProbeError> {
+        self.driving(Self::find_drive_unguarded)
+    }
+
+    fn find_drive_unguarded(&mut self) -> Result<Drive, ProbeError> {
         let (latch, counters) = self.found_encoders("the drive step")?;
         let scan = self.scan.ok_or(ProbeError::OutOfOrder {
             step: "the drive step",
@@ -82,7 +98,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
              write-only registers until a cart moves, kicking the watchdog with bits {:#04x} of \
              register {:#04x} every {KICK_EVERY} s; the carts must be free to move",
             self.options.pulse_time,
-            Self::kick_all(&latch),
+            self.kick_bits(&latch),
             latch.control
         ));
         if !self.operator.confirm(
@@ -100,22 +116,13 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             .map(|a| (a, a + 1))
             .filter(|&(l, h)| open(l) && open(h))
             .collect();
+        // Every pair of write-only addresses is a candidate: nothing tells a
+        // PWM register from any other write-only one before it moves a
+        // cart. The pulses are kept few: the duties in rising order, each
+        // pair left at the first that moves a cart, the search at the first
+        // pair that does; and every pulse ends in a write of zero to both.
         for (low, high) in pairs {
-            for duty in self.options.pulse_duties {
-                let moved = self.pulse(&latch, &counters, low, high, duty)?;
-                let Some((axis, counts)) = moved else {
-                    continue;
-                };
-                self.settle(&latch, &counters)?;
-                if counts < 0 {
-                    return Err(ProbeError::ReversedMotor { axis, counts });
-                }
-                self.operator.tell(&format!(
-                    "  PWM low byte {low:#04x}, high byte {high:#04x}: {duty} per mille moved \
-                     cart {axis} {counts} counts away from the wall"
-                ));
-                let drive = Drive { low, high, duty };
-                self.drive = Some(drive);
+            if let Some(drive) = self.try_pair(&latch, &counters, low, high)? {
                 return Ok(drive);
             }
         }
@@ -126,9 +133,45 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         })
     }
 
+    /// Pulses (`low`, `high`) at each of the
+    /// [`pulse_duties`](super::ProbeOptions::pulse_duties) in turn until a
+    /// cart moves: the drive, once the carts have settled again, if one
+    /// did.
+    ///
+    /// # Errors
+    ///
+    /// [`ProbeError::ReversedMotor`] when positive duty moved a cart towards
+    /// the wall (the PWM already zeroed); the port's.
+    pub(super) fn try_pair(
+        &mut self,
+        latch: &Latch,
+        counters: &[Counter; 2],
+        low: u8,
+        high: u8,
+    ) -> Result<Option<Drive>, ProbeError> {
+        for duty in self.options.pulse_duties {
+            let moved = self.pulse(latch, counters, low, high, duty)?;
+            let Some((axis, counts)) = moved else {
+                continue;
+            };
+            self.settle(latch, counters)?;
+            if counts < 0 {
+                return Err(ProbeError::ReversedMotor { axis, counts });
+            }
+            self.operator.tell(&format!(
+                "  PWM low byte {low:#04x}, high byte {high:#04x}: {duty} per mille moved \
+                 cart {axis} {counts} counts away from the wall"
+            ));
+            let drive = Drive { low, high, duty };
+            self.drive = Some(drive);
+            return Ok(Some(drive));
+        }
+        Ok(None)
+    }
+
     /// One pulse of `duty` on (`low`, `high`), kicked throughout with every
     /// control bit but the latch and the clear; see [`pulse_with`](Self::pulse_with).
-    fn pulse(
+    pub(super) fn pulse(
         &mut self,
         latch: &Latch,
         counters: &[Counter; 2],
@@ -136,7 +179,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         high: u8,
         duty: i16,
     ) -> Result<Option<(usize, i64)>, ProbeError> {
-        let kick = Self::kick_all(latch);
+        let kick = self.kick_bits(latch);
         self.write(latch.control, kick)?;
         let before = self.counts(latch, counters)?;
         self.pulse_with(latch, counters, (low, high), duty, kick, before)
@@ -156,6 +199,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         kick: u8,
         before: [u32; 2],
     ) -> Result<Option<(usize, i64)>, ProbeError> {
+        self.driven = Some((low, high));
         let result = (|| {
             let (low_byte, high_byte) = pwm_bytes(duty);
             self.write(low, low_byte)?;
@@ -163,14 +207,16 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             self.write(latch.control, kick)?;
             let steps = (self.options.pulse_time / KICK_EVERY).ceil().max(1.0) as usize;
             for _ in 0..steps {
-                self.operator
-                    .wait(&mut self.port, self.options.pulse_time / steps as f64);
+                self.wait(self.options.pulse_time / steps as f64)?;
                 self.write(latch.control, kick)?;
             }
             let after = self.counts(latch, counters)?;
             Ok::<_, ProbeError>(self.moved(counters, before, after))
         })();
         let stop = self.write(low, 0).and_then(|()| self.write(high, 0));
+        if stop.is_ok() {
+            self.driven = None;
+        }
         let moved = result?;
         stop?;
         Ok(moved)
@@ -178,7 +224,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
 
     /// The cart that moved most between two readings and how far, counts
     /// (positive away from the wall), if `min_counts` or more.
-    fn moved(
+    pub(super) fn moved(
         &self,
         counters: &[Counter; 2],
         before: [u32; 2],
@@ -204,7 +250,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// of the [`pulse_duties`](super::ProbeOptions::pulse_duties), for a
     /// clear margin over friction, in alternating directions. The PWM is
     /// zeroed and the watchdog re-armed afterwards, then the carts settle.
-    fn obeyed(&mut self, silence: f64, kick: u8) -> Result<bool, ProbeError> {
+    pub(super) fn obeyed(&mut self, silence: f64, kick: u8) -> Result<bool, ProbeError> {
         let (latch, counters) = self.found_encoders("the watchdog step")?;
         let drive = self.drive.ok_or(ProbeError::OutOfOrder {
             step: "the watchdog step",
@@ -224,7 +270,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             self.reverse = !self.reverse;
             let duty = if self.reverse { -largest } else { largest };
             self.write(latch.control, kick)?;
-            self.operator.wait(&mut self.port, silence);
+            self.wait(silence)?;
             let before = self.counts(&latch, &counters)?;
             let moved = self.pulse_with(
                 &latch,
@@ -234,7 +280,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
                 kick,
                 before,
             )?;
-            self.write(latch.control, Self::kick_all(&latch))?;
+            self.write(latch.control, self.kick_bits(&latch))?;
             self.settle(&latch, &counters)?;
             if moved.is_some() {
                 return Ok(true);
@@ -243,47 +289,36 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         Ok(false)
     }
 
-    /// Step 4: whether a PWM write is still obeyed after a silence without
-    /// a kick, bisected to the watchdog timeout (to 0.5 ms), and which
-    /// control bit kicks it.
+    /// Times the watchdog kicked with `kick`: `None` when a PWM write is
+    /// still obeyed [`max_watchdog`](super::ProbeOptions::max_watchdog)
+    /// after a kick, else the bracket it trips in (s) and the timeout,
+    /// rounded to the millisecond.
     ///
     /// # Errors
     ///
-    /// [`ProbeError::OutOfOrder`] before [`find_drive`](Self::find_drive);
     /// [`ProbeError::NotFound`] when a write 10 ms after a kick is not
-    /// obeyed, or no single bit kicks.
-    pub fn find_watchdog(&mut self) -> Result<Option<f64>, ProbeError> {
-        let (latch, _) = self.found_encoders("the watchdog step")?;
-        let kick_all = Self::kick_all(&latch);
+    /// obeyed; the port's.
+    pub(super) fn time_watchdog(
+        &mut self,
+        kick: u8,
+    ) -> Result<Option<(f64, f64, f64)>, ProbeError> {
         let max = self.options.max_watchdog;
-        self.operator.tell(&format!(
-            "step 4/4, watchdog: short pulses of the drive found in step 3, each after a \
-             silence without a kick, from 10 ms to {max} s, to time the watchdog; then each \
-             control bit alone as the kick"
-        ));
-        self.operator.hands(Hands::Off);
-        if !self.obeyed(0.01, kick_all)? {
+        if !self.obeyed(0.01, kick)? {
             return Err(ProbeError::NotFound {
                 what: "a watchdog kick",
-                hint: "a PWM write 10 ms after writing every control bit but the latch and \
-                       clear was not obeyed",
+                hint: "a PWM write 10 ms after writing the kick bits to the control register \
+                       was not obeyed",
             });
         }
-        if self.obeyed(max, kick_all)? {
-            let bit = kick_all & kick_all.wrapping_neg();
-            self.notes.push(format!(
-                "no watchdog: PWM writes are still obeyed {max} s after the last kick; \
-                 watchdog_bit set to {bit:#04x}, unverified"
-            ));
+        if self.obeyed(max, kick)? {
             self.operator.tell(&format!("  no watchdog within {max} s"));
-            self.watchdog = Some((bit, None));
             return Ok(None);
         }
         let (mut lo, mut hi) = (0.01, max);
         // Halving from at most 10 s to 0.5 ms: at most 15 rounds.
         while hi - lo > RESOLUTION {
             let mid = 0.5 * (lo + hi);
-            if self.obeyed(mid, kick_all)? {
+            if self.obeyed(mid, kick)? {
                 lo = mid;
             } else {
                 hi = mid;
@@ -293,9 +328,44 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         self.operator.tell(&format!(
             "  the watchdog trips between {lo:.4} s and {hi:.4} s without a kick: {timeout} s"
         ));
+        Ok(Some((lo, hi, timeout)))
+    }
+
+    /// Step 4 of the blind scan: whether a PWM write is still obeyed after
+    /// a silence without a kick, bisected to the watchdog timeout (to 0.5
+    /// ms), and which control bit kicks it.
+    ///
+    /// # Errors
+    ///
+    /// [`ProbeError::OutOfOrder`] before [`find_drive`](Self::find_drive);
+    /// [`ProbeError::NotFound`] when a write 10 ms after a kick is not
+    /// obeyed, or no single bit kicks.
+    pub fn find_watchdog(&mut self) -> Result<Option<f64>, ProbeError> {
+        self.driving(Self::find_watchdog_unguarded)
+    }
+
+    fn find_watchdog_unguarded(&mut self) -> Result<Option<f64>, ProbeError> {
+        let (latch, _) = self.found_encoders("the watchdog step")?;
+        let kick_all = self.kick_bits(&latch);
+        let max = self.options.max_watchdog;
+        self.operator.tell(&format!(
+            "step 4/4, watchdog: short pulses of the drive found in step 3, each after a \
+             silence without a kick, from 10 ms to {max} s, to time the watchdog; then each \
+             control bit alone as the kick"
+        ));
+        self.operator.hands(Hands::Off);
+        let Some((_, hi, timeout)) = self.time_watchdog(kick_all)? else {
+            let bit = kick_all & kick_all.wrapping_neg();
+            self.notes.push(format!(
+                "no watchdog: PWM writes are still obeyed {max} s after the last kick; \
+                 watchdog_bit set to {bit:#04x}, unverified"
+            ));
+            self.watchdog = Some((bit, None));
+            return Ok(None);
+        };
         for bit in (0..8).map(|b| 1u8 << b).filter(|&b| kick_all & b != 0) {
             // Let the watchdog trip, then kick with this bit alone.
-            self.operator.wait(&mut self.port, hi + KICK_EVERY);
+            self.wait(hi + KICK_EVERY)?;
             if self.obeyed(0.01, bit)? {
                 self.operator
                     .tell(&format!("  the watchdog is kicked by bit {bit:#04x}"));

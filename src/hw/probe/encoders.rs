@@ -12,8 +12,16 @@ const DWELL: f64 = 0.01;
 /// How long the carts get to come to rest, s.
 const SETTLE: f64 = 1.0;
 
+/// The test patterns of the latch search: bit `i` is in the two patterns
+/// named by the `i`-th pair of {0, …, 4} (01, 02, 03, 04, 12, 13, 14, 23),
+/// so for any two bits — the latch and the clear — one pattern has the
+/// first without the second: a write that latches without clearing. Five
+/// patterns is the fewest with that property for eight bits.
+const PATTERNS: [u8; 5] = [0x0f, 0x71, 0x92, 0xa4, 0x48];
+
 impl<P: EppPort, O: Operator<P>> Probe<P, O> {
-    /// Step 2: with the motor supply off (the operator confirms), finds the
+    /// Step 2 of the blind scan: with the motor supply off (the operator
+    /// confirms), finds the
     /// control register and its latch bit, both carts' counters with their
     /// signs, and the clear bit, asking the user to move each cart by hand.
     ///
@@ -42,12 +50,12 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             });
         }
         self.operator.hands(Hands::Off);
-        self.operator.wait(&mut self.port, SETTLE);
+        self.wait(SETTLE)?;
         let still = snapshot(&mut self.port)?;
         self.operator.hands(Hands::Move(1));
         let interval = self.options.sample_interval;
         for _ in 0..self.options.samples {
-            self.operator.wait(&mut self.port, interval);
+            self.wait(interval)?;
             if scan.changed(&still, &snapshot(&mut self.port)?) {
                 return Err(ProbeError::Unsupported {
                     what: "registers change with the carts without a latch (transparent \
@@ -85,7 +93,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     fn settled(&mut self, control: u8, latch_bit: u8) -> Result<Snapshot, ProbeError> {
         let mut before = self.latched(control, latch_bit)?;
         for _ in 0..10 {
-            self.operator.wait(&mut self.port, SETTLE);
+            self.wait(SETTLE)?;
             let now = self.latched(control, latch_bit)?;
             if now == before {
                 return Ok(now);
@@ -103,26 +111,43 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         Ok(snapshot(&mut self.port)?)
     }
 
-    /// Each bit of each open-bus (write-only or unmapped) address in turn,
-    /// written and then zeroed, until the counters read new values, twice
-    /// more to be sure. At most 256 × 8 candidates.
+    /// The control register and its latch bit, with as few writes to
+    /// addresses nobody described as the search allows.
+    ///
+    /// Nothing tells a write-only register from an unmapped address, or
+    /// from an FPGA's configuration register, before a write: every
+    /// open-bus address is a candidate, and each write to one is a risk.
+    /// So each candidate gets the five [`PATTERNS`], each followed by a
+    /// zero (ten writes, where each of the eight bits in turn would be
+    /// sixteen), and the search ends at the first address that latches;
+    /// only there are single bits tried, and only the bits of the pattern
+    /// that latched. One pattern of every bit (`0xff`) would not do: where
+    /// the clear bit shares the register, a write of both clears and
+    /// latches, and counters that read zero before read zero again. The
+    /// motor supply is off (the operator confirmed): a pattern in a PWM
+    /// high byte commands duty for the time of one read of every address.
     fn find_latch(&mut self, scan: &Scan) -> Result<(u8, u8), ProbeError> {
         let candidates: Vec<u8> = scan.addresses(|c| c == RegisterClass::Open).collect();
         self.operator.tell(&format!(
-            "  writing 0x01, 0x02, … 0x80 in turn to each of the {} write-only addresses, each \
-             followed by a read of every address and a write of 0 back, until the counters \
-             change; keep moving cart 1",
+            "  writing 5 patterns ({}), each followed by 0x00, to each of the {} write-only \
+             addresses in turn, each pattern followed by a read of every address, until the \
+             counters change; then single bits at the one address that changed them; keep \
+             moving cart 1",
+            PATTERNS.map(|p| format!("{p:#04x}")).join(", "),
             candidates.len()
         ));
         let mut before = snapshot(&mut self.port)?;
         for &address in &candidates {
-            for bit in (0..8).map(|b| 1u8 << b) {
-                self.operator.wait(&mut self.port, DWELL);
-                let after = self.latch_try(address, bit)?;
-                if scan.changed(&before, &after) && self.confirm_latch(scan, address, bit, after)? {
+            for pattern in PATTERNS {
+                self.wait(DWELL)?;
+                let after = self.latch_try(address, pattern)?;
+                let changed = scan.changed(&before, &after);
+                before = after;
+                if changed
+                    && let Some(bit) = self.find_latch_bit(scan, address, pattern, &mut before)?
+                {
                     return Ok((address, bit));
                 }
-                before = after;
             }
         }
         Err(ProbeError::NotFound {
@@ -130,6 +155,27 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             hint: "keep the cart moving during the search; check the encoder cables and the \
                    card's power",
         })
+    }
+
+    /// The bit of `pattern` at `address` that latches the counters: each
+    /// bit alone, written and then zeroed, until the counters read new
+    /// values, twice more to be sure.
+    fn find_latch_bit(
+        &mut self,
+        scan: &Scan,
+        address: u8,
+        pattern: u8,
+        before: &mut Snapshot,
+    ) -> Result<Option<u8>, ProbeError> {
+        for bit in (0..8).map(|b| 1u8 << b).filter(|b| pattern & b != 0) {
+            self.wait(DWELL)?;
+            let after = self.latch_try(address, bit)?;
+            if scan.changed(before, &after) && self.confirm_latch(scan, address, bit, after)? {
+                return Ok(Some(bit));
+            }
+            *before = after;
+        }
+        Ok(None)
     }
 
     fn latch_try(&mut self, address: u8, bit: u8) -> Result<Snapshot, ProbeError> {
@@ -149,8 +195,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         mut before: Snapshot,
     ) -> Result<bool, ProbeError> {
         for _ in 0..2 {
-            self.operator
-                .wait(&mut self.port, self.options.sample_interval);
+            self.wait(self.options.sample_interval)?;
             let after = self.latch_try(address, bit)?;
             if !scan.changed(&before, &after) {
                 return Ok(false);
@@ -182,8 +227,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         samples.push(*rest);
         let mut changes = [0usize; 256];
         for _ in 0..self.options.samples {
-            self.operator
-                .wait(&mut self.port, self.options.sample_interval);
+            self.wait(self.options.sample_interval)?;
             let s = self.latched(control, latch_bit)?;
             let last = samples.last().unwrap_or(rest);
             for (a, n) in changes.iter_mut().enumerate() {
@@ -244,7 +288,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             _ => {}
         }
         self.operator.hands(Hands::Away(axis));
-        self.operator.wait(&mut self.port, 0.2);
+        self.wait(0.2)?;
         self.write(control, latch_bit)?;
         let away = self.read_u32_le(low)?;
         let moved = i64::from(away.wrapping_sub(value(rest)) as i32);

@@ -17,11 +17,17 @@ use crate::hw::{ConfigError, PortError};
 /// #     fn hands(&mut self, _: Hands) {}
 /// #     fn wait(&mut self, _: &mut P, _: f64) {}
 /// # }
-/// // Every address reads 0: no card.
-/// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+/// // Every address reads 0: the blind scan finds no card.
+/// let blind = ProbeOptions { scan: true, ..Default::default() };
+/// let mut probe = Probe::new(RegisterFile::new(), Nobody, blind)?;
 /// let err = probe.scan().unwrap_err();
 /// assert!(matches!(err, ProbeError::NoCard { .. }));
 /// assert!(err.to_string().contains("every address reads 0x00"));
+/// // The default probe, given a map, finds no ID where the map says.
+/// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+/// let err = probe.check_id().unwrap_err();
+/// assert!(matches!(err, ProbeError::WrongMap { .. }));
+/// assert!(err.to_string().contains("nothing was written"));
 /// # Ok::<(), ctrlab::hw::RigError>(())
 /// ```
 #[derive(Debug, thiserror::Error)]
@@ -74,6 +80,28 @@ pub enum ProbeError {
         /// How far, counts (sign-corrected).
         counts: i64,
     },
+    /// The card does not answer as the given register map says (the
+    /// default probe, which confirms a map): a wrong map, or a card other
+    /// than the one the card file describes.
+    #[error(
+        "the card does not answer as the given register map says: {reason}. Check the map (the card file's [map]) against the lab's existing driver or the FPGA's sources"
+    )]
+    WrongMap {
+        /// What the card did instead.
+        reason: String,
+    },
+    /// A step of the blind scan was called without
+    /// [`ProbeOptions::scan`](super::ProbeOptions::scan). Nothing was read
+    /// or written.
+    #[error(
+        "the blind scan writes test patterns to card addresses no map describes, which on an FPGA can hit configuration registers; it runs only when asked for (ProbeOptions::scan, the probe example's --scan). Nothing was read or written"
+    )]
+    ScanNotEnabled,
+    /// A stop was requested ([`StopSignal`](crate::hw::StopSignal): Ctrl-C,
+    /// SIGTERM or code); the probe zeroed the PWM it had driven and
+    /// stopped.
+    #[error("stopped on request (Ctrl-C or a stop signal); the PWM the probe drove was zeroed")]
+    Interrupted,
     /// A step was called before the one it needs.
     #[error("{step} needs {needs} first")]
     OutOfOrder {

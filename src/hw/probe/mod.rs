@@ -1,43 +1,62 @@
-//! Bringing up an unknown card: [`Probe`] finds the card's register map,
-//! encoder signs, motor polarity and watchdog on a live port, one step at a
-//! time, each step saying what it does before doing it.
+//! Bringing up a card: [`Probe`] confirms a card's register map — or,
+//! only when asked, finds one blind — with its encoder signs, motor
+//! polarity and watchdog, on a live port, one step at a time, each step
+//! saying what it does before doing it.
 //!
-//! No register map of the lab's PC104 card is published. The probe assumes
-//! only the card's *kind* (EPP registers; 32-bit counters latched by a bit
-//! of a control register; 10-bit PWM duties in a low and a high byte, the
-//! high byte applying the duty, as [`RegisterMap`] documents) and finds
-//! *where* everything is:
+//! # By default: confirm the map you give
 //!
-//! 1. **Scan** ([`Probe::scan`]): two read-only scans of all 256 addresses
-//!    tell constant, volatile and open-bus registers apart and find the ID
-//!    register. No card (an open bus, or EPP cycles that time out) stops
-//!    here, before any register is written.
-//! 2. **Encoders** ([`Probe::find_encoders`]): with the motor supply *off*
-//!    (the operator confirms), the user moves each cart by hand while the
-//!    probe searches for the latch (a bit of a write-only register after
-//!    which the counters read new values), the counters (which bytes
-//!    change, and in which order of significance), each encoder's sign
-//!    (the user holds the cart away from the wall) and the clear bit.
-//! 3. **Drive** ([`Probe::find_drive`]): only after the operator confirms
+//! Take the register map from the lab's existing driver or the FPGA's
+//! sources (a card file's `[map]`, [`ProbeOptions::map`]). The probe then
+//! touches **no address outside that map** — not even to read:
+//!
+//! 1. **ID** ([`Probe::check_id`]): the map's ID register, read twice,
+//!    must read a constant (the card file's `card_id`, when given). A
+//!    wrong map or no card stops here, before any write.
+//! 2. **Encoders** ([`Probe::check_encoders`]): with the motor supply
+//!    *off* (the operator confirms), the user moves each cart by hand while
+//!    the probe latches the map's counters and reads them: which counter
+//!    follows each cart, and its sign (the user holds the cart away from
+//!    the wall); then the map's clear bit must zero them.
+//! 3. **Drive** ([`Probe::check_drive`]): only after the operator confirms
 //!    (motor supply on, e-stop at hand), pulses of about 5 %, then 10 and
-//!    12 % duty for 0.15 s on each candidate register pair until a cart
-//!    moves, checking that positive duty moves it away from the wall.
-//! 4. **Watchdog** ([`Probe::find_watchdog`]): whether a PWM write is still
-//!    obeyed after a silence of T without a kick, bisected to the timeout,
-//!    and which control bit kicks it.
+//!    12 % duty for 0.15 s on the map's PWM channels in turn until a cart
+//!    moves, kicking with the map's watchdog bit, checking that positive
+//!    duty moves it away from the wall.
+//! 4. **Watchdog** ([`Probe::check_watchdog`]): whether a PWM write is
+//!    still obeyed after a silence of T without a kick, bisected to the
+//!    timeout.
 //!
-//! Channels without a cart or motor on them cannot be observed; the map
-//! places them by the stride of the ones found (say so, in
-//! [`ProbeReport::notes`]).
+//! # Only with `scan`: the blind scan
+//!
+//! With [`ProbeOptions::scan`] the probe assumes only the card's *kind*
+//! (EPP registers; 32-bit counters latched by a bit of a control register;
+//! 10-bit PWM duties in a low and a high byte, the high byte applying the
+//! duty, as [`RegisterMap`] documents) and finds *where* everything is:
+//! [`Probe::scan`] (two read-only scans of all 256 addresses),
+//! [`Probe::find_encoders`] (the latch found by writing test patterns to
+//! write-only addresses), [`Probe::find_drive`] (PWM duties written to
+//! pairs of them), [`Probe::find_watchdog`]. **It writes to addresses no
+//! map describes, which on an FPGA can hit configuration registers**: see
+//! [`ProbeOptions::scan`]. Channels without a cart or motor on them
+//! cannot be observed; the map places them by the stride of the ones found
+//! (say so, in [`ProbeReport::notes`]).
+//!
+//! # Stopping
+//!
+//! Give the probe a [`StopSignal`] ([`Probe::with_stop`], from
+//! [`StopSignal::on_interrupt`] in a program): it is looked at after every
+//! wait, pulses included, and a stop — like any error — zeroes the PWM the
+//! probe drove before the step returns ([`ProbeError::Interrupted`]).
 //!
 //! The probe talks to the world through an [`Operator`]: a console (the
 //! `probe` example) or a simulated hand
 //! ([`lab::SimulatedOperator`](crate::lab::SimulatedOperator)), with which
-//! the probe rediscovers the simulated card's map exactly.
+//! the probe confirms, or rediscovers, the simulated card's map.
 //!
 //! Software must not be trusted for safety: keep a hardware e-stop within
 //! reach whenever the motor supply is on.
 
+mod check;
 mod drive;
 mod encoders;
 mod error;
@@ -48,7 +67,7 @@ pub use error::ProbeError;
 pub use options::ProbeOptions;
 pub use scan::{OPEN_BUS, RegisterClass, Scan, Snapshot};
 
-use super::{ConfigError, EppPort, PortError, RegisterMap};
+use super::{ConfigError, EppPort, PortError, RegisterMap, StopSignal};
 
 /// What the user's hands are doing, as the probe asks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,7 +107,8 @@ pub enum Hands {
 ///
 /// let mut card = RegisterFile::new();
 /// card.set(0x00, 0xa5); // an ID register, nothing else
-/// let mut probe = Probe::new(RecordingPort::new(card), Careful, ProbeOptions::default())?;
+/// let options = ProbeOptions { scan: true, ..Default::default() };
+/// let mut probe = Probe::new(RecordingPort::new(card), Careful, options)?;
 /// probe.scan()?;
 /// assert!(matches!(probe.find_encoders(), Err(ProbeError::Declined { .. })));
 /// assert!(probe.port().log().iter().all(|c| c.kind() != CycleKind::DataWrite));
@@ -182,26 +202,31 @@ pub struct ProbeReport {
 }
 
 /// The bring-up probe on a port, step by step (see the [module
-/// docs](self)). [`run`](Self::run) takes every step in order.
+/// docs](self)). [`run`](Self::run) takes every step in order: the map's
+/// check by default, the blind scan with [`ProbeOptions::scan`].
 ///
 /// # Examples
 ///
 /// The simulated card, probed by a simulated hand that answers "yes" twice,
-/// gives back its own register map:
+/// confirms the map it is given, touching no other address; the blind
+/// scan finds the same map:
 ///
 /// ```
 /// use ctrlab::hw::probe::{Probe, ProbeOptions};
 /// use ctrlab::hw::{Clock, VirtualClock};
 /// use ctrlab::lab::{SimulatedOperator, SimulatedRig};
 ///
-/// let clock = VirtualClock::new();
 /// let rig = SimulatedRig::default();
-/// let card = rig.card(&Clock::Virtual(clock.clone()))?;
-/// let hand = SimulatedOperator::new(clock, [true, true]);
-/// let mut probe = Probe::new(card, hand, ProbeOptions::default())?;
-/// let report = probe.run()?;
-/// assert_eq!(report.map, rig.card.map);
-/// assert_eq!(report.watchdog_timeout, Some(0.1));
+/// for scan in [false, true] {
+///     let clock = VirtualClock::new();
+///     let card = rig.card(&Clock::Virtual(clock.clone()))?;
+///     let hand = SimulatedOperator::new(clock, [true, true]);
+///     let options = ProbeOptions { scan, map: rig.card.map, ..Default::default() };
+///     let mut probe = Probe::new(card, hand, options)?;
+///     let report = probe.run()?;
+///     assert_eq!(report.map, rig.card.map);
+///     assert_eq!(report.watchdog_timeout, Some(0.1));
+/// }
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug)]
@@ -215,6 +240,14 @@ pub struct Probe<P, O> {
     counters: Option<[Counter; 2]>,
     drive: Option<Drive>,
     watchdog: Option<(u8, Option<f64>)>,
+    /// Cart 1's and cart 2's encoder channel in the given map (the check).
+    channels: Option<[usize; 2]>,
+    /// The motor's PWM channel in the given map (the check).
+    pwm_channel: Option<usize>,
+    /// The PWM register pair written with a duty and not yet zeroed.
+    driven: Option<(u8, u8)>,
+    /// Looked at after every wait.
+    stop: Option<StopSignal>,
     /// The direction of the last watchdog test pulse.
     reverse: bool,
     notes: Vec<String>,
@@ -259,9 +292,46 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             counters: None,
             drive: None,
             watchdog: None,
+            channels: None,
+            pwm_channel: None,
+            driven: None,
+            stop: None,
             reverse: false,
             notes: Vec::new(),
         })
+    }
+
+    /// The probe, stopping at `stop`: after every wait (pulses included)
+    /// the probe looks at it, and once it is raised zeroes the PWM it drove
+    /// and returns [`ProbeError::Interrupted`]. A program passes
+    /// [`StopSignal::on_interrupt`], so Ctrl-C during a pulse cannot leave
+    /// duty on.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::StopSignal;
+    /// use ctrlab::hw::probe::{Probe, ProbeError, ProbeOptions};
+    /// use ctrlab::hw::testing::RegisterFile;
+    /// # use ctrlab::hw::probe::{Hands, Operator};
+    /// # struct Nobody;
+    /// # impl<P> Operator<P> for Nobody {
+    /// #     fn tell(&mut self, _: &str) {}
+    /// #     fn confirm(&mut self, _: &str) -> bool { false }
+    /// #     fn hands(&mut self, _: Hands) {}
+    /// #     fn wait(&mut self, _: &mut P, _: f64) {}
+    /// # }
+    /// let mut card = RegisterFile::new();
+    /// card.set(0x00, 0xa5);
+    /// let stop = StopSignal::new();
+    /// let mut probe = Probe::new(card, Nobody, ProbeOptions::default())?.with_stop(stop.clone());
+    /// stop.request(); // as Ctrl-C would
+    /// assert!(matches!(probe.check_id(), Err(ProbeError::Interrupted)));
+    /// # Ok::<(), ctrlab::hw::RigError>(())
+    /// ```
+    pub fn with_stop(mut self, stop: StopSignal) -> Self {
+        self.stop = Some(stop);
+        self
     }
 
     /// The port.
@@ -284,30 +354,57 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         (self.port, self.operator)
     }
 
-    /// Takes every step in order and assembles the report.
+    /// Takes every step in order and assembles the report: the check of
+    /// [`ProbeOptions::map`] ([`check_id`](Self::check_id),
+    /// [`check_encoders`](Self::check_encoders),
+    /// [`check_drive`](Self::check_drive),
+    /// [`check_watchdog`](Self::check_watchdog)) by default, the blind
+    /// scan ([`scan`](Self::scan), [`find_encoders`](Self::find_encoders),
+    /// [`find_drive`](Self::find_drive),
+    /// [`find_watchdog`](Self::find_watchdog)) with
+    /// [`ProbeOptions::scan`]. On any error the PWM the probe drove is
+    /// zeroed first.
     ///
     /// # Errors
     ///
     /// The first step's that fails; the steps' own docs say which.
     pub fn run(&mut self) -> Result<ProbeReport, ProbeError> {
-        self.scan()?;
-        self.find_encoders()?;
-        self.find_drive()?;
-        self.find_watchdog()?;
+        let result = self.steps();
+        if result.is_err() {
+            self.zero_pwm();
+        }
+        result
+    }
+
+    fn steps(&mut self) -> Result<ProbeReport, ProbeError> {
+        if self.options.scan {
+            self.scan()?;
+            self.find_encoders()?;
+            self.find_drive()?;
+            self.find_watchdog()?;
+        } else {
+            self.check_id()?;
+            self.check_encoders()?;
+            self.check_drive()?;
+            self.check_watchdog()?;
+        }
         self.report()
     }
 
-    /// Step 1: two read-only scans of all 256 addresses and the card's ID.
+    /// Step 1 of the blind scan (only with [`ProbeOptions::scan`]): two
+    /// read-only scans of all 256 addresses and the card's ID.
     ///
     /// # Errors
     ///
-    /// [`ProbeError::NoCard`] when EPP cycles time out or no address reads
-    /// a constant other than `0x00`/`0xff`; no register is written.
+    /// [`ProbeError::ScanNotEnabled`] without [`ProbeOptions::scan`]
+    /// (nothing read or written); [`ProbeError::NoCard`] when EPP cycles
+    /// time out or no address reads a constant other than `0x00`/`0xff`;
+    /// no register is written.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::hw::probe::{Probe, ProbeOptions, RegisterClass};
+    /// use ctrlab::hw::probe::{Probe, ProbeError, ProbeOptions, RegisterClass};
     /// use ctrlab::hw::testing::RegisterFile;
     /// # use ctrlab::hw::probe::{Hands, Operator};
     /// # struct Nobody;
@@ -320,13 +417,20 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// let mut card = RegisterFile::new();
     /// card.set(0x07, 0x3c); // the ID
     /// card.set(0x10, 0xff); // open bus
-    /// let mut probe = Probe::new(card, Nobody, ProbeOptions::default())?;
+    /// let blind = ProbeOptions { scan: true, ..Default::default() };
+    /// let mut probe = Probe::new(card.clone(), Nobody, ProbeOptions::default())?;
+    /// assert!(matches!(probe.scan(), Err(ProbeError::ScanNotEnabled)));
+    /// let mut probe = Probe::new(card, Nobody, blind)?;
     /// let scan = probe.scan()?;
     /// assert_eq!(scan.id(), Some((0x07, 0x3c)));
     /// assert_eq!(scan.class(0x10), RegisterClass::Open);
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn scan(&mut self) -> Result<&Scan, ProbeError> {
+        if !self.options.scan {
+            return Err(ProbeError::ScanNotEnabled);
+        }
+        self.check_stop()?;
         self.operator.tell(
             "step 1/4, scan: reading all 256 addresses twice (read-only), to tell constant, \
              volatile and open-bus registers apart and find the card's ID register",
@@ -338,7 +442,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             other => ProbeError::Port(other),
         };
         let first = scan::snapshot(&mut self.port).map_err(no_card)?;
-        self.operator.wait(&mut self.port, 0.05);
+        self.wait(0.05)?;
         let second = scan::snapshot(&mut self.port).map_err(no_card)?;
         let scan = Scan { first, second };
         let Some((address, value)) = scan.id() else {
@@ -400,6 +504,9 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             step: "the report",
             needs,
         };
+        if !self.options.scan {
+            return self.check_report();
+        }
         let (id_address, card_id) = self.id.ok_or(missing("the scan"))?;
         let latch = self.latch.ok_or(missing("the encoder step"))?;
         let counters = self.counters.ok_or(missing("the encoder step"))?;
@@ -461,6 +568,46 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             watchdog_timeout,
             notes,
         })
+    }
+
+    /// Lets `seconds` pass (the operator's wait), then looks at the stop
+    /// signal.
+    fn wait(&mut self, seconds: f64) -> Result<(), ProbeError> {
+        self.operator.wait(&mut self.port, seconds);
+        self.check_stop()
+    }
+
+    /// [`ProbeError::Interrupted`] once a stop was requested.
+    fn check_stop(&self) -> Result<(), ProbeError> {
+        match &self.stop {
+            Some(stop) if stop.is_requested() => Err(ProbeError::Interrupted),
+            _ => Ok(()),
+        }
+    }
+
+    /// Zeroes the PWM pair the probe left driven, if any (best effort:
+    /// called on the way out of a failed step).
+    fn zero_pwm(&mut self) {
+        if let Some((low, high)) = self.driven
+            && self
+                .write(low, 0)
+                .and_then(|()| self.write(high, 0))
+                .is_ok()
+        {
+            self.driven = None;
+        }
+    }
+
+    /// Runs a step that drives the motor, zeroing the PWM if it fails.
+    fn driving<T>(
+        &mut self,
+        step: impl FnOnce(&mut Self) -> Result<T, ProbeError>,
+    ) -> Result<T, ProbeError> {
+        let result = self.check_stop().and_then(|()| step(self));
+        if result.is_err() {
+            self.zero_pwm();
+        }
+        result
     }
 
     /// Writes `value` to `address`, saying nothing (the steps say what
