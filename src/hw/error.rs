@@ -409,6 +409,7 @@ impl ConfigError {
     /// The same error under another key (a value derived from a
     /// configuration's field, reported under that field's key).
     #[must_use]
+    #[cfg(feature = "lab")]
     pub(crate) fn with_key(mut self, new: String) -> Self {
         let (ConfigError::Invalid { key, .. } | ConfigError::Conflict { key, .. }) = &mut self;
         *key = new;
@@ -427,6 +428,7 @@ pub(crate) fn check_positive(key: &'static str, value: f64) -> Result<(), Config
 
 /// Each of `values` finite and > 0, the key of a bad one indexed
 /// (`travel_limits[1]`).
+#[cfg(feature = "lab")]
 pub(crate) fn check_all_positive(key: &'static str, values: &[f64]) -> Result<(), ConfigError> {
     match values.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
         None => Ok(()),

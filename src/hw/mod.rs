@@ -74,7 +74,9 @@ pub use error::{
     ConfigError, ConfigErrorKind, CycleKind, LoopFault, LoopFaultKind, PortError, PortErrorKind,
     RealTimeError, RealTimeErrorKind, RigError, RigErrorKind,
 };
-pub(crate) use error::{check_all_positive, check_positive};
+#[cfg(feature = "lab")]
+pub(crate) use error::check_all_positive;
+pub(crate) use error::check_positive;
 pub use pc104::{
     ENCODER_CHANNELS, MAX_DUTY, PWM_CHANNELS, PWM_DIRECTION_BIT, Pc104, RegisterMap,
     duty_from_bytes, pwm_bytes,
