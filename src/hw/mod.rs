@@ -83,7 +83,7 @@ pub use pc104::{
 pub use ppdev::{PortModes, Ppdev, ioctl};
 pub use realtime::RealTime;
 pub use rig::Rig;
-pub use run::{LoopConfig, LoopStats, RunError, RunOutcome, run};
+pub use run::{GAP_PERIODS, LoopConfig, LoopStats, RunError, RunOutcome, run};
 pub use sim_card::{MAX_CATCH_UP_STEPS, SimulatedCard};
 pub use sim_config::{SIMULATED_CARD_ID, SimulatedCardConfig};
 pub use stop::StopSignal;
