@@ -8,9 +8,14 @@ use std::path::Path;
 use ctrlab::hw::{Pc104, Ppdev, RigError};
 use ctrlab::lab::{MassSpringRig, RigConfig};
 
-/// The card file named by `--card` and its configuration, checked;
-/// without one, how to make it.
-pub fn load<'a>(port: &Path, card: Option<&'a Path>) -> Result<(&'a Path, RigConfig), String> {
+/// The card file named by `--card` and its configuration, checked (a card
+/// without a watchdog must be acknowledged, in the file or by
+/// `--no-watchdog-acknowledged`); without one, how to make it.
+pub fn load<'a>(
+    port: &Path,
+    card: Option<&'a Path>,
+    no_watchdog_acknowledged: bool,
+) -> Result<(&'a Path, RigConfig), String> {
     let Some(card) = card else {
         return Err(format!(
             "--port {port} needs the card's register map and calibration: --card card.toml. \
@@ -21,8 +26,17 @@ pub fn load<'a>(port: &Path, card: Option<&'a Path>) -> Result<(&'a Path, RigCon
             port = port.display()
         ));
     };
-    let config =
+    let mut config =
         RigConfig::read_toml(card).map_err(|e| format!("card file {}: {e}", card.display()))?;
+    config.calibration.no_watchdog_acknowledged |= no_watchdog_acknowledged;
+    // Before anything is opened: the same check building the rig makes.
+    config.calibration.check_watchdog().map_err(|e| {
+        format!(
+            "card file {}: {}",
+            card.display(),
+            e.in_table("calibration")
+        )
+    })?;
     Ok((card, config))
 }
 
@@ -60,12 +74,12 @@ pub fn check_id(port: &Path, config: &RigConfig) -> Result<u8, RigError> {
     Ok(card.probe_id(config.calibration.card_id)?)
 }
 
-/// The rig on the card with the file's map and calibration: the ID is
-/// probed (building the rig) before the counters are cleared, the first
-/// write.
+/// The rig on the card with the file's map and calibration
+/// ([`RigConfig::rig`]: a card without a watchdog only if acknowledged):
+/// the ID is probed (building the rig) before the counters are cleared, the
+/// first write.
 pub fn rig(port: &Path, config: &RigConfig, period: f64) -> Result<MassSpringRig<Ppdev>, RigError> {
-    let card = Pc104::with_map(Ppdev::open(port)?, config.map)?;
-    let mut rig = MassSpringRig::new(card, config.calibration, period)?;
+    let mut rig = config.rig(Ppdev::open(port)?, period)?;
     rig.card_mut().clear_counters()?;
     Ok(rig)
 }
