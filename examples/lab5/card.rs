@@ -57,7 +57,8 @@ pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> S
          runs: 5 open-loop runs of 5 s with a ±{ident_volts} V square wave, 20 more of 5 s \
          comparing inputs of the same peak (square wave, PRBS, multisine, chirp), then 26 closed-loop \
          runs of 3 s (24 for Tables 5 and 6, 2 for the Design section's LQI) saturated at ±{full} V, 3 s pauses between runs; each run \
-         halts the motor at the first fault (travel limit, bus fault, stall, timing, Ctrl-C).\n\
+         halts the motor at the first fault (travel limit, bus fault, stall, a dead cart-2 encoder, \
+         the drive held at its limit, timing, Ctrl-C and the other stop signals).\n\
          Nothing has been written to the card. Next: open the port and read the ID register \
          {id:#04x} (a read only).",
         port = port.display(),

@@ -509,8 +509,8 @@ impl fmt::Display for RigConfig {
             f,
             "plausibility: a count change faster than {} m/s is a bus fault; {} V of new drive \
              that does not move cart 2's encoder {} counts within {} s is a stalled motor or \
-             encoder, and within {} s once cart 1 has moved a dead cart-2 encoder; the drive \
-             halts after {} s at ±{} V",
+             encoder, and within {} s while it moves cart 1 the way it pushes a dead cart-2 \
+             encoder; the rig halts after {} s of drive at ±{} V",
             cal.max_speed,
             cal.stall_volts,
             cal.stall_counts,
