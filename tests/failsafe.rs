@@ -2,9 +2,10 @@
 //! behind the loop, each through the full stack (`hw::run` →
 //! `MassSpringRig` → `Pc104` → the simulated card).
 //!
-//! - a dead encoder on the driven cart (cart 2) halts the rig before the
-//!   true cart passes its travel limit, and a drive held at its limit is
-//!   halted after `Calibration::max_saturation_time`;
+//! - a dead encoder on the driven cart (cart 2), from the start or dying
+//!   mid-run, halts the rig before the true cart passes its travel limit,
+//!   and a drive held at its limit is halted after
+//!   `Calibration::max_saturation_time`;
 //! - a card without a watchdog is driven only when acknowledged, and the
 //!   loop keeps a gap limit of its own;
 //! - SIGINT, SIGTERM, SIGHUP, SIGQUIT and SIGTSTP each stop the run with its
@@ -783,4 +784,99 @@ fn dropping_the_rig_zeroes_every_pwm_channel() {
     for channel in 0..PWM_CHANNELS {
         assert_eq!(card.pwm_duty(channel), 0, "PWM channel {channel}");
     }
+}
+
+/// Passes every cycle to the card, except that counter 1's bytes (cart 2's
+/// encoder, registers 0x24–0x27) read what they read at `freeze_after`
+/// reads of them: an encoder whose cable comes loose mid-run.
+struct Freezes<P> {
+    inner: P,
+    selected: u8,
+    reads: usize,
+    freeze_after: usize,
+    frozen: [u8; 4],
+}
+
+impl<P: ctrlab::hw::EppPort> ctrlab::hw::EppPort for Freezes<P> {
+    fn write_address(&mut self, address: u8) -> Result<(), ctrlab::hw::PortError> {
+        self.selected = address;
+        self.inner.write_address(address)
+    }
+    fn read_data(&mut self) -> Result<u8, ctrlab::hw::PortError> {
+        let value = self.inner.read_data()?;
+        if !(0x24..=0x27).contains(&self.selected) {
+            return Ok(value);
+        }
+        let byte = usize::from(self.selected - 0x24);
+        self.reads += 1;
+        if self.reads <= self.freeze_after {
+            self.frozen[byte] = value;
+            Ok(value)
+        } else {
+            Ok(self.frozen[byte])
+        }
+    }
+    fn write_data(&mut self, value: u8) -> Result<(), ctrlab::hw::PortError> {
+        self.inner.write_data(value)
+    }
+}
+
+#[test]
+fn an_encoder_that_dies_mid_run_is_caught_at_the_next_change_of_drive() {
+    // Table 5's Kf = [0 0 10 0.1] to 30 mm; cart 2's encoder freezes at
+    // 1 s (500 reads of its four bytes), with the cart settled; at 1.5 s the
+    // setpoint moves to 25 mm, and the controller, blind to cart 2, drives
+    // it with everything it has.
+    let sim = SimulatedRig::default();
+    let clock = VirtualClock::new();
+    let virtual_clock = Clock::Virtual(clock.clone());
+    let port = Freezes {
+        inner: sim.card(&virtual_clock).unwrap(),
+        selected: 0,
+        reads: 0,
+        freeze_after: 4 * 500,
+        frozen: [0; 4],
+    };
+    let mut rig = MassSpringRig::with_clock(
+        Pc104::new(port),
+        sim.calibration,
+        PERIOD,
+        virtual_clock.clone(),
+    )
+    .unwrap();
+    let kf = LabGains::new([0.0, 0.0, 10.0, 0.1], Cart::Two)
+        .state_feedback()
+        .unwrap();
+    let reference = |t: f64| {
+        if t < 1.5 {
+            vector![0.030]
+        } else {
+            vector![0.025]
+        }
+    };
+    let err = run(&mut rig, kf, reference, &virtual_clock, &config(3.0)).unwrap_err();
+    match err.error {
+        RigError::Fault(LoopFault::EncoderNotFollowing { cart, seconds, .. }) => {
+            assert_eq!(cart, 2);
+            assert!(seconds < 0.05, "{seconds}");
+        }
+        ref other => panic!("expected EncoderNotFollowing, got {other:?}"),
+    }
+    // Caught within a few tens of milliseconds of the new setpoint.
+    let n = err.recording.len();
+    assert!((750..780).contains(&n), "{n} samples");
+    let cal = sim.calibration;
+    let mut furthest = [0.0f64; 2];
+    for _ in 0..2000 {
+        clock.advance(1e-3).unwrap();
+        let card = &mut rig.card_mut().port_mut().inner;
+        card.sync().unwrap();
+        let x = card.true_state();
+        for c in 0..2 {
+            furthest[c] = furthest[c].max(x[2 * c].abs());
+        }
+        assert_eq!(card.pwm_duty(0), 0);
+    }
+    println!("after the halt: {furthest:?} m");
+    assert!(furthest[1] < cal.travel_limits[1], "{furthest:?}");
 }
