@@ -96,10 +96,12 @@ pub struct Calibration {
     /// See [`stall_volts`](Self::stall_volts), counts (≥ 1).
     pub stall_counts: i64,
     /// How long, s (> 0), the driven cart's encoder may lag a change of
-    /// drive of [`stall_volts`](Self::stall_volts) that has already moved
-    /// the other cart [`stall_counts`](Self::stall_counts) counts the way
-    /// the drive pushes: the motor works and cart 2 must be moving, so an
-    /// encoder that still has not moved is dead or on the wrong channel
+    /// drive of [`stall_volts`](Self::stall_volts) from what held the cart
+    /// at rest (at the run's start, or with its encoder still for this
+    /// long) once that change has moved the other cart
+    /// [`stall_counts`](Self::stall_counts) counts the way the drive
+    /// pushes: the motor works and cart 2 must be moving, so an encoder
+    /// that still has not moved is dead or on the wrong channel
     /// ([`LoopFault::EncoderNotFollowing`]). Short, because at full drive
     /// the lab's cart 2 reaches its ±50 mm within about 60 ms: by default
     /// 10 ms (the real cart answers 6 V within a few milliseconds, and
