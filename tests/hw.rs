@@ -93,7 +93,7 @@ fn golden_rig_iteration() {
     let mut rig = MassSpringRig::new(Pc104::new(&mut port), Calibration::default(), 0.002).unwrap();
     let x = rig.read_state().unwrap();
     rig.apply_voltage(-6.0).unwrap(); // -250 = 0x0fa, negative
-    drop(rig); // drop writes PWM 0
+    drop(rig); // drop writes PWM 0 on every channel, the motor's (0) first
     assert_eq!(x, vector![0.010, 0.0, -0.010, 0.0]);
     assert_eq!(
         port.log(),
@@ -125,6 +125,18 @@ fn golden_rig_iteration() {
             A(0x10),
             W(0x00),
             A(0x11),
+            W(0x00),
+            A(0x12),
+            W(0x00),
+            A(0x13),
+            W(0x00),
+            A(0x14),
+            W(0x00),
+            A(0x15),
+            W(0x00),
+            A(0x16),
+            W(0x00),
+            A(0x17),
             W(0x00),
         ]
     );

@@ -44,6 +44,9 @@ fn unusual() -> RigConfig {
     cal.stall_volts = 4.5;
     cal.stall_time = 0.75;
     cal.stall_counts = 7;
+    cal.no_watchdog_acknowledged = true;
+    cal.follow_time = 0.02;
+    cal.max_saturation_time = 1.5;
     config.port.data_dir = true;
     config
 }
@@ -151,7 +154,10 @@ fn the_file_is_commented_and_in_hex_where_it_helps() {
 #[test]
 fn the_file_has_every_field_of_both_structs() {
     let keys = keys(&lab().to_toml());
-    assert_eq!(keys.len(), 8 + 12 + 1, "{keys:?}");
+    // 8 of the map, 15 of the calibration (12, and the safety keys
+    // no_watchdog_acknowledged, follow_time, max_saturation_time), 1 of the
+    // port.
+    assert_eq!(keys.len(), 8 + 15 + 1, "{keys:?}");
     assert!(keys.iter().filter(|k| k.starts_with("map.")).count() == 8);
     assert_eq!(keys.last().map(String::as_str), Some("port.data_dir"));
 }
@@ -272,6 +278,9 @@ fn a_bad_value_names_its_key_and_line() {
         ("calibration.stall_volts", "0.0", "refused"),
         ("calibration.stall_time", "-inf", "refused"),
         ("calibration.stall_counts", "0", "refused"),
+        ("calibration.follow_time", "0.0", "refused"),
+        ("calibration.max_saturation_time", "-2.0", "refused"),
+        ("calibration.no_watchdog_acknowledged", "1", "invalid type"),
     ] {
         let written = key.split('[').next().unwrap();
         let bad = with_value(&text, written, value);
@@ -723,5 +732,93 @@ fn a_truth_file_keeps_defaults_refuses_unknown_keys_and_round_trips() {
         "[calibration]",
     ] {
         assert!(text.contains(table), "{table} missing from\n{text}");
+    }
+}
+
+// ---- the safety keys: defaults, checks, the same error from file and code ------
+
+#[test]
+fn the_safety_keys_have_defaults_checks_and_the_same_errors_from_file_and_code() {
+    let d = Calibration::default();
+    assert_eq!(
+        (
+            d.no_watchdog_acknowledged,
+            d.follow_time,
+            d.max_saturation_time
+        ),
+        (false, 0.01, 2.0)
+    );
+    // A truth file leaving them out keeps the defaults.
+    let rig = SimulatedRig::from_toml("[calibration]\nstall_time = 0.4").unwrap();
+    assert_eq!(rig.calibration.follow_time, d.follow_time);
+    assert_eq!(rig.calibration.max_saturation_time, d.max_saturation_time);
+    assert!(!rig.calibration.no_watchdog_acknowledged);
+    // A card file must say them (its every key is required): named.
+    let text = lab().to_toml();
+    for key in [
+        "calibration.no_watchdog_acknowledged",
+        "calibration.follow_time",
+        "calibration.max_saturation_time",
+    ] {
+        let err = RigConfig::from_toml(&without(&text, key)).unwrap_err();
+        assert_eq!(
+            (err.kind(), err.key()),
+            (FileErrorKind::MissingKey, Some(key))
+        );
+    }
+    // A bad value: the same ConfigError from a truth file, from code, and
+    // (under its table) from a card file.
+    let base = SimulatedRig::default();
+    for (name, value, calibration) in [
+        (
+            "follow_time",
+            "0.0",
+            Calibration {
+                follow_time: 0.0,
+                ..d
+            },
+        ),
+        (
+            "follow_time",
+            "nan",
+            Calibration {
+                follow_time: f64::NAN,
+                ..d
+            },
+        ),
+        (
+            "max_saturation_time",
+            "-1.0",
+            Calibration {
+                max_saturation_time: -1.0,
+                ..d
+            },
+        ),
+        (
+            "max_saturation_time",
+            "inf",
+            Calibration {
+                max_saturation_time: f64::INFINITY,
+                ..d
+            },
+        ),
+    ] {
+        let key = format!("calibration.{name}");
+        let code = SimulatedRig {
+            calibration,
+            ..base.clone()
+        };
+        same_error(&format!("[calibration]\n{name} = {value}"), &code, &key);
+        let from_code = calibration.validate().unwrap_err();
+        assert_eq!(from_code.key(), name);
+        match RigConfig::from_toml(&with_value(&text, &key, value)) {
+            Err(FileError::Invalid { error, .. }) => {
+                assert_eq!(
+                    format!("{error:?}"),
+                    format!("{:?}", from_code.in_table("calibration"))
+                );
+            }
+            other => panic!("expected {key} refused, got {other:?}"),
+        }
     }
 }

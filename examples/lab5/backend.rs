@@ -21,7 +21,8 @@ pub struct Backend {
     pub kind: BackendKind,
     /// Real-time scheduling for the loop (`--rt-priority`).
     pub realtime: Option<RealTime>,
-    /// Ctrl-C and SIGTERM stop the run in progress (the rig halts).
+    /// Ctrl-C, SIGTERM, SIGHUP, SIGQUIT and Ctrl-Z stop the run in
+    /// progress (the rig halts).
     pub stop: StopSignal,
     /// Where each run's CSV goes (`runs/` under it).
     pub out: PathBuf,
@@ -233,7 +234,8 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
         }
         #[cfg(all(feature = "ppdev", target_os = "linux"))]
         Some(port) => {
-            let (file, config) = crate::card::load(port, args.card.as_deref())?;
+            let (file, config) =
+                crate::card::load(port, args.card.as_deref(), args.no_watchdog_acknowledged)?;
             println!(
                 "{}",
                 crate::card::plan(port, file, &config, ctrlab::lab::protocol::IDENT_VOLTS)

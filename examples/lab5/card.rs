@@ -8,9 +8,14 @@ use std::path::Path;
 use ctrlab::hw::{Pc104, Ppdev, RigError};
 use ctrlab::lab::{MassSpringRig, RigConfig};
 
-/// The card file named by `--card` and its configuration, checked;
-/// without one, how to make it.
-pub fn load<'a>(port: &Path, card: Option<&'a Path>) -> Result<(&'a Path, RigConfig), String> {
+/// The card file named by `--card` and its configuration, checked (a card
+/// without a watchdog must be acknowledged, in the file or by
+/// `--no-watchdog-acknowledged`); without one, how to make it.
+pub fn load<'a>(
+    port: &Path,
+    card: Option<&'a Path>,
+    no_watchdog_acknowledged: bool,
+) -> Result<(&'a Path, RigConfig), String> {
     let Some(card) = card else {
         return Err(format!(
             "--port {port} needs the card's register map and calibration: --card card.toml. \
@@ -21,8 +26,17 @@ pub fn load<'a>(port: &Path, card: Option<&'a Path>) -> Result<(&'a Path, RigCon
             port = port.display()
         ));
     };
-    let config =
+    let mut config =
         RigConfig::read_toml(card).map_err(|e| format!("card file {}: {e}", card.display()))?;
+    config.calibration.no_watchdog_acknowledged |= no_watchdog_acknowledged;
+    // Before anything is opened: the same check building the rig makes.
+    config.calibration.check_watchdog().map_err(|e| {
+        format!(
+            "card file {}: {}",
+            card.display(),
+            e.in_table("calibration")
+        )
+    })?;
     Ok((card, config))
 }
 
@@ -43,7 +57,8 @@ pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> S
          runs: 5 open-loop runs of 5 s with a ±{ident_volts} V square wave, 20 more of 5 s \
          comparing inputs of the same peak (square wave, PRBS, multisine, chirp), then 26 closed-loop \
          runs of 3 s (24 for Tables 5 and 6, 2 for the Design section's LQI) saturated at ±{full} V, 3 s pauses between runs; each run \
-         halts the motor at the first fault (travel limit, bus fault, stall, timing, Ctrl-C).\n\
+         halts the motor at the first fault (travel limit, bus fault, stall, a dead cart-2 encoder, \
+         the drive held at its limit, timing, Ctrl-C and the other stop signals).\n\
          Nothing has been written to the card. Next: open the port and read the ID register \
          {id:#04x} (a read only).",
         port = port.display(),
@@ -60,12 +75,12 @@ pub fn check_id(port: &Path, config: &RigConfig) -> Result<u8, RigError> {
     Ok(card.probe_id(config.calibration.card_id)?)
 }
 
-/// The rig on the card with the file's map and calibration: the ID is
-/// probed (building the rig) before the counters are cleared, the first
-/// write.
+/// The rig on the card with the file's map and calibration
+/// ([`RigConfig::rig`]: a card without a watchdog only if acknowledged):
+/// the ID is probed (building the rig) before the counters are cleared, the
+/// first write.
 pub fn rig(port: &Path, config: &RigConfig, period: f64) -> Result<MassSpringRig<Ppdev>, RigError> {
-    let card = Pc104::with_map(Ppdev::open_with(port, config.port)?, config.map)?;
-    let mut rig = MassSpringRig::new(card, config.calibration, period)?;
+    let mut rig = config.rig(Ppdev::open_with(port, config.port)?, period)?;
     rig.card_mut().clear_counters()?;
     Ok(rig)
 }

@@ -44,6 +44,12 @@ pub struct Args {
     /// written by the probe
     #[arg(long, value_name = "FILE", value_parser = existing_file, requires = "port")]
     pub card: Option<PathBuf>,
+    /// Drive a card whose card file says `watchdog_timeout = "none"`: nothing
+    /// on it stops the motor if this program stops driving it (as
+    /// `no_watchdog_acknowledged = true` in the card file). Keep a hand on
+    /// the emergency stop
+    #[arg(long, requires = "card")]
+    pub no_watchdog_acknowledged: bool,
     /// Offline: identify from every *.csv in DIR (two or more identification
     /// runs: columns t, u, x1, x2 with units, e.g. t_s;u_V;x1_mm;x2_mm)
     #[arg(

@@ -16,7 +16,9 @@
 //!
 //! Writes `report.md`, one SVG per table and every run's recording as CSV
 //! (`runs/`) into `--out DIR` (default `target/lab5`). Ctrl-C halts the rig,
-//! keeps the run's recording and the report so far.
+//! keeps the run's recording and the report so far; so do SIGTERM, a closed
+//! terminal (SIGHUP), Ctrl-\\ (SIGQUIT) and Ctrl-Z (SIGTSTP), which stops the
+//! run rather than suspending lab5 with the motor on.
 //!
 //! ```text
 //! cargo run --release --example lab5
@@ -41,7 +43,11 @@
 //! written by `cargo run --example probe --features ppdev -- --port
 //! /dev/parport0`): lab5 prints what it will do, reads the card's ID (a
 //! read only), and drives nothing unless the card answers with the ID the
-//! file names.
+//! file names. A card file saying `watchdog_timeout = "none"` is refused
+//! unless it also says `no_watchdog_acknowledged = true`, or lab5 is given
+//! `--no-watchdog-acknowledged`: then nothing on the card stops the motor
+//! if lab5 stops driving it (the loop still halts after 25 periods without
+//! a sample).
 
 #[cfg(all(feature = "ppdev", target_os = "linux"))]
 mod card;

@@ -7,8 +7,8 @@
 //!   calibration, a simulated card or rig, a loop or real-time setting),
 //!   named by its key;
 //! - [`LoopFault`]: what [`run`](super::run) halted the rig for (a travel
-//!   limit, lost timing, a panic, a stop request, a bus fault, a motor that
-//!   does not respond);
+//!   limit, lost timing, a panic, a stop request, a bus fault, a motor or
+//!   an encoder that does not respond, a drive held at its limit);
 //! - [`RealTimeError`]: real-time scheduling was asked for and not granted;
 //! - [`RigError`]: any of them, what a [`Rig`](super::Rig) and
 //!   [`run`](super::run) return, so `?` carries each of the others into it.
@@ -461,17 +461,22 @@ pub enum LoopFaultKind {
     /// deadlines in a window, or a gap between samples long enough for the
     /// card's watchdog to trip.
     Timing,
-    /// The controller or the reference function panicked.
+    /// The controller (its update, `applied` or `reset`), the reference
+    /// function or the rig's read or apply panicked.
     Panic,
-    /// The run was interrupted (Ctrl-C, SIGTERM, or a stop request).
+    /// The run was interrupted (Ctrl-C, SIGTERM, SIGHUP, SIGQUIT, Ctrl-Z's
+    /// SIGTSTP, or a stop request).
     Interrupted,
     /// A measurement is physically impossible (an encoder count jumped
     /// further in one sample than the carts can move): a bus or encoder
     /// fault.
     BusFault,
     /// Sustained drive with no encoder motion: the motor, its driver or the
-    /// encoders are not responding.
+    /// encoders are not responding (the driven cart's encoder among them:
+    /// [`LoopFault::EncoderNotFollowing`]).
     NotResponding,
+    /// The drive stayed at its limit (saturated) longer than allowed.
+    Saturated,
 }
 
 /// What the control loop, or a rig checking its measurements and commands,
@@ -519,9 +524,10 @@ pub enum LoopFault {
     },
     /// Too long without a sample (or a controller that took too long): the
     /// card's watchdog may trip and, kicked again, re-energise the motor
-    /// with a stale command.
+    /// with a stale command; without a watchdog, nothing would stop a motor
+    /// left at its last command.
     #[error(
-        "{what} took {gap:.4} s at t = {at:.4} s, longer than the {limit:.4} s allowed (half the watchdog timeout); rig halted"
+        "{what} took {gap:.4} s at t = {at:.4} s, longer than the {limit:.4} s allowed (half the watchdog timeout, 25 periods on a card without one, or `LoopConfig::max_gap`); rig halted"
     )]
     Gap {
         /// What took too long (`"the interval between two samples"`,
@@ -534,10 +540,13 @@ pub enum LoopFault {
         /// Time into the run, s.
         at: f64,
     },
-    /// The controller or reference function panicked.
+    /// The controller, the reference function or the rig panicked; the
+    /// panic was caught, the rig halted and the recording kept.
     #[error("the {what} panicked at t = {at:.4} s: {message}; rig halted")]
     Panicked {
-        /// `"controller"` or `"reference"`.
+        /// Where: `"controller"` (its update), `"controller (applied)"`,
+        /// `"controller (reset)"` (before the first tick, `at` = 0),
+        /// `"reference"`, `"rig (read)"` or `"rig (apply)"`.
         what: &'static str,
         /// The panic's message.
         message: String,
@@ -545,7 +554,9 @@ pub enum LoopFault {
         at: f64,
     },
     /// The run was stopped by a signal or a stop request.
-    #[error("interrupted at t = {at:.4} s (Ctrl-C, SIGTERM or a stop request); rig halted")]
+    #[error(
+        "interrupted at t = {at:.4} s (Ctrl-C, SIGTERM, SIGHUP, SIGQUIT, Ctrl-Z or a stop request); rig halted"
+    )]
     Interrupted {
         /// Time into the run, s.
         at: f64,
@@ -567,17 +578,54 @@ pub enum LoopFault {
         /// The largest plausible speed, m/s.
         limit: f64,
     },
-    /// Sustained drive, no motion.
+    /// Sustained drive, no motion of the driven cart's encoder.
     #[error(
-        "motor or encoder not responding: {volts:.2} V applied for {seconds:.3} s and no encoder moved more than {counts} counts; rig halted"
+        "motor or encoder not responding: a change of drive of {volts:.2} V held for {seconds:.3} s did not move the driven cart's encoder {counts} counts; check the motor, its driver and the encoder's wiring; rig halted"
     )]
     NotResponding {
-        /// The drive applied, V (its smallest magnitude over the episode).
+        /// The change of drive, V (its smallest magnitude over the episode).
         volts: f64,
         /// How long, s.
         seconds: f64,
         /// The motion threshold, counts.
         counts: i64,
+    },
+    /// The drive moved the carts (the other cart's encoder counted) but
+    /// the driven cart's own encoder did not follow: a dead or disconnected
+    /// encoder, with which the driven cart's travel limit cannot be
+    /// checked.
+    #[error(
+        "the encoder of cart {cart} (the driven cart, encoder channel {channel}) does not follow the drive: a change of {volts:.2} V moved cart {other} {moved} counts within {seconds:.3} s while cart {cart}'s encoder moved fewer than {counts}; check that encoder and its channel in the calibration; rig halted"
+    )]
+    EncoderNotFollowing {
+        /// The driven cart, counted from 1 (the lab: cart 2).
+        cart: usize,
+        /// Its encoder channel.
+        channel: usize,
+        /// The other cart, counted from 1.
+        other: usize,
+        /// The change of drive, V (its smallest magnitude over the episode).
+        volts: f64,
+        /// How long the driven cart's encoder had not answered, s.
+        seconds: f64,
+        /// How far the other cart moved meanwhile, counts.
+        moved: i64,
+        /// The motion threshold, counts.
+        counts: i64,
+    },
+    /// The drive stayed at its limit longer than allowed: a controller
+    /// that cannot reach its reference, or a measurement that is wrong,
+    /// pushing with everything it has.
+    #[error(
+        "the drive stayed at its limit (±{volts} V) for {seconds:.3} s, the {limit} s allowed (calibration `max_saturation_time`): the controller cannot reach its reference or a measurement is wrong; rig halted"
+    )]
+    Saturated {
+        /// The drive's limit, V (magnitude).
+        volts: f64,
+        /// How long the drive had been at it, s.
+        seconds: f64,
+        /// The longest allowed, s.
+        limit: f64,
     },
 }
 
@@ -590,6 +638,9 @@ impl LoopFault {
     /// use ctrlab::hw::{LoopFault, LoopFaultKind};
     /// let gap = LoopFault::Gap { what: "the controller", gap: 0.2, limit: 0.05, at: 1.0 };
     /// assert_eq!(gap.kind(), LoopFaultKind::Timing);
+    /// let pinned = LoopFault::Saturated { volts: 24.0, seconds: 2.0, limit: 2.0 };
+    /// assert_eq!(pinned.kind(), LoopFaultKind::Saturated);
+    /// assert!(pinned.to_string().contains("max_saturation_time"));
     /// ```
     pub fn kind(&self) -> LoopFaultKind {
         match self {
@@ -598,7 +649,10 @@ impl LoopFault {
             LoopFault::Panicked { .. } => LoopFaultKind::Panic,
             LoopFault::Interrupted { .. } => LoopFaultKind::Interrupted,
             LoopFault::BusFault { .. } => LoopFaultKind::BusFault,
-            LoopFault::NotResponding { .. } => LoopFaultKind::NotResponding,
+            LoopFault::NotResponding { .. } | LoopFault::EncoderNotFollowing { .. } => {
+                LoopFaultKind::NotResponding
+            }
+            LoopFault::Saturated { .. } => LoopFaultKind::Saturated,
         }
     }
 }

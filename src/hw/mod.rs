@@ -70,13 +70,13 @@ pub mod testing;
 
 pub use clock::{Clock, Jitter, VirtualClock};
 pub use epp::EppPort;
+#[cfg(feature = "lab")]
+pub(crate) use error::check_all_positive;
+pub(crate) use error::check_positive;
 pub use error::{
     ConfigError, ConfigErrorKind, CycleKind, LoopFault, LoopFaultKind, PortError, PortErrorKind,
     RealTimeError, RealTimeErrorKind, RigError, RigErrorKind,
 };
-#[cfg(feature = "lab")]
-pub(crate) use error::check_all_positive;
-pub(crate) use error::check_positive;
 pub use pc104::{
     ENCODER_CHANNELS, MAX_DUTY, PWM_CHANNELS, PWM_DIRECTION_BIT, Pc104, RegisterMap,
     duty_from_bytes, pwm_bytes,
@@ -87,7 +87,7 @@ pub use ppdev::{PortModes, Ppdev, ioctl};
 pub use ppdev_options::PpdevOptions;
 pub use realtime::RealTime;
 pub use rig::Rig;
-pub use run::{LATE_FRACTION, LoopConfig, LoopStats, RunError, RunOutcome, run};
+pub use run::{GAP_PERIODS, LATE_FRACTION, LoopConfig, LoopStats, RunError, RunOutcome, run};
 pub use sim_card::{MAX_CATCH_UP_STEPS, SimulatedCard};
 pub use sim_config::{SIMULATED_CARD_ID, SimulatedCardConfig};
 pub use stop::StopSignal;

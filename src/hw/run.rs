@@ -8,17 +8,22 @@
 //!
 //! - a rig error (port fault, travel limit, bus fault, a motor that does
 //!   not respond, a non-finite command);
-//! - a panic in the controller or the reference function
-//!   ([`LoopFault::Panicked`]);
+//! - a panic anywhere in the loop: the controller (its `update`, `applied`
+//!   or `reset`), the reference function, or the rig's `read` or `apply`
+//!   ([`LoopFault::Panicked`], naming where);
 //! - too many timing faults — overruns (a tick whose work ends after the
 //!   next deadline) and skipped deadlines (the loop fell a period or more
 //!   behind) — within a window ([`LoopFault::TimingFaults`]);
 //! - a gap: two samples, or a controller update, further apart than
-//!   `max_gap` (by default half the rig's watchdog timeout), after which the
+//!   `max_gap` (by default half the rig's watchdog timeout, after which the
 //!   card's watchdog would cut the motor and the next kick would silently
-//!   re-energise it with a stale command ([`LoopFault::Gap`]);
-//! - a stop request, e.g. Ctrl-C through [`StopSignal::on_interrupt`]
-//!   ([`LoopFault::Interrupted`]).
+//!   re-energise it with a stale command; on a rig without a watchdog
+//!   [`GAP_PERIODS`] periods, the software's own limit, as nothing else
+//!   would stop a motor left at its last command) ([`LoopFault::Gap`]);
+//! - a stop request, e.g. Ctrl-C, a closed terminal or Ctrl-Z through
+//!   [`StopSignal::on_interrupt`] ([`LoopFault::Interrupted`]).
+//!
+//! In every case the rig is halted and the run returns what it recorded.
 //!
 //! The recording's time stamps are the actual sampling (latch) instants on
 //! the monotonic clock, so a missed tick shows as a gap, never papered over;
@@ -87,14 +92,52 @@ pub struct LoopConfig {
     pub timing_window: f64,
     /// Longest allowed time between two samples, or for one controller
     /// update, s. `None` (the default) means half the rig's
-    /// [`watchdog_timeout`](Rig::watchdog_timeout), or no limit for a rig
-    /// without a watchdog. Must be at least the period.
+    /// [`watchdog_timeout`](Rig::watchdog_timeout), or [`GAP_PERIODS`]
+    /// periods for a rig without a watchdog (50 ms at the lab's 2 ms): the
+    /// loop always has a gap limit ([`gap_limit`](Self::gap_limit)). Must be
+    /// at least the period (`f64::INFINITY` switches the check off).
     pub max_gap: Option<f64>,
     /// Real-time scheduling for the loop's thread (Linux; opt in).
     pub realtime: Option<RealTime>,
     /// A stop request checked every tick (e.g. Ctrl-C:
     /// [`StopSignal::on_interrupt`]).
     pub stop: Option<StopSignal>,
+}
+
+/// The default gap limit of a rig without a watchdog, in periods: the
+/// loop halts after this many periods without a sample (or a controller
+/// update that long). 25 periods is 50 ms at the lab's 2 ms, what half the
+/// lab card's 100 ms watchdog allows.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{GAP_PERIODS, LoopConfig};
+/// assert_eq!(LoopConfig::default().gap_limit(0.002, None), GAP_PERIODS * 0.002);
+/// ```
+pub const GAP_PERIODS: f64 = 25.0;
+
+impl LoopConfig {
+    /// The gap limit a run of a rig with period `period` (s) and watchdog
+    /// `watchdog_timeout` (s, if it has one) uses, s: [`max_gap`](Self::max_gap)
+    /// if set, else half the watchdog timeout, else [`GAP_PERIODS`]
+    /// periods.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::LoopConfig;
+    /// let config = LoopConfig::default();
+    /// assert_eq!(config.gap_limit(0.002, Some(0.1)), 0.05);
+    /// assert_eq!(config.gap_limit(0.002, None), 0.05); // 25 periods: still a limit
+    /// let set = LoopConfig { max_gap: Some(0.02), ..config };
+    /// assert_eq!(set.gap_limit(0.002, None), 0.02);
+    /// ```
+    pub fn gap_limit(&self, period: f64, watchdog_timeout: Option<f64>) -> f64 {
+        self.max_gap
+            .or_else(|| watchdog_timeout.map(|w| 0.5 * w))
+            .unwrap_or(GAP_PERIODS * period)
+    }
 }
 
 impl Default for LoopConfig {
@@ -288,8 +331,10 @@ const SPIN: Duration = Duration::from_micros(200);
 ///
 /// The same controller object runs unchanged in the sampled-data simulator
 /// [`sim::run_sampled`](crate::sim::run_sampled), which follows the same
-/// order. Panics in the controller and the reference are caught (unless
-/// the binary is built with `panic = "abort"`).
+/// order. Panics in the controller (`update`, `applied`, `reset`), the
+/// reference and the rig's `read` and `apply` are caught (unless the binary
+/// is built with `panic = "abort"`): the rig is halted and the recording
+/// kept, as for any other fault.
 ///
 /// # Errors
 ///
@@ -302,11 +347,13 @@ const SPIN: Duration = Duration::from_micros(200);
 /// - [`RigError::Port`] and [`RigError::Fault`] from the rig (a port fault,
 ///   [`LoopFault::TravelLimit`], [`LoopFault::BusFault`],
 ///   [`LoopFault::NotResponding`], a non-finite command);
-/// - [`RigError::Fault`] from the loop: a panic in the controller or the
-///   reference ([`LoopFault::Panicked`]); `max_timing_faults` overruns and
-///   skipped deadlines within `timing_window` ([`LoopFault::TimingFaults`]);
-///   two samples, or one controller update, further apart than `max_gap`
-///   ([`LoopFault::Gap`]); a stop request ([`LoopFault::Interrupted`]);
+/// - [`RigError::Fault`] from the loop: a panic in the controller, the
+///   reference or the rig ([`LoopFault::Panicked`], its `what` saying
+///   where); `max_timing_faults` overruns and skipped deadlines within
+///   `timing_window` ([`LoopFault::TimingFaults`]); two samples, or one
+///   controller update, further apart than the gap limit
+///   ([`LoopConfig::gap_limit`], [`LoopFault::Gap`]); a stop request
+///   ([`LoopFault::Interrupted`]);
 /// - [`RigError::Config`] for a bad `config` (named by its field), a rig
 ///   whose period is not finite and ≥ 1 µs, a controller designed for
 ///   another period, or a rig whose schema does not have `M` inputs and `P`
@@ -369,10 +416,7 @@ where
         }
         Ok(ticks)
     });
-    let max_gap = config
-        .max_gap
-        .or_else(|| rig.watchdog_timeout().map(|w| 0.5 * w))
-        .unwrap_or(f64::INFINITY);
+    let max_gap = config.gap_limit(period, rig.watchdog_timeout());
     let checked = checked.and_then(|ticks| {
         if max_gap < period {
             return Err(ConfigError::conflict(
@@ -411,9 +455,6 @@ where
     let mut faults = FaultWindow::new(config.max_timing_faults, config.timing_window, ticks);
     let mut stats = LoopStats::default();
     let mut consecutive = 0usize;
-    controller.reset();
-    // The rig may have been used before: its last sample is not this run's.
-    rig.restart();
 
     let wall_start = Instant::now();
     let virtual_start = match clock {
@@ -428,6 +469,12 @@ where
             return Err(stop(rig, $error.into(), recording, $last, stats, lateness))
         };
     }
+
+    if let Err(payload) = catch_unwind(AssertUnwindSafe(|| controller.reset())) {
+        fail!(panicked("controller (reset)", &payload, 0.0), None);
+    }
+    // The rig may have been used before: its last sample is not this run's.
+    rig.restart();
 
     let mut k = 0usize;
     while k < ticks {
@@ -512,9 +559,10 @@ where
             }
         }
 
-        let y = match rig.read() {
-            Ok(y) => y,
-            Err(error) => fail!(error, None),
+        let y = match catch_unwind(AssertUnwindSafe(|| rig.read())) {
+            Ok(Ok(y)) => y,
+            Ok(Err(error)) => fail!(error, None),
+            Err(payload) => fail!(panicked("rig (read)", &payload, t), None),
         };
         previous_sample = Some(t);
         let r = match catch_unwind(AssertUnwindSafe(|| reference(t))) {
@@ -545,14 +593,23 @@ where
                 fail!(error, Some(y.as_slice().to_vec()));
             }
         }
-        let applied = match rig.apply(&u) {
-            Ok(v) => v,
-            Err(error) => fail!(error, Some(y.as_slice().to_vec())),
+        let applied = match catch_unwind(AssertUnwindSafe(|| rig.apply(&u))) {
+            Ok(Ok(v)) => v,
+            Ok(Err(error)) => fail!(error, Some(y.as_slice().to_vec())),
+            Err(payload) => fail!(
+                panicked("rig (apply)", &payload, t),
+                Some(y.as_slice().to_vec())
+            ),
         };
-        controller.applied(&applied);
+        let told = catch_unwind(AssertUnwindSafe(|| controller.applied(&applied)));
         // Cannot fail: the schema's sizes were checked above.
         recording.push_vectors(t, &applied, &y).ok();
         stats.ticks += 1;
+        if let Err(payload) = told {
+            // The input reached the motor, so its sample is recorded; then
+            // the rig is halted.
+            fail!(panicked("controller (applied)", &payload, t), None);
+        }
 
         // An overrun: this tick's work ended after the next deadline.
         if let Clock::RealTime = clock {
@@ -646,8 +703,9 @@ fn stop<G: Rig<M, P>, const M: usize, const P: usize>(
     mut lateness: Vec<f64>,
 ) -> Box<RunError> {
     // The error to report is the cause; a failing halt is left to the card's
-    // watchdog.
-    rig.halt().ok();
+    // watchdog, and so is a rig whose halt panics (after its read or apply
+    // did).
+    catch_unwind(AssertUnwindSafe(|| rig.halt())).ok();
     finish_stats(&mut stats, &mut lateness);
     Box::new(RunError {
         error,

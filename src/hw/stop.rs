@@ -1,5 +1,5 @@
-//! [`StopSignal`]: a request to stop a running loop, from Ctrl-C, SIGTERM
-//! or code.
+//! [`StopSignal`]: a request to stop a running loop, from Ctrl-C, SIGTERM,
+//! a closed terminal (SIGHUP), Ctrl-\\ (SIGQUIT), Ctrl-Z (SIGTSTP) or code.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -8,10 +8,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// halted and the run returns [`LoopFault::Interrupted`](super::LoopFault::Interrupted) with everything
 /// recorded so far. Clones share the flag.
 ///
-/// [`on_interrupt`](Self::on_interrupt) sets it on SIGINT (Ctrl-C) and
-/// SIGTERM, so stopping a lab run from the terminal halts the motor and
-/// keeps the data instead of killing the process with the PWM at its last
-/// duty.
+/// [`on_interrupt`](Self::on_interrupt) sets it on SIGINT (Ctrl-C),
+/// SIGTERM, SIGHUP (the terminal closed), SIGQUIT (Ctrl-\\) and SIGTSTP
+/// (Ctrl-Z), so stopping a lab run from the terminal in any of these ways
+/// halts the motor and keeps the data, instead of killing the process (or
+/// freezing it) with the PWM at its last duty.
 ///
 /// # Examples
 ///
@@ -58,42 +59,42 @@ impl StopSignal {
         Self::default()
     }
 
-    /// A flag raised by SIGINT (Ctrl-C) and SIGTERM. Registering replaces
-    /// those signals' default action (ending the process) for the whole
-    /// process: the loop stops, halts the rig and returns its recording,
-    /// and the caller decides what to do next (write the data, exit).
+    /// A flag raised by the signals that ask a program to stop: on Unix
+    /// SIGINT (Ctrl-C), SIGTERM (`kill`), SIGHUP (the terminal closed, an
+    /// SSH session dropped), SIGQUIT (Ctrl-\\) and SIGTSTP (Ctrl-Z); elsewhere
+    /// Ctrl-C, Ctrl-Break and the console closing (through the `ctrlc`
+    /// crate).
+    ///
+    /// Registering replaces those signals' default actions for the whole
+    /// process, for as long as it runs: the loop stops at its next tick,
+    /// halts the rig and returns its recording, and the caller decides what
+    /// to do next (write the data, exit). That is intended for each of
+    /// them, SIGTSTP included: Ctrl-Z no longer suspends the process, which
+    /// would freeze the loop with the motor at its last duty (the card's
+    /// watchdog, if it has one, is all that would stop it), but stops the
+    /// run cleanly; and SIGQUIT no longer dumps core. (SIGKILL and SIGSTOP
+    /// cannot be caught: `kill -9` and `kill -STOP` leave the motor to the
+    /// card's watchdog.) Each call registers a new flag; every registered
+    /// flag is raised by each of these signals.
     ///
     /// # Errors
     ///
-    /// The operating system's error, saying what failed, when the handlers
-    /// cannot be registered (or on a platform without Unix signals).
+    /// The operating system's error, saying which signal failed, when a
+    /// handler cannot be registered (on non-Unix platforms, also when
+    /// the `ctrlc` crate's handler cannot be set).
     ///
     /// # Examples
     ///
     /// ```no_run
     /// use ctrlab::hw::StopSignal;
     /// let stop = StopSignal::on_interrupt()?;
-    /// assert!(!stop.is_requested()); // until Ctrl-C
+    /// assert!(!stop.is_requested()); // until Ctrl-C, Ctrl-Z, a closed terminal, …
     /// // … pass `Some(stop.clone())` in `LoopConfig::stop`; Ctrl-C now halts the rig.
     /// # Ok::<(), std::io::Error>(())
     /// ```
     pub fn on_interrupt() -> Result<Self, std::io::Error> {
         let stop = Self::new();
-        let refused = |source: std::io::Error| {
-            std::io::Error::new(
-                source.kind(),
-                format!("register SIGINT/SIGTERM on signal handler failed: {source}"),
-            )
-        };
-        #[cfg(unix)]
-        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
-            signal_hook::flag::register(signal, Arc::clone(&stop.flag)).map_err(refused)?;
-        }
-        #[cfg(not(unix))]
-        return Err(refused(std::io::Error::other(
-            "no Unix signals on this platform",
-        )));
-        #[cfg(unix)]
+        platform::register(&stop.flag)?;
         Ok(stop)
     }
 
@@ -137,5 +138,72 @@ impl StopSignal {
     /// ```
     pub fn clear(&self) {
         self.flag.store(false, Ordering::SeqCst);
+    }
+}
+
+/// The signals [`StopSignal::on_interrupt`] registers on Unix, with their
+/// names for error messages.
+#[cfg(unix)]
+mod platform {
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGTERM, SIGTSTP};
+
+    /// Every signal that asks the program to stop, by name.
+    pub(super) const SIGNALS: [(i32, &str); 5] = [
+        (SIGINT, "SIGINT"),
+        (SIGTERM, "SIGTERM"),
+        (SIGHUP, "SIGHUP"),
+        (SIGQUIT, "SIGQUIT"),
+        (SIGTSTP, "SIGTSTP"),
+    ];
+
+    /// Raises `flag` on each of [`SIGNALS`].
+    pub(super) fn register(flag: &Arc<AtomicBool>) -> Result<(), std::io::Error> {
+        for (signal, name) in SIGNALS {
+            signal_hook::flag::register(signal, Arc::clone(flag)).map_err(|source| {
+                std::io::Error::new(
+                    source.kind(),
+                    format!("registering a stop handler for {name} failed: {source}"),
+                )
+            })?;
+        }
+        Ok(())
+    }
+}
+
+/// Ctrl-C, Ctrl-Break and the console closing, through the `ctrlc` crate,
+/// whose one handler (it can be set only once per process) raises every
+/// flag registered.
+#[cfg(not(unix))]
+mod platform {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::{Arc, Mutex, PoisonError};
+
+    /// The flags to raise; empty until the first registration.
+    static FLAGS: Mutex<Vec<Arc<AtomicBool>>> = Mutex::new(Vec::new());
+
+    /// Adds `flag` to those the handler raises, setting the handler on the
+    /// first call.
+    pub(super) fn register(flag: &Arc<AtomicBool>) -> Result<(), std::io::Error> {
+        let mut flags = FLAGS.lock().unwrap_or_else(PoisonError::into_inner);
+        if flags.is_empty() {
+            // The handler runs on ctrlc's own thread, not in a signal
+            // context: it may lock.
+            ctrlc::set_handler(|| {
+                let flags = FLAGS.lock().unwrap_or_else(PoisonError::into_inner);
+                for flag in flags.iter() {
+                    flag.store(true, Ordering::SeqCst);
+                }
+            })
+            .map_err(|source| {
+                std::io::Error::other(format!(
+                    "registering a stop handler for Ctrl-C failed: {source}"
+                ))
+            })?;
+        }
+        flags.push(Arc::clone(flag));
+        Ok(())
     }
 }

@@ -6,9 +6,9 @@
 use std::fmt;
 use std::path::Path;
 
-use super::Calibration;
 use super::file::{self, FileError};
-use crate::hw::{ConfigError, PpdevOptions, RegisterMap};
+use super::{Calibration, MassSpringRig};
+use crate::hw::{ConfigError, EppPort, Pc104, PpdevOptions, RegisterMap, RigError};
 
 /// A rig's card file (`card.toml`): where the card's registers are and how
 /// the rig's counts and volts map to SI.
@@ -50,10 +50,13 @@ use crate::hw::{ConfigError, PpdevOptions, RegisterMap};
 ///     travel_limits = [0.04, 0.05]      # m, ± about where the counters were cleared
 ///     card_id = 0x3c                    # what the ID register must read
 ///     watchdog_timeout = 0.1            # s, or "none" for a card without one
+///     no_watchdog_acknowledged = false  # true: drive a card without a watchdog anyway
 ///     max_speed = 2.0                   # m/s: a faster count change is a bus fault
-///     stall_volts = 6.0                 # V of new drive that must move an encoder
-///     stall_time = 0.5                  # s the carts may take to answer it
+///     stall_volts = 6.0                 # V of new drive that must move cart 2's encoder
+///     stall_time = 0.5                  # s cart 2 may take to answer it
 ///     stall_counts = 3                  # counts that answer it
+///     follow_time = 0.01                # s cart 2's encoder may lag cart 1's in answering it
+///     max_saturation_time = 2.0         # s the drive may stay at ± volts_full_scale
 ///
 ///     ## How this PC's parallel port is driven (optional; keys default).
 ///     [port]
@@ -81,6 +84,20 @@ use crate::hw::{ConfigError, PpdevOptions, RegisterMap};
 /// on most ports, so the table and each of its keys may be left out. An
 /// unknown key in it is refused all the same, and a value of the wrong type
 /// (`data_dir = "yes"`) is named `port.data_dir`.
+///
+/// The safety keys added in 0.4 (`no_watchdog_acknowledged`, `follow_time`,
+/// `max_saturation_time`) are required like the others: a card file written
+/// before them is refused, naming the first one missing; add them (the
+/// example above has their defaults: `false`, `0.01`, `2.0`).
+///
+/// # A card without a watchdog
+///
+/// `watchdog_timeout = "none"` describes a card; driving it also takes
+/// `no_watchdog_acknowledged = true` (or lab5's `--no-watchdog-acknowledged`):
+/// [`rig`](Self::rig) refuses it otherwise, with a message saying what to
+/// add. The control loop then still halts after 25 periods without a sample
+/// ([`LoopConfig::max_gap`](crate::hw::LoopConfig::max_gap)), but nothing
+/// on the card stops a motor the PC stopped driving.
 ///
 /// # Examples
 ///
@@ -123,7 +140,7 @@ const fn field(key: &'static str, comment: &'static str, hex: bool) -> Field {
 }
 
 /// Every key of the file, in the order [`RigConfig::to_toml`] writes them.
-const FIELDS: [Field; 21] = [
+const FIELDS: [Field; 24] = [
     field("map.id", "card ID register (read)", true),
     field(
         "map.control",
@@ -181,21 +198,36 @@ const FIELDS: [Field; 21] = [
         false,
     ),
     field(
+        "calibration.no_watchdog_acknowledged",
+        "true: drive a card without a watchdog anyway",
+        false,
+    ),
+    field(
         "calibration.max_speed",
         "m/s: a faster count change is a bus fault",
         false,
     ),
     field(
         "calibration.stall_volts",
-        "V of new drive that must move an encoder",
+        "V of new drive that must move cart 2's encoder",
         false,
     ),
     field(
         "calibration.stall_time",
-        "s the carts may take to answer it",
+        "s cart 2 may take to answer it",
         false,
     ),
     field("calibration.stall_counts", "counts that answer it", false),
+    field(
+        "calibration.follow_time",
+        "s cart 2's encoder may lag cart 1's in answering it",
+        false,
+    ),
+    field(
+        "calibration.max_saturation_time",
+        "s the drive may stay at ± volts_full_scale",
+        false,
+    ),
     field(
         "port.data_dir",
         "PPDATADIR around each EPP read (default false)",
@@ -398,6 +430,50 @@ impl RigConfig {
             .validate()
             .map_err(|e| e.in_table("calibration"))
     }
+
+    /// The rig this card file describes, on the card behind `port`, read
+    /// every `period` seconds on the wall clock: the file is checked
+    /// ([`validate`](Self::validate)), a card without a watchdog must be
+    /// acknowledged ([`Calibration::check_watchdog`]), then the driver
+    /// takes the file's map and the rig probes the card's ID (a read, the
+    /// first access). Nothing is written to the card.
+    ///
+    /// # Errors
+    ///
+    /// [`RigError::Config`] naming the key (`calibration.…`, `map.…`): an
+    /// invalid value, or `calibration.no_watchdog_acknowledged` for a card
+    /// without a watchdog that nobody acknowledged (the message says what
+    /// to add); the errors of [`MassSpringRig::new`] (a bad period, no card
+    /// or another card answering, port errors).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Clock, ConfigErrorKind, RegisterMap, RigError};
+    /// use ctrlab::lab::{Calibration, RigConfig, SimulatedRig};
+    ///
+    /// let sim = SimulatedRig {
+    ///     calibration: Calibration { watchdog_timeout: None, ..Calibration::default() },
+    ///     ..SimulatedRig::default()
+    /// };
+    /// let mut file = RigConfig { map: RegisterMap::default(), calibration: sim.calibration };
+    /// let err = file.rig(sim.card(&Clock::RealTime)?, 0.002).unwrap_err();
+    /// assert_eq!(err.kind(), ConfigErrorKind::Conflict);
+    /// assert!(err.to_string().contains("add `no_watchdog_acknowledged = true`"), "{err}");
+    ///
+    /// file.calibration.no_watchdog_acknowledged = true;
+    /// let rig = file.rig(sim.card(&Clock::RealTime)?, 0.002)?;
+    /// assert_eq!(rig.calibration().watchdog_timeout, None);
+    /// # Ok::<(), RigError>(())
+    /// ```
+    pub fn rig<P: EppPort>(&self, port: P, period: f64) -> Result<MassSpringRig<P>, RigError> {
+        self.validate()?;
+        self.calibration
+            .check_watchdog()
+            .map_err(|e| e.in_table("calibration"))?;
+        let card = Pc104::with_map(port, self.map).map_err(|e| e.in_table("map"))?;
+        MassSpringRig::new(card, self.calibration, period)
+    }
 }
 
 /// What the rig will use, for a person to check before anything moves: the
@@ -461,16 +537,31 @@ impl fmt::Display for RigConfig {
                 map.control,
                 timeout * 5e2,
             )?,
+            None if cal.no_watchdog_acknowledged => writeln!(
+                f,
+                "watchdog: NONE (acknowledged: no_watchdog_acknowledged = true); nothing on the \
+                 card stops the motor if the PC stops driving it: keep a hand on the emergency \
+                 stop. The loop still halts after 25 periods without a sample"
+            )?,
             None => writeln!(
                 f,
-                "watchdog: none; nothing on the card stops the motor if the PC stops driving it"
+                "watchdog: none; nothing on the card stops the motor if the PC stops driving it. \
+                 Not acknowledged: the rig is not driven until no_watchdog_acknowledged = true"
             )?,
         }
         writeln!(
             f,
             "plausibility: a count change faster than {} m/s is a bus fault; {} V of new drive \
-             that moves no encoder {} counts within {} s is a stalled motor or encoder",
-            cal.max_speed, cal.stall_volts, cal.stall_counts, cal.stall_time
+             that does not move cart 2's encoder {} counts within {} s is a stalled motor or \
+             encoder, and within {} s while it moves cart 1 the way it pushes a dead cart-2 \
+             encoder; the rig halts after {} s of drive at ±{} V",
+            cal.max_speed,
+            cal.stall_volts,
+            cal.stall_counts,
+            cal.stall_time,
+            cal.follow_time,
+            cal.max_saturation_time,
+            cal.volts_full_scale
         )?;
         write!(
             f,

@@ -7,9 +7,15 @@ use crate::nalgebra::{SVector, vector};
 use super::Calibration;
 use crate::data::Schema;
 use crate::hw::{
-    Clock, ConfigError, EppPort, LATE_FRACTION, LoopFault, MAX_DUTY, Pc104, PortError, Rig,
-    RigError,
+    Clock, ConfigError, EppPort, LATE_FRACTION, LoopFault, MAX_DUTY, PWM_CHANNELS, Pc104,
+    PortError, Rig, RigError,
 };
+
+/// The cart the motor drives (cart 2, [`Cart::Two`](super::Cart::Two)), as
+/// an index into the calibration's per-cart arrays.
+const DRIVEN: usize = 1;
+/// The other cart (cart 1), moved only through the spring between them.
+const OTHER: usize = 0;
 
 /// The lab's two-cart rig on a [`Pc104`] card: counts to metres, volts to
 /// PWM duty, with the safety the rig needs. A [`Rig`] with one input (the
@@ -29,17 +35,26 @@ use crate::hw::{
 /// - Every read checks the measurement is physical, halting the rig
 ///   otherwise: a cart beyond its travel limit ([`LoopFault::TravelLimit`]),
 ///   a count change of more than one count faster than
-///   [`Calibration::max_speed`] ([`LoopFault::BusFault`]: a flipped bit, a
-///   glitch on the bus), or a change of drive that moves no encoder
-///   ([`LoopFault::NotResponding`]).
+///   [`Calibration::max_speed`]
+///   ([`LoopFault::BusFault`]: a flipped bit, a glitch on the bus), a
+///   change of drive that does not move the driven cart's (cart 2's)
+///   encoder ([`LoopFault::NotResponding`]), or one that moves cart 1 while
+///   cart 2's encoder stays still ([`LoopFault::EncoderNotFollowing`]: a
+///   dead encoder, with which cart 2's travel limit cannot be checked).
 /// - [`apply_voltage`](Self::apply_voltage) saturates to
 ///   ±`volts_full_scale` and quantises to the card's 0.1 % duty steps; a
 ///   non-finite command halts the rig and returns
 ///   [`PortError::InvalidCommand`]. A command more than the watchdog timeout
 ///   after the last read would re-energise a motor the card has cut: it is
-///   refused ([`LoopFault::Gap`]) and the rig halted.
-/// - Dropping the rig sets the PWM to zero (errors ignored: there is no one
-///   left to tell).
+///   refused ([`LoopFault::Gap`]) and the rig halted. A drive held at its
+///   limit for longer than [`Calibration::max_saturation_time`] is refused
+///   too ([`LoopFault::Saturated`]), and the rig halted.
+/// - Halting ([`Rig::halt`], and before any fault above) sets **every** PWM
+///   channel of the card to zero, the motor's first: a channel the
+///   calibration does not name may still have been set (by another
+///   program, or a card file naming the wrong channel).
+/// - Dropping the rig halts it the same way (errors ignored: there is no
+///   one left to tell).
 ///
 /// Nothing allocates in `read_state` or `apply_voltage`. The simulated rig
 /// in one call is [`SimulatedRig::rig`](super::SimulatedRig::rig).
@@ -76,12 +91,39 @@ pub struct MassSpringRig<P: EppPort> {
     last_kick: Option<f64>,
     /// The voltage last applied, V.
     volts: f64,
-    /// The counts when an encoder last moved `stall_counts`, and the drive
-    /// then, V.
-    motion: Option<([i64; 2], f64)>,
-    /// Since when the drive has differed from that by `stall_volts` or more
-    /// with no motion, and the smallest such difference, V.
-    stall: Option<(f64, f64)>,
+    /// The counts when the driven cart's encoder last moved
+    /// `stall_counts` (or at the run's first read), the drive then, V, and
+    /// when, s on `clock`.
+    motion: Option<([i64; 2], f64, f64)>,
+    /// The episode of a drive that has differed from that by `stall_volts`
+    /// or more with no motion of the driven cart's encoder.
+    stall: Option<Episode>,
+    /// The driven cart at rest, the baseline of the follow check.
+    rest: Option<Rest>,
+    /// Since when the drive has been at its limit (s on `clock`).
+    saturated: Option<f64>,
+}
+
+/// A change of drive of `stall_volts` or more that the driven cart's
+/// encoder has not answered yet.
+#[derive(Debug, Clone, Copy)]
+struct Episode {
+    /// When it was first seen, s on the rig's clock.
+    since: f64,
+    /// The smallest change of drive over it, V.
+    weakest: f64,
+}
+
+/// The driven cart at rest: at the run's first read, or once its encoder
+/// has not moved `stall_counts` for `follow_time`.
+#[derive(Debug, Clone, Copy)]
+struct Rest {
+    /// The other cart's counts then.
+    other: i64,
+    /// The drive then, V.
+    drive: f64,
+    /// A change of drive from it not answered yet.
+    pushed: Option<Episode>,
 }
 
 impl<P: EppPort> MassSpringRig<P> {
@@ -157,6 +199,8 @@ impl<P: EppPort> MassSpringRig<P> {
             volts: 0.0,
             motion: None,
             stall: None,
+            rest: None,
+            saturated: None,
         })
     }
 
@@ -268,8 +312,11 @@ impl<P: EppPort> MassSpringRig<P> {
     ///
     /// Port errors; after halting: [`LoopFault::TravelLimit`] when a cart is
     /// beyond its limit, [`LoopFault::BusFault`] for a count change of more
-    /// than one count faster than the carts can move,
-    /// [`LoopFault::NotResponding`] for sustained drive with no motion.
+    /// than one count faster than the carts can move, [`LoopFault::NotResponding`] for a change of
+    /// drive the driven cart's encoder does not answer within
+    /// [`Calibration::stall_time`], [`LoopFault::EncoderNotFollowing`] for
+    /// one that moved the other cart and not, within
+    /// [`Calibration::follow_time`], the driven cart's encoder.
     ///
     /// # Examples
     ///
@@ -357,35 +404,115 @@ impl<P: EppPort> MassSpringRig<P> {
         Ok(x)
     }
 
-    /// A change of drive must move an encoder (see
-    /// [`Calibration::stall_volts`]): the drive is compared with what it
-    /// was when an encoder last moved, so a deflection held against the
-    /// springs, or carts stuck in their friction under a steady drive, is
-    /// not a fault, while a motor that does not answer a new command is.
+    /// A change of drive must move the driven cart's encoder (see
+    /// [`Calibration::stall_volts`] and [the driven
+    /// cart](Calibration#the-driven-cart)): the drive is compared with what
+    /// it was when that encoder last moved, so a deflection held against
+    /// the springs, or carts stuck in their friction under a steady drive,
+    /// is not a fault, while a motor that does not answer a new command is
+    /// ([`LoopFault::NotResponding`], after `stall_time`). Only the driven
+    /// cart's own encoder counts: the other cart's motion never stands in
+    /// for it. It only excuses it: the other cart moving *against* the
+    /// change of drive stretches the spring against it, which may be what
+    /// holds the driven cart (a controller feeding back cart 1's position
+    /// does that, Table 6's among them).
+    ///
+    /// Then [`check_follow`](Self::check_follow).
     fn check_response(&mut self, counts: [i64; 2], now: f64) -> Result<(), RigError> {
         let cal = self.calibration;
-        let (reference, drive) = *self.motion.get_or_insert((counts, 0.0));
-        let motion = (0..2)
-            .map(|i| counts[i].saturating_sub(reference[i]).saturating_abs())
-            .max()
-            .unwrap_or(0);
+        if self.motion.is_none() {
+            // A run starts with the carts at rest.
+            self.rest = Some(Rest {
+                other: counts[OTHER],
+                drive: self.volts,
+                pushed: None,
+            });
+        }
+        let (reference, drive, moved_at) = *self.motion.get_or_insert((counts, self.volts, now));
+        let motion = counts[DRIVEN]
+            .saturating_sub(reference[DRIVEN])
+            .saturating_abs();
         if motion >= cal.stall_counts {
-            self.motion = Some((counts, self.volts));
+            self.motion = Some((counts, self.volts, now));
+            self.stall = None;
+            self.rest = None;
+            return Ok(());
+        }
+        if self.rest.is_none() && now - moved_at >= cal.follow_time {
+            self.rest = Some(Rest {
+                other: counts[OTHER],
+                drive: self.volts,
+                pushed: None,
+            });
+        }
+        self.check_follow(counts, now)?;
+        let change = self.volts - drive;
+        let other = counts[OTHER].saturating_sub(reference[OTHER]);
+        if change.abs() < cal.stall_volts
+            || along(other, cal.sign[OTHER], change) <= -cal.stall_counts
+        {
             self.stall = None;
             return Ok(());
         }
-        let change = (self.volts - drive).abs();
-        if change < cal.stall_volts {
-            self.stall = None;
-            return Ok(());
-        }
-        let (since, weakest) = self.stall.get_or_insert((now, change));
-        *weakest = weakest.min(change);
-        let (since, weakest) = (*since, *weakest);
+        let stall = self.stall.get_or_insert(Episode {
+            since: now,
+            weakest: change.abs(),
+        });
+        stall.weakest = stall.weakest.min(change.abs());
+        let Episode { since, weakest } = *stall;
         if now - since >= cal.stall_time {
             return self.fault(LoopFault::NotResponding {
                 volts: weakest,
                 seconds: now - since,
+                counts: cal.stall_counts,
+            });
+        }
+        Ok(())
+    }
+
+    /// The driven cart at rest must move when the drive changes by
+    /// `stall_volts` and the other cart moves the way it pushes
+    /// ([`LoopFault::EncoderNotFollowing`] after `follow_time`, see
+    /// [`Calibration::follow_time`]). At rest the force on the driven cart,
+    /// the drive's plus the spring's, is within its stiction; a change of
+    /// drive of `stall_volts` (far more than the stiction) with the other
+    /// cart pulling the spring the same way can only set it moving, and
+    /// the other cart only moves after it: if its encoder stays still, the
+    /// encoder is dead. (With the calibration's signs, a positive drive
+    /// pushes cart 2 away from the wall, as the probe checks.) A cart that
+    /// has just stopped is not at rest in this sense (the force that
+    /// stopped it is still changing): the baseline is the run's first read,
+    /// or the driven cart's encoder still for `follow_time`.
+    fn check_follow(&mut self, counts: [i64; 2], now: f64) -> Result<(), RigError> {
+        let cal = self.calibration;
+        let volts = self.volts;
+        let Some(rest) = self.rest.as_mut() else {
+            return Ok(());
+        };
+        let change = volts - rest.drive;
+        if change.abs() < cal.stall_volts {
+            rest.pushed = None;
+            return Ok(());
+        }
+        let pushed = rest.pushed.get_or_insert(Episode {
+            since: now,
+            weakest: change.abs(),
+        });
+        pushed.weakest = pushed.weakest.min(change.abs());
+        let Episode { since, weakest } = *pushed;
+        let moved = along(
+            counts[OTHER].saturating_sub(rest.other),
+            cal.sign[OTHER],
+            change,
+        );
+        if moved >= cal.stall_counts && now - since >= cal.follow_time {
+            return self.fault(LoopFault::EncoderNotFollowing {
+                cart: DRIVEN + 1,
+                channel: cal.encoder_channels[DRIVEN],
+                other: OTHER + 1,
+                volts: weakest,
+                seconds: now - since,
+                moved,
                 counts: cal.stall_counts,
             });
         }
@@ -401,7 +528,9 @@ impl<P: EppPort> MassSpringRig<P> {
     /// Port errors; after halting: [`PortError::InvalidCommand`] for a
     /// non-finite voltage, [`LoopFault::Gap`] when the watchdog timeout has
     /// passed since the last read (the card has cut the motor; applying now
-    /// would re-energise it with a stale command).
+    /// would re-energise it with a stale command), [`LoopFault::Saturated`]
+    /// when the drive would stay at its limit (±`volts_full_scale`) beyond
+    /// [`Calibration::max_saturation_time`].
     ///
     /// # Examples
     ///
@@ -434,14 +563,40 @@ impl<P: EppPort> MassSpringRig<P> {
             }
         }
         let duty = self.duty(volts);
+        if duty.abs() == MAX_DUTY {
+            let now = self.now();
+            let since = *self.saturated.get_or_insert(now);
+            let limit = self.calibration.max_saturation_time;
+            if now - since >= limit {
+                let error = LoopFault::Saturated {
+                    volts: self.calibration.volts_full_scale,
+                    seconds: now - since,
+                    limit,
+                };
+                return self.fault(error);
+            }
+        } else {
+            self.saturated = None;
+        }
         self.card.set_pwm(self.calibration.pwm_channel, duty)?;
         self.volts = f64::from(duty) / f64::from(MAX_DUTY) * self.calibration.volts_full_scale;
         Ok(self.volts)
     }
 
+    /// Zeroes every PWM channel, the motor's first; every channel is
+    /// tried even if one fails, and the first failure is returned.
     fn halt_motor(&mut self) -> Result<(), PortError> {
         self.volts = 0.0;
-        self.card.set_pwm(self.calibration.pwm_channel, 0)
+        self.saturated = None;
+        let motor = self.calibration.pwm_channel;
+        let mut result = self.card.set_pwm(motor, 0);
+        for channel in (0..PWM_CHANNELS).filter(|&c| c != motor) {
+            let zeroed = self.card.set_pwm(channel, 0);
+            if result.is_ok() {
+                result = zeroed;
+            }
+        }
+        result
     }
 }
 
@@ -482,6 +637,8 @@ impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
         self.history = History::default();
         self.motion = None;
         self.stall = None;
+        self.rest = None;
+        self.saturated = None;
     }
 }
 
@@ -530,9 +687,21 @@ impl History {
 }
 
 impl<P: EppPort> Drop for MassSpringRig<P> {
+    /// Halts: every PWM channel to zero, as [`Rig::halt`].
     fn drop(&mut self) {
         // Best effort: a failing port cannot be reported from a destructor,
-        // and the card's watchdog zeroes the PWM anyway.
+        // and the card's watchdog zeroes the PWM anyway (if it has one).
         self.halt_motor().ok();
+    }
+}
+
+/// How far a cart moved, `counts` with encoder sign `sign`, the way a
+/// change of drive `change` (V) pushes: positive along it, negative
+/// against it.
+fn along(counts: i64, sign: f64, change: f64) -> i64 {
+    if counts as f64 * sign * change > 0.0 {
+        counts.saturating_abs()
+    } else {
+        -counts.saturating_abs()
     }
 }
