@@ -61,6 +61,7 @@ mod config;
 pub mod excitation;
 mod file;
 pub mod frequency;
+mod friction_plant;
 mod gains;
 pub mod ident;
 pub mod lqi;
@@ -76,12 +77,13 @@ pub mod validation;
 pub use calibration::Calibration;
 pub use config::RigConfig;
 pub use file::{FileError, FileErrorKind};
+pub use friction_plant::FrictionPlant;
 pub use gains::LabGains;
 pub use plant::{Cart, MassSpring};
 pub use probe::SimulatedOperator;
 pub use rig::MassSpringRig;
 pub use sensor::EncoderSensor;
-pub use simulated::{CardSettings, Friction, FrictionPlant, SimulatedRig};
+pub use simulated::{CardSettings, Friction, SimulatedRig};
 
 use nalgebra::SMatrix;
 

@@ -1,5 +1,8 @@
 //! The lab's two-cart rig on the PC104 card, [`MassSpringRig`].
 
+mod checks;
+mod history;
+
 use std::time::Instant;
 
 use crate::nalgebra::{SVector, vector};
@@ -10,6 +13,7 @@ use crate::hw::{
     Clock, ConfigError, EppPort, LATE_FRACTION, LoopFault, MAX_DUTY, PWM_CHANNELS, Pc104,
     PortError, Rig, RigError,
 };
+use history::{History, Read};
 
 /// The cart the motor drives (cart 2, [`Cart::Two`](super::Cart::Two)), as
 /// an index into the calibration's per-cart arrays.
@@ -404,121 +408,6 @@ impl<P: EppPort> MassSpringRig<P> {
         Ok(x)
     }
 
-    /// A change of drive must move the driven cart's encoder (see
-    /// [`Calibration::stall_volts`] and [the driven
-    /// cart](Calibration#the-driven-cart)): the drive is compared with what
-    /// it was when that encoder last moved, so a deflection held against
-    /// the springs, or carts stuck in their friction under a steady drive,
-    /// is not a fault, while a motor that does not answer a new command is
-    /// ([`LoopFault::NotResponding`], after `stall_time`). Only the driven
-    /// cart's own encoder counts: the other cart's motion never stands in
-    /// for it. It only excuses it: the other cart moving *against* the
-    /// change of drive stretches the spring against it, which may be what
-    /// holds the driven cart (a controller feeding back cart 1's position
-    /// does that, Table 6's among them).
-    ///
-    /// Then [`check_follow`](Self::check_follow).
-    fn check_response(&mut self, counts: [i64; 2], now: f64) -> Result<(), RigError> {
-        let cal = self.calibration;
-        if self.motion.is_none() {
-            // A run starts with the carts at rest.
-            self.rest = Some(Rest {
-                other: counts[OTHER],
-                drive: self.volts,
-                pushed: None,
-            });
-        }
-        let (reference, drive, moved_at) = *self.motion.get_or_insert((counts, self.volts, now));
-        let motion = counts[DRIVEN]
-            .saturating_sub(reference[DRIVEN])
-            .saturating_abs();
-        if motion >= cal.stall_counts {
-            self.motion = Some((counts, self.volts, now));
-            self.stall = None;
-            self.rest = None;
-            return Ok(());
-        }
-        if self.rest.is_none() && now - moved_at >= cal.follow_time {
-            self.rest = Some(Rest {
-                other: counts[OTHER],
-                drive: self.volts,
-                pushed: None,
-            });
-        }
-        self.check_follow(counts, now)?;
-        let change = self.volts - drive;
-        let other = counts[OTHER].saturating_sub(reference[OTHER]);
-        if change.abs() < cal.stall_volts
-            || along(other, cal.sign[OTHER], change) <= -cal.stall_counts
-        {
-            self.stall = None;
-            return Ok(());
-        }
-        let stall = self.stall.get_or_insert(Episode {
-            since: now,
-            weakest: change.abs(),
-        });
-        stall.weakest = stall.weakest.min(change.abs());
-        let Episode { since, weakest } = *stall;
-        if now - since >= cal.stall_time {
-            return self.fault(LoopFault::NotResponding {
-                volts: weakest,
-                seconds: now - since,
-                counts: cal.stall_counts,
-            });
-        }
-        Ok(())
-    }
-
-    /// The driven cart at rest must move when the drive changes by
-    /// `stall_volts` and the other cart moves the way it pushes
-    /// ([`LoopFault::EncoderNotFollowing`] after `follow_time`, see
-    /// [`Calibration::follow_time`]). At rest the force on the driven cart,
-    /// the drive's plus the spring's, is within its stiction; a change of
-    /// drive of `stall_volts` (far more than the stiction) with the other
-    /// cart pulling the spring the same way can only set it moving, and
-    /// the other cart only moves after it: if its encoder stays still, the
-    /// encoder is dead. (With the calibration's signs, a positive drive
-    /// pushes cart 2 away from the wall, as the probe checks.) A cart that
-    /// has just stopped is not at rest in this sense (the force that
-    /// stopped it is still changing): the baseline is the run's first read,
-    /// or the driven cart's encoder still for `follow_time`.
-    fn check_follow(&mut self, counts: [i64; 2], now: f64) -> Result<(), RigError> {
-        let cal = self.calibration;
-        let volts = self.volts;
-        let Some(rest) = self.rest.as_mut() else {
-            return Ok(());
-        };
-        let change = volts - rest.drive;
-        if change.abs() < cal.stall_volts {
-            rest.pushed = None;
-            return Ok(());
-        }
-        let pushed = rest.pushed.get_or_insert(Episode {
-            since: now,
-            weakest: change.abs(),
-        });
-        pushed.weakest = pushed.weakest.min(change.abs());
-        let Episode { since, weakest } = *pushed;
-        let moved = along(
-            counts[OTHER].saturating_sub(rest.other),
-            cal.sign[OTHER],
-            change,
-        );
-        if moved >= cal.stall_counts && now - since >= cal.follow_time {
-            return self.fault(LoopFault::EncoderNotFollowing {
-                cart: DRIVEN + 1,
-                channel: cal.encoder_channels[DRIVEN],
-                other: OTHER + 1,
-                volts: weakest,
-                seconds: now - since,
-                moved,
-                counts: cal.stall_counts,
-            });
-        }
-        Ok(())
-    }
-
     /// Applies `volts` to the motor, saturated to ±`volts_full_scale` and
     /// quantised to the card's 0.1 % duty steps, and returns the voltage
     /// actually applied, V. [`Rig::apply`] is this.
@@ -642,66 +531,11 @@ impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
     }
 }
 
-/// One read of the counters: the counts, its time stamp (s on the rig's
-/// clock, the middle of the instants bracketing the latch) and the
-/// earliest the latch can have been.
-#[derive(Debug, Clone, Copy)]
-struct Read {
-    counts: [i64; 2],
-    stamp: f64,
-    earliest: f64,
-}
-
-/// Reads kept for the speeds: the loop needs two (the read two ticks back
-/// is always over a period old); four leave room for reads between ticks.
-const HISTORY: usize = 4;
-
-/// The last [`HISTORY`] reads, newest at `newest`, in a fixed ring.
-#[derive(Debug, Clone, Copy, Default)]
-struct History {
-    reads: [Option<Read>; HISTORY],
-    newest: usize,
-}
-
-impl History {
-    fn push(&mut self, read: Read) {
-        self.newest = (self.newest + 1) % HISTORY;
-        self.reads[self.newest] = Some(read);
-    }
-
-    /// The newest read at least `min_age` older than `now`, else the
-    /// oldest read stored (`None` when there is none).
-    fn base(&self, now: f64, min_age: f64) -> Option<Read> {
-        let mut oldest = None;
-        for back in 0..HISTORY {
-            let Some(read) = self.reads[(self.newest + HISTORY - back) % HISTORY] else {
-                break;
-            };
-            if now - read.stamp >= min_age {
-                return Some(read);
-            }
-            oldest = Some(read);
-        }
-        oldest
-    }
-}
-
 impl<P: EppPort> Drop for MassSpringRig<P> {
     /// Halts: every PWM channel to zero, as [`Rig::halt`].
     fn drop(&mut self) {
         // Best effort: a failing port cannot be reported from a destructor,
         // and the card's watchdog zeroes the PWM anyway (if it has one).
         self.halt_motor().ok();
-    }
-}
-
-/// How far a cart moved, `counts` with encoder sign `sign`, the way a
-/// change of drive `change` (V) pushes: positive along it, negative
-/// against it.
-fn along(counts: i64, sign: f64, change: f64) -> i64 {
-    if counts as f64 * sign * change > 0.0 {
-        counts.saturating_abs()
-    } else {
-        -counts.saturating_abs()
     }
 }
