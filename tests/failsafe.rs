@@ -20,6 +20,9 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
+mod common;
+
+use common::{assert_recorded, loop_config as config};
 use std::time::Duration;
 
 use ctrlab::hw::testing::{Cycle, RecordingPort};
@@ -40,13 +43,6 @@ type Card = SimulatedCard<FrictionPlant, 4>;
 /// The lab's rig on it.
 type SimRig = MassSpringRig<Card>;
 
-fn config(duration: f64) -> LoopConfig {
-    LoopConfig {
-        duration,
-        ..LoopConfig::default()
-    }
-}
-
 /// `sim`'s card on `clock` read by a rig with `calibration` (which may wire
 /// the carts differently from the card).
 fn rig_with(sim: &SimulatedRig, calibration: Calibration, clock: &Clock) -> SimRig {
@@ -64,13 +60,6 @@ fn assert_every_channel_off(rig: &mut SimRig, clock: &VirtualClock) {
     for channel in 0..PWM_CHANNELS {
         assert_eq!(card.pwm_duty(channel), 0, "PWM channel {channel}");
     }
-}
-
-/// The recording holds `samples` samples, the last at `last` s.
-fn assert_recorded(err: &RunError, samples: usize, last: f64) {
-    assert_eq!(err.recording.len(), samples, "{err}");
-    let t = *err.recording.time().last().unwrap();
-    assert!((t - last).abs() < 1e-12, "last sample at {t} s, not {last}");
 }
 
 /// A rig that passes everything to the lab's rig inside and, at every read,

@@ -19,6 +19,9 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
+mod common;
+
+use common::{assert_recorded, loop_config as config};
 use std::time::Duration;
 
 use ctrlab::hw::testing::{Cycle, RecordingPort, RegisterFile};
@@ -49,13 +52,6 @@ fn virtual_rig(sim: &SimulatedRig) -> (VirtualClock, LoggedRig) {
     let clock = VirtualClock::new();
     let rig = logged_rig(sim, &Clock::Virtual(clock.clone()));
     (clock, rig)
-}
-
-fn config(duration: f64) -> LoopConfig {
-    LoopConfig {
-        duration,
-        ..LoopConfig::default()
-    }
 }
 
 /// The PWM duties written to channel 0 (registers 0x10, 0x11), in order,
@@ -90,22 +86,6 @@ fn assert_drive_off(rig: &mut LoggedRig, clock: &Clock) {
     let card = rig.card_mut().port_mut().inner_mut();
     card.sync().unwrap();
     assert_eq!(card.pwm_duty(0), 0, "the card applies the halt");
-}
-
-/// The recording holds exactly `samples` samples, the last at `last` s
-/// (virtual time: exact to the nanosecond the clock counts in).
-fn assert_recorded(err: &RunError, samples: usize, last: f64) {
-    assert_eq!(err.recording.len(), samples, "{err}");
-    assert_eq!(err.stats.ticks, samples);
-    let t = *err.recording.time().last().unwrap();
-    assert!(
-        (t - last).abs() < 1e-12,
-        "last sample at {t} s, not {last} s"
-    );
-    assert!(
-        err.to_string()
-            .contains(&format!("after {samples} samples"))
-    );
 }
 
 /// The voltage the last recorded sample applied, V.

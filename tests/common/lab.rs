@@ -124,3 +124,28 @@ pub fn saturated(rec: &Recording) -> usize {
         .filter(|u| u.abs() >= 24.0)
         .count()
 }
+
+/// The loop's default settings, for a run of `duration` s.
+pub fn loop_config(duration: f64) -> LoopConfig {
+    LoopConfig {
+        duration,
+        ..LoopConfig::default()
+    }
+}
+
+/// The halted run's recording holds exactly `samples` samples, the last at
+/// `last` s (virtual time: exact to the nanosecond the clock counts in), and
+/// the error says how many.
+pub fn assert_recorded(err: &hw::RunError, samples: usize, last: f64) {
+    assert_eq!(err.recording.len(), samples, "{err}");
+    assert_eq!(err.stats.ticks, samples);
+    let t = *err.recording.time().last().unwrap();
+    assert!(
+        (t - last).abs() < 1e-12,
+        "last sample at {t} s, not {last} s"
+    );
+    assert!(
+        err.to_string()
+            .contains(&format!("after {samples} samples"))
+    );
+}
