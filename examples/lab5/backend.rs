@@ -9,6 +9,7 @@ use ctrlab::hw::{
     Clock, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome, StopSignal,
     VirtualClock, run,
 };
+use ctrlab::lab::ident_input::IdentInput;
 use ctrlab::lab::protocol::PERIOD;
 use ctrlab::lab::{Calibration, CardSettings, FrictionPlant, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::SVector;
@@ -25,6 +26,9 @@ pub struct Backend {
     pub stop: StopSignal,
     /// Where each run's CSV goes (`runs/` under it).
     pub out: PathBuf,
+    /// The identification input asked for: the card file's `[ident]` (or
+    /// the lab's default) with `--ident-*` on top.
+    pub ident: IdentInput,
 }
 
 pub enum BackendKind {
@@ -55,6 +59,8 @@ pub struct LoopTiming {
     pub overruns: usize,
     /// Skipped ticks, summed.
     pub skipped: usize,
+    /// Late ticks (sampled after their deadline), summed.
+    pub late: usize,
     /// Longest interval between samples, s.
     pub max_interval: f64,
 }
@@ -72,6 +78,13 @@ impl Backend {
         // the process during the real card's countdown, before anything is
         // driven.
         let kind = kind(args)?;
+        let base = match &kind {
+            BackendKind::Simulated { .. } => IdentInput::default(),
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { config, .. } => config.ident,
+        };
+        let ident = args.ident_input(base);
+        ident.validate()?;
         // Then Ctrl-C halts the rig and ends the run with its recording,
         // instead of killing the process with the motor at its last duty.
         let stop = StopSignal::on_interrupt()?;
@@ -80,6 +93,7 @@ impl Backend {
             realtime,
             stop,
             out: args.out.clone(),
+            ident,
         })
     }
 
@@ -130,6 +144,7 @@ impl Backend {
             realtime: self.realtime,
             stop: self.stop.clone(),
             out: self.out.clone(),
+            ident: self.ident,
         }
     }
 
@@ -213,6 +228,7 @@ impl Backend {
             lateness_max: worst(|s| s.lateness_max),
             overruns: stats.iter().map(|s| s.overruns).sum(),
             skipped: stats.iter().map(|s| s.skipped).sum(),
+            late: stats.iter().map(|s| s.late).sum(),
             max_interval: worst(|s| s.max_interval),
         })
     }
@@ -236,7 +252,7 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
             let (file, config) = crate::card::load(port, args.card.as_deref())?;
             println!(
                 "{}",
-                crate::card::plan(port, file, &config, ctrlab::lab::protocol::IDENT_VOLTS)
+                crate::card::plan(port, file, &config, &args.ident_input(config.ident))
             );
             let id = crate::card::check_id(port, &config)?;
             println!(

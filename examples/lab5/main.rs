@@ -124,14 +124,18 @@ fn rig_sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn st
     report.table2(&table2)?;
     let truth = backend.friction_truth();
     let (runs, source) = identification::rig_runs(backend)?;
+    if let identification::Source::Rig { input, .. } = &source {
+        report.identification_input(input, &runs);
+    }
     let mut ident = identification::identify(runs, source)?;
     report.identification(Some(backend), &ident, truth.as_ref())?;
-    ident.equal_springs = identification::equal_springs(backend)?;
+    let volts = ident.volts();
+    ident.equal_springs = identification::equal_springs(backend, volts)?;
     if let Some(e) = &ident.equal_springs {
         report.equal_springs(e);
     }
-    let excitation = excitation::section(backend)?;
-    report.excitation(&excitation.inputs);
+    let excitation = excitation::section(backend, volts)?;
+    report.excitation(excitation.volts, &excitation.inputs);
     let model = backend
         .sim()
         .map_or_else(SimulationModel::default, SimulatedRig::simulation_model);

@@ -41,7 +41,7 @@ use super::excitation::{Input, MULTISINE_LINES, PRBS_BITS, PRBS_CLOCK, PRBS_SEED
 use super::protocol::{IDENT_HALF_PERIOD, IDENT_VOLTS, PERIOD};
 use crate::Recording;
 use crate::error::Error;
-use crate::hw::ConfigError;
+use crate::hw::{ConfigError, RigError, RunError};
 use crate::signal::{Multisine, Phases, Prbs, SquareWave};
 
 /// The largest predicted peak excursion of either cart, as a fraction of
@@ -629,4 +629,178 @@ impl AmplitudeSearch {
             limits: self.limits,
         })
     }
+}
+
+/// An identification run that completed: its seed (its number in the
+/// lab's order, from 1) and recording.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident_input::CompletedRun;
+/// let run = CompletedRun { seed: 1, recording: ctrlab::Recording::new(ctrlab::lab::schema()) };
+/// assert_eq!(run.seed, 1);
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompletedRun {
+    /// The run's seed (its number, from 1).
+    pub seed: u64,
+    /// Its recording.
+    pub recording: Recording,
+}
+
+/// An identification run the rig halted (a travel limit, say): its seed,
+/// the loop's error and what it recorded up to the fault.
+#[derive(Debug)]
+pub struct HaltedRun {
+    /// The run's seed (its number, from 1).
+    pub seed: u64,
+    /// Why the rig halted it (a [`LoopFault::TravelLimit`] names the cart's
+    /// axis, its position and the limit, m).
+    ///
+    /// [`LoopFault::TravelLimit`]: crate::hw::LoopFault::TravelLimit
+    pub error: RigError,
+    /// Every sample before the fault.
+    pub recording: Recording,
+}
+
+/// The identification runs on a rig: those that completed, which the
+/// identification averages, and those the rig halted, which it leaves
+/// out. A halted run does not stop the others.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::{LoopFault, RigError, RunError, LoopStats};
+/// use ctrlab::lab::ident_input::IdentRuns;
+/// use ctrlab::Recording;
+/// let runs = IdentRuns::collect(1..=3, |seed| {
+///     let recording = Recording::new(ctrlab::lab::schema());
+///     Ok::<_, ctrlab::Error>(if seed == 2 {
+///         let error = RigError::Fault(LoopFault::TravelLimit { axis: 2, position: 0.051, limit: 0.05 });
+///         Err(Box::new(RunError { error, recording, last_measurement: None, stats: LoopStats::default() }))
+///     } else {
+///         Ok(recording)
+///     })
+/// })?;
+/// assert_eq!(runs.completed.iter().map(|r| r.seed).collect::<Vec<_>>(), [1, 3]);
+/// assert_eq!(runs.halted[0].seed, 2);
+/// assert!(runs.enough().is_ok());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[derive(Debug, Default)]
+pub struct IdentRuns {
+    /// The runs that completed, in order.
+    pub completed: Vec<CompletedRun>,
+    /// The runs the rig halted, in order.
+    pub halted: Vec<HaltedRun>,
+}
+
+impl IdentRuns {
+    /// Runs `run` for each of `seeds` (bounded by the iterator) and sorts
+    /// the outcomes: a run's own error (the rig halted it, with what it
+    /// recorded) goes to [`halted`](Self::halted) and the next run goes
+    /// on; `run`'s outer error (a set-up failure, Ctrl-C) stops here.
+    ///
+    /// # Errors
+    ///
+    /// `run`'s outer error.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident_input::IdentRuns;
+    /// let runs = IdentRuns::collect(1..=2, |_| Ok::<_, ctrlab::Error>(Ok(ctrlab::Recording::new(ctrlab::lab::schema()))))?;
+    /// assert_eq!((runs.completed.len(), runs.halted.len()), (2, 0));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn collect<E>(
+        seeds: impl IntoIterator<Item = u64>,
+        mut run: impl FnMut(u64) -> Result<Result<Recording, Box<RunError>>, E>,
+    ) -> Result<Self, E> {
+        let mut runs = Self::default();
+        for seed in seeds {
+            match run(seed)? {
+                Ok(recording) => runs.completed.push(CompletedRun { seed, recording }),
+                Err(e) => {
+                    let RunError {
+                        error, recording, ..
+                    } = *e;
+                    runs.halted.push(HaltedRun {
+                        seed,
+                        error,
+                        recording,
+                    });
+                }
+            }
+        }
+        Ok(runs)
+    }
+
+    /// The completed runs' recordings, in order, for
+    /// [`summarize`](super::ident::summarize).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident_input::IdentRuns;
+    /// assert_eq!(IdentRuns::default().recordings().count(), 0);
+    /// ```
+    pub fn recordings(&self) -> impl Iterator<Item = &Recording> {
+        self.completed.iter().map(|r| &r.recording)
+    }
+
+    /// Whether enough runs completed for the averages (and a fresh run
+    /// for the validation): at least two.
+    ///
+    /// # Errors
+    ///
+    /// [`TooFewRuns`], naming each halted run and why.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident_input::IdentRuns;
+    /// let err = IdentRuns::default().enough().unwrap_err();
+    /// assert_eq!((err.completed, err.total), (0, 0));
+    /// assert!(err.to_string().starts_with("only 0 of 0 identification runs completed"), "{err}");
+    /// ```
+    pub fn enough(&self) -> Result<(), TooFewRuns> {
+        if self.completed.len() >= 2 {
+            return Ok(());
+        }
+        Err(TooFewRuns {
+            completed: self.completed.len(),
+            total: self.completed.len() + self.halted.len(),
+            halted: self
+                .halted
+                .iter()
+                .map(|h| format!("run {}: {}", h.seed, h.error))
+                .collect(),
+        })
+    }
+}
+
+/// Fewer than two identification runs completed: the averages (and the
+/// validation on a fresh run) need two.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident_input::TooFewRuns;
+/// let e = TooFewRuns { completed: 1, total: 5, halted: vec!["run 2: beyond its travel limit".into()] };
+/// assert!(e.to_string().contains("only 1 of 5") && e.to_string().contains("run 2: beyond"));
+/// ```
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "only {completed} of {total} identification runs completed (halted: {}); the averages and the validation on a fresh run need at least two: lower the amplitude",
+    halted.join("; ")
+)]
+pub struct TooFewRuns {
+    /// Runs that completed.
+    pub completed: usize,
+    /// Runs tried.
+    pub total: usize,
+    /// Each halted run and why, as `run 3: <the loop's error>`.
+    pub halted: Vec<String>,
 }
