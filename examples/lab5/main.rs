@@ -3,7 +3,11 @@
 //! (`lab::MassSpringRig` → `Pc104` → `SimulatedCard`) with a virtual clock:
 //!
 //! - Tables 1 and 2 in simulation (nominal model);
-//! - five identification runs on the rig, Tables 3 and 4 with averages, by
+//! - the identification input's amplitude, chosen from two short probe runs
+//!   so that neither cart is predicted past 60 % of its travel
+//!   (`lab::ident_input`; `--ident-*` to choose the signal and amplitude);
+//! - five identification runs on the rig (a run the rig halts is reported
+//!   and left out), Tables 3 and 4 with averages, by
 //!   the lab's formulas and the bias-free central scheme, and the identified
 //!   state equations;
 //! - Tables 5 and 6 run on the rig with the lab's gains;
@@ -23,6 +27,7 @@
 //! cargo run --release --example lab5 -- --out my_report      # elsewhere
 //! cargo run --release --example lab5 -- --truth truth.toml   # another simulated rig
 //! cargo run --release --example lab5 -- --logs my_runs        # Tables 3 and 4 from my CSV logs
+//! cargo run --release --example lab5 -- --ident-signal prbs --ident-volts 6   # another input
 //! cargo run --release --example lab5 -- --real-time          # wall-clock loop (about two minutes)
 //! cargo run --release --example lab5 -- --real-time --rt-priority 80   # with SCHED_FIFO
 //! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml
