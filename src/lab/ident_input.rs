@@ -18,7 +18,15 @@
 //! probes look concave. The amplitude is then the largest, up to the one
 //! asked for, whose predicted peak on either cart is at most
 //! [`TRAVEL_FRACTION`] of its travel limit
-//! ([`Calibration::travel_limits`](super::Calibration::travel_limits)).
+//! ([`Calibration::travel_limits`](super::Calibration::travel_limits)),
+//! rounded down to 10 mV.
+//!
+//! How well, measured on the simulated rigs (`tests/lab_ident_input.rs`):
+//! where the travel limits the amplitude, the runs' peak is within 3 % of
+//! the prediction (the square wave: −1.3 % on the default rig, −0.3 % on a
+//! lighter-damped one; a PRBS +2.5 %). Where the amplitude asked for fits,
+//! the prediction is farther off (a multisine whose probes barely clear
+//! the friction: +45 %) but far from the limit.
 //!
 //! # Examples
 //!
@@ -434,7 +442,8 @@ impl fmt::Display for Reason {
 pub struct AmplitudeChoice {
     /// The peak voltage asked for, V.
     pub asked: f64,
-    /// The peak voltage chosen, V (at most `asked`).
+    /// The peak voltage chosen, V (at most `asked`; when scaled, rounded
+    /// down to 10 mV).
     pub volts: f64,
     /// Why.
     pub reason: Reason,
@@ -617,7 +626,12 @@ impl AmplitudeSearch {
         let (volts, reason) = match cart {
             None => (self.asked, Reason::NoMotion),
             Some(_) if largest >= self.asked => (self.asked, Reason::Fits),
-            Some(cart) => (largest.max(0.0), Reason::Scaled { cart }),
+            // Down to 10 mV (below the drive's 24 mV step): a round
+            // number to report, never above the prediction's.
+            Some(cart) => (
+                ((largest * 100.0).floor() / 100.0).max(0.0),
+                Reason::Scaled { cart },
+            ),
         };
         Ok(AmplitudeChoice {
             asked: self.asked,

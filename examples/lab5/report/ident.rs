@@ -137,12 +137,17 @@ impl Report {
             ],
             &rows,
         );
-        for f in &input.failed {
+        if !input.failed.is_empty() {
+            let halted: Vec<String> = input
+                .failed
+                .iter()
+                .map(|f| format!("`{}` after {:.3} s ({})", f.name, f.ran, f.error))
+                .collect();
             self.add(&format!(
-                "Identification run `{}` was halted after {:.3} s: {}. It is left out: the identification uses the {} runs that completed.\n",
-                f.name,
-                f.ran,
-                f.error,
+                "The rig halted {} of the {} identification runs: {}. They are left out: the identification uses the {} that completed.\n",
+                input.failed.len(),
+                input.failed.len() + runs.len(),
+                halted.join("; "),
                 runs.len()
             ));
         }
