@@ -112,15 +112,13 @@ fn assert_usual_bounds(s: &Summary, sim: &SimulatedRig) {
     ] {
         assert!(rel(got, want) < 0.005, "{name}: {got} against {want}");
     }
-    let f = s.coulomb();
-    for c in 0..2 {
-        let want = sim.friction.coulomb[c];
-        assert!(
-            rel(f[c], want) < 0.05,
-            "F{}: {} against {want}",
-            c + 1,
-            f[c]
-        );
+    for (c, (got, want)) in s
+        .coulomb()
+        .into_iter()
+        .zip(sim.friction.coulomb)
+        .enumerate()
+    {
+        assert!(rel(got, want) < 0.05, "F{}: {got} against {want}", c + 1);
     }
 }
 
@@ -199,8 +197,8 @@ fn on_the_lighter_damped_rig_8_v_hits_the_travel_limit_and_the_chosen_amplitude_
     );
     assert!(err.error.to_string().contains("travel limit"), "{err}");
 
-    // Probes: 9.06 mm at 2 V, 25.11 mm at 4 V (8.0 mm/V through both);
-    // 60 % of the travel: 4.608 V, scaled for cart 2.
+    // Probes: 9.06 mm at 2 V, 25.12 mm at 4 V (8.0 mm/V through both);
+    // 60 % of the travel: 4.608 V, rounded down to 4.60 V, for cart 2.
     let choice = choose(&sim, &ident);
     assert_eq!(choice.reason, Reason::Scaled { cart: 1 });
     assert!((4.5..4.7).contains(&choice.volts), "{}", choice.volts);
@@ -218,10 +216,10 @@ fn on_the_lighter_damped_rig_8_v_hits_the_travel_limit_and_the_chosen_amplitude_
 #[test]
 fn prbs_and_multisine_on_the_lighter_rig_stay_within_the_travel_with_the_measured_slack() {
     let sim = lighter();
-    // Measured: the PRBS at 5.732 V peaks at 30.75 mm on cart 2 (102.5 %
+    // Measured: the PRBS at 5.73 V peaks at 30.75 mm on cart 2 (102.5 %
     // of the 30 mm allowed: its largest excursion comes from a bit pattern
     // the probes at 2 and 4 V meet less squarely), the multisine at
-    // 6.505 V at 29.66 mm (98.9 %). Slack: 3 %.
+    // 6.50 V at 29.66 mm (98.9 %). Slack: 3 %.
     for (signal, volts) in [(IdentSignal::Prbs, 5.73), (IdentSignal::Multisine, 6.50)] {
         let ident = IdentInput {
             signal,
