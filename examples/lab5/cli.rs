@@ -67,7 +67,7 @@ pub struct Args {
     /// The identification input's peak voltage asked for, V: lowered to
     /// keep both carts within 60 % of their travel (from two short probe
     /// runs) unless --ident-fixed [default: 8, or the card file's]
-    #[arg(long, value_name = "V", value_parser = ident_volts, conflicts_with = "logs")]
+    #[arg(long, value_name = "V", value_parser = ident_volts, allow_negative_numbers = true, conflicts_with = "logs")]
     pub ident_volts: Option<f64>,
     /// The square wave's half period, s [default: 0.2, or the card file's]
     #[arg(long, value_name = "S", value_parser = ident_half_period, conflicts_with = "logs")]
