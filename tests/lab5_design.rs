@@ -10,18 +10,39 @@ mod common;
 
 use common::run_on_rig;
 use ctrlab::lab::ident::{SEPARATE_SPRINGS, identify_with};
+use ctrlab::lab::ident_input::{AmplitudeSearch, IdentInput, PROBE_DURATION, peaks};
 use ctrlab::lab::lqi::{self, Design, Metrics, Spec};
 use ctrlab::lab::protocol::{self, IDENT_DURATION};
 use ctrlab::lab::{CardSettings, Cart, Friction, MassSpring, SimulatedRig};
+use ctrlab::signal::SquareWave;
 use std::sync::OnceLock;
 
 const SETPOINT: f64 = 0.030;
 
 /// The plant and Coulomb friction identified from one of lab5's
-/// identification runs (±8 V square wave, 0.2 s half period, 5 s) on
-/// `sim`, with the masses known.
+/// identification runs on `sim` (the square wave of 0.2 s half period,
+/// 5 s, at the amplitude lab5 chooses from its probe runs: 7.64 V on the
+/// default rig), with the masses known.
 fn identified(sim: &SimulatedRig) -> (MassSpring, [f64; 2]) {
-    let wave = protocol::ident_square_wave().unwrap();
+    let ident = IdentInput::default();
+    let mut n = 0;
+    let volts = AmplitudeSearch::new(ident.volts, sim.calibration.travel_limits)
+        .unwrap()
+        .run(|v| {
+            n += 1;
+            let probe = SimulatedRig {
+                card: CardSettings {
+                    seed: 100 + n,
+                    ..sim.card
+                },
+                ..sim.clone()
+            };
+            let input = ident.input(v, IDENT_DURATION).unwrap();
+            peaks(&common::open_loop(&probe, &input, PROBE_DURATION))
+        })
+        .unwrap()
+        .volts;
+    let wave = SquareWave::new(volts, protocol::IDENT_HALF_PERIOD).unwrap();
     let rec = common::open_loop(sim, &wave, IDENT_DURATION);
     let (m1, m2) = (sim.truth.m1, sim.truth.m2);
     let e = identify_with(&rec, m1, m2, &SEPARATE_SPRINGS).unwrap();

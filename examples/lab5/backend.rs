@@ -9,6 +9,7 @@ use ctrlab::hw::{
     Clock, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome, StopSignal,
     VirtualClock, run,
 };
+use ctrlab::lab::ident_input::IdentInput;
 use ctrlab::lab::protocol::PERIOD;
 use ctrlab::lab::{Calibration, CardSettings, FrictionPlant, MassSpring, SimulatedRig};
 use ctrlab::nalgebra::SVector;
@@ -26,6 +27,9 @@ pub struct Backend {
     pub stop: StopSignal,
     /// Where each run's CSV goes (`runs/` under it).
     pub out: PathBuf,
+    /// The identification input asked for: the card file's `[ident]` (or
+    /// the lab's default) with `--ident-*` on top.
+    pub ident: IdentInput,
 }
 
 pub enum BackendKind {
@@ -40,7 +44,7 @@ pub enum BackendKind {
     #[cfg(all(feature = "ppdev", target_os = "linux"))]
     Card {
         port: PathBuf,
-        config: ctrlab::lab::RigConfig,
+        config: Box<ctrlab::lab::RigConfig>,
     },
 }
 
@@ -56,6 +60,8 @@ pub struct LoopTiming {
     pub overruns: usize,
     /// Skipped ticks, summed.
     pub skipped: usize,
+    /// Late ticks (sampled after their deadline), summed.
+    pub late: usize,
     /// Longest interval between samples, s.
     pub max_interval: f64,
 }
@@ -73,6 +79,13 @@ impl Backend {
         // the process during the real card's countdown, before anything is
         // driven.
         let kind = kind(args)?;
+        let base = match &kind {
+            BackendKind::Simulated { .. } => IdentInput::default(),
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { config, .. } => config.ident,
+        };
+        let ident = args.ident_input(base);
+        ident.validate()?;
         // Then Ctrl-C halts the rig and ends the run with its recording,
         // instead of killing the process with the motor at its last duty.
         let stop = StopSignal::on_interrupt()?;
@@ -81,6 +94,7 @@ impl Backend {
             realtime,
             stop,
             out: args.out.clone(),
+            ident,
         })
     }
 
@@ -131,6 +145,7 @@ impl Backend {
             realtime: self.realtime,
             stop: self.stop.clone(),
             out: self.out.clone(),
+            ident: self.ident,
         }
     }
 
@@ -214,6 +229,7 @@ impl Backend {
             lateness_max: worst(|s| s.lateness_max),
             overruns: stats.iter().map(|s| s.overruns).sum(),
             skipped: stats.iter().map(|s| s.skipped).sum(),
+            late: stats.iter().map(|s| s.late).sum(),
             max_interval: worst(|s| s.max_interval),
         })
     }
@@ -238,7 +254,7 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
                 crate::card::load(port, args.card.as_deref(), args.no_watchdog_acknowledged)?;
             println!(
                 "{}",
-                crate::card::plan(port, file, &config, ctrlab::lab::protocol::IDENT_VOLTS)
+                crate::card::plan(port, file, &config, &args.ident_input(config.ident))
             );
             let id = crate::card::check_id(port, &config)?;
             println!(
@@ -249,7 +265,7 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
             std::thread::sleep(std::time::Duration::from_secs(10));
             Ok(BackendKind::Card {
                 port: port.clone(),
-                config,
+                config: Box::new(config),
             })
         }
         #[cfg(not(all(feature = "ppdev", target_os = "linux")))]

@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use ctrlab::hw::{Pc104, Ppdev, RigError};
+use ctrlab::lab::ident_input::{IdentInput, PROBE_DURATION, PROBE_FRACTIONS, TRAVEL_FRACTION};
 use ctrlab::lab::{MassSpringRig, RigConfig};
 
 /// The card file named by `--card` and its configuration, checked (a card
@@ -42,7 +43,7 @@ pub fn load<'a>(
 
 /// What the run will do, for the person at the rig to check before the
 /// first register access.
-pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> String {
+pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident: &IdentInput) -> String {
     let cal = &config.calibration;
     let what = config
         .to_string()
@@ -54,7 +55,7 @@ pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> S
          port: {port}\n\
          card file: {card}\n\
          {what}\
-         runs: 5 open-loop runs of 5 s with a ±{ident_volts} V square wave, 20 more of 5 s \
+         runs: {probes}5 open-loop runs of 5 s with a {signal} of {ident_volts}, 20 more of 5 s \
          comparing inputs of the same peak (square wave, PRBS, multisine, chirp), then 26 closed-loop \
          runs of 3 s (24 for Tables 5 and 6, 2 for the Design section's LQI) saturated at ±{full} V, 3 s pauses between runs; each run \
          halts the motor at the first fault (travel limit, bus fault, stall, a dead cart-2 encoder, \
@@ -65,6 +66,25 @@ pub fn plan(port: &Path, card: &Path, config: &RigConfig, ident_volts: f64) -> S
         card = card.display(),
         full = cal.volts_full_scale,
         id = config.map.id,
+        signal = ident.signal,
+        probes = if ident.scale_to_travel {
+            format!(
+                "2 probe runs of {PROBE_DURATION} s at {} and {} V, ",
+                PROBE_FRACTIONS[0] * ident.volts,
+                PROBE_FRACTIONS[1] * ident.volts
+            )
+        } else {
+            String::new()
+        },
+        ident_volts = if ident.scale_to_travel {
+            format!(
+                "at most ±{} V (lowered to keep both carts within {:.0} % of their travel)",
+                ident.volts,
+                TRAVEL_FRACTION * 100.0
+            )
+        } else {
+            format!("±{} V (fixed)", ident.volts)
+        },
     )
 }
 

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use clap::Parser;
+use ctrlab::lab::ident_input::{IdentInput, IdentSignal};
 
 /// The whole of Lab 5 (state feedback control of the two-cart rig): every
 /// table, the identification, validation, frequency response and design,
@@ -21,6 +22,8 @@ use clap::Parser;
   cargo run --release --example lab5 -- --truth truth.toml
   cargo run --release --example lab5 -- --logs my_runs --metres-per-count 0.000009765625
   cargo run --release --example lab5 -- --real-time --rt-priority 80
+  cargo run --release --example lab5 -- --ident-signal prbs --ident-volts 6
+  cargo run --release --example lab5 -- --ident-volts 12 --ident-fixed
   cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml"
 )]
 pub struct Args {
@@ -63,6 +66,69 @@ pub struct Args {
     /// logged in counts
     #[arg(long, value_name = "M", value_parser = positive_metres, requires = "logs")]
     pub metres_per_count: Option<f64>,
+    /// The identification input's signal: square (the lab's), prbs or
+    /// multisine [default: square, or the card file's [ident] signal]
+    #[arg(long, value_name = "SIGNAL", value_parser = ident_signal, conflicts_with = "logs")]
+    pub ident_signal: Option<IdentSignal>,
+    /// The identification input's peak voltage asked for, V: lowered to
+    /// keep both carts within 60 % of their travel (from two short probe
+    /// runs) unless --ident-fixed [default: 8, or the card file's]
+    #[arg(long, value_name = "V", value_parser = ident_volts, allow_negative_numbers = true, conflicts_with = "logs")]
+    pub ident_volts: Option<f64>,
+    /// The square wave's half period, s [default: 0.2, or the card file's]
+    #[arg(long, value_name = "S", value_parser = ident_half_period, conflicts_with = "logs")]
+    pub ident_half_period: Option<f64>,
+    /// Run the identification input at --ident-volts as is: no probe runs,
+    /// no scaling to the travel (a run that hits a travel limit is
+    /// reported and the lab goes on with the others)
+    #[arg(long, conflicts_with = "logs")]
+    pub ident_fixed: bool,
+}
+
+impl Args {
+    /// The identification input: `base` (the card file's, or the lab's
+    /// default) with the command line's `--ident-*` on top.
+    pub fn ident_input(&self, base: IdentInput) -> IdentInput {
+        IdentInput {
+            signal: self.ident_signal.unwrap_or(base.signal),
+            volts: self.ident_volts.unwrap_or(base.volts),
+            half_period: self.ident_half_period.unwrap_or(base.half_period),
+            scale_to_travel: base.scale_to_travel && !self.ident_fixed,
+        }
+    }
+}
+
+/// `--ident-signal`: one of [`IdentSignal::ALL`].
+fn ident_signal(s: &str) -> Result<IdentSignal, String> {
+    s.parse().map_err(|_| {
+        let names: Vec<&str> = IdentSignal::ALL.iter().map(|k| k.name()).collect();
+        format!("`{s}` is not one of {}", names.join(", "))
+    })
+}
+
+/// `--ident-volts`: checked as the card file's `ident.volts` is
+/// ([`IdentInput::validate`]), with the same reason.
+fn ident_volts(s: &str) -> Result<f64, String> {
+    let volts: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    IdentInput {
+        volts,
+        ..IdentInput::default()
+    }
+    .validate()
+    .map_err(|e| e.reason().to_owned())?;
+    Ok(volts)
+}
+
+/// `--ident-half-period`: checked as the card file's `ident.half_period`.
+fn ident_half_period(s: &str) -> Result<f64, String> {
+    let half_period: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    IdentInput {
+        half_period,
+        ..IdentInput::default()
+    }
+    .validate()
+    .map_err(|e| e.reason().to_owned())?;
+    Ok(half_period)
 }
 
 /// `--out`: a directory, or a path that does not exist yet.

@@ -5,9 +5,7 @@
 use ctrlab::Recording;
 use ctrlab::lab::excitation::{Estimates, Failure, Input, InputResult, inputs};
 use ctrlab::lab::ident::{MassSpringEstimate, SEPARATE_SPRINGS, identify_with};
-use ctrlab::lab::protocol::{
-    IDENT_DURATION, IDENT_HALF_PERIOD, IDENT_RUNS, IDENT_VOLTS, M1, M2, PERIOD,
-};
+use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, M1, M2, PERIOD};
 use ctrlab::nalgebra::vector;
 use ctrlab::signal::Signal;
 
@@ -16,6 +14,8 @@ use crate::backend::Backend;
 /// Every input's result, and the first PRBS run's recording: a run the
 /// Validation section's models have not seen.
 pub struct Excitation {
+    /// The inputs' peak, V: the identification's amplitude.
+    pub volts: f64,
     pub inputs: Vec<InputResult>,
     pub fresh: Option<Recording>,
 }
@@ -23,13 +23,14 @@ pub struct Excitation {
 /// The name of the fresh run's recording.
 pub const FRESH_RUN: &str = "runs/excite_1_1.csv";
 
-/// Every input [`IDENT_RUNS`] times (recordings `runs/excite_{i}_{seed}`),
-/// up to the first run that fails.
-pub fn section(backend: &Backend) -> Result<Excitation, Box<dyn std::error::Error>> {
+/// Every input [`IDENT_RUNS`] times at `volts` peak (the identification's
+/// amplitude; recordings `runs/excite_{i}_{seed}`), up to the first run
+/// that fails.
+pub fn section(backend: &Backend, volts: f64) -> Result<Excitation, Box<dyn std::error::Error>> {
     let truth = backend.friction_truth();
     let mut results = Vec::new();
     let mut fresh = None;
-    for (i, input) in inputs(IDENT_VOLTS, IDENT_DURATION, IDENT_HALF_PERIOD)?
+    for (i, input) in inputs(volts, IDENT_DURATION, backend.ident.half_period)?
         .into_iter()
         .enumerate()
     {
@@ -71,6 +72,7 @@ pub fn section(backend: &Backend) -> Result<Excitation, Box<dyn std::error::Erro
         });
     }
     Ok(Excitation {
+        volts,
         inputs: results,
         fresh,
     })

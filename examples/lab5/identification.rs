@@ -8,9 +8,12 @@ use ctrlab::data::CsvOptions;
 use ctrlab::hw::LoopStats;
 use ctrlab::lab::MassSpring;
 use ctrlab::lab::ident::{EqualSprings, Summary, SummaryError, summarize};
-use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, M1, M2, ident_square_wave};
+use ctrlab::lab::ident_input::{
+    AmplitudeChoice, AmplitudeSearch, IdentInput, IdentRuns, PROBE_DURATION, TooFewRuns, peaks,
+};
+use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, M1, M2};
 use ctrlab::nalgebra::vector;
-use ctrlab::signal::Signal;
+use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::{OpenLoop, Recording};
 
 use crate::backend::{Backend, LoopTiming};
@@ -21,11 +24,34 @@ pub struct Run {
     pub recording: Recording,
 }
 
+/// An identification run the rig halted (a travel limit, say): left out
+/// of the averages.
+pub struct FailedRun {
+    pub name: String,
+    /// The run's error, as the loop gives it (it names the limit).
+    pub error: String,
+    /// How long it ran, s.
+    pub ran: f64,
+    /// Both carts' largest |x| before it halted, m.
+    pub peaks: [f64; 2],
+}
+
+/// The identification input on the rig: what was asked, the amplitude
+/// chosen and why, and the runs the rig halted.
+pub struct RigInput {
+    pub input: IdentInput,
+    pub choice: AmplitudeChoice,
+    pub failed: Vec<FailedRun>,
+}
+
 /// Where the runs come from.
 pub enum Source {
-    /// [`IDENT_RUNS`] runs of the square wave on the rig, and the loop's
-    /// timing when it ran in real time.
-    Rig { timing: Option<LoopTiming> },
+    /// [`IDENT_RUNS`] runs of the identification input on the rig (those
+    /// that completed), and the loop's timing when it ran in real time.
+    Rig {
+        timing: Option<LoopTiming>,
+        input: Box<RigInput>,
+    },
     /// Every `*.csv` of a directory, read with a calibration.
     Logs {
         dir: PathBuf,
@@ -54,37 +80,101 @@ impl Identification {
         self.summary.coulomb()
     }
 
+    /// The identification input's peak voltage on the rig, V (the lab's
+    /// default for logs).
+    pub fn volts(&self) -> f64 {
+        match &self.source {
+            Source::Rig { input, .. } => input.choice.volts,
+            Source::Logs { .. } => ctrlab::lab::protocol::IDENT_VOLTS,
+        }
+    }
+
     /// The runs' recordings, in order.
     pub fn recordings(&self) -> Vec<&Recording> {
         self.runs.iter().map(|r| &r.recording).collect()
     }
 }
 
-/// The lab's identification runs on the rig: [`IDENT_RUNS`] runs of the
-/// square wave, each saved as `runs/ident_{seed}.csv`.
+/// The lab's identification runs on the rig: the amplitude chosen from
+/// two probe runs (`runs/ident_probe_{n}.csv`; none with `--ident-fixed`),
+/// then [`IDENT_RUNS`] runs of the input at it, each saved as
+/// `runs/ident_{seed}.csv`. A run the rig halts (a travel limit) is kept
+/// in [`RigInput::failed`] and the others go on; set-up failures and
+/// Ctrl-C stop here.
 pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::error::Error>> {
-    let wave = ident_square_wave()?;
-    let mut runs = Vec::new();
+    let ident = backend.ident;
+    let limits = backend.calibration().travel_limits;
     let mut stats: Vec<LoopStats> = Vec::new();
-    for seed in 1..=IDENT_RUNS {
-        let name = format!("ident_{seed}");
-        let out = backend
-            .experiment(
-                &name,
-                seed,
-                OpenLoop,
-                |t| vector![wave.value(t)],
-                IDENT_DURATION,
-            )?
-            .map_err(|e| format!("identification run {seed}: {e}"))?;
-        stats.push(out.stats);
-        runs.push(Run {
-            name,
-            recording: out.recording,
-        });
-    }
+    let choice = if ident.scale_to_travel {
+        let mut n = 0;
+        AmplitudeSearch::new(ident.volts, limits)?.run(
+            |volts| -> Result<[f64; 2], Box<dyn std::error::Error>> {
+                n += 1;
+                // The runs' own signal (a multisine's lines are the run's
+                // harmonics), for the probe's length.
+                let input = ident.input(volts, IDENT_DURATION)?;
+                let outcome = backend.experiment(
+                    &format!("ident_probe_{n}"),
+                    100 + n,
+                    OpenLoop,
+                    |t| vector![input.value(t)],
+                    PROBE_DURATION,
+                )?;
+                let recording = match &outcome {
+                    Ok(out) => &out.recording,
+                    Err(e) => &e.recording,
+                };
+                Ok(peaks(recording)?)
+            },
+        )?
+    } else {
+        AmplitudeChoice::fixed(ident.volts, limits)
+    };
+    let input = ident.input(choice.volts, IDENT_DURATION)?;
+    let collected = IdentRuns::collect(1..=IDENT_RUNS, |seed| {
+        let outcome = backend.experiment(
+            &format!("ident_{seed}"),
+            seed,
+            OpenLoop,
+            |t| vector![input.value(t)],
+            IDENT_DURATION,
+        )?;
+        Ok::<_, Box<dyn std::error::Error>>(match outcome {
+            Ok(out) => {
+                stats.push(out.stats);
+                Ok(out.recording)
+            }
+            Err(e) => {
+                stats.push(e.stats.clone());
+                Err(e)
+            }
+        })
+    })?;
+    let runs = collected
+        .completed
+        .into_iter()
+        .map(|r| Run {
+            name: format!("ident_{}", r.seed),
+            recording: r.recording,
+        })
+        .collect();
+    let failed = collected
+        .halted
+        .into_iter()
+        .map(|h| FailedRun {
+            name: format!("ident_{}", h.seed),
+            error: h.error.to_string(),
+            ran: h.recording.time().last().copied().unwrap_or(0.0),
+            peaks: peaks(&h.recording).unwrap_or([f64::NAN; 2]),
+        })
+        .collect();
     let timing = backend.timing(&stats);
-    Ok((runs, Source::Rig { timing }))
+    let input = Box::new(RigInput {
+        input: ident,
+        choice,
+        failed,
+    });
+    Ok((runs, Source::Rig { timing, input }))
 }
 
 /// Every `*.csv` file in `dir`, in file-name order, read with `options`.
@@ -128,10 +218,26 @@ pub fn log_runs(
 }
 
 /// Tables 3 and 4 from `runs`: every run identified three ways, averaged.
+/// Fewer than two runs (the rig halted the others) is an error that says
+/// so.
 pub fn identify(
     runs: Vec<Run>,
     source: Source,
 ) -> Result<Identification, Box<dyn std::error::Error>> {
+    if let Source::Rig { input, .. } = &source
+        && runs.len() < 2
+    {
+        // The rig halted the others: say which and why, not a bare error.
+        return Err(Box::new(TooFewRuns {
+            completed: runs.len(),
+            total: runs.len() + input.failed.len(),
+            halted: input
+                .failed
+                .iter()
+                .map(|f| format!("{}: {}", f.name, f.error))
+                .collect(),
+        }));
+    }
     let summary = summarize(runs.iter().map(|r| &r.recording), M1, M2).map_err(|e| match e {
         SummaryError::Run { run, source } => format!("run {}: {source}", runs[run].name),
         other => other.to_string(),
@@ -147,8 +253,11 @@ pub fn identify(
 /// One more run on a card whose springs are equal and without Coulomb
 /// friction (simulated rig only), where the lab's model is exact: the
 /// schemes' own bias.
+/// The square wave at `volts` (the identification's amplitude) with the
+/// identification input's half period.
 pub fn equal_springs(
     backend: &Backend,
+    volts: f64,
 ) -> Result<Option<EqualSprings>, Box<dyn std::error::Error>> {
     let Some(sim) = backend.sim() else {
         return Ok(None);
@@ -158,7 +267,7 @@ pub fn equal_springs(
     // finite differences themselves.
     let card = EqualSprings::card(sim);
     let truth = card.truth;
-    let wave = ident_square_wave()?;
+    let wave = SquareWave::new(volts, backend.ident.half_period)?;
     let out = backend
         .with_sim(card)
         .experiment(

@@ -3,7 +3,11 @@
 //! (`lab::MassSpringRig` → `Pc104` → `SimulatedCard`) with a virtual clock:
 //!
 //! - Tables 1 and 2 in simulation (nominal model);
-//! - five identification runs on the rig, Tables 3 and 4 with averages, by
+//! - the identification input's amplitude, chosen from two short probe runs
+//!   so that neither cart is predicted past 60 % of its travel
+//!   (`lab::ident_input`; `--ident-*` to choose the signal and amplitude);
+//! - five identification runs on the rig (a run the rig halts is reported
+//!   and left out), Tables 3 and 4 with averages, by
 //!   the lab's formulas and the bias-free central scheme, and the identified
 //!   state equations;
 //! - Tables 5 and 6 run on the rig with the lab's gains;
@@ -25,6 +29,7 @@
 //! cargo run --release --example lab5 -- --out my_report      # elsewhere
 //! cargo run --release --example lab5 -- --truth truth.toml   # another simulated rig
 //! cargo run --release --example lab5 -- --logs my_runs        # Tables 3 and 4 from my CSV logs
+//! cargo run --release --example lab5 -- --ident-signal prbs --ident-volts 6   # another input
 //! cargo run --release --example lab5 -- --real-time          # wall-clock loop (about two minutes)
 //! cargo run --release --example lab5 -- --real-time --rt-priority 80   # with SCHED_FIFO
 //! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml
@@ -130,14 +135,18 @@ fn rig_sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn st
     report.table2(&table2)?;
     let truth = backend.friction_truth();
     let (runs, source) = identification::rig_runs(backend)?;
+    if let identification::Source::Rig { input, .. } = &source {
+        report.identification_input(input, &runs);
+    }
     let mut ident = identification::identify(runs, source)?;
     report.identification(Some(backend), &ident, truth.as_ref())?;
-    ident.equal_springs = identification::equal_springs(backend)?;
+    let volts = ident.volts();
+    ident.equal_springs = identification::equal_springs(backend, volts)?;
     if let Some(e) = &ident.equal_springs {
         report.equal_springs(e);
     }
-    let excitation = excitation::section(backend)?;
-    report.excitation(&excitation.inputs);
+    let excitation = excitation::section(backend, volts)?;
+    report.excitation(excitation.volts, &excitation.inputs);
     let model = backend
         .sim()
         .map_or_else(SimulationModel::default, SimulatedRig::simulation_model);

@@ -7,6 +7,7 @@ use std::fmt;
 use std::path::Path;
 
 use super::file::{self, FileError};
+use super::ident_input::IdentInput;
 use super::{Calibration, MassSpringRig};
 use crate::hw::{ConfigError, EppPort, Pc104, PpdevOptions, RegisterMap, RigError};
 
@@ -85,6 +86,26 @@ use crate::hw::{ConfigError, EppPort, Pc104, PpdevOptions, RegisterMap, RigError
 /// unknown key in it is refused all the same, and a value of the wrong type
 /// (`data_dir = "yes"`) is named `port.data_dir`.
 ///
+/// The `[ident]` table is optional too: the identification input for
+/// this rig ([`IdentInput`]: `signal`, `volts`, `half_period`,
+/// `scale_to_travel`), each key defaulting to the lab's ±8 V square wave
+/// scaled to the travel. Its values are checked as in code, and named
+/// `ident.volts`:
+///
+/// ```
+/// use ctrlab::{hw::RegisterMap, lab::{Calibration, FileError, RigConfig}};
+/// use ctrlab::lab::ident_input::{IdentInput, IdentSignal};
+/// let text = RigConfig::new(RegisterMap::default(), Calibration::default()).to_toml();
+/// let config = RigConfig::from_toml(&format!("{text}\n[ident]\nsignal = \"prbs\"\nvolts = 5.0\n"))?;
+/// assert_eq!((config.ident.signal, config.ident.volts), (IdentSignal::Prbs, 5.0));
+/// assert_eq!(config.ident.half_period, IdentInput::default().half_period);
+/// let err = RigConfig::from_toml(&format!("{text}\n[ident]\nvolts = -5.0\n")).unwrap_err();
+/// let FileError::Invalid { error, .. } = err else { panic!("{err}") };
+/// let code = IdentInput { volts: -5.0, ..IdentInput::default() }.validate().unwrap_err();
+/// assert_eq!((error.key(), error.reason()), ("ident.volts", code.reason()));
+/// # Ok::<(), FileError>(())
+/// ```
+///
 /// The safety keys added in 0.4 (`no_watchdog_acknowledged`, `follow_time`,
 /// `max_saturation_time`) are required like the others: a card file written
 /// before them is refused, naming the first one missing; add them (the
@@ -124,6 +145,11 @@ pub struct RigConfig {
     /// defaults, see [`PpdevOptions`]).
     #[serde(default)]
     pub port: PpdevOptions,
+    /// The identification input for this rig (`[ident]`, optional: each
+    /// key defaults, see [`IdentInput`]; written only when it is not the
+    /// default).
+    #[serde(default, skip_serializing_if = "IdentInput::is_default")]
+    pub ident: IdentInput,
 }
 
 /// One key of the file: its dotted name, what it means (the comment
@@ -140,7 +166,7 @@ const fn field(key: &'static str, comment: &'static str, hex: bool) -> Field {
 }
 
 /// Every key of the file, in the order [`RigConfig::to_toml`] writes them.
-const FIELDS: [Field; 24] = [
+const FIELDS: [Field; 28] = [
     field("map.id", "card ID register (read)", true),
     field(
         "map.control",
@@ -233,6 +259,22 @@ const FIELDS: [Field; 24] = [
         "PPDATADIR around each EPP read (default false)",
         false,
     ),
+    field(
+        "ident.signal",
+        "identification input: square, prbs or multisine",
+        false,
+    ),
+    field(
+        "ident.volts",
+        "V peak asked for (the largest the scaling chooses)",
+        false,
+    ),
+    field("ident.half_period", "s, the square wave's", false),
+    field(
+        "ident.scale_to_travel",
+        "probe runs first, amplitude within 60 % of the travel",
+        false,
+    ),
 ];
 
 /// The [`FIELDS`] entry of `name` in `section`.
@@ -283,6 +325,7 @@ impl RigConfig {
             map,
             calibration,
             port: PpdevOptions::default(),
+            ident: IdentInput::default(),
         }
     }
 
@@ -405,14 +448,15 @@ impl RigConfig {
         file::write(path.as_ref(), &text)
     }
 
-    /// Checks the map ([`RegisterMap::validate`]) and the calibration
-    /// ([`Calibration::validate`]). The port's one key, a boolean, has no
+    /// Checks the map ([`RegisterMap::validate`]), the calibration
+    /// ([`Calibration::validate`]) and the identification input
+    /// ([`IdentInput::validate`]). The port's one key, a boolean, has no
     /// value to refuse: its type is checked when the file is read.
     ///
     /// # Errors
     ///
     /// [`ConfigError`] whose key is the file's dotted key (`map.encoder[3]`,
-    /// `calibration.travel_limits[1]`).
+    /// `calibration.travel_limits[1]`, `ident.volts`).
     ///
     /// # Examples
     ///
@@ -428,7 +472,8 @@ impl RigConfig {
         self.map.validate().map_err(|e| e.in_table("map"))?;
         self.calibration
             .validate()
-            .map_err(|e| e.in_table("calibration"))
+            .map_err(|e| e.in_table("calibration"))?;
+        self.ident.validate().map_err(|e| e.in_table("ident"))
     }
 
     /// The rig this card file describes, on the card behind `port`, read

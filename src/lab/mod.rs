@@ -19,7 +19,9 @@
 //! - the lab's recording layout, [`schema`]: input `u` (V), measurements
 //!   `x1` (m), `v1` (m/s), `x2` (m), `v2` (m/s);
 //! - how the lab's experiments are run (period, masses, identification
-//!   input), [`protocol`];
+//!   input), [`protocol`]; an identification input that respects the
+//!   rig's travel (its signal and amplitude, scaled from probe runs),
+//!   [`ident_input`];
 //! - the lab's tables as data (the gains of Tables 2, 5 and 6, their
 //!   setpoints and groups of rows) and their computations, [`tables`];
 //! - the LQI design to a spec on an identified model, [`lqi`];
@@ -64,6 +66,7 @@ pub mod frequency;
 mod friction_plant;
 mod gains;
 pub mod ident;
+pub mod ident_input;
 pub mod lqi;
 mod plant;
 mod probe;

@@ -3,15 +3,14 @@
 //! answer on the state equations.
 
 use ctrlab::lab::ident::{EqualSprings, MassSpringEstimate, Parameter, Spread, Summary};
-use ctrlab::lab::protocol::{
-    IDENT_DURATION, IDENT_HALF_PERIOD, IDENT_RUNS, IDENT_VOLTS, M1, M2, PERIOD,
-};
+use ctrlab::lab::ident_input::{IdentInput, IdentSignal, PROBE_DURATION, Reason, peaks};
+use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, M1, M2, PERIOD};
 use ctrlab::lab::tables::poles_display;
 use ctrlab::lab::{Cart, FrictionPlant};
 
 use super::{ParamPanel, Report, describe, mm, pct, timing_text};
 use crate::backend::Backend;
-use crate::identification::{Identification, Source};
+use crate::identification::{Identification, RigInput, Run, Source};
 
 /// `mean ± sd` to `digits` decimals.
 fn pm(s: &Spread, digits: usize) -> String {
@@ -37,7 +36,123 @@ pub(super) fn header(p: Parameter) -> String {
     format!("{} ({})", p.symbol(), p.unit())
 }
 
+/// The identification input in words: `a ±8 V square wave, 0.2 s half
+/// period`.
+fn signal_text(input: &IdentInput, volts: f64) -> String {
+    match input.signal {
+        IdentSignal::Square => format!(
+            "a ±{volts:.2} V square wave, {} s half period",
+            input.half_period
+        ),
+        IdentSignal::Prbs => format!("a ±{volts:.2} V PRBS (a new bit every 40 ms, 127 bits)"),
+        IdentSignal::Multisine => {
+            format!("a multisine of {volts:.2} V peak (50 lines, 0.2 to 10 Hz, Schroeder phases)")
+        }
+    }
+}
+
+/// mm to two decimals.
+fn mm2(x: f64) -> String {
+    format!("{:.2}", x * 1e3)
+}
+
 impl Report {
+    /// The identification input: what was asked, the probe runs, the
+    /// amplitude chosen and why, and every identification run's peak
+    /// excursion or why the rig halted it.
+    pub fn identification_input(&mut self, input: &RigInput, runs: &[Run]) {
+        let choice = &input.choice;
+        let allowed = choice.allowed();
+        self.heading(2, "Identification input");
+        let mut text = format!(
+            "Asked for: {}. Travel limits ±{:.1} / ±{:.1} mm; a run should keep each cart within {:.1} / {:.1} mm (60 %).",
+            signal_text(&input.input, choice.asked),
+            choice.limits[0] * 1e3,
+            choice.limits[1] * 1e3,
+            allowed[0] * 1e3,
+            allowed[1] * 1e3,
+        );
+        if choice.reason != Reason::Fixed {
+            text += &format!(
+                " Two probe runs of {PROBE_DURATION} s came first (`runs/ident_probe_*.csv`), at a quarter and half of it (the second lowered if the first said so). Each cart's peak at a higher amplitude is predicted as the larger of the line through the two probes' peaks (friction takes a fixed force off the small one) and the line through the origin and the larger probe (`lab::ident_input::predict`)."
+            );
+        }
+        text += &format!(" **Chosen: {:.2} V**, {}.", choice.volts, choice.reason);
+        if let Some(at_asked) = choice.predicted_asked
+            && choice.volts < choice.asked
+        {
+            text += &format!(
+                " At {:.2} V the peaks would have been {} / {} mm.",
+                choice.asked,
+                mm2(at_asked[0]),
+                mm2(at_asked[1])
+            );
+        }
+        self.add(&format!("{text}\n"));
+        let mut rows = Vec::new();
+        for (n, p) in choice.probes.iter().enumerate() {
+            rows.push(vec![
+                format!("probe {}", n + 1),
+                format!("{:.2}", p.volts),
+                mm2(p.peaks[0]),
+                mm2(p.peaks[1]),
+                "probe".into(),
+            ]);
+        }
+        if let Some(p) = choice.predicted {
+            rows.push(vec![
+                "prediction".into(),
+                format!("{:.2}", choice.volts),
+                mm2(p[0]),
+                mm2(p[1]),
+                "predicted".into(),
+            ]);
+        }
+        for run in runs {
+            let [x1, x2] = peaks(&run.recording).unwrap_or([f64::NAN; 2]);
+            rows.push(vec![
+                format!("`{}`", run.name),
+                format!("{:.2}", choice.volts),
+                mm2(x1),
+                mm2(x2),
+                "completed".into(),
+            ]);
+        }
+        for f in &input.failed {
+            rows.push(vec![
+                format!("`{}`", f.name),
+                format!("{:.2}", choice.volts),
+                mm2(f.peaks[0]),
+                mm2(f.peaks[1]),
+                format!("halted after {:.3} s", f.ran),
+            ]);
+        }
+        self.table(
+            &[
+                "run",
+                "peak input (V)",
+                "cart 1 peak (mm)",
+                "cart 2 peak (mm)",
+                "outcome",
+            ],
+            &rows,
+        );
+        if !input.failed.is_empty() {
+            let halted: Vec<String> = input
+                .failed
+                .iter()
+                .map(|f| format!("`{}` after {:.3} s ({})", f.name, f.ran, f.error))
+                .collect();
+            self.add(&format!(
+                "The rig halted {} of the {} identification runs: {}. They are left out: the identification uses the {} that completed.\n",
+                input.failed.len(),
+                input.failed.len() + runs.len(),
+                halted.join("; "),
+                runs.len()
+            ));
+        }
+    }
+
     /// The identification runs, Tables 3 and 4 with their figures, the
     /// identified state equations and the model's uncertainty.
     pub fn identification(
@@ -48,12 +163,20 @@ impl Report {
     ) -> Result<(), Box<dyn std::error::Error>> {
         self.heading(2, "Identification runs");
         let intro = match (&ident.source, backend) {
-            (Source::Rig { timing }, Some(backend)) => {
+            (Source::Rig { timing, input }, Some(backend)) => {
                 let mut intro = format!(
-                    "{IDENT_RUNS} open-loop runs on {}: a ±{IDENT_VOLTS} V square wave, {IDENT_HALF_PERIOD} s half period, {IDENT_DURATION} s at T = {} ms, through `MassSpringRig` → `Pc104` → the card (recordings in `runs/ident_*.csv`).",
+                    "{IDENT_RUNS} open-loop runs on {}: {}, {IDENT_DURATION} s at T = {} ms, through `MassSpringRig` → `Pc104` → the card (recordings in `runs/ident_*.csv`).",
                     describe(backend),
+                    signal_text(&input.input, input.choice.volts),
                     PERIOD * 1e3
                 );
+                if !input.failed.is_empty() {
+                    intro += &format!(
+                        " {} of them completed and are identified below; the rig halted {} (see above).",
+                        ident.runs.len(),
+                        input.failed.len()
+                    );
+                }
                 if let Some(t) = timing {
                     intro += &format!(" {}", timing_text(t));
                 }

@@ -225,7 +225,7 @@ fn describe(backend: &crate::backend::Backend) -> String {
 /// A sentence on the loop's timing over a section's real-time runs.
 fn timing_text(t: &crate::backend::LoopTiming) -> String {
     format!(
-        "Loop timing over these runs ({}): worst p99 lateness {:.1} µs, worst max {:.1} µs, {} overruns, {} skipped ticks (they show as gaps in the recordings; identification splits at gaps), longest interval between samples {:.2} ms.\n",
+        "Loop timing over these runs ({}): worst p99 lateness {:.1} µs, worst max {:.1} µs, {} overruns, {} skipped ticks (they show as gaps in the recordings; identification splits at gaps), {} late ticks (sampled after their deadline), longest interval between samples {:.2} ms.\n",
         if t.fifo {
             "SCHED_FIFO"
         } else {
@@ -235,6 +235,7 @@ fn timing_text(t: &crate::backend::LoopTiming) -> String {
         t.lateness_max * 1e6,
         t.overruns,
         t.skipped,
+        t.late,
         t.max_interval * 1e3
     )
 }
