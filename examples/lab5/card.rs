@@ -21,8 +21,8 @@ pub fn load<'a>(
         return Err(format!(
             "--port {port} needs the card's register map and calibration: --card card.toml. \
              The built-in map is the simulated card's, and nothing is driven on a real card \
-             from it. The probe measures the card step by step and writes the card file:\n  \
-             cargo run --example probe --features ppdev -- --port {port}\n\
+             from it. Write the map from the lab's driver or the FPGA's sources in card.toml; the probe confirms it step by step and writes the card file (--scan searches blind, see docs/hardware.md):\n  \
+             cargo run --example probe --features ppdev -- --port {port} --card card.toml --out card.toml\n\
              then: cargo run --release --example lab5 --features ppdev -- --port {port} --card card.toml",
             port = port.display()
         ));

@@ -1,8 +1,8 @@
 //! [`Ppdev`]: the real parallel port through Linux's `ppdev` driver
 //! (`/dev/parportN`), in IEEE 1284 EPP mode. Feature `ppdev`, Linux only.
 //!
-//! This is the only file of the crate with `unsafe` code: the `ioctl`
-//! calls. Reads and writes go through `std::fs::File`.
+//! With `hw::realtime` (the scheduler's system calls), one of the crate's
+//! two files with `unsafe` code: the `ioctl` calls. Reads and writes go through `std::fs::File`.
 #![allow(unsafe_code)]
 
 use std::ffi::{c_int, c_uchar, c_uint};

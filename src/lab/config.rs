@@ -501,7 +501,7 @@ impl RigConfig {
     ///     calibration: Calibration { watchdog_timeout: None, ..Calibration::default() },
     ///     ..SimulatedRig::default()
     /// };
-    /// let mut file = RigConfig { map: RegisterMap::default(), calibration: sim.calibration };
+    /// let mut file = RigConfig::new(RegisterMap::default(), sim.calibration);
     /// let err = file.rig(sim.card(&Clock::RealTime)?, 0.002).unwrap_err();
     /// assert_eq!(err.kind(), ConfigErrorKind::Conflict);
     /// assert!(err.to_string().contains("add `no_watchdog_acknowledged = true`"), "{err}");
