@@ -638,3 +638,45 @@ proptest! {
         prop_assert_eq!(rig.card().port().inner().pwm_duty(0), 0);
     }
 }
+
+/// A rig whose halt panics: one state, its input echoed.
+struct HaltPanics;
+
+impl Rig<1, 1> for HaltPanics {
+    fn read(&mut self) -> Result<SVector<f64, 1>, RigError> {
+        Ok(vector![0.0])
+    }
+    fn apply(&mut self, u: &SVector<f64, 1>) -> Result<SVector<f64, 1>, RigError> {
+        Ok(*u)
+    }
+    fn halt(&mut self) -> Result<(), RigError> {
+        panic!("halt register write refused")
+    }
+    fn period(&self) -> f64 {
+        0.01
+    }
+}
+
+#[test]
+fn a_panic_in_the_final_halt_is_an_error_that_keeps_the_recording() {
+    let config = LoopConfig {
+        duration: 0.1,
+        ..LoopConfig::default()
+    };
+    let err = run(
+        HaltPanics,
+        OpenLoop,
+        |_| vector![1.0],
+        &Clock::Virtual(VirtualClock::new()),
+        &config,
+    )
+    .unwrap_err();
+    match &err.error {
+        RigError::Fault(LoopFault::Panicked { what, message, .. }) => {
+            assert_eq!(what.to_string(), "rig (halt)");
+            assert_eq!(message.to_string(), "halt register write refused");
+        }
+        other => panic!("expected Panicked, got {other:?}"),
+    }
+    assert_eq!(err.recording.len(), 10, "every sample of the run is kept");
+}
