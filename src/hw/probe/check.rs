@@ -284,16 +284,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             map.watchdog_bit,
             map.control
         ));
-        if !self.operator.confirm(
-            "Switch the motor supply ON now. Carts free, hands off, e-stop within reach: \
-             pulse the motor?",
-        ) {
-            return Err(ProbeError::Declined {
-                step: "the drive step",
-            });
-        }
-        self.operator.hands(Hands::Off);
-        self.settle(&latch, &counters)?;
+        self.motor_on(&latch, &counters)?;
         for channel in 0..PWM_CHANNELS {
             let (low, high) = (map.pwm_low[channel], map.pwm_high[channel]);
             if let Some(drive) = self.try_pair(&latch, &counters, low, high)? {

@@ -47,6 +47,27 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
         ])
     }
 
+    /// The drive step's confirmation, shared by the confirmed map and the
+    /// blind scan: the operator switches the motor supply on and confirms
+    /// (else [`ProbeError::Declined`]), hands go off, and the carts settle
+    /// before the first pulse.
+    pub(super) fn motor_on(
+        &mut self,
+        latch: &Latch,
+        counters: &[Counter; 2],
+    ) -> Result<(), ProbeError> {
+        if !self.operator.confirm(
+            "Switch the motor supply ON now. Carts free, hands off, e-stop within reach: \
+             pulse the motor?",
+        ) {
+            return Err(ProbeError::Declined {
+                step: "the drive step",
+            });
+        }
+        self.operator.hands(Hands::Off);
+        self.settle(latch, counters)
+    }
+
     /// Waits until both counters stay within `min_counts` over [`SETTLE`]
     /// (the carts at rest), at most 40 looks (10 s).
     pub(super) fn settle(
@@ -101,16 +122,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
             self.kick_bits(&latch),
             latch.control
         ));
-        if !self.operator.confirm(
-            "Switch the motor supply ON now. Carts free, hands off, e-stop within reach: \
-             pulse the motor?",
-        ) {
-            return Err(ProbeError::Declined {
-                step: "the drive step",
-            });
-        }
-        self.operator.hands(Hands::Off);
-        self.settle(&latch, &counters)?;
+        self.motor_on(&latch, &counters)?;
         let open = |a: u8| scan.class(a) == RegisterClass::Open && a != latch.control;
         let pairs: Vec<(u8, u8)> = (0..u8::MAX)
             .map(|a| (a, a + 1))
