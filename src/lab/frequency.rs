@@ -106,19 +106,44 @@ pub fn peaks_hz(g: &FrequencyEstimate, count: usize) -> Vec<f64> {
 
 /// The ETFE on the multisine's lines (bins above them hold only the
 /// drive's quantisation) and the smoothed estimate on `w` (rad/s), from u
-/// (V) to x2 (m) over the periods after the first, sampled every `period`
-/// s.
+/// (V) to x2 (m) over the periods after the first, on the grid of one
+/// `period` (s) from the first sample. A recording with late samples or
+/// gaps (skipped ticks) is first brought onto that grid
+/// ([`on_period_grid`]); a uniform one is used as it is.
 ///
 /// # Errors
 ///
 /// A recording without `u` or `x2`, or too short for the window.
+///
+/// # Examples
+///
+/// A 2 Hz sine through a gain of 0.5 m/V, every tenth sample lost: the
+/// line is still at 2 Hz with its gain.
+///
+/// ```
+/// use ctrlab::data::Recording;
+/// use ctrlab::lab::frequency::{self, MS_PERIOD, PERIODS};
+/// let (period, hz) = (0.002, 2.0);
+/// let mut rec = Recording::new(ctrlab::lab::schema());
+/// let n = (PERIODS as f64 * MS_PERIOD / period) as usize;
+/// for k in (0..n).filter(|k| k % 10 != 5) {
+///     let t = k as f64 * period;
+///     let u = (std::f64::consts::TAU * hz * t).sin();
+///     rec.push(t, &[u], &[0.0, 0.0, 0.5 * u, 0.0])?;
+/// }
+/// let (raw, smooth) = frequency::estimates(&rec, &[std::f64::consts::TAU * hz], period)?;
+/// let line = raw.frequency_hz().iter().position(|f| (f - hz).abs() < 1e-9).unwrap();
+/// assert!((raw.magnitude()[line] - 0.5).abs() < 0.01, "{}", raw.magnitude()[line]);
+/// assert!((smooth.magnitude()[0] - 0.5).abs() < 0.02, "{}", smooth.magnitude()[0]);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub fn estimates(
     rec: &Recording,
     w: &[f64],
     period: f64,
 ) -> Result<(FrequencyEstimate, FrequencyEstimate), Error> {
     let skip = (MS_PERIOD / period).round() as usize;
-    let (u, x2) = (rec.channel("u")?, rec.channel("x2")?);
+    let (u, x2) = on_period_grid(rec, period)?;
     if u.len() <= skip {
         return Err(Error::TooFewSamples {
             what: "multisine run after its first period",
@@ -134,6 +159,42 @@ pub fn estimates(
     raw.response.truncate(keep);
     let smooth = spa(u, y, period, Some((SPA_WINDOW / period) as usize), w)?;
     Ok((raw, smooth))
+}
+
+/// u (V) and x2 (m) of `rec` on the grid `t0 + k·period` from its first
+/// sample to its last: the spectral estimates assume one sample per
+/// period, and a late sample or a gap of skipped ticks would otherwise
+/// compress time and move every line (a run that skipped 10 % of its
+/// ticks put the second mode at 3.0 Hz instead of 8.5). A sample within
+/// [`MAX_JITTER`](crate::data::MAX_JITTER) of a grid point is that point,
+/// so a uniform recording is used exactly as it is; between samples, u is
+/// the last one applied (the drive holds it) and x2 is interpolated
+/// linearly (the cart moves continuously).
+fn on_period_grid(rec: &Recording, period: f64) -> Result<(Vec<f64>, Vec<f64>), Error> {
+    let (t, u, x2) = (rec.time(), rec.channel("u")?, rec.channel("x2")?);
+    let (Some(&first), Some(&last)) = (t.first(), t.last()) else {
+        return Ok((Vec::new(), Vec::new()));
+    };
+    let tol = crate::data::MAX_JITTER * period;
+    let points = ((last - first + tol) / period).floor() as usize + 1;
+    let (mut u_grid, mut x_grid) = (Vec::with_capacity(points), Vec::with_capacity(points));
+    // `j`: the last sample at or before the grid point (within `tol`).
+    let mut j = 0;
+    for k in 0..points {
+        let tk = first + k as f64 * period;
+        while j + 1 < t.len() && t[j + 1] <= tk + tol {
+            j += 1;
+        }
+        let x = if (t[j] - tk).abs() <= tol || j + 1 == t.len() {
+            x2[j]
+        } else {
+            let a = (tk - t[j]) / (t[j + 1] - t[j]);
+            x2[j] + a * (x2[j + 1] - x2[j])
+        };
+        u_grid.push(u[j]);
+        x_grid.push(x);
+    }
+    Ok((u_grid, x_grid))
 }
 
 /// Median relative distance between two magnitude curves on one grid.
