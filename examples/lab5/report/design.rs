@@ -215,15 +215,19 @@ impl Report {
             if let Some((pr, mr)) = c.comparison.rest {
                 // A step without figures (not settled: a cart hunting on
                 // a jittered clock) has no steady-state error to print.
-                let counts = |step: &Result<_, _>| {
-                    step.as_ref().map_or_else(
-                        |_| "none (no figures)".to_owned(),
-                        |s: &ctrlab::lab::lqi::Step| format!("{:+.2} counts", s.error_counts),
-                    )
+                let errors = match (&p.step, &m.step) {
+                    (Ok(ps), Ok(ms)) => {
+                        format!(
+                            "{:+.2} against {:+.2} counts",
+                            ps.error_counts, ms.error_counts
+                        )
+                    }
+                    (Ok(ps), Err(_)) => format!("{:+.2} counts against none", ps.error_counts),
+                    (Err(_), Ok(ms)) => format!("none against {:+.2} counts", ms.error_counts),
+                    (Err(_), Err(_)) => "none on either".to_owned(),
                 };
-                let (perr, merr) = (counts(&p.step), counts(&m.step));
                 let at_rest = format!(
-                    "over the last {REST_TAIL} s the predicted cart {}, the rig's {} (steady-state error {perr} against {merr})",
+                    "over the last {REST_TAIL} s the predicted cart {}, the rig's {} (steady-state error {errors})",
                     rests(&pr),
                     rests(&mr)
                 );
