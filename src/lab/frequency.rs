@@ -147,25 +147,33 @@ pub fn peaks_hz(g: &FrequencyEstimate, count: usize) -> Vec<f64> {
 ///
 /// # Examples
 ///
-/// A 2 Hz sine through a gain of 0.5 m/V, every tenth sample lost: the
-/// line is still at 2 Hz with its gain.
+/// The model's own multisine run, and the same run with every tenth
+/// sample lost (skipped ticks): the same two modes. (Taken as uniform, the
+/// gaps would compress time by a tenth and move them up by as much.)
 ///
 /// ```
-/// use ctrlab::data::Recording;
-/// use ctrlab::lab::frequency::{self, MS_PERIOD, PERIODS};
-/// let (period, hz) = (0.002, 2.0);
-/// let mut rec = Recording::new(ctrlab::lab::schema());
-/// let n = (PERIODS as f64 * MS_PERIOD / period) as usize;
-/// for k in (0..n).filter(|k| k % 10 != 5) {
-///     let t = k as f64 * period;
-///     let u = (std::f64::consts::TAU * hz * t).sin();
-///     rec.push(t, &[u], &[0.0, 0.0, 0.5 * u, 0.0])?;
+/// use ctrlab::{OpenLoop, Recording};
+/// use ctrlab::freq::logspace;
+/// use ctrlab::lab::{SimulatedRig, frequency, lqi};
+/// use ctrlab::nalgebra::vector;
+/// use ctrlab::signal::Signal;
+/// let sim = SimulatedRig::default();
+/// let rig = lqi::predicted_rig(sim.truth, sim.friction.coulomb, &sim.calibration, sim.period);
+/// let ms = frequency::multisine(8.0)?;
+/// let rec = ctrlab::run_sampled(rig.plant(), rig.sensor(), OpenLoop, |t| vector![ms.value(t)],
+///                               vector![0.0, 0.0, 0.0, 0.0], &rig.sampled_config(frequency::DURATION))?;
+/// let mut gaps = Recording::new(rec.schema().clone());
+/// for k in (0..rec.len()).filter(|k| k % 10 != 5) {
+///     let y: Vec<f64> = (0..4).map(|i| rec.measurement(i).unwrap()[k]).collect();
+///     gaps.push(rec.time()[k], &[rec.input(0).unwrap()[k]], &y)?;
 /// }
-/// let (raw, smooth) = frequency::estimates(&rec, &[std::f64::consts::TAU * hz], period)?;
-/// let line = raw.frequency_hz().iter().position(|f| (f - hz).abs() < 1e-9).unwrap();
-/// assert!((raw.magnitude()[line] - 0.5).abs() < 0.01, "{}", raw.magnitude()[line]);
-/// assert!((smooth.magnitude()[0] - 0.5).abs() < 0.02, "{}", smooth.magnitude()[0]);
-/// # Ok::<(), ctrlab::Error>(())
+/// let tau = std::f64::consts::TAU;
+/// let w = logspace((0.2 * tau).log10(), (15.0 * tau).log10(), 400)?; // 0.2–15 Hz, rad/s
+/// let (_, full) = frequency::estimates(&rec, &w, sim.period)?;
+/// let (_, lost) = frequency::estimates(&gaps, &w, sim.period)?;
+/// let (a, b) = (frequency::peaks_hz(&full, 2), frequency::peaks_hz(&lost, 2));
+/// assert!(a.iter().zip(&b).all(|(a, b)| (a - b).abs() < 0.1), "{a:?} {b:?}");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn estimates(
     rec: &Recording,
