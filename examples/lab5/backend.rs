@@ -6,8 +6,8 @@
 use std::path::PathBuf;
 
 use ctrlab::hw::{
-    Clock, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome, StopSignal,
-    VirtualClock, run,
+    Clock, Jitter, LoopConfig, LoopFault, LoopStats, RealTime, RigError, RunError, RunOutcome,
+    StopSignal, VirtualClock, run,
 };
 use ctrlab::lab::ident_input::IdentInput;
 use ctrlab::lab::protocol::PERIOD;
@@ -34,10 +34,12 @@ pub struct Backend {
 
 pub enum BackendKind {
     /// The register-level simulated card with `sim` inside (`--truth`),
-    /// virtual or real time.
+    /// virtual or real time; on a virtual clock, its ticks late and
+    /// stalled by `jitter` (`--jitter`).
     Simulated {
         sim: Box<SimulatedRig>,
         real_time: bool,
+        jitter: Option<Jitter>,
     },
     /// The real PC104 card on a parallel port, with its card file's map
     /// and calibration.
@@ -48,10 +50,11 @@ pub enum BackendKind {
     },
 }
 
-/// The loop's timing over a section's runs (real-time runs only).
+/// The loop's timing over a section's runs (real-time or jittered runs).
 pub struct LoopTiming {
-    /// The loop ran with SCHED_FIFO (`--rt-priority`).
-    pub fifo: bool,
+    /// How the loop was scheduled, in words: SCHED_FIFO (`--rt-priority`),
+    /// normal scheduling, or the jittered virtual clock (`--jitter`).
+    pub clock: &'static str,
     /// Worst 99th percentile of the tick's lateness, s.
     pub lateness_p99: f64,
     /// Worst lateness, s.
@@ -135,12 +138,22 @@ impl Backend {
         }
     }
 
+    /// The virtual clock's schedule of late ticks and stalls (`--jitter`).
+    pub fn jitter(&self) -> Option<Jitter> {
+        match &self.kind {
+            BackendKind::Simulated { jitter, .. } => *jitter,
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { .. } => None,
+        }
+    }
+
     /// The same backend on another simulated card (the equal-springs run).
     pub fn with_sim(&self, sim: SimulatedRig) -> Self {
         Self {
             kind: BackendKind::Simulated {
                 sim: Box::new(sim),
                 real_time: self.real_time(),
+                jitter: self.jitter(),
             },
             realtime: self.realtime,
             stop: self.stop.clone(),
@@ -161,23 +174,36 @@ impl Backend {
         reference: impl FnMut(f64) -> SVector<f64, 1>,
         duration: f64,
     ) -> Result<Result<RunOutcome, Box<RunError>>, Box<dyn std::error::Error>> {
-        let loop_config = LoopConfig {
+        let mut loop_config = LoopConfig {
             duration,
             realtime: self.realtime,
             stop: Some(self.stop.clone()),
             ..LoopConfig::default()
         };
+        if self.jitter().is_some() {
+            // The clock double's skipped deadlines are what is under test
+            // (the default schedule skips about 25 per 0.5 s, the default
+            // limit): the analyses must take them, so they never stop a
+            // run. A stall still stops it past the gap limit (50 ms).
+            loop_config.max_timing_faults = usize::MAX;
+        }
         let outcome = match &self.kind {
-            BackendKind::Simulated { sim, real_time } => {
+            BackendKind::Simulated {
+                sim,
+                real_time,
+                jitter,
+            } => {
                 let sim = SimulatedRig {
                     card: CardSettings { seed, ..sim.card },
                     period: PERIOD,
                     ..(**sim).clone()
                 };
-                let clock = if *real_time {
-                    Clock::RealTime
-                } else {
-                    Clock::Virtual(VirtualClock::new())
+                let clock = match (real_time, jitter) {
+                    (true, _) => Clock::RealTime,
+                    (false, None) => Clock::Virtual(VirtualClock::new()),
+                    (false, Some(j)) => {
+                        Clock::Virtual(VirtualClock::new().with_jitter(run_schedule(j, name))?)
+                    }
                 };
                 let rig = sim.rig(&clock)?;
                 run(rig, controller, reference, &clock, &loop_config)
@@ -217,14 +243,19 @@ impl Backend {
         Ok(path)
     }
 
-    /// The loop's timing over `stats`, for real-time runs.
+    /// The loop's timing over `stats`, for real-time or jittered runs (on
+    /// the ideal virtual clock every tick is on time).
     pub fn timing(&self, stats: &[LoopStats]) -> Option<LoopTiming> {
-        if !self.real_time() || stats.is_empty() {
+        if !(self.real_time() || self.jitter().is_some()) || stats.is_empty() {
             return None;
         }
         let worst = |f: fn(&LoopStats) -> f64| stats.iter().map(f).fold(0.0, f64::max);
         Some(LoopTiming {
-            fifo: self.realtime.is_some(),
+            clock: match (self.jitter(), self.realtime) {
+                (Some(_), _) => "the jittered virtual clock",
+                (None, Some(_)) => "SCHED_FIFO",
+                (None, None) => "normal scheduling",
+            },
             lateness_p99: worst(|s| s.lateness_p99),
             lateness_max: worst(|s| s.lateness_max),
             overruns: stats.iter().map(|s| s.overruns).sum(),
@@ -246,6 +277,7 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
             Ok(BackendKind::Simulated {
                 sim: Box::new(sim),
                 real_time: args.real_time,
+                jitter: args.jitter,
             })
         }
         #[cfg(all(feature = "ppdev", target_os = "linux"))]
@@ -274,5 +306,18 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
                         --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml"
                 .into(),
         ),
+    }
+}
+
+/// Run `name`'s own schedule from `jitter`: its seed mixed with the run's
+/// name (FNV-1a), so that no two runs are late on the same ticks and the
+/// same `--jitter` still gives the same report.
+fn run_schedule(jitter: &Jitter, name: &str) -> Jitter {
+    let hash = name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    Jitter {
+        seed: jitter.seed ^ hash,
+        ..*jitter
     }
 }

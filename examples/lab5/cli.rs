@@ -4,7 +4,9 @@
 use std::path::PathBuf;
 
 use clap::Parser;
+use ctrlab::hw::Jitter;
 use ctrlab::lab::ident_input::{IdentInput, IdentSignal};
+use ctrlab::lab::protocol::PERIOD;
 
 /// The whole of Lab 5 (state feedback control of the two-cart rig): every
 /// table, the identification, validation, frequency response and design,
@@ -22,6 +24,8 @@ use ctrlab::lab::ident_input::{IdentInput, IdentSignal};
   cargo run --release --example lab5 -- --truth truth.toml
   cargo run --release --example lab5 -- --logs my_runs --metres-per-count 0.000009765625
   cargo run --release --example lab5 -- --real-time --rt-priority 80
+  cargo run --release --example lab5 -- --jitter 11
+  cargo run --release --example lab5 -- --jitter 11,0.2,0.006,0.01,0.016
   cargo run --release --example lab5 -- --ident-signal prbs --ident-volts 6
   cargo run --release --example lab5 -- --ident-volts 12 --ident-fixed
   cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml"
@@ -36,6 +40,18 @@ pub struct Args {
     /// Run the rig sections on the wall clock instead of virtual time
     #[arg(long)]
     pub real_time: bool,
+    /// Simulated rig on a virtual clock whose ticks come late and stall as
+    /// on a loaded machine (seeded, reproducible): SEED alone is 10 % of
+    /// ticks late by up to 6 ms and 0.5 % stalled for 8–16 ms; or
+    /// SEED,LATE_FRACTION,MAX_LATE_S,STALL_FRACTION,STALL_S. Skipped ticks
+    /// never stop a run here; the report counts them
+    #[arg(
+        long,
+        value_name = "SEED[,...]",
+        value_parser = jitter,
+        conflicts_with_all = ["real_time", "port"]
+    )]
+    pub jitter: Option<Jitter>,
     /// Run the loop with SCHED_FIFO priority N, memory locked (Linux)
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(i32).range(1..=99))]
     pub rt_priority: Option<i32>,
@@ -59,7 +75,7 @@ pub struct Args {
         long,
         value_name = "DIR",
         value_parser = existing_dir,
-        conflicts_with_all = ["truth", "real_time", "rt_priority", "port", "card"]
+        conflicts_with_all = ["truth", "real_time", "rt_priority", "port", "card", "jitter"]
     )]
     pub logs: Option<PathBuf>,
     /// With --logs: the encoders' calibration, m per count, for positions
@@ -129,6 +145,47 @@ fn ident_half_period(s: &str) -> Result<f64, String> {
     .validate()
     .map_err(|e| e.reason().to_owned())?;
     Ok(half_period)
+}
+
+/// `--jitter`: a seed alone (the default schedule: 10 % of ticks late by
+/// up to three periods, 6 ms, and one in 200 stalled for 4 to 8 periods,
+/// 8–16 ms, as tests/late_ticks.rs uses), or the seed and the schedule's
+/// four numbers ([`Jitter`]'s fields, durations in s), checked by
+/// [`Jitter::validate`] with its reason.
+fn jitter(s: &str) -> Result<Jitter, String> {
+    let mut fields = s.split(',').map(str::trim);
+    let seed = fields.next().unwrap_or_default();
+    let seed: u64 = seed
+        .parse()
+        .map_err(|_| format!("`{seed}` is not a seed (an integer >= 0)"))?;
+    let rest: Vec<f64> = fields
+        .map(|f| f.parse().map_err(|_| format!("`{f}` is not a number")))
+        .collect::<Result<_, _>>()?;
+    let jitter = match rest[..] {
+        [] => Jitter {
+            seed,
+            late_fraction: 0.1,
+            max_late: 3.0 * PERIOD,
+            stall_fraction: 0.005,
+            stall: 8.0 * PERIOD,
+        },
+        [late_fraction, max_late, stall_fraction, stall] => Jitter {
+            seed,
+            late_fraction,
+            max_late,
+            stall_fraction,
+            stall,
+        },
+        _ => {
+            return Err(format!(
+                "`{s}` is SEED or SEED,LATE_FRACTION,MAX_LATE_S,STALL_FRACTION,STALL_S"
+            ));
+        }
+    };
+    jitter
+        .validate()
+        .map_err(|e| format!("{}: {}", e.key(), e.reason()))?;
+    Ok(jitter)
 }
 
 /// `--out`: a directory, or a path that does not exist yet.

@@ -13,6 +13,13 @@
 //! - Tables 5 and 6 run on the rig with the lab's gains;
 //! - the answers the lab report asks for, stated from the numbers.
 //!
+//! With `--jitter SEED` the simulated rig runs on a virtual clock whose
+//! ticks come late and stall as on a loaded machine (`hw::Jitter`, seeded
+//! and reproducible; or `--jitter SEED,LATE_FRACTION,MAX_LATE_S,
+//! STALL_FRACTION,STALL_S`): every section takes the late samples and the
+//! gaps of skipped ticks, and the report counts them beside each section's
+//! runs.
+//!
 //! With `--logs DIR` lab5 works offline on a student's own recordings
 //! instead: Tables 1 and 2 in simulation, then Tables 3 and 4, the
 //! identified model with its uncertainty, and the validation from every
@@ -30,6 +37,7 @@
 //! cargo run --release --example lab5 -- --truth truth.toml   # another simulated rig
 //! cargo run --release --example lab5 -- --logs my_runs        # Tables 3 and 4 from my CSV logs
 //! cargo run --release --example lab5 -- --ident-signal prbs --ident-volts 6   # another input
+//! cargo run --release --example lab5 -- --jitter 11          # late ticks and stalls, seeded
 //! cargo run --release --example lab5 -- --real-time          # wall-clock loop (about two minutes)
 //! cargo run --release --example lab5 -- --real-time --rt-priority 80   # with SCHED_FIFO
 //! cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml

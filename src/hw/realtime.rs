@@ -73,6 +73,7 @@ pub(crate) struct Guard {
     param: libc::sched_param,
     #[cfg(target_os = "linux")]
     affinity: Option<libc::cpu_set_t>,
+    #[cfg(target_os = "linux")]
     locked: bool,
 }
 

@@ -213,10 +213,21 @@ impl Report {
                 (Ok(_), Ok(_), None) => {}
             }
             if let Some((pr, mr)) = c.comparison.rest {
-                let perr = p.step.as_ref().map_or(f64::NAN, |s| s.error_counts);
-                let merr = m.step.as_ref().map_or(f64::NAN, |s| s.error_counts);
+                // A step without figures (not settled: a cart hunting on
+                // a jittered clock) has no steady-state error to print.
+                let errors = match (&p.step, &m.step) {
+                    (Ok(ps), Ok(ms)) => {
+                        format!(
+                            "{:+.2} against {:+.2} counts",
+                            ps.error_counts, ms.error_counts
+                        )
+                    }
+                    (Ok(ps), Err(_)) => format!("{:+.2} counts against none", ps.error_counts),
+                    (Err(_), Ok(ms)) => format!("none against {:+.2} counts", ms.error_counts),
+                    (Err(_), Err(_)) => "none on either".to_owned(),
+                };
                 let at_rest = format!(
-                    "over the last {REST_TAIL} s the predicted cart {}, the rig's {} (steady-state error {perr:+.2} against {merr:+.2} counts)",
+                    "over the last {REST_TAIL} s the predicted cart {}, the rig's {} (steady-state error {errors})",
                     rests(&pr),
                     rests(&mr)
                 );
@@ -230,21 +241,28 @@ impl Report {
                         Cart::Two => "2 F_s2 / K",
                         Cart::One => "2 (F_s1 + F_s2) / K",
                     };
-                    s += &format!(
-                        " At rest they differ: {at_rest}. Likely reason: {}. A stuck cart is held anywhere within ± its breakaway force, and the integrator (|K_z| = {:.3e} V/(m·s)) moves the drive by {:.2} V/s under a {:.1}-count error, where crossing that band can take {band} = {:.1} V: up to {:.1} s, {} the {:.1} s the run has after settling.",
-                        friction_reason(backend, d.coulomb, spec.cart),
-                        w.kz,
-                        w.rate,
-                        w.error_counts,
-                        w.band,
-                        w.time,
-                        if w.exceeds_run() {
-                            "longer than"
-                        } else {
-                            "within"
-                        },
-                        w.left,
-                    );
+                    let reason = friction_reason(backend, d.coulomb, spec.cart);
+                    if !w.error_counts.is_finite() {
+                        // No steady-state error (the rig's step has no
+                        // figures): no rate for the integrator to walk at.
+                        s += &format!(" At rest they differ: {at_rest}. Likely reason: {reason}.");
+                    } else {
+                        s += &format!(
+                            " At rest they differ: {at_rest}. Likely reason: {}. A stuck cart is held anywhere within ± its breakaway force, and the integrator (|K_z| = {:.3e} V/(m·s)) moves the drive by {:.2} V/s under a {:.1}-count error, where crossing that band can take {band} = {:.1} V: up to {:.1} s, {} the {:.1} s the run has after settling.",
+                            reason,
+                            w.kz,
+                            w.rate,
+                            w.error_counts,
+                            w.band,
+                            w.time,
+                            if w.exceeds_run() {
+                                "longer than"
+                            } else {
+                                "within"
+                            },
+                            w.left,
+                        );
+                    }
                 }
             }
             if !c.comparison.voltage_agrees {

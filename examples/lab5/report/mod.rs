@@ -197,11 +197,27 @@ fn curve(title: String, rec: &ctrlab::Recording, channel: &str) -> Result<RunCur
 fn describe(backend: &crate::backend::Backend) -> String {
     use crate::backend::BackendKind;
     match &backend.kind {
-        BackendKind::Simulated { sim, real_time } => {
+        BackendKind::Simulated {
+            sim,
+            real_time,
+            jitter,
+        } => {
             let t = sim.truth;
+            let clock = match (real_time, jitter) {
+                (true, _) => "real-time clock".to_owned(),
+                (false, None) => "virtual clock".to_owned(),
+                (false, Some(j)) => format!(
+                    "virtual clock with seeded jitter {}: {} % of ticks late by up to {} ms, {} % stalled for {}–{} ms",
+                    j.seed,
+                    100.0 * j.late_fraction,
+                    j.max_late * 1e3,
+                    100.0 * j.stall_fraction,
+                    0.5 * j.stall * 1e3,
+                    j.stall * 1e3
+                ),
+            };
             format!(
-                "the simulated PC104 card ({} clock): m1 = {} kg, m2 = {} kg, k1 = {} N/m, k2 = {} N/m, b1 = {} N·s/m, b2 = {} N·s/m, K = {} N/V, Coulomb friction {} / {} N (breakaway {} / {} N), PWM delay {} ms, encoder noise σ = {} counts",
-                if *real_time { "real-time" } else { "virtual" },
+                "the simulated PC104 card ({clock}): m1 = {} kg, m2 = {} kg, k1 = {} N/m, k2 = {} N/m, b1 = {} N·s/m, b2 = {} N·s/m, K = {} N/V, Coulomb friction {} / {} N (breakaway {} / {} N), PWM delay {} ms, encoder noise σ = {} counts",
                 t.m1,
                 t.m2,
                 t.k1,
@@ -226,11 +242,7 @@ fn describe(backend: &crate::backend::Backend) -> String {
 fn timing_text(t: &crate::backend::LoopTiming) -> String {
     format!(
         "Loop timing over these runs ({}): worst p99 lateness {:.1} µs, worst max {:.1} µs, {} overruns, {} skipped ticks (they show as gaps in the recordings; identification splits at gaps), {} late ticks (sampled after their deadline), longest interval between samples {:.2} ms.\n",
-        if t.fifo {
-            "SCHED_FIFO"
-        } else {
-            "normal scheduling"
-        },
+        t.clock,
         t.lateness_p99 * 1e6,
         t.lateness_max * 1e6,
         t.overruns,

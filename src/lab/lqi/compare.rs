@@ -210,6 +210,8 @@ impl IntegratorWalk {
     /// The walk of `design`'s integrator on its rig run `rig` with figures
     /// `measured`, for carts breaking away at `breakaway` (N, cart 1 and 2)
     /// on a drive of `gain` (N/V), in counts of `metres_per_count` (m).
+    /// A run without figures (not settled) has no steady-state error:
+    /// `error_counts`, `rate` and `time` are then NaN.
     pub fn of(
         design: &Design,
         rig: (&Recording, &Metrics),
