@@ -5,8 +5,10 @@
 //! rig's [`Calibration`].
 
 mod parts;
+mod unmodelled;
 
 pub use parts::{CardSettings, Friction};
+pub use unmodelled::Unmodelled;
 
 use nalgebra::SVector;
 
@@ -141,8 +143,14 @@ pub struct SimulatedRig {
     pub initial_state: [f64; 4],
     /// The linear plant inside; `truth.gain` is the motor's N per volt.
     pub truth: MassSpring,
-    /// The Coulomb friction and stiction on the carts.
+    /// The Coulomb friction and stiction on the carts: their nominal
+    /// values, which each run's card varies (see
+    /// [`Unmodelled::friction_variation`]).
     pub friction: Friction,
+    /// What the real rig has and the identification's model does not:
+    /// rotor mass on cart 2, drive deadband, friction along the rail and
+    /// from run to run.
+    pub unmodelled: Unmodelled,
     /// The simulated card's own settings.
     pub card: CardSettings,
     /// What the software uses, and what the simulated card is built to
@@ -157,6 +165,7 @@ impl Default for SimulatedRig {
             initial_state: [0.0; 4],
             truth: Self::default_truth(),
             friction: Friction::default(),
+            unmodelled: Unmodelled::default(),
             card: CardSettings::default(),
             calibration: Calibration::default(),
         }
@@ -209,6 +218,7 @@ impl SimulatedRig {
         Self {
             truth,
             friction: Friction::NONE,
+            unmodelled: Unmodelled::NONE,
             card: CardSettings::ideal(),
             ..Self::default()
         }
@@ -295,17 +305,66 @@ impl SimulatedRig {
         self.calibration.metres_per_count
     }
 
-    /// The plant inside the card: the truth with its friction.
+    /// The linear plant the carts really are: the truth with cart 2's
+    /// mass `m2 + rotor_mass` (kg; see [`Unmodelled::rotor_mass`]), the
+    /// rest as [`truth`](Self::truth) says. What an identification that
+    /// fits cart 2's effective mass should find.
     ///
     /// # Examples
     ///
     /// ```
-    /// use ctrlab::lab::{Friction, SimulatedRig};
-    /// let sim = SimulatedRig { friction: Friction::coulomb([1.0, 2.0]), ..Default::default() };
+    /// use ctrlab::lab::SimulatedRig;
+    /// let sim = SimulatedRig::default();
+    /// assert!((sim.effective_truth().m2 - 0.76).abs() < 1e-12);
+    /// assert_eq!(sim.effective_truth().gain, sim.truth.gain);
+    /// ```
+    pub fn effective_truth(&self) -> MassSpring {
+        MassSpring {
+            m2: self.truth.m2 + self.unmodelled.rotor_mass,
+            ..self.truth
+        }
+    }
+
+    /// The friction of this rig's run: the nominal [`friction`](Self::friction)
+    /// drawn for the card's seed ([`Unmodelled::draw_friction`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{CardSettings, SimulatedRig};
+    /// let sim = SimulatedRig::default();
+    /// let other = SimulatedRig { card: CardSettings { seed: 2, ..sim.card }, ..sim.clone() };
+    /// assert_ne!(sim.run_friction(), other.run_friction());
+    /// assert_eq!(SimulatedRig::ideal(sim.truth).run_friction().coulomb, [0.0; 2]);
+    /// ```
+    pub fn run_friction(&self) -> crate::lab::Friction {
+        self.unmodelled.draw_friction(&self.friction, self.card.seed)
+    }
+
+    /// The plant inside the card: the [effective truth](Self::effective_truth)
+    /// with this run's friction ([`run_friction`](Self::run_friction)),
+    /// varying along the rail, behind the drive's deadband.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Friction, SimulatedRig, Unmodelled};
+    /// let sim = SimulatedRig {
+    ///     friction: Friction::coulomb([1.0, 2.0]),
+    ///     unmodelled: Unmodelled::NONE,
+    ///     ..Default::default()
+    /// };
     /// assert_eq!(sim.plant().friction(), [1.0, 2.0]);
+    /// let real = SimulatedRig::default().plant();
+    /// assert_eq!((real.deadband(), real.friction_ripple()), (0.3, (0.15, 0.02)));
     /// ```
     pub fn plant(&self) -> FrictionPlant {
-        FrictionPlant::new(self.truth, self.friction.coulomb).with_stiction(self.friction.stiction)
+        let friction = self.run_friction();
+        let u = &self.unmodelled;
+        FrictionPlant::new(self.effective_truth(), friction.coulomb)
+            .with_stiction(friction.stiction)
+            .with_deadband(u.deadband)
+            .with_friction_ripple(u.friction_ripple, u.ripple_period)
     }
 
     /// The card's configuration: the card's settings, what the calibration
@@ -524,11 +583,21 @@ impl SimulatedRig {
         self.friction
             .validate()
             .map_err(|e| e.in_table("friction"))?;
+        self.unmodelled
+            .validate()
+            .map_err(|e| e.in_table("unmodelled"))?;
         self.check_accelerations()?;
         self.calibration
             .validate()
             .map_err(|e| e.in_table("calibration"))?;
         let cal = &self.calibration;
+        if self.unmodelled.deadband >= cal.volts_full_scale {
+            return Err(ConfigError::conflict(
+                "unmodelled.deadband",
+                self.unmodelled.deadband,
+                "must be below the drive's full scale (calibration.volts_full_scale): the drive would give no force",
+            ));
+        }
         if let Some(c) = cal.sign.iter().position(|&s| s != 1.0) {
             return Err(ConfigError::invalid(
                 format!("calibration.sign[{c}]"),
@@ -563,17 +632,18 @@ impl SimulatedRig {
     /// too small for its springs, damping, motor or friction would make
     /// the simulated card diverge at its first step.
     fn check_accelerations(&self) -> Result<(), ConfigError> {
-        let p = &self.truth;
+        let p = &self.effective_truth();
+        let friction = self.friction.coulomb;
         let per_mass = [
             (
                 "truth.m1",
                 p.m1,
-                [p.k1 + p.k2, p.b1, p.k2, self.friction.coulomb[0]],
+                [p.k1 + p.k2, p.b1, p.k2, friction[0]],
             ),
             (
                 "truth.m2",
                 p.m2,
-                [p.k2, p.b2, p.gain, self.friction.coulomb[1]],
+                [p.k2, p.b2, p.gain, friction[1]],
             ),
         ];
         for (key, mass, forces) in per_mass {
