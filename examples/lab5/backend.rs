@@ -112,9 +112,15 @@ impl Backend {
         self.sim().map(|s| s.truth)
     }
 
-    /// The plant and Coulomb friction behind a simulated rig.
+    /// The plant and Coulomb friction behind a simulated rig, as the
+    /// identification is judged against: cart 2's effective mass (with the
+    /// rotor) and the nominal friction, the mean of the runs' draws
+    /// (`Unmodelled::draw_friction`).
     pub fn friction_truth(&self) -> Option<FrictionPlant> {
-        self.sim().map(SimulatedRig::plant)
+        self.sim().map(|s| {
+            FrictionPlant::new(s.effective_truth(), s.friction.coulomb)
+                .with_stiction(s.friction.stiction)
+        })
     }
 
     /// The card's calibration: the simulated card's, or the real card's

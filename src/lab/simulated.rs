@@ -361,10 +361,14 @@ impl SimulatedRig {
     pub fn plant(&self) -> FrictionPlant {
         let friction = self.run_friction();
         let u = &self.unmodelled;
-        FrictionPlant::new(self.effective_truth(), friction.coulomb)
+        let plant = FrictionPlant::new(self.effective_truth(), friction.coulomb)
             .with_stiction(friction.stiction)
-            .with_deadband(u.deadband)
-            .with_friction_ripple(u.friction_ripple, u.ripple_period)
+            .with_deadband(u.deadband);
+        if u.friction_ripple > 0.0 {
+            plant.with_friction_ripple(u.friction_ripple, u.ripple_period)
+        } else {
+            plant
+        }
     }
 
     /// The card's configuration: the card's settings, what the calibration
