@@ -39,7 +39,8 @@ fn off_the_plant_is_the_truth_with_its_friction() {
         ..SimulatedRig::default()
     };
     let f = Friction::default();
-    let want = FrictionPlant::new(SimulatedRig::default_truth(), f.coulomb).with_stiction(f.stiction);
+    let want =
+        FrictionPlant::new(SimulatedRig::default_truth(), f.coulomb).with_stiction(f.stiction);
     assert_eq!(sim.plant(), want);
     assert_eq!(sim.effective_truth(), sim.truth);
     assert_eq!(SimulatedRig::ideal(sim.truth).unmodelled, Unmodelled::NONE);
@@ -56,7 +57,11 @@ fn an_input_inside_the_deadband_leaves_the_carts_at_rest() {
     for channel in ["x1", "x2"] {
         assert!(rec.channel(channel).unwrap().iter().all(|&x| x == 0.0));
     }
-    let free = open_loop(&ideal_with(Unmodelled::NONE), &Step::new(0.29, 0.0).unwrap(), 1.0);
+    let free = open_loop(
+        &ideal_with(Unmodelled::NONE),
+        &Step::new(0.29, 0.0).unwrap(),
+        1.0,
+    );
     assert!(free.channel("x2").unwrap().iter().any(|&x| x != 0.0));
     // Above it, u − 0.3 V acts: 1.3 V deflects cart 2 as 1 V does,
     // K·1 V·(1/k1 + 1/k2) = 2.257 mm at rest.
@@ -64,10 +69,16 @@ fn an_input_inside_the_deadband_leaves_the_carts_at_rest() {
     let want = t.gain * (1.0 / t.k1 + 1.0 / t.k2);
     let rec = open_loop(&sim, &Step::new(1.3, 0.0).unwrap(), 6.0);
     let x2 = *rec.channel("x2").unwrap().last().unwrap();
-    assert!((x2 - want).abs() <= 1.5 * sim.metres_per_count(), "{x2} {want}");
+    assert!(
+        (x2 - want).abs() <= 1.5 * sim.metres_per_count(),
+        "{x2} {want}"
+    );
     let neg = open_loop(&sim, &Step::new(-1.3, 0.0).unwrap(), 6.0);
     let x2 = *neg.channel("x2").unwrap().last().unwrap();
-    assert!((x2 + want).abs() <= 1.5 * sim.metres_per_count(), "{x2} {want}");
+    assert!(
+        (x2 + want).abs() <= 1.5 * sim.metres_per_count(),
+        "{x2} {want}"
+    );
 }
 
 #[test]
@@ -151,7 +162,10 @@ fn each_runs_friction_is_drawn_from_its_seed() {
     // sample sd over 400 is σ/√800 = 0.18 %, so ±0.6 % is over 3 of it.
     let draws: Vec<Friction> = (0..400).map(|seed| u.draw_friction(&f, seed)).collect();
     for cart in 0..2 {
-        let factors: Vec<f64> = draws.iter().map(|d| d.coulomb[cart] / f.coulomb[cart]).collect();
+        let factors: Vec<f64> = draws
+            .iter()
+            .map(|d| d.coulomb[cart] / f.coulomb[cart])
+            .collect();
         let n = factors.len() as f64;
         let mean = factors.iter().sum::<f64>() / n;
         let sd = (factors.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
@@ -184,9 +198,18 @@ fn the_unmodelled_table_reads_writes_and_names_its_keys() {
     for (text, key) in [
         ("[unmodelled]\nrotor_mass = -0.1", "unmodelled.rotor_mass"),
         ("[unmodelled]\ndeadband = 24.0", "unmodelled.deadband"),
-        ("[unmodelled]\nfriction_ripple = 1.5", "unmodelled.friction_ripple"),
-        ("[unmodelled]\nripple_period = 0.0", "unmodelled.ripple_period"),
-        ("[unmodelled]\nfriction_variation = 0.5", "unmodelled.friction_variation"),
+        (
+            "[unmodelled]\nfriction_ripple = 1.5",
+            "unmodelled.friction_ripple",
+        ),
+        (
+            "[unmodelled]\nripple_period = 0.0",
+            "unmodelled.ripple_period",
+        ),
+        (
+            "[unmodelled]\nfriction_variation = 0.5",
+            "unmodelled.friction_variation",
+        ),
         ("[unmodelled]\nrotor = 0.1", "unmodelled.rotor"),
     ] {
         let err = SimulatedRig::from_toml(text).unwrap_err();
@@ -211,10 +234,7 @@ fn the_unmodelled_table_reads_writes_and_names_its_keys() {
 fn scan_identification_on_the_default_rig() {
     let base = SimulatedRig::default();
     let rig = |seed| SimulatedRig {
-        card: CardSettings {
-            seed,
-            ..base.card
-        },
+        card: CardSettings { seed, ..base.card },
         period: PERIOD,
         ..base.clone()
     };

@@ -45,7 +45,9 @@ use crate::design::{
 };
 use crate::discretize::Discretization;
 use crate::error::Error;
-use crate::lab::{self, Calibration, CardSettings, Cart, Friction, MassSpring, SimulatedRig, Unmodelled};
+use crate::lab::{
+    self, Calibration, CardSettings, Cart, Friction, MassSpring, SimulatedRig, Unmodelled,
+};
 use crate::model::{Discrete, StateSpace};
 use crate::sim::run_sampled;
 
