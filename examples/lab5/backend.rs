@@ -109,7 +109,8 @@ impl Backend {
 
     /// The plant behind a simulated rig, when there is one.
     pub fn truth(&self) -> Option<MassSpring> {
-        self.sim().map(|s| s.truth)
+        // Cart 2 with the rotor: the linear plant the carts really are.
+        self.sim().map(SimulatedRig::effective_truth)
     }
 
     /// The plant and Coulomb friction behind a simulated rig, as the
