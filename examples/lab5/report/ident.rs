@@ -319,7 +319,7 @@ impl Report {
         let mean =
             |f: fn(&MassSpringEstimate) -> f64| free.iter().map(f).sum::<f64>() / free.len() as f64;
         self.add(&format!(
-            "Not recovered: **the rotor's mass**, with m2 fixed at the weighed value: the missing {:.3} kg of inertia goes into K and b2. **The deadband**: a ±{volts:.2} V square wave holds |u| constant, so the deadband's K·{:.2} V·sign(u) looks like a smaller K (about {:+.1} % at this amplitude), and nothing in the model separates them. **Friction along the rail** is averaged into one Coulomb force per cart. **The per-run friction** shows as the Coulomb forces' spread over the runs, and their mean is off the nominal by the draws' own mean. Fitting cart 2's effective mass as well (`Options::free_m2`) finds m2 = {:.3} kg ({} against {m2:.3} kg) and b2 {}, but K stays {} off: the deadband's bias, which no mass explains.\n",
+            "Not recovered: **the rotor's mass**, with m2 fixed at the weighed value: the missing {:.3} kg of inertia goes into K and b2. **The deadband**: a ±{volts:.2} V square wave holds |u| constant, so the deadband's K·{:.2} V·sign(u) looks like a smaller K (about {:+.1} % at this amplitude), and nothing in the model separates them. **Friction along the rail** is averaged into one Coulomb force per cart. **The per-run friction** shows as the Coulomb forces' spread over the runs, and their mean is off the nominal by the draws' own mean. Fitting cart 2's effective mass as well (`Options::free_m2`) finds m2 = {:.3} kg ({} against {m2:.3} kg) and b2 {}, but K is {} off: mostly the deadband's bias, which no mass explains.\n",
             u.rotor_mass,
             u.deadband,
             -100.0 * u.deadband / volts,
