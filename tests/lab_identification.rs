@@ -40,8 +40,9 @@ fn rig(seed: u64) -> SimulatedRig {
 }
 
 /// The identification amplitude lab5 chooses on the default rig (probes
-/// on seeds 101 and 102, `lab::ident_input`): 7.64 V, not the 8 V asked
-/// for, which would take cart 2 past 60 % of its travel.
+/// on seeds 101 and 102, `lab::ident_input`): the 8 V asked for, which
+/// keeps cart 2 within 60 % of its travel with the unmodelled effects on
+/// (the deadband and the rotor; 7.64 V without them).
 fn volts() -> f64 {
     static VOLTS: OnceLock<f64> = OnceLock::new();
     *VOLTS.get_or_init(|| {
