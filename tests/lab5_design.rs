@@ -21,8 +21,9 @@ const SETPOINT: f64 = 0.030;
 
 /// The plant and Coulomb friction identified from one of lab5's
 /// identification runs on `sim` (the square wave of 0.2 s half period,
-/// 5 s, at the amplitude lab5 chooses from its probe runs: 7.64 V on the
-/// default rig), with the masses known.
+/// 5 s, at the amplitude lab5 chooses from its probe runs: 8 V on the
+/// default rig, 7.64 V without its unmodelled effects), with the masses
+/// known.
 fn identified(sim: &SimulatedRig) -> (MassSpring, [f64; 2]) {
     let ident = IdentInput::default();
     let mut n = 0;

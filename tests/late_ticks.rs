@@ -26,6 +26,7 @@ use ctrlab::lab::ident::{
 };
 use ctrlab::lab::{
     Calibration, CardSettings, Cart, Friction, LabGains, MassSpring, MassSpringRig, SimulatedRig,
+    Unmodelled,
 };
 use ctrlab::metrics::{StepInfoOptions, step_info_channel};
 use ctrlab::signal::{Signal, SquareWave};
@@ -432,6 +433,9 @@ fn noiseless_rig() -> SimulatedRig {
             encoder_noise: 0.0,
             ..CardSettings::default()
         },
+        // Off: these tests check the timing machinery (late ticks, the
+        // input delay on actual instants) against the model, not realism.
+        unmodelled: Unmodelled::NONE,
         ..SimulatedRig::default()
     }
 }
@@ -503,6 +507,9 @@ fn refinement_and_bootstrap_on_jittered_recordings_stay_within_their_bounds() {
             coulomb: [1.0, 2.0],
             stiction: [1.2, 2.4],
         },
+        // Off: ident_refine's bounds are the refinement's against its own
+        // model structure; jitter is what this test adds.
+        unmodelled: Unmodelled::NONE,
         ..SimulatedRig::default()
     };
     let volts = 12.0 / sim.truth.gain;

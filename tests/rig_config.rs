@@ -12,6 +12,7 @@ use ctrlab::MassSpring;
 use ctrlab::hw::{Clock, RegisterMap};
 use ctrlab::lab::{
     Calibration, CardSettings, FileError, FileErrorKind, Friction, RigConfig, SimulatedRig,
+    Unmodelled,
 };
 
 fn lab() -> RigConfig {
@@ -705,6 +706,13 @@ fn a_truth_file_keeps_defaults_refuses_unknown_keys_and_round_trips() {
         initial_state: [0.001, 0.0, -0.002, 0.01],
         truth: MassSpring::nominal(),
         friction: Friction::coulomb([0.3, 0.6]),
+        unmodelled: Unmodelled {
+            rotor_mass: 0.04,
+            deadband: 0.1,
+            friction_ripple: 0.2,
+            ripple_period: 0.03,
+            friction_variation: 0.02,
+        },
         card: CardSettings {
             encoder_noise: 0.1,
             seed: 3,
@@ -727,6 +735,7 @@ fn a_truth_file_keeps_defaults_refuses_unknown_keys_and_round_trips() {
     for table in [
         "[truth]",
         "[friction]",
+        "[unmodelled]",
         "[card]",
         "[card.map]",
         "[calibration]",

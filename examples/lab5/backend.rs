@@ -112,12 +112,19 @@ impl Backend {
 
     /// The plant behind a simulated rig, when there is one.
     pub fn truth(&self) -> Option<MassSpring> {
-        self.sim().map(|s| s.truth)
+        // Cart 2 with the rotor: the linear plant the carts really are.
+        self.sim().map(SimulatedRig::effective_truth)
     }
 
-    /// The plant and Coulomb friction behind a simulated rig.
+    /// The plant and Coulomb friction behind a simulated rig, as the
+    /// identification is judged against: cart 2's effective mass (with the
+    /// rotor) and the nominal friction, the mean of the runs' draws
+    /// (`Unmodelled::draw_friction`).
     pub fn friction_truth(&self) -> Option<FrictionPlant> {
-        self.sim().map(SimulatedRig::plant)
+        self.sim().map(|s| {
+            FrictionPlant::new(s.effective_truth(), s.friction.coulomb)
+                .with_stiction(s.friction.stiction)
+        })
     }
 
     /// The card's calibration: the simulated card's, or the real card's

@@ -213,7 +213,8 @@ impl<D: Dynamics<N, 1>, const N: usize> SimulatedCard<D, N> {
     /// use ctrlab::{hw::Clock, lab::SimulatedRig};
     /// let rig = SimulatedRig::default();
     /// let card = rig.card(&Clock::RealTime)?;
-    /// assert_eq!(card.plant().truth(), rig.truth);
+    /// assert_eq!(card.plant().truth(), rig.effective_truth()); // cart 2 with the rotor
+    /// assert_eq!(card.plant(), &rig.plant());
     /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     pub fn plant(&self) -> &D {

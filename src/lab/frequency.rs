@@ -328,11 +328,11 @@ pub fn frequency_response(
         &rig.sampled_config(DURATION),
     )?;
     let (_, simulated) = estimates(&simulated, &omega, rig.period)?;
-    let model = bode(&rig.truth.state_space(Cart::Two)?, &omega)?;
+    let model = bode(&rig.effective_truth().state_space(Cart::Two)?, &omega)?;
     let truth_bode = truth
         .map(|t| bode(&t.state_space(Cart::Two)?, &omega))
         .transpose()?;
-    let model_modes = modes_hz(&rig.truth)?;
+    let model_modes = modes_hz(&rig.effective_truth())?;
     let measured_peaks = peaks_hz(&smoothed, 2);
     let simulated_peaks = peaks_hz(&simulated, 2);
     let truth_modes = truth.map(modes_hz).transpose()?;

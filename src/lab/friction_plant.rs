@@ -52,6 +52,11 @@ pub struct FrictionPlant {
     accel: Accelerations,
     /// Coulomb force over mass per cart, m/s².
     friction_accel: [f64; 2],
+    /// The drive's deadband, V (0: none).
+    deadband: f64,
+    /// Relative amplitude (0: none) and spatial period (m) of the friction
+    /// forces' variation along the rail.
+    ripple: [f64; 2],
 }
 
 /// The nonzero entries of the rows of `[A B]` that give the accelerations.
@@ -103,6 +108,119 @@ impl FrictionPlant {
             direction: [0.0; 2],
             accel: Accelerations::of(&truth),
             friction_accel: [friction[0] / truth.m1, friction[1] / truth.m2],
+            deadband: 0.0,
+            ripple: [0.0, 1.0],
+        }
+    }
+
+    /// The same plant behind a drive with a deadband of `volts` V (≥ 0):
+    /// an input of |u| ≤ `volts` gives no force, a larger one acts as
+    /// `u − volts·sign(u)`. 0 (the default) leaves the input as it is.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::Dynamics;
+    /// use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// use ctrlab::nalgebra::vector;
+    /// let p = FrictionPlant::new(MassSpring::nominal(), [0.0; 2]).with_deadband(0.3);
+    /// assert_eq!(p.deadband(), 0.3);
+    /// let x = vector![0.0, 0.0, 0.0, 0.0];
+    /// assert_eq!(p.derivative(0.0, &x, &vector![0.25])[3], 0.0); // inside: no force
+    /// let a = p.derivative(0.0, &x, &vector![1.3])[3]; // 1 V acts: 1 N on 0.7 kg
+    /// assert!((a - 1.0 / 0.7).abs() < 1e-12);
+    /// ```
+    #[must_use]
+    pub fn with_deadband(mut self, volts: f64) -> Self {
+        self.deadband = volts;
+        self
+    }
+
+    /// The same plant with Coulomb and breakaway forces that vary along
+    /// the rail by the relative `amplitude` (0 ≤ a < 1) over `period` m
+    /// (> 0): cart 1 feels `F·(1 + a·sin(2π x1 / period))`, cart 2
+    /// `F·(1 + a·cos(2π x2 / period))`. An amplitude of 0 (the default)
+    /// keeps them constant.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// let p = FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]).with_friction_ripple(0.15, 0.02);
+    /// assert_eq!(p.friction_ripple(), (0.15, 0.02));
+    /// // Cart 2 at 0 is at the ripple's crest, 10 mm on at its trough.
+    /// assert!((p.coulomb_at(1, 0.0) - 2.3).abs() < 1e-12);
+    /// assert!((p.coulomb_at(1, 0.01) - 1.7).abs() < 1e-12);
+    /// assert_eq!(p.coulomb_at(0, 0.0), 1.0);
+    /// ```
+    #[must_use]
+    pub fn with_friction_ripple(mut self, amplitude: f64, period: f64) -> Self {
+        self.ripple = [amplitude, period];
+        self
+    }
+
+    /// The drive's deadband, V.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// assert_eq!(FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]).deadband(), 0.0);
+    /// ```
+    pub fn deadband(&self) -> f64 {
+        self.deadband
+    }
+
+    /// The friction's variation along the rail: relative amplitude and
+    /// period, m (see [`with_friction_ripple`](Self::with_friction_ripple)).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// assert_eq!(FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]).friction_ripple().0, 0.0);
+    /// ```
+    pub fn friction_ripple(&self) -> (f64, f64) {
+        (self.ripple[0], self.ripple[1])
+    }
+
+    /// The Coulomb force on `cart` (0 or 1; any other is cart 2) at
+    /// position `x` m, N: its [`friction`](Self::friction) times the
+    /// variation along the rail.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{FrictionPlant, MassSpring};
+    /// let p = FrictionPlant::new(MassSpring::nominal(), [1.0, 2.0]);
+    /// assert_eq!((p.coulomb_at(0, 0.3), p.coulomb_at(1, -0.2)), (1.0, 2.0));
+    /// ```
+    pub fn coulomb_at(&self, cart: usize, x: f64) -> f64 {
+        let cart = cart.min(1);
+        self.friction[cart] * self.ripple_factor(cart, x)
+    }
+
+    /// The friction's factor along the rail on `cart` (0 or 1) at `x` m.
+    #[inline]
+    fn ripple_factor(&self, cart: usize, x: f64) -> f64 {
+        let [amplitude, period] = self.ripple;
+        if amplitude == 0.0 {
+            return 1.0;
+        }
+        let phase = std::f64::consts::TAU * x / period;
+        1.0 + amplitude * if cart == 0 { phase.sin() } else { phase.cos() }
+    }
+
+    /// The input that acts, V: `u` less the deadband.
+    #[inline]
+    fn acting(&self, u: f64) -> f64 {
+        let d = self.deadband;
+        if d == 0.0 {
+            u
+        } else if u.abs() <= d {
+            0.0
+        } else {
+            u - d.copysign(u)
         }
     }
 
@@ -167,9 +285,9 @@ impl FrictionPlant {
         self.direction
     }
 
-    /// The force that holds a cart at rest, N.
-    fn breakaway(&self, cart: usize) -> f64 {
-        self.stiction[cart].max(self.friction[cart])
+    /// The force that holds a cart at rest at position `x` m, N.
+    fn breakaway(&self, cart: usize, x: f64) -> f64 {
+        self.stiction[cart].max(self.friction[cart]) * self.ripple_factor(cart, x)
     }
 
     fn mass(&self, cart: usize) -> f64 {
@@ -182,7 +300,7 @@ impl FrictionPlant {
 
     /// Net force on `cart` from everything but Coulomb friction, N.
     fn other_force(&self, x: &SVector<f64, 4>, u: &SVector<f64, 1>, cart: usize) -> f64 {
-        self.accel.at(x, u[0])[cart] * self.mass(cart)
+        self.accel.at(x, self.acting(u[0]))[cart] * self.mass(cart)
     }
 }
 
@@ -190,7 +308,7 @@ impl Dynamics<4, 1> for FrictionPlant {
     #[inline]
     fn derivative(&self, _t: f64, x: &SVector<f64, 4>, u: &SVector<f64, 1>) -> SVector<f64, 4> {
         let mut dx = SVector::from([x[1], 0.0, x[3], 0.0]);
-        let accel = self.accel.at(x, u[0]);
+        let accel = self.accel.at(x, self.acting(u[0]));
         for cart in 0..2 {
             dx[2 * cart + 1] = accel[cart];
             if self.friction[cart] > 0.0 {
@@ -198,7 +316,9 @@ impl Dynamics<4, 1> for FrictionPlant {
                     dx[2 * cart] = 0.0;
                     dx[2 * cart + 1] = 0.0;
                 } else {
-                    dx[2 * cart + 1] -= self.friction_accel[cart] * self.direction[cart];
+                    dx[2 * cart + 1] -= self.friction_accel[cart]
+                        * self.ripple_factor(cart, x[2 * cart])
+                        * self.direction[cart];
                 }
             }
         }
@@ -218,7 +338,7 @@ impl Dynamics<4, 1> for FrictionPlant {
             let direction = self.direction[cart];
             if direction != 0.0 && v * direction <= 0.0 {
                 let force = self.other_force(x, u, cart);
-                if force.abs() <= self.breakaway(cart) {
+                if force.abs() <= self.breakaway(cart, x[2 * cart]) {
                     x[2 * cart + 1] = 0.0;
                     self.direction[cart] = 0.0;
                 } else {
@@ -231,7 +351,7 @@ impl Dynamics<4, 1> for FrictionPlant {
                 self.direction[cart] = v.signum();
             } else if self.direction[cart] == 0.0 {
                 let force = self.other_force(x, u, cart);
-                if force.abs() > self.breakaway(cart) {
+                if force.abs() > self.breakaway(cart, x[2 * cart]) {
                     self.direction[cart] = force.signum();
                 }
             } else if v != 0.0 {

@@ -86,7 +86,7 @@ pub use plant::{Cart, MassSpring};
 pub use probe::SimulatedOperator;
 pub use rig::MassSpringRig;
 pub use sensor::EncoderSensor;
-pub use simulated::{CardSettings, Friction, SimulatedRig};
+pub use simulated::{CardSettings, Friction, SimulatedRig, Unmodelled};
 
 use nalgebra::SMatrix;
 

@@ -6,7 +6,7 @@ use ctrlab::lab::ident::{EqualSprings, MassSpringEstimate, Parameter, Spread, Su
 use ctrlab::lab::ident_input::{IdentInput, IdentSignal, PROBE_DURATION, Reason, peaks};
 use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, M1, M2, PERIOD};
 use ctrlab::lab::tables::poles_display;
-use ctrlab::lab::{Cart, FrictionPlant};
+use ctrlab::lab::{Cart, FrictionPlant, Unmodelled};
 
 use super::{ParamPanel, Report, describe, mm, pct, timing_text};
 use crate::backend::Backend;
@@ -234,6 +234,11 @@ impl Report {
             poles_display(&sys.poles()?)
         ));
         self.uncertainty(s, truth);
+        if let Some(sim) = backend.and_then(Backend::sim)
+            && sim.unmodelled != Unmodelled::NONE
+        {
+            self.not_recovered(sim, ident)?;
+        }
         Ok(())
     }
 
@@ -490,8 +495,16 @@ impl Report {
             m.m1, m.m2, m.k1, m.k2, m.b1, m.b2, m.gain, f1, f2, ident.summary.average.runs
         );
         if let Some(sim) = backend.and_then(Backend::sim) {
+            let drawn = if sim.unmodelled.friction_variation > 0.0 {
+                format!(
+                    " (nominal: each run's is drawn with σ = {:.0} %)",
+                    100.0 * sim.unmodelled.friction_variation
+                )
+            } else {
+                String::new()
+            };
             s += &format!(
-                " The card's Coulomb friction is {} N and {} N: identified {} and {}.",
+                " The card's Coulomb friction is {} N and {} N{drawn}: identified {} and {}.",
                 sim.friction.coulomb[0],
                 sim.friction.coulomb[1],
                 pct(f1, sim.friction.coulomb[0]),
@@ -501,7 +514,7 @@ impl Report {
             let lab_k = ident.summary.lab_average.gain.mean;
             let cen_k = ident.summary.central_average.gain.mean;
             s += &format!(
-                " Against the simulated card's truth: k1 {}, k2 {}, b1 {}, b2 {}, K {}. The card's springs differ (k1 = {:.0}, k2 = {:.0} N/m) and its carts have Coulomb friction, so the lab's model is wrong for it whatever the differences: its K is off by {} (Lab) and {} (Central), while identifying k1, k2 and the friction separately recovers K within {}.",
+                " Against the simulated card's truth: k1 {}, k2 {}, b1 {}, b2 {}, K {}. The card's springs differ (k1 = {:.0}, k2 = {:.0} N/m) and its carts have Coulomb friction, so the lab's model is wrong for it whatever the differences: its K is off by {} (Lab) and {} (Central), while identifying k1, k2 and the friction separately gives K within {}{}.",
                 pct(m.k1, t.k1),
                 pct(m.k2, t.k2),
                 pct(m.b1, t.b1),
@@ -512,6 +525,11 @@ impl Report {
                 pct(lab_k, t.gain),
                 pct(cen_k, t.gain),
                 pct(m.gain, t.gain),
+                if sim.unmodelled == Unmodelled::NONE {
+                    ""
+                } else {
+                    " (the rest is what the model lacks: see \"What the identification does not recover\")"
+                },
             );
         }
         if let Some(e) = &ident.equal_springs {

@@ -16,6 +16,7 @@ mod figures;
 mod ident;
 mod models;
 mod tables;
+mod unmodelled;
 
 use std::path::{Path, PathBuf};
 

@@ -418,12 +418,14 @@ pub fn refine(rec: &Recording, start: &MassSpringEstimate) -> Result<Refined, Er
 /// # Examples
 ///
 /// ```
-/// use ctrlab::lab::SimulatedRig;
+/// use ctrlab::lab::{SimulatedRig, Unmodelled};
 /// use ctrlab::lab::ident::{Options, SpringModel, identify_with, refine_with};
 /// use ctrlab::signal::SquareWave;
 /// # use ctrlab::{OpenLoop, hw::{self, Clock, LoopConfig, VirtualClock}};
 /// # use ctrlab::nalgebra::vector;
-/// let sim = SimulatedRig::default();
+/// // The default rig without what the model lacks (its rotor, deadband,
+/// // friction along the rail and per run), so the truth is recoverable.
+/// let sim = SimulatedRig { unmodelled: Unmodelled::NONE, ..SimulatedRig::default() };
 /// // A 3 s square-wave run on the simulated card (its Coulomb friction,
 /// // stiction, PWM delay and encoder noise), as `hw::run` records it.
 /// # let clock = VirtualClock::new();

@@ -329,7 +329,9 @@ pub struct EqualSprings {
 }
 
 impl EqualSprings {
-    /// `sim` with k2 = k1 and no dry friction: the card to run.
+    /// `sim` with k2 = k1, no dry friction and none of its
+    /// [`Unmodelled`](crate::lab::Unmodelled) effects (the lab's model is
+    /// exact on it): the card to run.
     ///
     /// # Examples
     ///
@@ -337,6 +339,7 @@ impl EqualSprings {
     /// use ctrlab::lab::{SimulatedRig, ident::EqualSprings};
     /// let card = EqualSprings::card(&SimulatedRig::default());
     /// assert_eq!((card.truth.k2, card.friction.coulomb), (950.0, [0.0; 2]));
+    /// assert_eq!(card.unmodelled, ctrlab::lab::Unmodelled::NONE);
     /// ```
     pub fn card(sim: &SimulatedRig) -> SimulatedRig {
         SimulatedRig {
@@ -345,6 +348,7 @@ impl EqualSprings {
                 ..sim.truth
             },
             friction: Friction::NONE,
+            unmodelled: crate::lab::Unmodelled::NONE,
             ..sim.clone()
         }
     }

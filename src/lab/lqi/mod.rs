@@ -45,7 +45,9 @@ use crate::design::{
 };
 use crate::discretize::Discretization;
 use crate::error::Error;
-use crate::lab::{self, Calibration, CardSettings, Cart, Friction, MassSpring, SimulatedRig};
+use crate::lab::{
+    self, Calibration, CardSettings, Cart, Friction, MassSpring, SimulatedRig, Unmodelled,
+};
 use crate::model::{Discrete, StateSpace};
 use crate::sim::run_sampled;
 
@@ -202,6 +204,8 @@ pub fn predicted_rig(
     SimulatedRig {
         truth: model,
         friction: Friction::coulomb(coulomb),
+        // The model's prediction: nothing the model lacks.
+        unmodelled: Unmodelled::NONE,
         card: CardSettings {
             pwm_delay: DRIVE_DELAY,
             encoder_noise: 0.0,

@@ -132,7 +132,7 @@ pub fn design_search(rig: &SimulatedRig, spec: Spec) -> Result<Design, Error> {
             });
         }
     }
-    let discrete = position_model(&rig.truth, rig.period)?;
+    let discrete = position_model(&rig.effective_truth(), rig.period)?;
     let count = rig.metres_per_count();
     let candidates: Vec<Candidate> = rho_grid()
         .map(|rho| Candidate {
