@@ -36,13 +36,19 @@ fn lab5_binary() -> PathBuf {
     bin
 }
 
-/// Runs lab5 with `--jitter jitter`; its report.
+/// Runs lab5 with `--jitter jitter` (on the ideal virtual clock when
+/// `jitter` is empty); its report.
 fn lab5(jitter: &str) -> String {
+    let name = if jitter.is_empty() { "ideal" } else { jitter };
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join("lab5-jitter")
-        .join(jitter.replace(',', "_"));
-    let run = Command::new(lab5_binary())
-        .args(["--jitter", jitter, "--out"])
+        .join(name.replace(',', "_"));
+    let mut command = Command::new(lab5_binary());
+    if !jitter.is_empty() {
+        command.args(["--jitter", jitter]);
+    }
+    let run = command
+        .arg("--out")
         .arg(&out)
         .output()
         .expect("lab5 starts");
@@ -123,10 +129,61 @@ fn timing(report: &str) -> Vec<[usize; 3]> {
         .collect()
 }
 
+/// What the jittered runs are held to beside the ideal clock's run of the
+/// same lab5 (the same rig, the same per-run seeds): its refined fit,
+/// bootstrap k1, measured modes and identification errors.
+struct Ideal {
+    fit: [f64; 2],
+    k1: f64,
+    modes: Vec<f64>,
+    errors: Vec<(String, f64)>,
+}
+
+impl Ideal {
+    fn run() -> Self {
+        let report = lab5("");
+        let (fit, k1) = refinement(&report);
+        Self {
+            fit,
+            k1,
+            modes: measured_modes(&report),
+            errors: identification_errors(&report),
+        }
+    }
+}
+
+/// The refined model's fit on both carts (%) and the bootstrap's k1 (N/m).
+fn refinement(report: &str) -> ([f64; 2], f64) {
+    let validation = rows(report, "Validation");
+    let refined = validation
+        .iter()
+        .find(|r| r[0] == "refined by output error")
+        .expect("the refined row");
+    let bootstrap = rows(report, "The refined parameters over every run");
+    let first = bootstrap
+        .iter()
+        .find(|r| r[0].contains("bootstrap"))
+        .expect("the bootstrap row");
+    (
+        [number(&refined[8]), number(&refined[9])],
+        number(&first[1]),
+    )
+}
+
+/// The frequency section's measured gain peaks, Hz.
+fn measured_modes(report: &str) -> Vec<f64> {
+    rows(report, "Frequency response")
+        .iter()
+        .skip(1)
+        .map(|m| number(&m[3]))
+        .collect()
+}
+
 /// Everything lab5 reports on a jittered run but the identification's
 /// bounds: each section ran, counted its late and skipped ticks, and the
-/// frequency section found both modes.
-fn check_sections(report: &str, jitter: &str) {
+/// refinement, the bootstrap and the frequency section agree with the
+/// ideal clock's run.
+fn check_sections(report: &str, jitter: &str, ideal: &Ideal) {
     // The identification runs, Table 5 and Table 6 say how the loop ran.
     let timing = timing(report);
     assert_eq!(timing.len(), 3, "--jitter {jitter}: {timing:?}");
@@ -137,34 +194,28 @@ fn check_sections(report: &str, jitter: &str) {
             "--jitter {jitter}: {skipped} {late}"
         );
     }
-    // Validation and refinement: the refined model simulates both carts
-    // within 1 % (fit ≥ 99 %; 99.95 % on the ideal clock, 99.93 % on
-    // `--jitter 11`), and the bootstrap gives k1 with its standard error.
-    let validation = rows(report, "Validation");
-    let refined = validation
-        .iter()
-        .find(|r| r[0] == "refined by output error")
-        .expect("the refined row");
+    // Validation and refinement against the ideal clock's: measured, the
+    // ideal run's refined model fits 96.31 / 95.30 % (the card has what the
+    // model lacks: the truth itself reaches about 96 %) and its bootstrap
+    // k1 is 929.3 N/m; twenty jittered runs (both schedules, seeds 1–10)
+    // fit 96.15–96.44 / 95.15–95.48 % with k1 928.9–929.7 N/m. Bounds:
+    // 0.5 points of fit, 0.2 % of k1.
+    let (fit, k1) = refinement(report);
+    for (got, want) in fit.iter().zip(ideal.fit) {
+        assert!((got - want).abs() < 0.5, "--jitter {jitter}: fit {fit:?}");
+    }
     assert!(
-        number(&refined[8]) >= 99.0 && number(&refined[9]) >= 99.0,
-        "{refined:?}"
+        (k1 / ideal.k1 - 1.0).abs() < 0.002,
+        "--jitter {jitter}: k1 {k1}"
     );
-    let bootstrap = rows(report, "The refined parameters over every run");
-    let first = bootstrap
-        .iter()
-        .find(|r| r[0].contains("bootstrap"))
-        .expect("the bootstrap row");
-    assert!((number(&first[1]) / 950.0 - 1.0).abs() < 0.005, "{first:?}");
-    // The frequency section: each measured gain peak within 0.5 Hz of the
-    // identified model's with friction, simulated (2.68 and 8.45 Hz; the
-    // ideal clock measures exactly those; the ten schedules of the scan
-    // below were off by at most 0.44 Hz, the second mode at 8.01 Hz).
-    for mode in rows(report, "Frequency response").iter().skip(1) {
-        let (simulated, measured) = (number(&mode[2]), number(&mode[3]));
-        assert!(
-            (measured - simulated).abs() < 0.5,
-            "--jitter {jitter}: {mode:?}"
-        );
+    // The frequency section: each measured gain peak within 0.2 Hz of the
+    // ideal clock's (2.71 and 7.92 Hz; the twenty runs measured 2.68–2.77
+    // and 7.92–8.01 Hz; before the section resampled gaps, `--jitter 11`
+    // measured 2.33 and 3.02 Hz).
+    let modes = measured_modes(report);
+    assert_eq!(modes.len(), ideal.modes.len(), "--jitter {jitter}");
+    for (got, want) in modes.iter().zip(&ideal.modes) {
+        assert!((got - want).abs() < 0.2, "--jitter {jitter}: {modes:?}");
     }
     for heading in [
         "Table 5",
@@ -176,82 +227,106 @@ fn check_sections(report: &str, jitter: &str) {
     }
 }
 
+/// The usual bounds of lab5's identification against the card's truth,
+/// those of tests/lab_identification.rs (the default rig with its
+/// unmodelled effects on, measured there over six sets of five runs):
+/// springs within 0.3 %, K −3.2 to −1.7 %, b2 +3.0 to +5.5 %, the Coulomb
+/// forces within 10 % of their nominal values; b1 unbounded.
+fn assert_usual_bounds(errors: &[(String, f64)], what: &str) {
+    for (name, e) in errors {
+        let ok = match name.as_str() {
+            "k1" | "k2" => e.abs() < 0.3,
+            "K" => (-3.2..-1.7).contains(e),
+            "b2" => (3.0..5.5).contains(e),
+            "F1" | "F2" => e.abs() < 10.0,
+            _ => true,
+        };
+        assert!(ok, "{what}: {name} {e:+.2} %");
+    }
+}
+
+/// Each jittered run's identification error minus the ideal clock's,
+/// percentage points, within `bounds` (k1/k2, K, b2, F1/F2).
+fn assert_near_ideal(errors: &[(String, f64)], ideal: &Ideal, bounds: [f64; 4], what: &str) {
+    assert_eq!(errors.len(), ideal.errors.len(), "{what}: {errors:?}");
+    for ((name, e), (_, i)) in errors.iter().zip(&ideal.errors) {
+        let bound = match name.as_str() {
+            "k1" | "k2" => bounds[0],
+            "K" => bounds[1],
+            "b2" => bounds[2],
+            "F1" | "F2" => bounds[3],
+            _ => f64::INFINITY,
+        };
+        assert!(
+            (e - i).abs() < bound,
+            "{what}: {name} {e:+.2} % against the ideal clock's {i:+.2} %"
+        );
+    }
+}
+
 /// The schedule of tests/late_ticks.rs's identification test: 3 % of ticks
 /// late by up to 6 ms (three periods), one in 500 stalled for 8–16 ms.
 const MILD: &str = "0.03,0.006,0.002,0.016";
 
+// Measured (% error of the five-run mean against the card's truth;
+// `cargo build --release --example lab5`, then `lab5` for the ideal clock
+// and `lab5 --jitter SEED[,0.03,0.006,0.002,0.016]`, seeds 1–10), on the
+// default rig with its unmodelled effects on:
+//
+//                       k1     k2     b1     b2     K      F1     F2
+//   ideal             +0.01  -0.08  -0.57  +4.07  -2.58  +6.80  +0.15
+//   mild, mean        +0.04  -0.04  -0.33  +3.98  -2.50  +5.94  +0.80
+//   mild, worst       +0.17  -0.18  -1.65  +2.73  -2.37  +10.4  +1.60
+//   default, mean     +0.01  -0.13  -0.84  +4.42  -2.58  +7.24  +0.38
+//   default, worst    -0.15  -0.36  -3.22  +2.35  -3.13  +15.1  +2.50
+//
+// Against the ideal run, a jittered one differs by at most (percentage
+// points) k 0.16, K 0.21, b2 1.34, F 6.9 (mild) and k 0.39, K 0.67,
+// b2 2.58, F 8.3 (default). The identification splits each recording at
+// every late sample and stall and fits fewer rows (tests/late_ticks.rs):
+// the spread grows, not the bias, so a single jittered run can leave the
+// usual bounds (b2 +2.73 % on mild seed 1) while the mean of ten is inside
+// them.
+
 #[test]
 #[ignore = "runs the lab5 binary: cargo build --release --example lab5, then --ignored"]
 fn lab5_on_jittered_and_stalled_clocks_identifies_within_the_ideal_clocks_bounds() {
-    // The bounds of tests/lab_identification.rs (lab5's identification on
-    // the ideal clock, the same rig): k1, k2, K and b2 within 0.5 % of the
-    // truth, F1 and F2 within 5 %. Here on each of ten jittered schedules
-    // the mean over lab5's five runs is within 1 % (5 % for F1, F2), and
-    // the mean over the ten within the ideal bounds.
-    //
-    // Measured (% error of the five-run mean; `cargo build --release
-    // --example lab5`, then `lab5 --jitter SEED,0.03,0.006,0.002,0.016`,
-    // seeds 1–10, and `lab5` for the ideal clock):
-    //
-    //             k1     k2     b1     b2     K      F1     F2
-    //   ideal   +0.04  -0.02  -0.41  -0.18  +0.19  +1.6   +1.35
-    //   mean    +0.05  +0.04  -0.02  -0.14  +0.29  +0.22  +1.54
-    //   worst   +0.12  +0.24  +0.92  -0.89  +0.57  -3.6   +2.5
-    //
-    // So a single jittered lab5 is not always within the ideal 0.5 % (b2
-    // -0.89 % on seed 1, K +0.57 % on seed 5): as tests/late_ticks.rs
-    // found, the identification splits each recording at every late
-    // sample and stall and fits fewer rows, so its spread grows, not its
-    // bias. The default `--jitter SEED` schedule (10 % late, one in 200
-    // stalled), seeds 1–10: mean k1 +0.04, k2 +0.12, b1 +0.67, b2 -0.17,
-    // K +0.39, F1 -1.32, F2 +1.85 %; worst b1 +2.95, b2 +1.78, K +1.20,
-    // F1 -7.6 %.
-    let mut sums = [0.0; 7];
+    let ideal = Ideal::run();
+    assert_usual_bounds(&ideal.errors, "the ideal clock");
+    let mut sums = vec![0.0; ideal.errors.len()];
     for seed in 1..=10 {
         let jitter = format!("{seed},{MILD}");
         let report = lab5(&jitter);
-        check_sections(&report, &jitter);
+        check_sections(&report, &jitter, &ideal);
         let errors = identification_errors(&report);
         println!("--jitter {jitter}: {errors:.2?} %");
-        assert_eq!(errors.len(), 7, "{errors:?}");
-        for (i, (name, e)) in errors.iter().enumerate() {
-            let bound = if name.starts_with('F') { 5.0 } else { 1.0 };
-            if name != "b1" {
-                assert!(e.abs() < bound, "--jitter {jitter}: {name} {e:+.2} %");
-            }
-            sums[i] += e / 10.0;
+        // Measured at most 0.16, 0.21, 1.34 and 6.9 points (above).
+        assert_near_ideal(&errors, &ideal, [0.3, 0.5, 2.0, 8.0], &jitter);
+        for (sum, (_, e)) in sums.iter_mut().zip(&errors) {
+            *sum += e / 10.0;
         }
     }
-    println!("mean of ten: {sums:.2?} %");
-    let names = ["k1", "k2", "b1", "b2", "K", "F1", "F2"];
-    for (name, mean) in names.iter().zip(sums) {
-        let bound = match *name {
-            "F1" | "F2" => 5.0,
-            "b1" => 1.0, // not bounded on the ideal clock either (-0.41 %)
-            _ => 0.5,
-        };
-        assert!(mean.abs() < bound, "mean {name} {mean:+.2} %");
-    }
+    let mean: Vec<(String, f64)> = ideal
+        .errors
+        .iter()
+        .zip(sums)
+        .map(|((name, _), m)| (name.clone(), m))
+        .collect();
+    println!("mean of ten: {mean:.2?} %");
+    assert_usual_bounds(&mean, "the mean of ten jittered runs");
 }
 
 #[test]
 #[ignore = "runs the lab5 binary: cargo build --release --example lab5, then --ignored"]
 fn lab5_on_the_default_jitter_schedule_completes_every_section() {
     // `--jitter 11`: 10 % of ticks late by up to 6 ms, one in 200 stalled
-    // for 8–16 ms; about 10 % of the ticks skipped (1259 over the five
-    // identification runs, 2471 over Table 6's). Measured: k1 +0.21, k2
-    // +0.32, b2 +0.02, K +0.57, F1 -1.0, F2 +2.0 %; modes 2.71 and
-    // 8.36 Hz (before the frequency section resampled gaps, 2.33 and
-    // 3.02 Hz). The bounds are the default schedule's worst over seeds
-    // 1–10 (above), rounded up: 2 % (k1, k2, K, b2), 10 % (F1, F2).
+    // for 8–16 ms; about 10 % of the ticks skipped. The bounds against the
+    // ideal run are the default schedule's worst over seeds 1–10 (above:
+    // k 0.39, K 0.67, b2 2.58, F 8.3 points), rounded up.
+    let ideal = Ideal::run();
     let report = lab5("11");
-    check_sections(&report, "11");
-    for (name, e) in identification_errors(&report) {
-        let bound = match name.as_str() {
-            "F1" | "F2" => 10.0,
-            "b1" => 5.0,
-            _ => 2.0,
-        };
-        assert!(e.abs() < bound, "{name} {e:+.2} %");
-    }
+    check_sections(&report, "11", &ideal);
+    let errors = identification_errors(&report);
+    println!("--jitter 11: {errors:.2?} %");
+    assert_near_ideal(&errors, &ideal, [0.5, 1.0, 3.0, 10.0], "--jitter 11");
 }
