@@ -92,7 +92,7 @@ fn choose(sim: &SimulatedRig, ident: &IdentInput) -> AmplitudeChoice {
 /// lab5's identification runs at `volts`: seeds 1 to 5.
 fn ident_runs(sim: &SimulatedRig, ident: &IdentInput, volts: f64) -> IdentRuns {
     IdentRuns::collect(1..=IDENT_RUNS, |seed| {
-        Ok::<_, RunFault>(run(sim, seed, ident, volts, IDENT_DURATION))
+        Ok::<_, Box<RunFault>>(run(sim, seed, ident, volts, IDENT_DURATION))
     })
     .unwrap()
 }
@@ -251,7 +251,7 @@ fn runs_the_rig_halts_are_reported_and_the_others_identify() {
     // at the chosen amplitude.
     let runs = IdentRuns::collect(1..=IDENT_RUNS, |seed| {
         let volts = if seed % 2 == 0 { 8.0 } else { choice.volts };
-        Ok::<_, RunFault>(run(&sim, seed, &ident, volts, IDENT_DURATION))
+        Ok::<_, Box<RunFault>>(run(&sim, seed, &ident, volts, IDENT_DURATION))
     })
     .unwrap();
     let halted: Vec<u64> = runs.halted.iter().map(|h| h.seed).collect();
@@ -274,7 +274,7 @@ fn runs_the_rig_halts_are_reported_and_the_others_identify() {
 
     // All five forced: nothing to average, and the error says why.
     let none = IdentRuns::collect(1..=IDENT_RUNS, |seed| {
-        Ok::<_, RunFault>(run(&sim, seed, &ident, 8.0, IDENT_DURATION))
+        Ok::<_, Box<RunFault>>(run(&sim, seed, &ident, 8.0, IDENT_DURATION))
     })
     .unwrap();
     let err = none.enough().unwrap_err();
@@ -483,7 +483,7 @@ fn ident_runs_go_on_only_after_a_travel_limit_or_saturation() {
         let mut made = Vec::new();
         let runs = IdentRuns::collect(1..=3, |seed| {
             made.push(seed);
-            Ok::<_, RunFault>(if seed == 2 {
+            Ok::<_, Box<RunFault>>(if seed == 2 {
                 Err(halted_with(RigError::Fault(fault.clone())))
             } else {
                 Ok(Recording::new(ctrlab::lab::schema()))
@@ -540,7 +540,7 @@ fn ident_runs_go_on_only_after_a_travel_limit_or_saturation() {
         let mut made = Vec::new();
         let err = IdentRuns::collect(1..=3, |seed| {
             made.push(seed);
-            Ok::<_, RunFault>(if seed == 2 {
+            Ok::<_, Box<RunFault>>(if seed == 2 {
                 Err(halted_with(error.take().unwrap()))
             } else {
                 Ok(Recording::new(ctrlab::lab::schema()))

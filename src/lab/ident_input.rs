@@ -42,6 +42,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use std::cmp::Ordering;
 use std::fmt;
 use std::str::FromStr;
 
@@ -269,7 +270,8 @@ impl IdentInput {
     pub fn check_drive(&self, volts_full_scale: f64) -> Result<(), ConfigError> {
         // Not `>`: a NaN full scale (refused by the calibration's own
         // check) must not let any amplitude through.
-        if !(self.volts <= volts_full_scale) {
+        let within = self.volts.partial_cmp(&volts_full_scale);
+        if !matches!(within, Some(Ordering::Less | Ordering::Equal)) {
             return Err(ConfigError::conflict(
                 "volts",
                 self.volts,
