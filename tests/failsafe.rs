@@ -14,6 +14,8 @@
 //!   named, with the recording and the PWM at zero;
 //! - halting zeroes every PWM channel of the card, not only the motor's.
 //!
+//! At small drives and at both drive limits: `tests/failsafe_small_drive.rs`.
+//!
 //! The true plant state comes from the simulated card
 //! (`SimulatedCard::true_state`), never from the encoders under test.
 

@@ -10,7 +10,7 @@ mod common;
 
 use common::run_on_rig;
 use ctrlab::lab::ident::{SEPARATE_SPRINGS, identify_with};
-use ctrlab::lab::ident_input::{AmplitudeSearch, IdentInput, PROBE_DURATION, peaks};
+use ctrlab::lab::ident_input::{AmplitudeSearch, IdentInput, PROBE_DURATION, ProbeFault, peaks};
 use ctrlab::lab::lqi::{self, Design, Metrics, Spec};
 use ctrlab::lab::protocol::{self, IDENT_DURATION};
 use ctrlab::lab::{CardSettings, Cart, Friction, MassSpring, SimulatedRig};
@@ -39,7 +39,7 @@ fn identified(sim: &SimulatedRig) -> (MassSpring, [f64; 2]) {
                 ..sim.clone()
             };
             let input = ident.input(v, IDENT_DURATION).unwrap();
-            peaks(&common::open_loop(&probe, &input, PROBE_DURATION))
+            Ok::<_, ProbeFault>(peaks(&common::open_loop(&probe, &input, PROBE_DURATION)).unwrap())
         })
         .unwrap()
         .volts;

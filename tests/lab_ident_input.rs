@@ -16,16 +16,21 @@ mod common;
 
 use common::try_open_loop;
 use ctrlab::Recording;
-use ctrlab::hw::{LoopFault, RigError};
+use ctrlab::hw::{
+    Clock, ConfigErrorKind, LoopConfig, LoopFault, LoopStats, Pc104, PortError, RigError, RunError,
+    VirtualClock,
+};
 use ctrlab::lab::ident::{Summary, summarize};
 use ctrlab::lab::ident_input::{
-    AmplitudeChoice, AmplitudeSearch, IdentInput, IdentRuns, IdentSignal, PROBE_DURATION, Reason,
-    peaks,
+    AmplitudeChoice, AmplitudeSearch, IdentInput, IdentRuns, IdentSignal, PROBE_DURATION,
+    ProbeFault, ProbeOutcome, Reason, RunFault, peaks,
 };
 use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, PERIOD};
 use ctrlab::lab::{
     Calibration, CardSettings, FileError, Friction, MassSpring, RigConfig, SimulatedRig, Unmodelled,
 };
+use ctrlab::nalgebra::vector;
+use ctrlab::signal::Signal;
 
 /// `sim` with noise seed `seed` at the lab's period, as lab5's backend
 /// runs each experiment.
@@ -81,9 +86,8 @@ fn choose(sim: &SimulatedRig, ident: &IdentInput) -> AmplitudeChoice {
         .unwrap()
         .run(|volts| {
             n += 1;
-            let rec =
-                run(sim, 100 + n, ident, volts, PROBE_DURATION).unwrap_or_else(|e| e.recording);
-            peaks(&rec)
+            ProbeOutcome::of(run(sim, 100 + n, ident, volts, PROBE_DURATION))
+                .map_err(|e| Box::new(e) as Box<dyn std::error::Error>)
         })
         .unwrap()
 }
@@ -91,7 +95,7 @@ fn choose(sim: &SimulatedRig, ident: &IdentInput) -> AmplitudeChoice {
 /// lab5's identification runs at `volts`: seeds 1 to 5.
 fn ident_runs(sim: &SimulatedRig, ident: &IdentInput, volts: f64) -> IdentRuns {
     IdentRuns::collect(1..=IDENT_RUNS, |seed| {
-        Ok::<_, ()>(run(sim, seed, ident, volts, IDENT_DURATION))
+        Ok::<_, Box<RunFault>>(run(sim, seed, ident, volts, IDENT_DURATION))
     })
     .unwrap()
 }
@@ -260,7 +264,7 @@ fn runs_the_rig_halts_are_reported_and_the_others_identify() {
     // at the chosen amplitude.
     let runs = IdentRuns::collect(1..=IDENT_RUNS, |seed| {
         let volts = if seed % 2 == 0 { 8.0 } else { choice.volts };
-        Ok::<_, ()>(run(&sim, seed, &ident, volts, IDENT_DURATION))
+        Ok::<_, Box<RunFault>>(run(&sim, seed, &ident, volts, IDENT_DURATION))
     })
     .unwrap();
     let halted: Vec<u64> = runs.halted.iter().map(|h| h.seed).collect();
@@ -283,7 +287,7 @@ fn runs_the_rig_halts_are_reported_and_the_others_identify() {
 
     // All five forced: nothing to average, and the error says why.
     let none = IdentRuns::collect(1..=IDENT_RUNS, |seed| {
-        Ok::<_, ()>(run(&sim, seed, &ident, 8.0, IDENT_DURATION))
+        Ok::<_, Box<RunFault>>(run(&sim, seed, &ident, 8.0, IDENT_DURATION))
     })
     .unwrap();
     let err = none.enough().unwrap_err();
@@ -349,4 +353,262 @@ fn a_fixed_input_is_not_probed_and_the_card_file_checks_ident_as_code_does() {
         "{text}"
     );
     assert_eq!(RigConfig::from_toml(&text).unwrap(), config);
+}
+
+// ---- review fixes: halted probes, faults in the runs, the drive's range ----
+
+/// `sim`'s card with cart 2's encoder read from counter 2, which the card
+/// leaves unconnected (a dead encoder), an open-loop run of `input`.
+fn dead_encoder_run(
+    sim: &SimulatedRig,
+    seed: u64,
+    input: &dyn Signal,
+    duration: f64,
+) -> Result<Recording, Box<RunError>> {
+    let sim = with_seed(sim, seed);
+    let clock = Clock::Virtual(VirtualClock::new());
+    let card = Pc104::with_map(sim.card(&clock).unwrap(), sim.card.map).unwrap();
+    let cal = Calibration {
+        encoder_channels: [0, 2],
+        ..sim.calibration
+    };
+    let rig = ctrlab::lab::MassSpringRig::with_clock(card, cal, sim.period, clock.clone()).unwrap();
+    let config = LoopConfig {
+        duration,
+        ..LoopConfig::default()
+    };
+    ctrlab::hw::run(
+        rig,
+        ctrlab::OpenLoop,
+        |t| vector![input.value(t)],
+        &clock,
+        &config,
+    )
+    .map(|out| out.recording)
+}
+
+#[test]
+fn a_probe_the_rig_halts_at_the_travel_limit_lowers_the_amplitude_and_is_not_a_measurement() {
+    // The lighter rig with cart 2's limit at 4 mm: the first probe (2 V)
+    // runs into it. The old search took its peaks up to the halt as a
+    // measurement (Reason::Scaled, "predicted"); now it is the answer that
+    // the amplitude must come down, said so.
+    let sim = SimulatedRig {
+        calibration: Calibration {
+            travel_limits: [0.05, 0.004],
+            ..Calibration::default()
+        },
+        ..lighter()
+    };
+    let ident = IdentInput::default();
+    let choice = choose(&sim, &ident);
+    let halted = choice
+        .halted
+        .expect("the first probe halts at cart 2's 4 mm");
+    assert_eq!(halted.volts, 2.0);
+    assert!(choice.probes.is_empty(), "no probe after the halt");
+    assert_eq!(choice.reason, Reason::Halted { cart: 1 });
+    assert!(
+        choice.predicted.is_none(),
+        "nothing completed to predict from"
+    );
+    // In proportion to what it reached (at least the limit, as the fault
+    // says: the read past it is not recorded): below 60 % of the probe's
+    // volts.
+    assert!(halted.peaks[1] > 0.004, "{:?}", halted.peaks);
+    let ceiling = 2.0 * 0.6 * 0.004 / halted.peaks[1];
+    assert!(
+        choice.volts <= ceiling && choice.volts > ceiling - 0.01,
+        "{}",
+        choice.volts
+    );
+    assert!(choice.volts < 0.6 * halted.volts);
+    println!(
+        "halted probe: {:.2} V reached {:.2} mm; chosen {:.2} V",
+        halted.volts,
+        halted.peaks[1] * 1e3,
+        choice.volts
+    );
+    assert!(choice.reason.to_string().contains("not a prediction"));
+}
+
+#[test]
+fn a_probe_halted_by_a_dead_encoder_stops_before_identification_with_the_fault_named() {
+    // Cart 2's encoder dead on the lighter rig: the first probe (2 V,
+    // which moves the carts there) is halted by EncoderNotFollowing, and
+    // the search stops, naming it, instead of taking cart 2's 0 mm as a
+    // peak (which would have let the amplitude rise to what cart 1 alone
+    // allows).
+    let sim = lighter();
+    let ident = IdentInput::default();
+    let mut n = 0;
+    let err = AmplitudeSearch::new(ident.volts, sim.calibration.travel_limits)
+        .unwrap()
+        .run(|volts| {
+            n += 1;
+            let input = ident.input(volts, IDENT_DURATION).unwrap();
+            Ok::<_, ProbeFault>(
+                ProbeOutcome::of(dead_encoder_run(&sim, 100 + n, &input, PROBE_DURATION)).unwrap(),
+            )
+        })
+        .unwrap_err();
+    assert_eq!((err.number, err.volts), (1, 2.0));
+    assert!(
+        matches!(
+            err.error,
+            RigError::Fault(LoopFault::EncoderNotFollowing { cart: 2, .. })
+        ),
+        "{}",
+        err.error
+    );
+    let text = err.to_string();
+    assert!(
+        text.contains("probe run 1 at 2.00 V") && text.contains("encoder of cart 2"),
+        "{text}"
+    );
+}
+
+/// A run the rig halted with `error`.
+fn halted_with(error: RigError) -> Box<RunError> {
+    Box::new(RunError {
+        error,
+        recording: Recording::new(ctrlab::lab::schema()),
+        last_measurement: None,
+        stats: LoopStats::default(),
+    })
+}
+
+#[test]
+fn ident_runs_go_on_only_after_a_travel_limit_or_saturation() {
+    let too_big = [
+        LoopFault::TravelLimit {
+            axis: 2,
+            position: 0.0501,
+            limit: 0.05,
+        },
+        LoopFault::Saturated {
+            volts: 24.0,
+            seconds: 2.0,
+            limit: 2.0,
+        },
+    ];
+    for fault in too_big {
+        let mut made = Vec::new();
+        let runs = IdentRuns::collect(1..=3, |seed| {
+            made.push(seed);
+            Ok::<_, Box<RunFault>>(if seed == 2 {
+                Err(halted_with(RigError::Fault(fault.clone())))
+            } else {
+                Ok(Recording::new(ctrlab::lab::schema()))
+            })
+        })
+        .unwrap();
+        assert_eq!(made, [1, 2, 3], "{fault}");
+        assert_eq!(runs.halted.len(), 1);
+    }
+    let not_the_input: Vec<RigError> = vec![
+        RigError::Fault(LoopFault::BusFault {
+            channel: 1,
+            counts: 900,
+            interval: 0.002,
+            speed: 4.4,
+            limit: 2.0,
+        }),
+        RigError::Fault(LoopFault::EncoderNotFollowing {
+            cart: 2,
+            channel: 2,
+            other: 1,
+            volts: 2.0,
+            seconds: 0.5,
+            moved: 120,
+            counts: 3,
+        }),
+        RigError::Fault(LoopFault::NotResponding {
+            volts: 6.0,
+            seconds: 0.5,
+            counts: 3,
+        }),
+        RigError::Fault(LoopFault::Gap {
+            what: "the time since the last watchdog kick",
+            gap: 0.2,
+            limit: 0.1,
+            at: 1.0,
+        }),
+        RigError::Fault(LoopFault::Interrupted { at: 1.0 }),
+        RigError::Fault(LoopFault::Panicked {
+            what: "controller",
+            message: "boom".into(),
+            at: 1.0,
+        }),
+        RigError::Port(PortError::InvalidCommand {
+            what: "voltage",
+            channel: Some(0),
+            value: f64::NAN,
+            limit: 24.0,
+        }),
+    ];
+    for error in not_the_input {
+        let name = error.to_string();
+        let mut error = Some(error);
+        let mut made = Vec::new();
+        let err = IdentRuns::collect(1..=3, |seed| {
+            made.push(seed);
+            Ok::<_, Box<RunFault>>(if seed == 2 {
+                Err(halted_with(error.take().unwrap()))
+            } else {
+                Ok(Recording::new(ctrlab::lab::schema()))
+            })
+        })
+        .unwrap_err();
+        assert_eq!((err.seed, made), (2, vec![1, 2]), "{name}");
+        assert_eq!(err.error.to_string(), name);
+        assert!(
+            err.to_string()
+                .starts_with("identification run 2 was halted"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn ident_volts_above_the_drive_full_scale_are_refused_in_code_and_card_file() {
+    let cal = Calibration::default();
+    let over = IdentInput {
+        volts: cal.volts_full_scale + 0.5,
+        ..IdentInput::default()
+    };
+    assert!(over.validate().is_ok(), "within 1000 V on its own");
+    let err = over.check_drive(cal.volts_full_scale).unwrap_err();
+    assert_eq!(
+        (err.kind(), err.key()),
+        (ConfigErrorKind::Conflict, "volts")
+    );
+    assert!(err.to_string().contains("volts_full_scale"), "{err}");
+    let at = IdentInput {
+        volts: cal.volts_full_scale,
+        ..IdentInput::default()
+    };
+    assert!(at.check_drive(cal.volts_full_scale).is_ok());
+    // The card file: [ident] volts = 24.5 on a 24 V drive.
+    let text = RigConfig::new(Default::default(), cal).to_toml();
+    let err = RigConfig::from_toml(&format!("{text}\n[ident]\nvolts = 24.5\n")).unwrap_err();
+    let FileError::Invalid { error, .. } = err else {
+        panic!("{err}")
+    };
+    assert_eq!(error, over.check_drive(24.0).unwrap_err().in_table("ident"));
+    assert_eq!(error.key(), "ident.volts");
+    // A 12 V drive refuses the lab's default 8 V? No: 8 V is within it;
+    // 12.5 V is not.
+    let small = Calibration {
+        volts_full_scale: 12.0,
+        ..cal
+    };
+    let config = RigConfig {
+        ident: IdentInput {
+            volts: 12.5,
+            ..IdentInput::default()
+        },
+        ..RigConfig::new(Default::default(), small)
+    };
+    assert_eq!(config.validate().unwrap_err().key(), "ident.volts");
 }

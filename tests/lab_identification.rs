@@ -19,7 +19,7 @@ use ctrlab::lab::frequency::{self, DURATION};
 use ctrlab::lab::ident::{
     EqualSprings, Parameter, SEPARATE_SPRINGS, Summary, identify_with, summarize,
 };
-use ctrlab::lab::ident_input::{AmplitudeSearch, IdentInput, PROBE_DURATION, peaks};
+use ctrlab::lab::ident_input::{AmplitudeSearch, IdentInput, PROBE_DURATION, ProbeFault, peaks};
 use ctrlab::lab::protocol::{
     IDENT_DURATION, IDENT_HALF_PERIOD, IDENT_RUNS, IDENT_VOLTS, M1, M2, PERIOD,
 };
@@ -56,7 +56,7 @@ fn volts() -> f64 {
         .run(|v| {
             n += 1;
             let input = ident.input(v, IDENT_DURATION).unwrap();
-            peaks(&open_loop(&rig(100 + n), &input, PROBE_DURATION))
+            Ok::<_, ProbeFault>(peaks(&open_loop(&rig(100 + n), &input, PROBE_DURATION)).unwrap())
         })
         .unwrap()
         .volts

@@ -89,6 +89,16 @@ impl Backend {
         };
         let ident = args.ident_input(base);
         ident.validate()?;
+        // --ident-volts above the drive's range: refused, named, before
+        // anything runs (the card file's [ident] was checked on reading).
+        let full_scale = match &kind {
+            BackendKind::Simulated { sim, .. } => sim.calibration.volts_full_scale,
+            #[cfg(all(feature = "ppdev", target_os = "linux"))]
+            BackendKind::Card { config, .. } => config.calibration.volts_full_scale,
+        };
+        ident
+            .check_drive(full_scale)
+            .map_err(|e| format!("--ident-volts (or the card file's ident.volts): {e}"))?;
         // Then Ctrl-C halts the rig and ends the run with its recording,
         // instead of killing the process with the motor at its last duty.
         let stop = StopSignal::on_interrupt()?;

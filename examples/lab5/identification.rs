@@ -9,7 +9,8 @@ use ctrlab::hw::LoopStats;
 use ctrlab::lab::MassSpring;
 use ctrlab::lab::ident::{EqualSprings, Summary, SummaryError, summarize};
 use ctrlab::lab::ident_input::{
-    AmplitudeChoice, AmplitudeSearch, IdentInput, IdentRuns, PROBE_DURATION, TooFewRuns, peaks,
+    AmplitudeChoice, AmplitudeSearch, IdentInput, IdentRuns, PROBE_DURATION, ProbeOutcome,
+    TooFewRuns, peaks,
 };
 use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, M1, M2};
 use ctrlab::nalgebra::vector;
@@ -98,9 +99,11 @@ impl Identification {
 /// The lab's identification runs on the rig: the amplitude chosen from
 /// two probe runs (`runs/ident_probe_{n}.csv`; none with `--ident-fixed`),
 /// then [`IDENT_RUNS`] runs of the input at it, each saved as
-/// `runs/ident_{seed}.csv`. A run the rig halts (a travel limit) is kept
-/// in [`RigInput::failed`] and the others go on; set-up failures and
-/// Ctrl-C stop here.
+/// `runs/ident_{seed}.csv`. A probe the rig halts at a travel limit
+/// lowers the amplitude; any other fault in a probe stops here, named. A
+/// run the rig halts because the input was too big (a travel limit, the
+/// drive saturated) is kept in [`RigInput::failed`] and the others go on;
+/// any other fault, set-up failures and Ctrl-C stop here.
 pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::error::Error>> {
     let ident = backend.ident;
     let limits = backend.calibration().travel_limits;
@@ -108,7 +111,7 @@ pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::er
     let choice = if ident.scale_to_travel {
         let mut n = 0;
         AmplitudeSearch::new(ident.volts, limits)?.run(
-            |volts| -> Result<[f64; 2], Box<dyn std::error::Error>> {
+            |volts| -> Result<ProbeOutcome, Box<dyn std::error::Error>> {
                 n += 1;
                 // The runs' own signal (a multisine's lines are the run's
                 // harmonics), for the probe's length.
@@ -120,11 +123,9 @@ pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::er
                     |t| vector![input.value(t)],
                     PROBE_DURATION,
                 )?;
-                let recording = match &outcome {
-                    Ok(out) => &out.recording,
-                    Err(e) => &e.recording,
-                };
-                Ok(peaks(recording)?)
+                // A probe halted at a travel limit says "lower"; any other
+                // fault stops the lab here, named (ProbeFault).
+                Ok(ProbeOutcome::of(outcome.map(|out| out.recording))?)
             },
         )?
     } else {

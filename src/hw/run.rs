@@ -317,6 +317,8 @@ where
     }
     // The rig may have been used before: its last sample is not this run's.
     rig.restart();
+    // A second Ctrl-C now only raises the flag: the loop halts the rig.
+    let _running = super::stop::Running::enter();
 
     let mut k = 0usize;
     while k < ticks {

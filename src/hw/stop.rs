@@ -1,8 +1,44 @@
 //! [`StopSignal`]: a request to stop a running loop, from Ctrl-C, SIGTERM,
 //! a closed terminal (SIGHUP), Ctrl-\\ (SIGQUIT), Ctrl-Z (SIGTSTP) or code.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+
+/// The process's interrupt flag, once [`StopSignal::on_interrupt`] has
+/// registered the handlers that raise it.
+static INTERRUPT: Mutex<Option<Arc<AtomicBool>>> = Mutex::new(None);
+
+/// How many control loops (or probes) are driving a rig now: a second
+/// signal ends the process only when none is.
+static RUNNING: AtomicUsize = AtomicUsize::new(0);
+
+/// A control loop driving a rig, from [`enter`](Self::enter) to its drop:
+/// while one lives, a second interrupt does not end the process (see
+/// [`StopSignal::on_interrupt`]).
+#[derive(Debug)]
+pub(crate) struct Running(());
+
+impl Running {
+    /// Counts a loop in, until the guard drops (panics included).
+    pub(crate) fn enter() -> Self {
+        RUNNING.fetch_add(1, Ordering::SeqCst);
+        Self(())
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        RUNNING.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// What a handler does with a signal: raises `flag` and, when it was
+/// already raised and no loop is running, says the process should end.
+/// Only atomics: safe in a signal handler.
+fn on_signal(flag: &AtomicBool) -> bool {
+    let again = flag.swap(true, Ordering::SeqCst);
+    again && RUNNING.load(Ordering::SeqCst) == 0
+}
 
 /// A shared flag that stops [`run`](super::run) at its next tick: the rig is
 /// halted and the run returns [`LoopFault::Interrupted`](super::LoopFault::Interrupted) with everything
@@ -59,11 +95,11 @@ impl StopSignal {
         Self::default()
     }
 
-    /// A flag raised by the signals that ask a program to stop: on Unix
-    /// SIGINT (Ctrl-C), SIGTERM (`kill`), SIGHUP (the terminal closed, an
-    /// SSH session dropped), SIGQUIT (Ctrl-\\) and SIGTSTP (Ctrl-Z); elsewhere
-    /// Ctrl-C, Ctrl-Break and the console closing (through the `ctrlc`
-    /// crate).
+    /// The process's interrupt flag, raised by the signals that ask a
+    /// program to stop: on Unix SIGINT (Ctrl-C), SIGTERM (`kill`), SIGHUP
+    /// (the terminal closed, an SSH session dropped), SIGQUIT (Ctrl-\\)
+    /// and SIGTSTP (Ctrl-Z); elsewhere Ctrl-C, Ctrl-Break and the console
+    /// closing (through the `ctrlc` crate).
     ///
     /// Registering replaces those signals' default actions for the whole
     /// process, for as long as it runs: the loop stops at its next tick,
@@ -74,14 +110,33 @@ impl StopSignal {
     /// watchdog, if it has one, is all that would stop it), but stops the
     /// run cleanly; and SIGQUIT no longer dumps core. (SIGKILL and SIGSTOP
     /// cannot be caught: `kill -9` and `kill -STOP` leave the motor to the
-    /// card's watchdog.) Each call registers a new flag; every registered
-    /// flag is raised by each of these signals.
+    /// card's watchdog.)
+    ///
+    /// The handlers are registered once, by the first call; every call
+    /// returns a handle on the same process-wide flag (so
+    /// [`clear`](Self::clear) on one clears it for all).
+    ///
+    /// # A second signal
+    ///
+    /// The first signal asks to stop gracefully. A second one while the
+    /// flag is still raised (nobody has [`clear`](Self::clear)ed it) and no
+    /// control loop is running ([`run`](super::run), or a
+    /// [`Probe`](super::probe::Probe) driving the card) ends the process at once,
+    /// with exit status 128 + the signal's number (130 for SIGINT), as a
+    /// shell reports a process a signal killed: a program busy between
+    /// runs (analysing, writing a report) does not make its user wait, or
+    /// reach for `kill -9`. Nothing is written or flushed then, and no
+    /// destructor runs (the motor is already halted: a run halts the rig
+    /// when it ends). While a loop runs, a second signal only raises the
+    /// flag again: the loop halts the rig at its next tick, and ending the
+    /// process before that could leave the motor at its last duty.
     ///
     /// # Errors
     ///
     /// The operating system's error, saying which signal failed, when a
     /// handler cannot be registered (on non-Unix platforms, also when
-    /// the `ctrlc` crate's handler cannot be set).
+    /// the `ctrlc` crate's handler cannot be set); none is left registered
+    /// then, and the next call tries again.
     ///
     /// # Examples
     ///
@@ -89,13 +144,21 @@ impl StopSignal {
     /// use ctrlab::hw::StopSignal;
     /// let stop = StopSignal::on_interrupt()?;
     /// assert!(!stop.is_requested()); // until Ctrl-C, Ctrl-Z, a closed terminal, …
+    /// assert_eq!(StopSignal::on_interrupt()?, stop); // registered once: one flag
     /// // … pass `Some(stop.clone())` in `LoopConfig::stop`; Ctrl-C now halts the rig.
     /// # Ok::<(), std::io::Error>(())
     /// ```
     pub fn on_interrupt() -> Result<Self, std::io::Error> {
-        let stop = Self::new();
-        platform::register(&stop.flag)?;
-        Ok(stop)
+        let mut registered = INTERRUPT.lock().unwrap_or_else(PoisonError::into_inner);
+        if let Some(flag) = registered.as_ref() {
+            return Ok(Self {
+                flag: Arc::clone(flag),
+            });
+        }
+        let flag = Arc::new(AtomicBool::new(false));
+        platform::register(&flag)?;
+        *registered = Some(Arc::clone(&flag));
+        Ok(Self { flag })
     }
 
     /// Asks the loop to stop at its next tick.
@@ -159,51 +222,65 @@ mod platform {
         (SIGTSTP, "SIGTSTP"),
     ];
 
-    /// Raises `flag` on each of [`SIGNALS`].
+    /// Raises `flag` on each of [`SIGNALS`], and ends the process on a
+    /// second one outside a loop ([`super::on_signal`]); on a failure,
+    /// unregisters those already registered.
     pub(super) fn register(flag: &Arc<AtomicBool>) -> Result<(), std::io::Error> {
+        let mut ids = Vec::with_capacity(SIGNALS.len());
         for (signal, name) in SIGNALS {
-            signal_hook::flag::register(signal, Arc::clone(flag)).map_err(|source| {
-                std::io::Error::new(
-                    source.kind(),
-                    format!("registering a stop handler for {name} failed: {source}"),
-                )
-            })?;
+            let flag = Arc::clone(flag);
+            let handler = move || {
+                if super::on_signal(&flag) {
+                    // 128 + the signal, as a shell reports a process the
+                    // signal killed; `_exit`, safe in a handler.
+                    signal_hook::low_level::exit(128 + signal);
+                }
+            };
+            // SAFETY: the handler only touches atomics (`on_signal`) and
+            // calls `_exit` (signal_hook's `exit`), all async-signal-safe;
+            // it allocates nothing and takes no lock.
+            #[allow(unsafe_code)]
+            let registered = unsafe { signal_hook::low_level::register(signal, handler) };
+            match registered {
+                Ok(id) => ids.push(id),
+                Err(source) => {
+                    for id in ids {
+                        signal_hook::low_level::unregister(id);
+                    }
+                    return Err(std::io::Error::new(
+                        source.kind(),
+                        format!("registering a stop handler for {name} failed: {source}"),
+                    ));
+                }
+            }
         }
         Ok(())
     }
 }
 
 /// Ctrl-C, Ctrl-Break and the console closing, through the `ctrlc` crate,
-/// whose one handler (it can be set only once per process) raises every
-/// flag registered.
+/// whose one handler (it can be set only once per process, and
+/// [`StopSignal::on_interrupt`] sets it once) raises the flag.
 #[cfg(not(unix))]
 mod platform {
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::{Arc, Mutex, PoisonError};
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
 
-    /// The flags to raise; empty until the first registration.
-    static FLAGS: Mutex<Vec<Arc<AtomicBool>>> = Mutex::new(Vec::new());
-
-    /// Adds `flag` to those the handler raises, setting the handler on the
-    /// first call.
+    /// Sets the handler raising `flag` (and ending the process on a second
+    /// Ctrl-C outside a loop, [`super::on_signal`]).
     pub(super) fn register(flag: &Arc<AtomicBool>) -> Result<(), std::io::Error> {
-        let mut flags = FLAGS.lock().unwrap_or_else(PoisonError::into_inner);
-        if flags.is_empty() {
-            // The handler runs on ctrlc's own thread, not in a signal
-            // context: it may lock.
-            ctrlc::set_handler(|| {
-                let flags = FLAGS.lock().unwrap_or_else(PoisonError::into_inner);
-                for flag in flags.iter() {
-                    flag.store(true, Ordering::SeqCst);
-                }
-            })
-            .map_err(|source| {
-                std::io::Error::other(format!(
-                    "registering a stop handler for Ctrl-C failed: {source}"
-                ))
-            })?;
-        }
-        flags.push(Arc::clone(flag));
-        Ok(())
+        let flag = Arc::clone(flag);
+        // The handler runs on ctrlc's own thread, not in a signal context.
+        ctrlc::set_handler(move || {
+            if super::on_signal(&flag) {
+                // 128 + SIGINT, as on Unix.
+                std::process::exit(130);
+            }
+        })
+        .map_err(|source| {
+            std::io::Error::other(format!(
+                "registering a stop handler for Ctrl-C failed: {source}"
+            ))
+        })
     }
 }

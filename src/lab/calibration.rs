@@ -111,10 +111,13 @@ pub struct Calibration {
     ///
     /// [`LoopFault::EncoderNotFollowing`]: crate::hw::LoopFault::EncoderNotFollowing
     pub follow_time: f64,
-    /// The longest the drive may stay at its limit (±`volts_full_scale`),
-    /// s (> 0; default 2 s): a controller pushing with everything it has
-    /// for longer cannot reach its reference, or acts on a wrong
-    /// measurement, and the rig is halted
+    /// The longest the drive may stay at one of its limits
+    /// (+`volts_full_scale` or −`volts_full_scale`), s (> 0; default 2 s):
+    /// a controller pushing one way with everything it has for longer
+    /// cannot reach its reference, or acts on a wrong measurement, and the
+    /// rig is halted. A flip from one limit to the other starts the time
+    /// again: a bang-bang drive (a square wave at full scale) is not
+    /// pushing one way against a limit
     /// ([`LoopFault::Saturated`](crate::hw::LoopFault::Saturated)). The
     /// lab's closed-loop runs saturate for a fraction of a second at a
     /// step.

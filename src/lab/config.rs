@@ -450,7 +450,8 @@ impl RigConfig {
 
     /// Checks the map ([`RegisterMap::validate`]), the calibration
     /// ([`Calibration::validate`]) and the identification input
-    /// ([`IdentInput::validate`]). The port's one key, a boolean, has no
+    /// ([`IdentInput::validate`], and its volts within the drive's range:
+    /// [`IdentInput::check_drive`]). The port's one key, a boolean, has no
     /// value to refuse: its type is checked when the file is read.
     ///
     /// # Errors
@@ -473,7 +474,10 @@ impl RigConfig {
         self.calibration
             .validate()
             .map_err(|e| e.in_table("calibration"))?;
-        self.ident.validate().map_err(|e| e.in_table("ident"))
+        self.ident.validate().map_err(|e| e.in_table("ident"))?;
+        self.ident
+            .check_drive(self.calibration.volts_full_scale)
+            .map_err(|e| e.in_table("ident"))
     }
 
     /// The rig this card file describes, on the card behind `port`, read

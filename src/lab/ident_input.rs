@@ -31,17 +31,18 @@
 //! # Examples
 //!
 //! ```
-//! use ctrlab::lab::ident_input::{AmplitudeSearch, Reason};
+//! use ctrlab::lab::ident_input::{AmplitudeSearch, ProbeFault, Reason};
 //! // A rig whose carts move 5 mm per volt above 1 V of friction, limits ±50 mm.
-//! let rig = |volts: f64| Ok::<_, ctrlab::Error>([0.0, 0.005 * (volts - 1.0).max(0.0)]);
+//! let rig = |volts: f64| Ok::<_, ProbeFault>([0.0, 0.005 * (volts - 1.0).max(0.0)]);
 //! let choice = AmplitudeSearch::new(8.0, [0.05, 0.05])?.run(rig)?;
 //! // 60 % of 50 mm is 30 mm: 5 mm/V × (V − 1 V) = 30 mm at 7 V.
 //! assert!((choice.volts - 7.0).abs() < 1e-9);
 //! assert_eq!(choice.reason, Reason::Scaled { cart: 1 });
 //! assert!((choice.predicted.unwrap()[1] - 0.030).abs() < 1e-12);
-//! # Ok::<(), ctrlab::Error>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use std::cmp::Ordering;
 use std::fmt;
 use std::str::FromStr;
 
@@ -49,8 +50,16 @@ use super::excitation::{Input, MULTISINE_LINES, PRBS_BITS, PRBS_CLOCK, PRBS_SEED
 use super::protocol::{IDENT_HALF_PERIOD, IDENT_VOLTS, PERIOD};
 use crate::Recording;
 use crate::error::Error;
-use crate::hw::{ConfigError, RigError, RunError};
+use crate::hw::{ConfigError, LoopFault, RigError};
 use crate::signal::{Multisine, Phases, Prbs, SquareWave};
+
+mod runs;
+mod search;
+
+pub use runs::{CompletedRun, HaltedRun, IdentRuns, RunFault, TooFewRuns};
+pub use search::{
+    AmplitudeChoice, AmplitudeSearch, Probe, ProbeFault, ProbeOutcome, Reason, predict,
+};
 
 /// The largest predicted peak excursion of either cart, as a fraction of
 /// its travel limit: 60 %.
@@ -235,6 +244,43 @@ impl IdentInput {
         Ok(())
     }
 
+    /// Checks `volts` against the drive's range: at most
+    /// `volts_full_scale` (V,
+    /// [`Calibration::volts_full_scale`](super::Calibration::volts_full_scale)).
+    /// Above it the drive saturates: the run is not the signal asked for
+    /// (a square wave becomes a bang-bang at the limit, a PRBS or a
+    /// multisine is clipped), and the amplitude the probes choose would be
+    /// scaled from a signal the rig never gives.
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Conflict`] naming `volts` (a card file names it
+    /// `ident.volts`; lab5's `--ident-volts` says so too).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::ConfigErrorKind;
+    /// use ctrlab::lab::ident_input::IdentInput;
+    /// let too_big = IdentInput { volts: 30.0, ..Default::default() };
+    /// let err = too_big.check_drive(24.0).unwrap_err();
+    /// assert_eq!((err.kind(), err.key(), err.value()), (ConfigErrorKind::Conflict, "volts", 30.0));
+    /// assert!(IdentInput { volts: 24.0, ..Default::default() }.check_drive(24.0).is_ok());
+    /// ```
+    pub fn check_drive(&self, volts_full_scale: f64) -> Result<(), ConfigError> {
+        // Not `>`: a NaN full scale (refused by the calibration's own
+        // check) must not let any amplitude through.
+        let within = self.volts.partial_cmp(&volts_full_scale);
+        if !matches!(within, Some(Ordering::Less | Ordering::Equal)) {
+            return Err(ConfigError::conflict(
+                "volts",
+                self.volts,
+                "must be at most the drive's full scale (calibration volts_full_scale): above it the drive saturates and the input is not the one asked for",
+            ));
+        }
+        Ok(())
+    }
+
     /// The signal at `volts` peak for runs of `duration` s (the multisine's
     /// lines are harmonics of `1 / duration`).
     ///
@@ -296,541 +342,27 @@ pub fn peaks(recording: &Recording) -> Result<[f64; 2], Error> {
     Ok([peak("x1")?, peak("x2")?])
 }
 
-/// A probe run: its amplitude and both carts' peak |x|.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::ident_input::Probe;
-/// let p = Probe { volts: 2.0, peaks: [0.004, 0.008] };
-/// assert_eq!(p.peaks[1] / p.volts, 0.004);
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Probe {
-    /// Peak voltage, V.
-    pub volts: f64,
-    /// Cart 1's and cart 2's largest |position|, m.
-    pub peaks: [f64; 2],
-}
-
-/// Each cart's predicted peak |x| at `volts` from `probes` (in increasing
-/// volts; see [the module](self#how-the-amplitude-is-chosen)), m: the
-/// larger of the line through the last two probes and the line through
-/// the origin and the last probe. `None` without probes.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::ident_input::{Probe, predict};
-/// let probes = [
-///     Probe { volts: 2.0, peaks: [0.001, 0.004] },
-///     Probe { volts: 4.0, peaks: [0.002, 0.010] },
-/// ];
-/// let p = predict(&probes, 8.0).unwrap();
-/// // Cart 1 is proportional (4 mm); cart 2 affine, 3 mm/V (22 mm).
-/// assert!((p[0] - 0.004).abs() < 1e-12 && (p[1] - 0.022).abs() < 1e-12);
-/// ```
-pub fn predict(probes: &[Probe], volts: f64) -> Option<[f64; 2]> {
-    let lines = lines(probes)?;
-    Some(lines.map(|cart| {
-        cart.iter()
-            .map(|l| l.slope * volts + l.intercept)
-            .fold(0.0, f64::max)
-    }))
-}
-
-/// A line of peak against volts: `slope` m/V, `intercept` m.
-#[derive(Debug, Clone, Copy)]
-struct Line {
-    slope: f64,
-    intercept: f64,
-}
-
-impl Line {
-    /// The largest volts at which the line is at most `peak` m (infinite
-    /// for a flat line: a cart the probes did not move).
-    fn volts_at(self, peak: f64) -> f64 {
-        if self.slope > 0.0 {
-            (peak - self.intercept) / self.slope
-        } else {
-            f64::INFINITY
-        }
-    }
-}
-
-/// Each cart's two lines: through the origin and the last probe, and
-/// through the last two probes (the first when the probes look concave or
-/// there is one).
-fn lines(probes: &[Probe]) -> Option<[[Line; 2]; 2]> {
-    let last = *probes.last()?;
-    let before = probes.len().checked_sub(2).map(|i| probes[i]);
-    Some([0, 1].map(|c| {
-        let proportional = Line {
-            slope: last.peaks[c] / last.volts,
-            intercept: 0.0,
-        };
-        let affine = before
-            .map(|b| (last.peaks[c] - b.peaks[c]) / (last.volts - b.volts))
-            .filter(|s| s.is_finite() && *s > proportional.slope)
-            .map_or(proportional, |slope| Line {
-                slope,
-                intercept: last.peaks[c] - slope * last.volts,
-            });
-        [proportional, affine]
-    }))
-}
-
-/// Why the amplitude is what it is.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::ident_input::Reason;
-/// assert_eq!(Reason::Scaled { cart: 1 }.to_string(), "scaled so that cart 2's predicted peak is 60 % of its travel limit");
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Reason {
-    /// As asked, without probe runs ([`IdentInput::scale_to_travel`]
-    /// false).
-    Fixed,
-    /// As asked: its predicted peaks are within [`TRAVEL_FRACTION`] of the
-    /// travel limits.
-    Fits,
-    /// Lowered so that cart `cart`'s (0 or 1) predicted peak is
-    /// [`TRAVEL_FRACTION`] of its travel limit.
-    Scaled {
-        /// The cart that limits it, 0 or 1.
-        cart: usize,
-    },
-    /// As asked, unpredicted: neither probe moved either cart (friction
-    /// held them), so the probes say nothing of the amplitude asked for.
-    NoMotion,
-}
-
-impl fmt::Display for Reason {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Reason::Fixed => f.write_str("as asked, not scaled to the travel"),
-            Reason::Fits => write!(
-                f,
-                "as asked: its predicted peaks are within {:.0} % of the travel limits",
-                TRAVEL_FRACTION * 100.0
-            ),
-            Reason::Scaled { cart } => write!(
-                f,
-                "scaled so that cart {}'s predicted peak is {:.0} % of its travel limit",
-                cart + 1,
-                TRAVEL_FRACTION * 100.0
-            ),
-            Reason::NoMotion => f.write_str(
-                "as asked, unpredicted: the probe runs did not move the carts past their friction",
-            ),
-        }
-    }
-}
-
-/// The amplitude chosen and why: the probes behind it and what they
-/// predict.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::ident_input::{AmplitudeChoice, Reason};
-/// let fixed = AmplitudeChoice::fixed(8.0, [0.05, 0.05]);
-/// assert_eq!((fixed.volts, fixed.reason), (8.0, Reason::Fixed));
-/// assert!(fixed.probes.is_empty() && fixed.predicted.is_none());
-/// assert_eq!(fixed.allowed(), [0.03, 0.03]);
-/// ```
-#[derive(Debug, Clone, PartialEq)]
-pub struct AmplitudeChoice {
-    /// The peak voltage asked for, V.
-    pub asked: f64,
-    /// The peak voltage chosen, V (at most `asked`; when scaled, rounded
-    /// down to 10 mV).
-    pub volts: f64,
-    /// Why.
-    pub reason: Reason,
-    /// The probe runs, in the order they ran (none for
-    /// [`Reason::Fixed`]).
-    pub probes: Vec<Probe>,
-    /// Each cart's predicted peak |x| at `volts`, m (none without probes).
-    pub predicted: Option<[f64; 2]>,
-    /// Each cart's predicted peak |x| at `asked`, m.
-    pub predicted_asked: Option<[f64; 2]>,
-    /// The carts' travel limits, m.
-    pub limits: [f64; 2],
-}
-
-impl AmplitudeChoice {
-    /// `asked` as is, without probes ([`Reason::Fixed`]), on a rig with
-    /// travel limits `limits` (m).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::AmplitudeChoice;
-    /// assert_eq!(AmplitudeChoice::fixed(12.0, [0.05, 0.04]).volts, 12.0);
-    /// ```
-    pub fn fixed(asked: f64, limits: [f64; 2]) -> Self {
-        Self {
-            asked,
-            volts: asked,
-            reason: Reason::Fixed,
-            probes: Vec::new(),
-            predicted: None,
-            predicted_asked: None,
-            limits,
-        }
-    }
-
-    /// The largest predicted peak allowed per cart, m: [`TRAVEL_FRACTION`]
-    /// of each travel limit.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::AmplitudeChoice;
-    /// assert_eq!(AmplitudeChoice::fixed(8.0, [0.05, 0.04]).allowed()[1], 0.6 * 0.04);
-    /// ```
-    pub fn allowed(&self) -> [f64; 2] {
-        self.limits.map(|l| TRAVEL_FRACTION * l)
-    }
-}
-
-/// The probe runs and the choice: ask for `asked` V on a rig with travel
-/// limits `limits` m, then [`run`](Self::run) the probes.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::ident_input::{AmplitudeSearch, Reason};
-/// // 2 mm per volt on cart 2, no friction: 8 V is 16 mm, within 30 mm.
-/// let choice = AmplitudeSearch::new(8.0, [0.05, 0.05])?
-///     .run(|v| Ok::<_, ctrlab::Error>([0.001 * v, 0.002 * v]))?;
-/// assert_eq!((choice.volts, choice.reason), (8.0, Reason::Fits));
-/// assert_eq!(choice.probes.iter().map(|p| p.volts).collect::<Vec<_>>(), [2.0, 4.0]);
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AmplitudeSearch {
-    asked: f64,
-    limits: [f64; 2],
-}
-
-impl AmplitudeSearch {
-    /// A search up to `asked` V on travel limits `limits` m.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::InvalidParameter`] for an `asked` or a limit that is not
-    /// finite and > 0.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::AmplitudeSearch;
-    /// assert!(AmplitudeSearch::new(8.0, [0.05, 0.0]).is_err());
-    /// assert!(AmplitudeSearch::new(f64::NAN, [0.05, 0.05]).is_err());
-    /// ```
-    pub fn new(asked: f64, limits: [f64; 2]) -> Result<Self, Error> {
-        if !(asked.is_finite() && asked > 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "volts",
-                value: asked,
-                reason: "must be finite and > 0 V",
-            });
-        }
-        if let Some(&l) = limits.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
-            return Err(Error::InvalidParameter {
-                name: "travel_limits",
-                value: l,
-                reason: "must be finite and > 0 m",
-            });
-        }
-        Ok(Self { asked, limits })
-    }
-
-    /// The amplitude asked for, V.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::AmplitudeSearch;
-    /// assert_eq!(AmplitudeSearch::new(8.0, [0.05, 0.05])?.asked(), 8.0);
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn asked(&self) -> f64 {
-        self.asked
-    }
-
-    /// The largest amplitude whose predicted peaks from `probes` are
-    /// within [`TRAVEL_FRACTION`] of the limits, V, and the cart that
-    /// limits it (infinite and `None` when no probe moved a cart).
-    fn largest(&self, probes: &[Probe]) -> (f64, Option<usize>) {
-        let Some(lines) = lines(probes) else {
-            return (f64::INFINITY, None);
-        };
-        let mut best = (f64::INFINITY, None);
-        for (c, cart) in lines.iter().enumerate() {
-            let allowed = TRAVEL_FRACTION * self.limits[c];
-            for line in cart {
-                let v = line.volts_at(allowed);
-                if v < best.0 {
-                    best = (v, Some(c));
-                }
-            }
-        }
-        best
-    }
-
-    /// Runs the probes with `probe` (which runs the signal at the volts
-    /// it is given for [`PROBE_DURATION`] s and returns both carts' peak
-    /// |x|, m: [`peaks`] of its recording, also when the run was halted)
-    /// and chooses the amplitude.
-    ///
-    /// The first probe runs at `PROBE_FRACTIONS[0]` of the amplitude
-    /// asked for; the second at `PROBE_FRACTIONS[1]`, lowered to what the
-    /// first predicts is allowed (and left out if that is not above the
-    /// first).
-    ///
-    /// # Errors
-    ///
-    /// `probe`'s own error, as it gives it.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::{AmplitudeSearch, Reason};
-    /// // 20 mm per volt: the first probe (2 V, 40 mm) is already too far.
-    /// let choice = AmplitudeSearch::new(8.0, [0.05, 0.05])?
-    ///     .run(|v| Ok::<_, ctrlab::Error>([0.0, 0.02 * v]))?;
-    /// assert_eq!(choice.probes.len(), 1);
-    /// assert!((choice.volts - 1.5).abs() < 1e-12);
-    /// assert_eq!(choice.reason, Reason::Scaled { cart: 1 });
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn run<E>(
-        &self,
-        mut probe: impl FnMut(f64) -> Result<[f64; 2], E>,
-    ) -> Result<AmplitudeChoice, E> {
-        let mut probes = Vec::with_capacity(PROBE_FRACTIONS.len());
-        for fraction in PROBE_FRACTIONS {
-            let mut volts = fraction * self.asked;
-            if !probes.is_empty() {
-                volts = volts.min(self.largest(&probes).0);
-                if probes.last().is_some_and(|p: &Probe| volts <= p.volts) {
-                    break;
-                }
-            }
-            let peaks = probe(volts)?;
-            probes.push(Probe { volts, peaks });
-        }
-        let (largest, cart) = self.largest(&probes);
-        let (volts, reason) = match cart {
-            None => (self.asked, Reason::NoMotion),
-            Some(_) if largest >= self.asked => (self.asked, Reason::Fits),
-            // Down to 10 mV (below the drive's 24 mV step): a round
-            // number to report, never above the prediction's.
-            Some(cart) => (
-                ((largest * 100.0).floor() / 100.0).max(0.0),
-                Reason::Scaled { cart },
-            ),
-        };
-        Ok(AmplitudeChoice {
-            asked: self.asked,
-            volts,
-            reason,
-            predicted: predict(&probes, volts),
-            predicted_asked: predict(&probes, self.asked),
-            probes,
-            limits: self.limits,
-        })
-    }
-}
-
-/// An identification run that completed: its seed (its number in the
-/// lab's order, from 1) and recording.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::ident_input::CompletedRun;
-/// let run = CompletedRun { seed: 1, recording: ctrlab::Recording::new(ctrlab::lab::schema()) };
-/// assert_eq!(run.seed, 1);
-/// ```
-#[derive(Debug, Clone, PartialEq)]
-pub struct CompletedRun {
-    /// The run's seed (its number, from 1).
-    pub seed: u64,
-    /// Its recording.
-    pub recording: Recording,
-}
-
-/// An identification run the rig halted (a travel limit, say): its seed,
-/// the loop's error and what it recorded up to the fault.
+/// Whether the rig halted a run because its input was too big for the
+/// rig: a cart past its travel limit ([`LoopFault::TravelLimit`]) or the
+/// drive held at its limit too long ([`LoopFault::Saturated`]). A smaller
+/// amplitude is the answer to these, and the other runs may go on; any
+/// other fault (a bus fault, a dead encoder, a motor not responding, a
+/// timing gap, Ctrl-C, a panic, a port error) says the rig or the program
+/// is not fit to measure, and no run after it means anything.
 ///
 /// # Examples
 ///
 /// ```
 /// use ctrlab::hw::{LoopFault, RigError};
-/// use ctrlab::lab::ident_input::HaltedRun;
-/// let run = HaltedRun {
-///     seed: 3,
-///     error: RigError::Fault(LoopFault::TravelLimit { axis: 2, position: 0.0501, limit: 0.05 }),
-///     recording: ctrlab::Recording::new(ctrlab::lab::schema()),
-/// };
-/// assert!(run.error.to_string().contains("beyond its travel limit"));
+/// use ctrlab::lab::ident_input::input_too_big;
+/// let travel = RigError::Fault(LoopFault::TravelLimit { axis: 2, position: 0.051, limit: 0.05 });
+/// assert!(input_too_big(&travel));
+/// let stopped = RigError::Fault(LoopFault::Interrupted { at: 1.0 });
+/// assert!(!input_too_big(&stopped));
 /// ```
-#[derive(Debug)]
-pub struct HaltedRun {
-    /// The run's seed (its number, from 1).
-    pub seed: u64,
-    /// Why the rig halted it (a [`LoopFault::TravelLimit`] names the cart's
-    /// axis, its position and the limit, m).
-    ///
-    /// [`LoopFault::TravelLimit`]: crate::hw::LoopFault::TravelLimit
-    pub error: RigError,
-    /// Every sample before the fault.
-    pub recording: Recording,
-}
-
-/// The identification runs on a rig: those that completed, which the
-/// identification averages, and those the rig halted, which it leaves
-/// out. A halted run does not stop the others.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::hw::{LoopFault, RigError, RunError, LoopStats};
-/// use ctrlab::lab::ident_input::IdentRuns;
-/// use ctrlab::Recording;
-/// let runs = IdentRuns::collect(1..=3, |seed| {
-///     let recording = Recording::new(ctrlab::lab::schema());
-///     Ok::<_, ctrlab::Error>(if seed == 2 {
-///         let error = RigError::Fault(LoopFault::TravelLimit { axis: 2, position: 0.051, limit: 0.05 });
-///         Err(Box::new(RunError { error, recording, last_measurement: None, stats: LoopStats::default() }))
-///     } else {
-///         Ok(recording)
-///     })
-/// })?;
-/// assert_eq!(runs.completed.iter().map(|r| r.seed).collect::<Vec<_>>(), [1, 3]);
-/// assert_eq!(runs.halted[0].seed, 2);
-/// assert!(runs.enough().is_ok());
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-#[derive(Debug, Default)]
-pub struct IdentRuns {
-    /// The runs that completed, in order.
-    pub completed: Vec<CompletedRun>,
-    /// The runs the rig halted, in order.
-    pub halted: Vec<HaltedRun>,
-}
-
-impl IdentRuns {
-    /// Runs `run` for each of `seeds` (bounded by the iterator) and sorts
-    /// the outcomes: a run's own error (the rig halted it, with what it
-    /// recorded) goes to [`halted`](Self::halted) and the next run goes
-    /// on; `run`'s outer error (a set-up failure, Ctrl-C) stops here.
-    ///
-    /// # Errors
-    ///
-    /// `run`'s outer error.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::IdentRuns;
-    /// let runs = IdentRuns::collect(1..=2, |_| Ok::<_, ctrlab::Error>(Ok(ctrlab::Recording::new(ctrlab::lab::schema()))))?;
-    /// assert_eq!((runs.completed.len(), runs.halted.len()), (2, 0));
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn collect<E>(
-        seeds: impl IntoIterator<Item = u64>,
-        mut run: impl FnMut(u64) -> Result<Result<Recording, Box<RunError>>, E>,
-    ) -> Result<Self, E> {
-        let mut runs = Self::default();
-        for seed in seeds {
-            match run(seed)? {
-                Ok(recording) => runs.completed.push(CompletedRun { seed, recording }),
-                Err(e) => {
-                    let RunError {
-                        error, recording, ..
-                    } = *e;
-                    runs.halted.push(HaltedRun {
-                        seed,
-                        error,
-                        recording,
-                    });
-                }
-            }
-        }
-        Ok(runs)
-    }
-
-    /// The completed runs' recordings, in order, for
-    /// [`summarize`](super::ident::summarize).
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::IdentRuns;
-    /// assert_eq!(IdentRuns::default().recordings().count(), 0);
-    /// ```
-    pub fn recordings(&self) -> impl Iterator<Item = &Recording> {
-        self.completed.iter().map(|r| &r.recording)
-    }
-
-    /// Whether enough runs completed for the averages (and a fresh run
-    /// for the validation): at least two.
-    ///
-    /// # Errors
-    ///
-    /// [`TooFewRuns`], naming each halted run and why.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::lab::ident_input::IdentRuns;
-    /// let err = IdentRuns::default().enough().unwrap_err();
-    /// assert_eq!((err.completed, err.total), (0, 0));
-    /// assert!(err.to_string().starts_with("only 0 of 0 identification runs completed"), "{err}");
-    /// ```
-    pub fn enough(&self) -> Result<(), TooFewRuns> {
-        if self.completed.len() >= 2 {
-            return Ok(());
-        }
-        Err(TooFewRuns {
-            completed: self.completed.len(),
-            total: self.completed.len() + self.halted.len(),
-            halted: self
-                .halted
-                .iter()
-                .map(|h| format!("run {}: {}", h.seed, h.error))
-                .collect(),
-        })
-    }
-}
-
-/// Fewer than two identification runs completed: the averages (and the
-/// validation on a fresh run) need two.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::lab::ident_input::TooFewRuns;
-/// let e = TooFewRuns { completed: 1, total: 5, halted: vec!["run 2: beyond its travel limit".into()] };
-/// assert!(e.to_string().contains("only 1 of 5") && e.to_string().contains("run 2: beyond"));
-/// ```
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error(
-    "only {completed} of {total} identification runs completed (halted: {}); the averages and the validation on a fresh run need at least two: lower the amplitude",
-    halted.join("; ")
-)]
-pub struct TooFewRuns {
-    /// Runs that completed.
-    pub completed: usize,
-    /// Runs tried.
-    pub total: usize,
-    /// Each halted run and why, as `run 3: <the loop's error>`.
-    pub halted: Vec<String>,
+pub fn input_too_big(error: &RigError) -> bool {
+    matches!(
+        error,
+        RigError::Fault(LoopFault::TravelLimit { .. } | LoopFault::Saturated { .. })
+    )
 }

@@ -50,9 +50,10 @@ const OTHER: usize = 0;
 ///   non-finite command halts the rig and returns
 ///   [`PortError::InvalidCommand`]. A command more than the watchdog timeout
 ///   after the last read would re-energise a motor the card has cut: it is
-///   refused ([`LoopFault::Gap`]) and the rig halted. A drive held at its
+///   refused ([`LoopFault::Gap`]) and the rig halted. A drive held at one
 ///   limit for longer than [`Calibration::max_saturation_time`] is refused
-///   too ([`LoopFault::Saturated`]), and the rig halted.
+///   too ([`LoopFault::Saturated`]), and the rig halted (a flip to the
+///   other limit starts the time again).
 /// - Halting ([`Rig::halt`], and before any fault above) sets **every** PWM
 ///   channel of the card to zero, the motor's first: a channel the
 ///   calibration does not name may still have been set (by another
@@ -104,8 +105,12 @@ pub struct MassSpringRig<P: EppPort> {
     stall: Option<Episode>,
     /// The driven cart at rest, the baseline of the follow check.
     rest: Option<Rest>,
-    /// Since when the drive has been at its limit (s on `clock`).
-    saturated: Option<f64>,
+    /// Since when the drive has been at its limit (s on `clock`), and at
+    /// which end (the duty's sign).
+    saturated: Option<(f64, i16)>,
+    /// Cart 1's counts at the start of the quiet check's window, and when
+    /// (s on `clock`); see `check_quiet`.
+    quiet: Option<(i64, f64)>,
 }
 
 /// A change of drive of `stall_volts` or more that the driven cart's
@@ -205,6 +210,7 @@ impl<P: EppPort> MassSpringRig<P> {
             stall: None,
             rest: None,
             saturated: None,
+            quiet: None,
         })
     }
 
@@ -454,7 +460,14 @@ impl<P: EppPort> MassSpringRig<P> {
         let duty = self.duty(volts);
         if duty.abs() == MAX_DUTY {
             let now = self.now();
-            let since = *self.saturated.get_or_insert(now);
+            // Time pushing one way against the limit: a flip from one end
+            // to the other (a bang-bang square wave at full scale) starts
+            // it again, as the drive has just done something else.
+            let since = match self.saturated {
+                Some((since, end)) if end == duty.signum() => since,
+                _ => now,
+            };
+            self.saturated = Some((since, duty.signum()));
             let limit = self.calibration.max_saturation_time;
             if now - since >= limit {
                 let error = LoopFault::Saturated {
@@ -528,6 +541,7 @@ impl<P: EppPort> Rig<1, 4> for MassSpringRig<P> {
         self.stall = None;
         self.rest = None;
         self.saturated = None;
+        self.quiet = None;
     }
 }
 

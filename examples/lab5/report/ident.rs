@@ -99,6 +99,15 @@ impl Report {
                 "probe".into(),
             ]);
         }
+        if let Some(p) = choice.halted {
+            rows.push(vec![
+                format!("probe {}", choice.probes.len() + 1),
+                format!("{:.2}", p.volts),
+                mm2(p.peaks[0]),
+                mm2(p.peaks[1]),
+                "probe halted at a travel limit (peaks cut short)".into(),
+            ]);
+        }
         if let Some(p) = choice.predicted {
             rows.push(vec![
                 "prediction".into(),

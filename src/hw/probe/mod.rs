@@ -369,6 +369,9 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     ///
     /// The first step's that fails; the steps' own docs say which.
     pub fn run(&mut self) -> Result<ProbeReport, ProbeError> {
+        // A second Ctrl-C during a pulse only raises the flag: the probe
+        // zeroes the PWM (see StopSignal::on_interrupt).
+        let _running = super::stop::Running::enter();
         let result = self.steps();
         if result.is_err() {
             self.zero_pwm();

@@ -37,8 +37,10 @@ impl<P: EppPort> MassSpringRig<P> {
             self.motion = Some((counts, self.volts, now));
             self.stall = None;
             self.rest = None;
+            self.quiet = None;
             return Ok(());
         }
+        self.check_quiet(counts, moved_at, now)?;
         if self.rest.is_none() && now - moved_at >= cal.follow_time {
             self.rest = Some(Rest {
                 other: counts[OTHER],
@@ -113,6 +115,73 @@ impl<P: EppPort> MassSpringRig<P> {
                 other: OTHER + 1,
                 volts: weakest,
                 seconds: now - since,
+                moved,
+                counts: cal.stall_counts,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// How far the other cart (cart 1) must move within one
+/// [`QUIET_WINDOW`] for [`MassSpringRig::check_quiet`], m: 1 mm.
+const QUIET_DISTANCE: f64 = 0.001;
+
+/// The window over which the other cart's motion is measured, as a
+/// fraction of [`Calibration::stall_time`](crate::lab::Calibration::stall_time):
+/// a fifth (0.1 s by default).
+const QUIET_WINDOW: f64 = 0.2;
+
+impl<P: EppPort> MassSpringRig<P> {
+    /// The other cart (cart 1) keeps moving while the driven cart's
+    /// encoder stays still, under a drive of either sign: the encoder is
+    /// dead ([`LoopFault::EncoderNotFollowing`]), whatever the amplitude.
+    /// [`check_follow`](Self::check_follow) needs a change of drive of
+    /// `stall_volts` (6 V) from rest, so a dead encoder under a small drive
+    /// (the 2 V and 4 V probe runs of `lab::ident_input`) went unnoticed,
+    /// and its cart 2 read as a cart that does not move.
+    ///
+    /// Cart 1 moves only through the spring from cart 2. While cart 2 is
+    /// held in its friction, cart 1 may still ring or settle for a while,
+    /// but every millimetre it moves changes the spring's force on cart 2
+    /// by about a newton (the lab's springs are about 1000 N/m, cart 2's
+    /// stiction 2.4 N), so it cannot keep moving long without setting
+    /// cart 2 moving too. The fault is: cart 2's encoder has not moved
+    /// `stall_counts` for [`stall_time`](Calibration::stall_time) (0.5 s)
+    /// and cart 1 moved at least [`QUIET_DISTANCE`] (1 mm) within the
+    /// last [`QUIET_WINDOW`] of it (0.1 s), the drive not zero. Measured on
+    /// the simulated default and a lighter-damped rig (square wave, PRBS,
+    /// multisine, 1 to 8 V, five seeds): cart 2's encoder was still for at
+    /// most 0.19 s while cart 1 had moved 1 mm since; with a dead encoder,
+    /// cart 1 moves 1 mm within 0.05 to 0.15 s of a square wave that moves
+    /// the carts at all (2 V on the lighter rig, 3 V on the default one,
+    /// whose friction holds both carts at 2 V).
+    ///
+    /// [`Calibration`]: crate::lab::Calibration
+    pub(super) fn check_quiet(
+        &mut self,
+        counts: [i64; 2],
+        moved_at: f64,
+        now: f64,
+    ) -> Result<(), RigError> {
+        let cal = self.calibration;
+        let window = QUIET_WINDOW * cal.stall_time;
+        let quiet = *self.quiet.get_or_insert((counts[OTHER], now));
+        if now - quiet.1 < window {
+            return Ok(());
+        }
+        self.quiet = Some((counts[OTHER], now));
+        let threshold =
+            ((QUIET_DISTANCE / cal.metres_per_count).ceil() as i64).max(cal.stall_counts);
+        let moved = counts[OTHER].saturating_sub(quiet.0).saturating_abs();
+        let seconds = now - moved_at;
+        if moved >= threshold && seconds >= cal.stall_time && self.volts != 0.0 {
+            return self.fault(LoopFault::EncoderNotFollowing {
+                cart: DRIVEN + 1,
+                channel: cal.encoder_channels[DRIVEN],
+                other: OTHER + 1,
+                volts: self.volts.abs(),
+                seconds,
                 moved,
                 counts: cal.stall_counts,
             });
