@@ -1,8 +1,9 @@
 //! [`Ppdev`]: the real parallel port through Linux's `ppdev` driver
 //! (`/dev/parportN`), in IEEE 1284 EPP mode. Feature `ppdev`, Linux only.
 //!
-//! With `hw::realtime` (the scheduler's system calls), one of the crate's
-//! two files with `unsafe` code: the `ioctl` calls. Reads and writes go through `std::fs::File`.
+//! One of the crate's three places with `unsafe` code, the `ioctl` calls
+//! (the others: `hw::realtime`'s scheduler calls and the one signal-handler
+//! registration in `hw::stop`). Reads and writes go through `std::fs::File`.
 #![allow(unsafe_code)]
 
 use std::ffi::{c_int, c_uchar, c_uint};

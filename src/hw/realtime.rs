@@ -2,8 +2,9 @@
 //! memory, CPU affinity and absolute-deadline sleeps.
 //!
 //! This is the crate's one file of `unsafe` code for the scheduler and
-//! clock system calls (the parallel port has its own, `ppdev.rs`); each
-//! block says why it is sound. On other systems asking for [`RealTime`] is
+//! clock system calls (the parallel port has its own, `ppdev.rs`, and
+//! `stop.rs` one block registering the stop signals' handler); each block
+//! says why it is sound. On other systems asking for [`RealTime`] is
 //! an error and sleeps fall back to `std::thread::sleep`.
 #![allow(unsafe_code)]
 
