@@ -246,6 +246,7 @@ fn scan_identification_on_the_default_rig() {
             n += 1;
             let input = ident.input(v, IDENT_DURATION).unwrap();
             peaks(&open_loop(&rig(100 + n), &input, PROBE_DURATION))
+                .map_err(|e| Box::new(e) as Box<dyn std::error::Error>)
         })
         .unwrap()
         .volts;
