@@ -841,6 +841,13 @@ fn every_field_changed() -> SimulatedRig {
             travel_limits: [0.06, 0.07],
             ..Calibration::default()
         },
+        // lab5's identification input: no part of the plant or the card.
+        ident: ctrlab::lab::ident_input::IdentInput {
+            signal: ctrlab::lab::ident_input::IdentSignal::Prbs,
+            volts: 6.0,
+            half_period: 0.3,
+            scale_to_travel: false,
+        },
     }
 }
 

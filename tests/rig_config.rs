@@ -10,6 +10,7 @@
 
 use ctrlab::MassSpring;
 use ctrlab::hw::{Clock, RegisterMap};
+use ctrlab::lab::ident_input::{IdentInput, IdentSignal};
 use ctrlab::lab::{
     Calibration, CardSettings, FileError, FileErrorKind, Friction, RigConfig, SimulatedRig,
     Unmodelled,
@@ -729,6 +730,12 @@ fn a_truth_file_keeps_defaults_refuses_unknown_keys_and_round_trips() {
             card_id: 0x3c,
             ..Calibration::default()
         },
+        ident: IdentInput {
+            signal: IdentSignal::Multisine,
+            volts: 5.0,
+            half_period: 0.25,
+            scale_to_travel: false,
+        },
     };
     let text = unusual.to_toml();
     assert_eq!(SimulatedRig::from_toml(&text).unwrap(), unusual, "{text}");
@@ -739,9 +746,18 @@ fn a_truth_file_keeps_defaults_refuses_unknown_keys_and_round_trips() {
         "[card]",
         "[card.map]",
         "[calibration]",
+        "[ident]",
     ] {
         assert!(text.contains(table), "{table} missing from\n{text}");
     }
+    // The identification input is written only when it is not lab5's
+    // default, as in a card file.
+    let default = SimulatedRig::default().to_toml();
+    assert!(!default.contains("[ident]"), "{default}");
+    assert_eq!(
+        SimulatedRig::from_toml(&default).unwrap(),
+        SimulatedRig::default()
+    );
 }
 
 // ---- the safety keys: defaults, checks, the same error from file and code ------

@@ -83,7 +83,7 @@ impl Backend {
         // driven.
         let kind = kind(args)?;
         let base = match &kind {
-            BackendKind::Simulated { .. } => IdentInput::default(),
+            BackendKind::Simulated { sim, .. } => sim.ident,
             #[cfg(all(feature = "ppdev", target_os = "linux"))]
             BackendKind::Card { config, .. } => config.ident,
         };

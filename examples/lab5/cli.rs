@@ -83,15 +83,15 @@ pub struct Args {
     #[arg(long, value_name = "M", value_parser = positive_metres, requires = "logs")]
     pub metres_per_count: Option<f64>,
     /// The identification input's signal: square (the lab's), prbs or
-    /// multisine [default: square, or the card file's [ident] signal]
+    /// multisine [default: square, or the card or truth file's [ident] signal]
     #[arg(long, value_name = "SIGNAL", value_parser = ident_signal, conflicts_with = "logs")]
     pub ident_signal: Option<IdentSignal>,
     /// The identification input's peak voltage asked for, V: lowered to
     /// keep both carts within 60 % of their travel (from two short probe
-    /// runs) unless --ident-fixed [default: 8, or the card file's]
+    /// runs) unless --ident-fixed [default: 8, or the card or truth file's]
     #[arg(long, value_name = "V", value_parser = ident_volts, allow_negative_numbers = true, conflicts_with = "logs")]
     pub ident_volts: Option<f64>,
-    /// The square wave's half period, s [default: 0.2, or the card file's]
+    /// The square wave's half period, s [default: 0.2, or the card or truth file's]
     #[arg(long, value_name = "S", value_parser = ident_half_period, conflicts_with = "logs")]
     pub ident_half_period: Option<f64>,
     /// Run the identification input at --ident-volts as is: no probe runs,
@@ -102,7 +102,7 @@ pub struct Args {
 }
 
 impl Args {
-    /// The identification input: `base` (the card file's, or the lab's
+    /// The identification input: `base` (the card or truth file's, or the lab's
     /// default) with the command line's `--ident-*` on top.
     pub fn ident_input(&self, base: IdentInput) -> IdentInput {
         IdentInput {

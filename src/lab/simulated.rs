@@ -15,6 +15,7 @@ pub use unmodelled::Unmodelled;
 use nalgebra::SVector;
 
 use super::file::{self, FileError};
+use super::ident_input::IdentInput;
 use super::{Calibration, EncoderSensor, FrictionPlant, MassSpring, MassSpringRig, schema};
 use crate::hw::{
     Clock, ConfigError, ENCODER_CHANNELS, MAX_DUTY, Pc104, RigError, SimulatedCard,
@@ -96,10 +97,10 @@ use crate::sim::SampledConfig;
 ///
 /// Every field can be set from a TOML file ([`from_toml`](Self::from_toml),
 /// `lab5 --truth truth.toml`), in the tables of the parts: `[truth]`,
-/// `[friction]`, `[unmodelled]`, `[card]` (with `[card.map]`) and
-/// `[calibration]` (the keys
-/// of a card file's, [`RigConfig`](super::RigConfig)), and `period` and
-/// `initial_state` on top. Keys left out keep their default (a table given
+/// `[friction]`, `[unmodelled]`, `[card]` (with `[card.map]`),
+/// `[calibration]` and `[ident]` (the keys of a card file's,
+/// [`RigConfig`](super::RigConfig): lab5's identification input on this
+/// rig), and `period` and `initial_state` on top. Keys left out keep their default (a table given
 /// in part keeps the default of the keys it lacks); unknown keys are an
 /// error, as is a value [`validate`](Self::validate) refuses, named by the
 /// key the file spells:
@@ -137,14 +138,22 @@ use crate::sim::SampledConfig;
 ///
 ///     [calibration]
 ///     travel_limits = [0.04, 0.05]    # m
+///
+///     [ident]                         # lab5's identification input
+///     signal = "prbs"
+///     volts = 6.0                     # V, peak asked for
 /// "#)?;
 /// assert_eq!((rig.truth.gain, rig.friction.coulomb[1]), (1.2, 1.5));
+/// assert_eq!((rig.ident.signal.name(), rig.ident.volts), ("prbs", 6.0));
 /// assert_eq!(rig.calibration.travel_limits, [0.04, 0.05]);
 /// assert_eq!(rig.calibration.watchdog_timeout, Some(0.1)); // a default
 /// assert_eq!((rig.unmodelled.rotor_mass, rig.effective_truth().m2), (0.05, 0.72 + 0.05));
 /// assert!(SimulatedRig::from_toml("[truth]\ngian = 1.2").is_err()); // a typo is refused
 /// let err = SimulatedRig::from_toml("[friction]\ncoulomb = [1.0, -2.0]").unwrap_err();
 /// assert_eq!((err.key(), err.line()), (Some("friction.coulomb[1]"), Some(2)));
+/// // More than the drive's ±24 V is refused, as in a card file.
+/// let err = SimulatedRig::from_toml("[ident]\nvolts = 30.0").unwrap_err();
+/// assert_eq!(err.key(), Some("ident.volts"));
 /// # Ok::<(), ctrlab::lab::FileError>(())
 /// ```
 ///
@@ -190,6 +199,12 @@ pub struct SimulatedRig {
     /// What the software uses, and what the simulated card is built to
     /// match (see [`SimulatedRig`]).
     pub calibration: Calibration,
+    /// The identification input lab5 asks for on this rig (`[ident]`,
+    /// optional, as in a card file: [`RigConfig::ident`](super::RigConfig::ident));
+    /// its volts at most the calibration's `volts_full_scale`. The command
+    /// line's `--ident-*` flags go on top.
+    #[serde(default, skip_serializing_if = "IdentInput::is_default")]
+    pub ident: IdentInput,
 }
 
 impl Default for SimulatedRig {
@@ -202,6 +217,7 @@ impl Default for SimulatedRig {
             unmodelled: Unmodelled::default(),
             card: CardSettings::default(),
             calibration: Calibration::default(),
+            ident: IdentInput::default(),
         }
     }
 }

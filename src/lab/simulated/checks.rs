@@ -26,7 +26,10 @@ impl SimulatedRig {
     ///   ([`SimulatedCardConfig::validate`](crate::hw::SimulatedCardConfig::validate));
     /// - the period (finite, ≥ 1 µs, at most 10⁶ sub-steps), a PWM delay
     ///   below it, and the initial state within the travel limits and the
-    ///   calibration's `max_speed`.
+    ///   calibration's `max_speed`;
+    /// - the identification input
+    ///   ([`IdentInput::validate`](crate::lab::ident_input::IdentInput::validate)),
+    ///   its volts within the drive's `volts_full_scale`.
     ///
     /// # Errors
     ///
@@ -34,7 +37,7 @@ impl SimulatedRig {
     /// ([`from_toml`](Self::from_toml) reports the same error):
     /// `truth.m1`, `friction.coulomb[1]`, `unmodelled.deadband`, `card.max_substep`,
     /// `card.map.encoder[3]`, `calibration.travel_limits[0]`, `period`,
-    /// `initial_state[2]`. A derived quantity that fails is reported under
+    /// `initial_state[2]`, `ident.volts`. A derived quantity that fails is reported under
     /// the key it comes from: a stiction over a Coulomb force that overflows
     /// under `friction.coulomb[i]`, an acceleration that overflows under the
     /// mass, a resolution the card cannot count in under
@@ -91,7 +94,11 @@ impl SimulatedRig {
         }
         self.card_config().validate().map_err(Self::card_key)?;
         self.check_timing()?;
-        self.check_counts()
+        self.check_counts()?;
+        self.ident.validate().map_err(|e| e.in_table("ident"))?;
+        self.ident
+            .check_drive(cal.volts_full_scale)
+            .map_err(|e| e.in_table("ident"))
     }
 
     /// A [`SimulatedCardConfig::validate`](crate::hw::SimulatedCardConfig::validate) error under the key of the
