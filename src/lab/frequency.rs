@@ -138,8 +138,8 @@ pub fn peaks_hz(g: &FrequencyEstimate, count: usize) -> Vec<f64> {
 /// drive's quantisation) and the smoothed estimate on `w` (rad/s), from u
 /// (V) to x2 (m) over the periods after the first, on the grid of one
 /// `period` (s) from the first sample. A recording with late samples or
-/// gaps (skipped ticks) is first brought onto that grid
-/// ([`on_period_grid`]); a uniform one is used as it is.
+/// gaps (skipped ticks) is first brought onto that grid (the input held,
+/// the positions interpolated); a uniform one is used as it is.
 ///
 /// # Errors
 ///

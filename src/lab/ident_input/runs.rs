@@ -157,7 +157,7 @@ impl IdentRuns {
     }
 
     /// The completed runs' recordings, in order, for
-    /// [`summarize`](super::ident::summarize).
+    /// [`summarize`](crate::lab::ident::summarize).
     ///
     /// # Examples
     ///

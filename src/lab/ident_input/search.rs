@@ -26,7 +26,7 @@ pub struct Probe {
 }
 
 /// Each cart's predicted peak |x| at `volts` from `probes` (in increasing
-/// volts; see [the module](self#how-the-amplitude-is-chosen)), m: the
+/// volts; see [the module](crate::lab::ident_input#how-the-amplitude-is-chosen)), m: the
 /// larger of the line through the last two probes and the line through
 /// the origin and the last probe. `None` without probes.
 ///
@@ -102,7 +102,7 @@ fn lines(probes: &[Probe]) -> Option<[[Line; 2]; 2]> {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reason {
-    /// As asked, without probe runs ([`IdentInput::scale_to_travel`]
+    /// As asked, without probe runs ([`IdentInput::scale_to_travel`](super::IdentInput::scale_to_travel)
     /// false).
     Fixed,
     /// As asked: its predicted peaks are within [`TRAVEL_FRACTION`] of the
