@@ -309,3 +309,44 @@ fn the_binary_refuses_bad_input_and_says_why() {
         assert!(!out.exists(), "{args:?} wrote {}", out.display());
     }
 }
+
+#[test]
+#[ignore = "needs the experiment binary: cargo build --release --example experiment"]
+fn a_saved_design_runs_with_its_g_and_is_named_by_it() {
+    let dir = out_dir("design");
+    std::fs::create_dir_all(&dir).unwrap();
+    let design = dir.join("design.toml");
+    std::fs::write(&design, "kf = [0, 0, 10, 0.1]\ng = [0, 0, 1.05, 0]\n").unwrap();
+    let out = dir.join("out");
+    let run = experiment(
+        &out,
+        &["--cart", "2", "--gains-file", design.to_str().unwrap()],
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        stdout.contains("G = [0 0 1.05 0], setpoint 30 mm"),
+        "{stdout}"
+    );
+    // G = 1.05 asks for 31.5 mm, which the loop's error brings back near 30.
+    assert!(
+        out.join("cart2_kf_0_0_10_0.1_g_0_0_1.05_0_to_30mm.csv")
+            .is_file()
+    );
+    // Three gains: refused, the file and what it should hold named.
+    std::fs::write(&design, "kf = [0, 0, 10]\n").unwrap();
+    let run = experiment(
+        &out,
+        &["--cart", "2", "--gains-file", design.to_str().unwrap()],
+    );
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("expected kf = [Kf1, Kf2, Kf3, Kf4]"),
+        "{stderr}"
+    );
+}

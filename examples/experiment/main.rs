@@ -147,7 +147,7 @@ fn real_card(
     experiment: &Experiment,
     realtime: Option<RealTime>,
 ) -> Result<Ended, Box<dyn std::error::Error>> {
-    use std::io::{BufRead, Write};
+    use std::io::Write;
 
     let (file, config) = card::load(port, args.card.as_deref(), args.no_watchdog_acknowledged)?;
     experiment.validate(&config.calibration)?;
@@ -174,10 +174,7 @@ fn real_card(
     if !args.yes {
         print!("Carts at rest, hand on the emergency stop? Drive the motor [y/N] ");
         std::io::stdout().flush()?;
-        let mut answer = String::new();
-        // End of input (a script without --yes) is a no.
-        std::io::stdin().lock().read_line(&mut answer)?;
-        if !matches!(answer.trim(), "y" | "Y" | "yes") {
+        if !confirmed(std::io::stdin().lock())? {
             println!("Nothing driven.");
             return Ok(Ended::Measured);
         }
@@ -193,6 +190,16 @@ fn real_card(
     };
     let run = experiment.run(rig, &Clock::RealTime, &loop_config)?;
     report(args, experiment, &run, cal.volts_full_scale)
+}
+
+/// The answer to "Drive the motor [y/N]": yes only for `y` or `yes`; an
+/// empty line, anything else or the end of input (a script without
+/// `--yes`) is no.
+#[cfg_attr(not(all(feature = "ppdev", target_os = "linux")), allow(dead_code))]
+fn confirmed(mut input: impl std::io::BufRead) -> std::io::Result<bool> {
+    let mut answer = String::new();
+    input.read_line(&mut answer)?;
+    Ok(matches!(answer.trim(), "y" | "Y" | "yes" | "Yes" | "YES"))
 }
 
 /// The experiment in the lab's words.
@@ -302,5 +309,24 @@ fn outcome(o: &RigOutcome, e: &Experiment, full_scale: f64) -> String {
             at,
             why: Halt::NoMetrics(e),
         } => format!("no metrics (run ended at t = {at:.3} s): {e}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::confirmed;
+
+    #[test]
+    fn only_a_yes_drives_the_motor() {
+        for (input, yes) in [
+            ("y\n", true),
+            ("yes\n", true),
+            ("\n", false),
+            ("n\n", false),
+            ("yy\n", false),
+            ("", false),
+        ] {
+            assert_eq!(confirmed(input.as_bytes()).unwrap(), yes, "{input:?}");
+        }
     }
 }

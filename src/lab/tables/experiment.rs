@@ -158,8 +158,7 @@ impl Experiment {
         }
         let limit_mm = calibration.travel_limits[self.cart.number() - 1] * 1e3;
         let max_mm = TRAVEL_FRACTION * limit_mm;
-        // `!(a <= b)` also refuses NaN.
-        if !(self.setpoint_mm.abs() <= max_mm) {
+        if self.setpoint_mm.is_nan() || self.setpoint_mm.abs() > max_mm {
             return Err(ExperimentError::Setpoint {
                 cart: self.cart.number(),
                 setpoint_mm: self.setpoint_mm,
