@@ -27,6 +27,7 @@ use ctrlab::lab::{Cart, LabGains};
   cargo run --release --example experiment -- --cart 1 --kf 1,0.005,0,0 --setpoint 15mm --duration 5
   cargo run --release --example experiment -- --cart 2 --gains-file design.toml --setpoint 0.03m
   cargo run --release --example experiment -- --cart 2 --kf 0,0,10,0.1 --truth truth.toml
+  cargo run --release --example experiment -- --cart 2 --kf 0,0,10,0.1 --scope --duration 10
   cargo run --release --example experiment --features ppdev -- --cart 2 --kf 0,0,10,0.1 \\
       --port /dev/parport0 --card card.toml"
 )]
@@ -88,6 +89,11 @@ pub struct Args {
     /// `no_watchdog_acknowledged = true` in the card file)
     #[arg(long, requires = "card")]
     pub no_watchdog_acknowledged: bool,
+    /// Draw the run live in the terminal (position against setpoint, and
+    /// the drive); q, Esc or Ctrl-C stops it. On the simulated rig the run
+    /// is then on the wall clock
+    #[arg(long)]
+    pub scope: bool,
     /// On the real card: do not ask before driving (for scripts)
     #[arg(long, requires = "port")]
     pub yes: bool,

@@ -24,7 +24,9 @@
 //! driven (the PWM channel, ±V, how long, the travel limits), reads the
 //! card's ID (a read only), and asks before anything is driven (`--yes`
 //! for scripts). Ctrl-C (and SIGTERM, SIGHUP, SIGQUIT, Ctrl-Z) halts the
-//! rig and keeps the recording. A run the rig halts (a fault, a travel
+//! rig and keeps the recording. With `--scope` the run is drawn live in the
+//! terminal (the cart's position against the setpoint, and the drive; on
+//! the simulated rig in wall-clock time), and q, Esc or Ctrl-C stop it. A run the rig halts (a fault, a travel
 //! limit) prints what halted it; any halt but a travel limit, which is an
 //! outcome of the gains, exits with status 1.
 
@@ -32,15 +34,20 @@
 #[path = "../lab5/card.rs"]
 mod card;
 mod cli;
+mod scope;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::rc::Rc;
+use std::sync::atomic::Ordering;
 
 use clap::Parser;
-use ctrlab::hw::{Clock, LoopConfig, LoopFault, RealTime, RigError, StopSignal, VirtualClock};
+use ctrlab::hw::{
+    self, Clock, EppPort, LoopConfig, LoopFault, RealTime, RigError, StopSignal, VirtualClock,
+};
 use ctrlab::lab::protocol::PERIOD;
 use ctrlab::lab::tables::{Experiment, ExperimentRun, Halt, RigOutcome, kf_display};
-use ctrlab::lab::{CardSettings, SimulatedRig};
+use ctrlab::lab::{CardSettings, MassSpringRig, SimulatedRig};
 
 fn main() -> ExitCode {
     let args = cli::Args::parse();
@@ -103,7 +110,9 @@ fn simulated(
         period: PERIOD,
         ..sim
     };
-    let clock = if args.real_time {
+    // The scope shows the run as it happens: in wall-clock time.
+    let real_time = args.real_time || args.scope;
+    let clock = if real_time {
         Clock::RealTime
     } else {
         Clock::Virtual(VirtualClock::new())
@@ -115,7 +124,7 @@ fn simulated(
     println!("{}", describe(experiment));
     println!(
         "rig: the simulated rig ({rig_name}), noise seed {seed}, {}",
-        if args.real_time {
+        if real_time {
             "on the wall clock"
         } else {
             "in virtual time"
@@ -135,7 +144,7 @@ fn simulated(
         stop: Some(StopSignal::on_interrupt()?),
         ..LoopConfig::default()
     };
-    let run = experiment.run(sim.rig(&clock)?, &clock, &config)?;
+    let run = run(args, experiment, sim.rig(&clock)?, &clock, config)?;
     report(args, experiment, &run, sim.calibration.volts_full_scale)
 }
 
@@ -188,8 +197,55 @@ fn real_card(
         stop: Some(stop),
         ..LoopConfig::default()
     };
-    let run = experiment.run(rig, &Clock::RealTime, &loop_config)?;
+    let run = run(args, experiment, rig, &Clock::RealTime, loop_config)?;
     report(args, experiment, &run, cal.volts_full_scale)
+}
+
+/// Runs `experiment` on `rig`: as the library runs it, or with `--scope`
+/// its controller and reference tapped for the live scope (the same
+/// controller, reference and metrics: `Experiment::controller`,
+/// `reference`, `measure`).
+fn run<P: EppPort>(
+    args: &cli::Args,
+    experiment: &Experiment,
+    rig: MassSpringRig<P>,
+    clock: &Clock,
+    config: LoopConfig,
+) -> Result<ExperimentRun, Box<dyn std::error::Error>> {
+    if !args.scope {
+        return Ok(experiment.run(rig, clock, &config)?);
+    }
+    let cal = *rig.calibration();
+    let stop = config.stop.clone().unwrap_or_default();
+    let (producer, consumer) = scope::queue();
+    let now = scope::Now::default();
+    let tap = scope::Tap::new(experiment.controller()?, producer, Rc::clone(&now));
+    let dropped = tap.dropped();
+    let frame = scope::Frame {
+        experiment: *experiment,
+        volts_full_scale: cal.volts_full_scale,
+        travel_mm: cal.travel_limits[experiment.cart.number() - 1] * 1e3,
+    };
+    // The terminal is taken before the run: without one, nothing is driven.
+    let scope = scope::Scope::start(consumer, stop.clone(), frame)
+        .map_err(|e| format!("--scope needs a terminal: {e}"))?;
+    let config = LoopConfig {
+        duration: experiment.duration,
+        stop: Some(stop),
+        ..config
+    };
+    let reference = scope::timed(experiment.reference(), now);
+    let outcome = hw::run(rig, tap, reference, clock, &config);
+    let drawn = scope.finish();
+    let run = experiment.measure(outcome, cal.volts_full_scale)?;
+    if let Err(e) = drawn {
+        eprintln!("experiment: the scope failed ({e}); the run and its recording are whole");
+    }
+    let dropped = dropped.load(Ordering::Relaxed);
+    if dropped > 0 {
+        println!("scope: {dropped} samples not drawn (the recording has them all)");
+    }
+    Ok(run)
 }
 
 /// The answer to "Drive the motor [y/N]": yes only for `y` or `yes`; an
