@@ -227,6 +227,7 @@ impl Report {
                 ("x1".into(), rec.time().to_vec(), mm(rec.channel("x1")?)),
                 ("x2".into(), rec.time().to_vec(), mm(rec.channel("x2")?)),
             ],
+            &[],
         )?;
         let [sf1, sf2] = s.coulomb;
         self.heading(3, "Identified state equations");
