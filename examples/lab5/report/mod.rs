@@ -11,6 +11,7 @@
 //! - [`design`]: the Design section;
 //! - [`figures`]: lab5's own SVG figures.
 
+mod axes;
 mod design;
 mod figures;
 mod ident;
@@ -155,16 +156,17 @@ impl Report {
         Ok(())
     }
 
-    /// Writes panels of overlaid runs (predicted and measured) and links
+    /// Writes panels of overlaid runs (predicted and measured), with the
+    /// drive's limits (V) and a zoom in counts (mm per count), and links
     /// the figure.
     fn compare(
         &mut self,
         file: &str,
         title: &str,
-        volts_full_scale: f64,
+        scales: (f64, f64),
         panels: &[ComparePanel],
     ) -> Result<(), Box<dyn std::error::Error>> {
-        figures::compare_svg(&self.out.join(file), title, volts_full_scale, panels)?;
+        figures::compare_svg(&self.out.join(file), title, scales, panels)?;
         self.link(file, title);
         Ok(())
     }
