@@ -296,6 +296,22 @@ fn visible_share(svg: &Svg, curve: &[&Line]) -> f64 {
     if total == 0 { 0.0 } else { seen as f64 / total as f64 }
 }
 
+/// Whether the box `rect` lies over a point of any curve (a polyline that
+/// is not a legend swatch, sampled every 2 px).
+fn covers(rect: &[f64; 4], svg: &Svg, entries: &[Entry]) -> bool {
+    svg.lines.iter().enumerate().any(|(j, l)| {
+        !entries.iter().any(|f| f.swatch.contains(&j))
+            && l.points.windows(2).any(|w| {
+                let n = (distance(w[1], w[0], w[0]) / 2.0).ceil().max(1.0) as usize;
+                (0..=n).any(|k| {
+                    let s = k as f64 / n as f64;
+                    let (x, y) = (w[0].0 + s * (w[1].0 - w[0].0), w[0].1 + s * (w[1].1 - w[0].1));
+                    x > rect[0] && x < rect[2] && y > rect[1] && y < rect[3]
+                })
+            })
+    })
+}
+
 /// Every problem of one figure: colliding text, legend entries twice, a
 /// legend entry without its curve, or with its curve out of sight.
 fn problems(svg_text: &str) -> Vec<String> {
@@ -326,6 +342,11 @@ fn problems(svg_text: &str) -> Vec<String> {
         if curve.is_empty() {
             found.push(format!("legend entry {:?}: no curve of its colour {}", e.label, e.color));
             continue;
+        }
+        if let Some(t) = svg.texts.iter().find(|t| t.text == e.label)
+            && covers(&t.rect, &svg, &entries)
+        {
+            found.push(format!("legend entry {:?} covers a curve", e.label));
         }
         let share = visible_share(&svg, &curve);
         if share < 0.02 {
