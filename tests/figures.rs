@@ -189,14 +189,20 @@ fn is_short_horizontal(l: &Line) -> Option<(f64, f64, f64)> {
 
 fn legend(svg: &Svg) -> Vec<Entry> {
     let mut entries = Vec::new();
-    for t in svg.texts.iter().filter(|t| t.anchor_start && !t.text.is_empty()) {
+    for t in svg
+        .texts
+        .iter()
+        .filter(|t| t.anchor_start && !t.text.is_empty())
+    {
         let near = |right: f64, y: f64| {
             let gap = t.rect[0] - right;
             (2.0..=16.0).contains(&gap) && (y - t.y_mid).abs() <= 0.6 * t.font
         };
-        let line = svg.lines.iter().enumerate().find(|(_, l)| {
-            is_short_horizontal(l).is_some_and(|(_, right, y)| near(right, y))
-        });
+        let line = svg
+            .lines
+            .iter()
+            .enumerate()
+            .find(|(_, l)| is_short_horizontal(l).is_some_and(|(_, right, y)| near(right, y)));
         if let Some((i, l)) = line {
             let (left, _, y) = is_short_horizontal(l).unwrap();
             // A dashed swatch: the pieces of the same colour on its row.
@@ -206,8 +212,9 @@ fn legend(svg: &Svg) -> Vec<Entry> {
                 .enumerate()
                 .filter(|(_, m)| {
                     m.color == l.color
-                        && is_short_horizontal(m)
-                            .is_some_and(|(a, b, my)| my == y && a >= left - 30.0 && b <= left + 40.0)
+                        && is_short_horizontal(m).is_some_and(|(a, b, my)| {
+                            my == y && a >= left - 30.0 && b <= left + 40.0
+                        })
                 })
                 .map(|(j, _)| j)
                 .chain([i])
@@ -274,7 +281,10 @@ fn visible_share(svg: &Svg, curve: &[&Line]) -> f64 {
             let n = (len / 2.0).ceil().max(1.0) as usize;
             for k in 0..=n {
                 let s = k as f64 / n as f64;
-                let p = (w[0].0 + s * (w[1].0 - w[0].0), w[0].1 + s * (w[1].1 - w[0].1));
+                let p = (
+                    w[0].0 + s * (w[1].0 - w[0].0),
+                    w[0].1 + s * (w[1].1 - w[0].1),
+                );
                 let cell = ((p.0 / CELL).floor() as i64, (p.1 / CELL).floor() as i64);
                 let covered = (-1..=1).any(|dx| {
                     (-1..=1).any(|dy| {
@@ -293,7 +303,11 @@ fn visible_share(svg: &Svg, curve: &[&Line]) -> f64 {
             }
         }
     }
-    if total == 0 { 0.0 } else { seen as f64 / total as f64 }
+    if total == 0 {
+        0.0
+    } else {
+        seen as f64 / total as f64
+    }
 }
 
 /// Whether the box `rect` lies over a point of any curve (a polyline that
@@ -305,7 +319,10 @@ fn covers(rect: &[f64; 4], svg: &Svg, entries: &[Entry]) -> bool {
                 let n = (distance(w[1], w[0], w[0]) / 2.0).ceil().max(1.0) as usize;
                 (0..=n).any(|k| {
                     let s = k as f64 / n as f64;
-                    let (x, y) = (w[0].0 + s * (w[1].0 - w[0].0), w[0].1 + s * (w[1].1 - w[0].1));
+                    let (x, y) = (
+                        w[0].0 + s * (w[1].0 - w[0].0),
+                        w[0].1 + s * (w[1].1 - w[0].1),
+                    );
                     x > rect[0] && x < rect[2] && y > rect[1] && y < rect[3]
                 })
             })
@@ -334,13 +351,14 @@ fn problems(svg_text: &str) -> Vec<String> {
             .lines
             .iter()
             .enumerate()
-            .filter(|(j, l)| {
-                l.color == e.color && !entries.iter().any(|f| f.swatch.contains(j))
-            })
+            .filter(|(j, l)| l.color == e.color && !entries.iter().any(|f| f.swatch.contains(j)))
             .map(|(_, l)| l)
             .collect();
         if curve.is_empty() {
-            found.push(format!("legend entry {:?}: no curve of its colour {}", e.label, e.color));
+            found.push(format!(
+                "legend entry {:?}: no curve of its colour {}",
+                e.label, e.color
+            ));
             continue;
         }
         if let Some(t) = svg.texts.iter().find(|t| t.text == e.label)
@@ -385,7 +403,10 @@ fn the_checks_catch_colliding_labels_and_missing_or_hidden_curves() {
     assert!(problems(&format!("<svg>{legend}{curve}</svg>")).is_empty());
     // The same curve drawn over by a wider one of another colour.
     let over = curve.replace("FF0000", "0000FF").replace("\"2\"", "\"3\"");
-    assert_eq!(problems(&format!("<svg>{legend}{curve}{over}</svg>")).len(), 1);
+    assert_eq!(
+        problems(&format!("<svg>{legend}{curve}{over}</svg>")).len(),
+        1
+    );
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -422,13 +443,26 @@ fn the_crate_figures_have_no_colliding_text_and_every_legend_curve_in_sight() {
     files.push(path);
     let path = dir.join("references.svg");
     let refs = [Reference::new("setpoint 30 mm", 30.0)];
-    responses_with_references_svg(&path, "With a setpoint", ("t (s)", "x2 (mm)"), &series, &refs)
-        .unwrap();
+    responses_with_references_svg(
+        &path,
+        "With a setpoint",
+        ("t (s)", "x2 (mm)"),
+        &series,
+        &refs,
+    )
+    .unwrap();
     files.push(path);
     // Small values, wide ranges: long labels.
     let small: Vec<f64> = t.iter().map(|t| 1e-4 * (t * 3.0).sin() + 0.00123).collect();
     let path = dir.join("small.svg");
-    responses_svg(&path, "Small", "t (s)", "x (m)", &[Series::new("x", &t, &small)]).unwrap();
+    responses_svg(
+        &path,
+        "Small",
+        "t (s)",
+        "x (m)",
+        &[Series::new("x", &t, &small)],
+    )
+    .unwrap();
     files.push(path);
 
     let nominal = MassSpring::nominal();
@@ -436,12 +470,25 @@ fn the_crate_figures_have_no_colliding_text_and_every_legend_curve_in_sight() {
     let b2 = bode(&nominal.state_space(Cart::Two).unwrap(), &w).unwrap();
     let b1 = bode(&nominal.state_space(Cart::One).unwrap(), &w).unwrap();
     let path = dir.join("bode.svg");
-    bode_svg(&path, "Plant", FrequencyUnit::Hertz, &[("force to x2", &b2)]).unwrap();
+    bode_svg(
+        &path,
+        "Plant",
+        FrequencyUnit::Hertz,
+        &[("force to x2", &b2)],
+    )
+    .unwrap();
     files.push(path);
     let path = dir.join("bode_marked.svg");
     let curves = [("force to x1", &b1), ("force to x2", &b2)];
     let marks = [("mode 1", 18.0), ("mode 2", 45.0)];
-    bode_marked_svg(&path, "Plant, modes", FrequencyUnit::RadPerSecond, &curves, &marks).unwrap();
+    bode_marked_svg(
+        &path,
+        "Plant, modes",
+        FrequencyUnit::RadPerSecond,
+        &curves,
+        &marks,
+    )
+    .unwrap();
     files.push(path);
     let l = TransferFunction::continuous(&[2.0], &[1.0, 3.0, 3.0, 1.0]).unwrap();
     let n = nyquist(&l, &logspace(-2.0, 2.0, 400).unwrap()).unwrap();
@@ -509,8 +556,16 @@ fn the_lab5_figures() {
         "table6.svg",
         "design.svg",
     ] {
-        assert!(names.iter().any(|n| n == expected), "{expected} missing in {names:?}");
+        assert!(
+            names.iter().any(|n| n == expected),
+            "{expected} missing in {names:?}"
+        );
     }
     let found: Vec<String> = files.iter().flat_map(|f| check(f)).collect();
-    assert!(found.is_empty(), "{} problems:\n{}", found.len(), found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "{} problems:\n{}",
+        found.len(),
+        found.join("\n")
+    );
 }

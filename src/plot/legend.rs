@@ -34,7 +34,9 @@ fn rows(entries: &[(&str, Mark)], width_px: f64, font_px: f64) -> Vec<Vec<(i32, 
             rows.push(Vec::new());
             x = 0.0;
         }
-        rows.last_mut().map(|r| r.push((x as i32, i)));
+        if let Some(r) = rows.last_mut() {
+            r.push((x as i32, i));
+        }
         x += w + SPACING;
     }
     rows
