@@ -72,7 +72,8 @@ impl Ticks {
     /// ```
     /// use ctrlab::plot::{Along, Ticks};
     ///
-    /// let t = Ticks::linear(-2.0, 31.5, 400.0, 11.0, Along::Vertical);
+    /// // 150 px: a label every 22 px, where 16.5 px (1.5 lines) are needed.
+    /// let t = Ticks::linear(-2.0, 31.5, 150.0, 11.0, Along::Vertical);
     /// assert_eq!(t.labels, ["0", "5", "10", "15", "20", "25", "30"]);
     /// ```
     pub fn linear(lo: f64, hi: f64, length_px: f64, font_px: f64, along: Along) -> Self {
