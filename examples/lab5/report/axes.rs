@@ -61,20 +61,33 @@ impl Ranged for Ticked {
 pub fn chart<'a, 'b>(
     area: &'a Area<'b>,
     caption: Option<&str>,
+    ranges: (Range<f64>, Range<f64>),
+    x_desc: Option<&str>,
+    y_desc: &str,
+) -> Result<Chart<'a, 'b>, Failure> {
+    chart_ticks(area, caption, ranges, x_desc, y_desc, None)
+}
+
+/// [`chart`] with the x ticks given (run numbers: whole numbers only).
+pub fn chart_ticks<'a, 'b>(
+    area: &'a Area<'b>,
+    caption: Option<&str>,
     (x, y): (Range<f64>, Range<f64>),
     x_desc: Option<&str>,
     y_desc: &str,
+    x_ticks: Option<Ticks>,
 ) -> Result<Chart<'a, 'b>, Failure> {
     let (w, h) = area.dim_in_pixel();
     let x_area = if x_desc.is_some() { 34 } else { 0 };
     let caption_px = if caption.is_some() { 22 } else { 0 };
     let inner_w = f64::from(w.saturating_sub(Y_AREA + 2 * MARGIN));
     let inner_h = f64::from(h.saturating_sub(x_area + 2 * MARGIN + caption_px));
-    let xt = Ticks::linear(x.start, x.end, inner_w, FONT, Along::Horizontal);
+    let xt =
+        x_ticks.unwrap_or_else(|| Ticks::linear(x.start, x.end, inner_w, FONT, Along::Horizontal));
     let yt = Ticks::linear(y.start, y.end, inner_h, FONT, Along::Vertical);
     let mut builder = ChartBuilder::on(area);
     if let Some(c) = caption {
-        builder.caption(c, ("sans-serif", 14));
+        builder.caption(c, ("sans-serif", 15));
     }
     let mut chart = builder
         .margin(MARGIN)

@@ -430,18 +430,21 @@ pub fn estimates_svg(
                 .flat_map(|(_, v)| v.iter().copied())
                 .chain(panel.truth),
         );
-        let mut chart = ChartBuilder::on(cell)
-            .caption(&panel.name, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(64)
-            .build_cartesian_2d(0.5..runs as f64 + 0.5, y0..y1)?;
-        chart
-            .configure_mesh()
-            .x_desc("run")
-            .x_labels(runs)
-            .label_style(("sans-serif", 11))
-            .draw()?;
+        // Run numbers, every one: whole numbers, not the 0.5 steps a
+        // linear axis would pick.
+        let run_ticks = ctrlab::plot::Ticks {
+            values: (1..=runs).map(|r| r as f64).collect(),
+            labels: (1..=runs).map(|r| r.to_string()).collect(),
+            minor: Vec::new(),
+        };
+        let mut chart = axes::chart_ticks(
+            cell,
+            Some(&panel.name),
+            (0.5..runs as f64 + 0.5, y0..y1),
+            Some("run"),
+            "",
+            Some(run_ticks),
+        )?;
         for (k, (_, values)) in panel.schemes.iter().enumerate() {
             let color = OKABE_ITO[k % OKABE_ITO.len()];
             // Schemes side by side within a run, so points do not hide.
@@ -483,10 +486,14 @@ pub fn estimates_svg(
         ))?;
         x += 330;
     }
-    legend.draw(&PathElement::new(
-        [(x, 30), (x + 30, 30)],
-        BLACK.stroke_width(2),
-    ))?;
+    // Dashed as the truth's line is.
+    for k in 0..3 {
+        let a = x + k * 11;
+        legend.draw(&PathElement::new(
+            [(a, 30), (a + 7, 30)],
+            BLACK.stroke_width(2),
+        ))?;
+    }
     legend.draw(&Text::new(
         "truth (dashed)",
         (x + 36, 22),
