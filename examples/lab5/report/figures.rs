@@ -79,7 +79,7 @@ fn upto(t: &[f64], y: &[f64], t_end: f64) -> Vec<(f64, f64)> {
 fn time_desc(t_show: f64, t_end: f64) -> String {
     if t_show < t_end {
         format!(
-            "t (s): the first {t_show} s of {t_end:.1}, where the runs move; after it they rest"
+            "t (s): the first {t_show} of {t_end:.1} s; later, a settling run moves < 5 % of the setpoint"
         )
     } else {
         "t (s)".to_owned()
