@@ -20,7 +20,15 @@
 
 use std::path::{Path, PathBuf};
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
+
+mod legend;
+mod ticks;
+
+pub(crate) use legend::{Mark, draw_strip, strip_height};
+pub(crate) use ticks::Ticked;
+pub use ticks::{Along, Ticks};
 
 use crate::error::Error;
 
@@ -210,6 +218,95 @@ pub fn responses_svg(
     y_label: &str,
     series: &[Series<'_>],
 ) -> Result<(), PlotError> {
+    responses_with_references_svg(path, title, (x_label, y_label), series, &[])
+}
+
+/// A labelled horizontal line across a figure (a setpoint, a limit), drawn
+/// dashed in black; its value is kept inside the y axis.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::plot::Reference;
+///
+/// let r = Reference::new("setpoint 30 mm", 30.0);
+/// assert_eq!(r.y, 30.0);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reference<'a> {
+    /// Legend entry.
+    pub label: &'a str,
+    /// The line's ordinate, in the series' units.
+    pub y: f64,
+}
+
+impl<'a> Reference<'a> {
+    /// A reference line from its label and ordinate.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::plot::Reference;
+    /// assert_eq!(Reference::new("limit", 24.0).label, "limit");
+    /// ```
+    pub fn new(label: &'a str, y: f64) -> Self {
+        Self { label, y }
+    }
+}
+
+/// Curve colours: Okabe–Ito, distinguishable by colour-blind readers
+/// (plotters' Palette99 has a yellow that vanishes on white).
+pub(crate) const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+];
+
+/// Label font size, px (plotters' size; the SVG says / 1.24).
+const LABEL_FONT: f64 = 14.0;
+/// The y axis' label area and the right margin, px.
+const Y_AREA: u32 = 72;
+const MARGIN: u32 = 12;
+
+/// [`responses_svg`] with reference lines (a setpoint, a limit) dashed
+/// across the axes, each with its own legend entry. The legend is a strip
+/// between the title and the axes, one entry per curve, so it covers no
+/// data; tick labels are spaced by their size ([`Ticks`]), so none
+/// collide.
+///
+/// # Errors
+///
+/// As [`responses_svg`]; a non-finite reference is [`Error::InvalidData`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::plot::{Reference, Series, responses_with_references_svg};
+///
+/// let t: Vec<f64> = (0..300).map(|k| k as f64 * 0.01).collect();
+/// let x: Vec<f64> = t.iter().map(|t| 28.5 * (1.0 - (-t / 0.1f64).exp())).collect();
+/// let path = std::env::temp_dir().join("ctrlab_plot_reference_doc.svg");
+/// responses_with_references_svg(
+///     &path,
+///     "Cart 2",
+///     ("t (s)", "x2 (mm)"),
+///     &[Series::new("Kf = [0 0 10 0.5]", &t, &x)],
+///     &[Reference::new("setpoint 30 mm", 30.0)],
+/// )?;
+/// assert!(std::fs::read_to_string(&path).unwrap().contains("setpoint 30 mm"));
+/// # Ok::<(), ctrlab::plot::PlotError>(())
+/// ```
+pub fn responses_with_references_svg(
+    path: impl AsRef<Path>,
+    title: &str,
+    (x_label, y_label): (&str, &str),
+    series: &[Series<'_>],
+    references: &[Reference<'_>],
+) -> Result<(), PlotError> {
     let path = path.as_ref();
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
@@ -241,6 +338,17 @@ pub fn responses_svg(
             reason: "no finite point to plot",
         }));
     }
+    for (index, r) in references.iter().enumerate() {
+        if !r.y.is_finite() {
+            return Err(PlotError::Data(Error::InvalidData {
+                what: "reference",
+                index,
+                reason: "not finite",
+            }));
+        }
+        y0 = y0.min(r.y);
+        y1 = y1.max(r.y);
+    }
     let too_wide = |what| Error::InvalidData {
         what,
         index: 0,
@@ -249,26 +357,61 @@ pub fn responses_svg(
     let (x0, x1) = axis(x0, x1, 0.0).ok_or_else(|| too_wide("series t"))?;
     let (y0, y1) = axis(y0, y1, 0.05).ok_or_else(|| too_wide("series y"))?;
 
+    let colors: Vec<RGBAColor> = (0..series.len())
+        .map(|i| PALETTE[i % PALETTE.len()].to_rgba())
+        .collect();
+    let mut entries: Vec<(&str, Mark)> = series
+        .iter()
+        .zip(&colors)
+        .map(|(s, &c)| (s.label, Mark::Line(c, 2)))
+        .collect();
+    entries.extend(
+        references
+            .iter()
+            .map(|r| (r.label, Mark::Dashed(BLACK.to_rgba()))),
+    );
     let plot_err = |e| write_error(path, e);
     let root = SVGBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(plot_err)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
+    let root = root.titled(title, ("sans-serif", 22)).map_err(plot_err)?;
+    let (legend, plot) = root.split_vertically(strip_height(&entries, SIZE.0, LABEL_FONT));
+    draw_strip(&legend, &entries, LABEL_FONT).map_err(plot_err)?;
+    let (w, h) = plot.dim_in_pixel();
+    let xt = Ticks::linear(
+        x0,
+        x1,
+        f64::from(w - Y_AREA - 2 * MARGIN),
+        LABEL_FONT,
+        Along::Horizontal,
+    );
+    let yt = Ticks::linear(
+        y0,
+        y1,
+        f64::from(h - 44 - 2 * MARGIN),
+        LABEL_FONT,
+        Along::Vertical,
+    );
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(MARGIN)
         .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d(x0..x1, y0..y1)
+        .y_label_area_size(Y_AREA)
+        .build_cartesian_2d(
+            Ticked::new(RangedCoordf64::from(x0..x1), &xt),
+            Ticked::new(RangedCoordf64::from(y0..y1), &yt),
+        )
         .map_err(plot_err)?;
     chart
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(y_label)
-        .label_style(("sans-serif", 14))
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
+        .bold_line_style(BLACK.mix(0.12))
+        .label_style(("sans-serif", LABEL_FONT))
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(plot_err)?;
-    for (i, s) in series.iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+    for (s, &color) in series.iter().zip(&colors) {
         // Every k-th sample (and the last), at most MAX_POINTS per series.
         let stride = s.t.len().div_ceil(MAX_POINTS).max(1);
         let last = s.t.len().saturating_sub(1);
@@ -282,18 +425,19 @@ pub fn responses_svg(
                 .map(|(&t, &y)| (t, y));
         chart
             .draw_series(LineSeries::new(points, color.stroke_width(2)))
-            .map_err(plot_err)?
-            .label(s.label)
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+            .map_err(plot_err)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::LowerRight)
-        .draw()
-        .map_err(plot_err)?;
+    // The references on top: a setpoint under six curves must still show.
+    for r in references {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x0, r.y), (x1, r.y)],
+                8,
+                5,
+                BLACK.stroke_width(2),
+            ))
+            .map_err(plot_err)?;
+    }
     root.present().map_err(plot_err)?;
     Ok(())
 }

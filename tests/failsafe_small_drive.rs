@@ -12,11 +12,12 @@
 
 mod common;
 
+use common::lighter;
 use common::loop_config as config;
 
 use ctrlab::OpenLoop;
 use ctrlab::hw::{Clock, LoopFault, Pc104, RigError, RunError, VirtualClock, run};
-use ctrlab::lab::{Calibration, MassSpring, MassSpringRig, SimulatedRig};
+use ctrlab::lab::{Calibration, MassSpringRig, SimulatedRig};
 use ctrlab::nalgebra::vector;
 
 const PERIOD: f64 = 0.002;
@@ -30,26 +31,6 @@ fn rig_with(
 ) -> MassSpringRig<ctrlab::hw::SimulatedCard<ctrlab::lab::FrictionPlant, 4>> {
     let card = Pc104::with_map(sim.card(clock).unwrap(), sim.card.map).unwrap();
     MassSpringRig::with_clock(card, calibration, sim.period, clock.clone()).unwrap()
-}
-
-/// A plausible rig with less damping than the default (as
-/// `tests/lab_ident_input.rs`'s): its carts move at 2 V, the default's
-/// friction holds them there.
-fn lighter() -> SimulatedRig {
-    SimulatedRig {
-        truth: MassSpring {
-            m2: 0.9,
-            b1: 5.0,
-            b2: 4.0,
-            gain: 1.2,
-            ..SimulatedRig::default_truth()
-        },
-        friction: ctrlab::lab::Friction {
-            coulomb: [0.5, 1.0],
-            stiction: [0.6, 1.2],
-        },
-        ..SimulatedRig::default()
-    }
 }
 
 /// An open-loop run of `input` on `sim` for `duration` s, read by a rig

@@ -26,9 +26,7 @@ use ctrlab::lab::ident_input::{
     ProbeFault, ProbeOutcome, Reason, RunFault, peaks,
 };
 use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, PERIOD};
-use ctrlab::lab::{
-    Calibration, CardSettings, FileError, Friction, MassSpring, RigConfig, SimulatedRig, Unmodelled,
-};
+use ctrlab::lab::{Calibration, CardSettings, FileError, RigConfig, SimulatedRig, Unmodelled};
 use ctrlab::nalgebra::vector;
 use ctrlab::signal::Signal;
 
@@ -42,26 +40,13 @@ fn with_seed(sim: &SimulatedRig, seed: u64) -> SimulatedRig {
     }
 }
 
-/// A plausible rig with less damping than the default: cart 2 at 0.9 kg
-/// with the motor's rotor, b1 = 5 and b2 = 4 N·s/m, K = 1.2 N/V, Coulomb
-/// friction 0.5 / 1 N (breakaway 1.2 × that, as the default's).
+/// [`common::lighter`] with the unmodelled effects off: the amplitude
+/// search's machinery on a rig the test sets; its bounds were measured
+/// without them.
 fn lighter() -> SimulatedRig {
     SimulatedRig {
-        truth: MassSpring {
-            m2: 0.9,
-            b1: 5.0,
-            b2: 4.0,
-            gain: 1.2,
-            ..SimulatedRig::default_truth()
-        },
-        friction: Friction {
-            coulomb: [0.5, 1.0],
-            stiction: [0.6, 1.2],
-        },
-        // Off: the amplitude search's machinery on a rig the test sets;
-        // its bounds were measured without them.
         unmodelled: Unmodelled::NONE,
-        ..SimulatedRig::default()
+        ..common::lighter()
     }
 }
 

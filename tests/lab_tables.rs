@@ -1,7 +1,8 @@
 //! The lab's tables as lab5 computes them, asserted on the typed results:
 //! Tables 1 and 2 on the nominal model (`lab::tables::table1`, `table2`),
 //! and Tables 5 and 6 run on the default simulated rig as lab5 runs them
-//! (card, driver, 2 ms loop; seeds 100 + row), each run classified
+//! (card, driver, 2 ms loop; seeds 100 + row; each row its
+//! `Experiment`, as `examples/experiment` runs one alone), each run classified
 //! (`RigOutcome::classify`) and predicted (`Prediction::of`), and what
 //! their groups of rows say about each gain (`GroupEffect`).
 
@@ -12,13 +13,14 @@ mod common;
 
 use std::sync::OnceLock;
 
-use common::try_run_on_rig;
+use ctrlab::Recording;
+use ctrlab::hw::{Clock, LoopConfig, VirtualClock};
 use ctrlab::lab::protocol::{PERIOD, STEP_DURATION};
 use ctrlab::lab::tables::{
-    FORCES, Gain, GainTable, GroupEffect, OvershootTrend, Prediction, RIG_TABLES, RigOutcome,
-    RigRun, TABLE2, table1, table2,
+    Experiment, ExperimentRun, FORCES, Gain, GainTable, GroupEffect, OvershootTrend, Prediction,
+    RIG_TABLES, RigOutcome, RigRun, TABLE2, TABLE5, table1, table2,
 };
-use ctrlab::lab::{CardSettings, LabGains, MassSpring, SimulatedRig};
+use ctrlab::lab::{CardSettings, Cart, LabGains, MassSpring, SimulatedRig};
 
 #[test]
 fn table_1_holds_every_force_at_its_static_deflection() {
@@ -67,49 +69,81 @@ fn table_2_measures_every_stable_row_and_names_the_unstable_ones() {
     assert!((overshoot - 5.03).abs() < 0.05, "{overshoot}");
 }
 
-/// Every row of `table` on the default simulated rig as lab5 runs it, with
-/// `model`'s prediction.
-fn run_table(table: &GainTable, model: &MassSpring) -> Vec<RigRun> {
-    let sim = SimulatedRig::default();
-    let full_scale = sim.calibration.volts_full_scale;
-    table
-        .rows()
-        .into_iter()
-        .enumerate()
-        .map(|(i, kf)| {
-            let rig = SimulatedRig {
-                card: CardSettings {
-                    seed: 100 + i as u64,
-                    ..sim.card
-                },
-                period: PERIOD,
-                ..sim.clone()
-            };
-            let ctrl = LabGains::new(kf, table.cart).state_feedback().unwrap();
-            let setpoint = table.setpoint_mm / 1e3;
-            let outcome = match try_run_on_rig(&rig, ctrl, setpoint, STEP_DURATION) {
-                Ok(out) => {
-                    RigOutcome::classify(&out.recording, table.cart, table.setpoint_mm, full_scale)
-                        .unwrap()
-                }
-                Err(e) => RigOutcome::halted(&e.recording, &e.error),
-            };
-            RigRun {
+/// Every row of `table` on the default simulated rig as lab5 runs it (each
+/// row its `Experiment`, seeds 100 + row), with `model`'s prediction and
+/// the row's recording.
+fn run_table(table: &GainTable, model: &MassSpring) -> Vec<(RigRun, Recording)> {
+    (0..table.rows().len())
+        .map(|i| {
+            let experiment = table.experiment(i).unwrap();
+            let run = on_default_rig(&experiment, table.row_seed(i));
+            let kf = experiment.gains.kf;
+            let rig_run = RigRun {
                 kf,
                 prediction: Prediction::of(model, kf, table.cart, PERIOD).unwrap(),
-                outcome,
-            }
+                outcome: run.outcome,
+            };
+            (rig_run, run.recording)
         })
         .collect()
 }
 
-/// Tables 5 and 6 on the default rig, predicted by its truth; run once.
-fn rig_tables() -> &'static [Vec<RigRun>; 2] {
-    static RUNS: OnceLock<[Vec<RigRun>; 2]> = OnceLock::new();
+/// `experiment` on the default simulated rig with noise `seed`, at the
+/// lab's period, in virtual time.
+fn on_default_rig(experiment: &Experiment, seed: u64) -> ExperimentRun {
+    let sim = SimulatedRig::default();
+    let sim = SimulatedRig {
+        card: CardSettings { seed, ..sim.card },
+        period: PERIOD,
+        ..sim
+    };
+    let clock = Clock::Virtual(VirtualClock::new());
+    experiment
+        .run(sim.rig(&clock).unwrap(), &clock, &LoopConfig::default())
+        .unwrap()
+}
+
+/// Tables 5 and 6 on the default rig, predicted by its truth, with their
+/// recordings; run once.
+fn rig_table_runs() -> &'static [Vec<(RigRun, Recording)>; 2] {
+    static RUNS: OnceLock<[Vec<(RigRun, Recording)>; 2]> = OnceLock::new();
     RUNS.get_or_init(|| {
         let truth = SimulatedRig::default_truth();
         RIG_TABLES.map(|t| run_table(&t, &truth))
     })
+}
+
+/// Tables 5 and 6's rows.
+fn rig_tables() -> &'static [Vec<RigRun>; 2] {
+    static ROWS: OnceLock<[Vec<RigRun>; 2]> = OnceLock::new();
+    ROWS.get_or_init(|| {
+        rig_table_runs()
+            .each_ref()
+            .map(|runs| runs.iter().map(|(r, _)| r.clone()).collect())
+    })
+}
+
+/// Issue 27's check: a row of Table 5 run alone, as `examples/experiment`
+/// builds it from its command line (cart 2, the row's Kf, 30 mm, 3 s, the
+/// seed the experiment finds for itself), gives the batch's metrics and
+/// the batch's recording, sample for sample.
+#[test]
+fn a_table_5_row_run_alone_is_the_batchs_row() {
+    let batch = &rig_table_runs()[0];
+    for (row, (batch_run, batch_recording)) in batch.iter().enumerate() {
+        let alone = Experiment {
+            cart: Cart::Two,
+            gains: LabGains::new(batch_run.kf, Cart::Two),
+            setpoint_mm: 30.0,
+            duration: 3.0,
+        };
+        assert_eq!(alone.table_row(), Some((TABLE5, row)));
+        let run = on_default_rig(&alone, alone.seed());
+        assert_eq!(run.outcome, batch_run.outcome, "row {}", row + 1);
+        assert_eq!(&run.recording, batch_recording, "row {}", row + 1);
+    }
+    // Kf = [0 0 10 0.1] settles (measured: POT 1.81 %, 1.26 mm).
+    assert!(batch[7].0.outcome.is_settled());
 }
 
 #[test]

@@ -303,7 +303,7 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
                 crate::card::load(port, args.card.as_deref(), args.no_watchdog_acknowledged)?;
             println!(
                 "{}",
-                crate::card::plan(port, file, &config, &args.ident_input(config.ident))
+                card_plan(port, file, &config, &args.ident_input(config.ident))
             );
             let id = crate::card::check_id(port, &config)?;
             println!(
@@ -324,6 +324,60 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
                 .into(),
         ),
     }
+}
+
+#[cfg(all(feature = "ppdev", target_os = "linux"))]
+/// What the run will do, for the person at the rig to check before the
+/// first register access.
+fn card_plan(
+    port: &std::path::Path,
+    card: &std::path::Path,
+    config: &ctrlab::lab::RigConfig,
+    ident: &IdentInput,
+) -> String {
+    use ctrlab::lab::ident_input::{PROBE_DURATION, PROBE_FRACTIONS, TRAVEL_FRACTION};
+    let cal = &config.calibration;
+    let what = config
+        .to_string()
+        .lines()
+        .map(|line| format!("  {line}\n"))
+        .collect::<String>();
+    format!(
+        "About to run the rig sections on the REAL card.\n\
+         port: {port}\n\
+         card file: {card}\n\
+         {what}\
+         runs: {probes}5 open-loop runs of 5 s with a {signal} of {ident_volts}, 20 more of 5 s \
+         comparing inputs of the same peak (square wave, PRBS, multisine, chirp), then 26 closed-loop \
+         runs of 3 s (24 for Tables 5 and 6, 2 for the Design section's LQI) saturated at ±{full} V, 3 s pauses between runs; each run \
+         halts the motor at the first fault (travel limit, bus fault, stall, a dead cart-2 encoder, \
+         the drive held at its limit, timing, Ctrl-C and the other stop signals).\n\
+         Nothing has been written to the card. Next: open the port and read the ID register \
+         {id:#04x} (a read only).",
+        port = port.display(),
+        card = card.display(),
+        full = cal.volts_full_scale,
+        id = config.map.id,
+        signal = ident.signal,
+        probes = if ident.scale_to_travel {
+            format!(
+                "2 probe runs of {PROBE_DURATION} s at {} and {} V, ",
+                PROBE_FRACTIONS[0] * ident.volts,
+                PROBE_FRACTIONS[1] * ident.volts
+            )
+        } else {
+            String::new()
+        },
+        ident_volts = if ident.scale_to_travel {
+            format!(
+                "at most ±{} V (lowered to keep both carts within {:.0} % of their travel)",
+                ident.volts,
+                TRAVEL_FRACTION * 100.0
+            )
+        } else {
+            format!("±{} V (fixed)", ident.volts)
+        },
+    )
 }
 
 /// Run `name`'s own schedule from `jitter`: its seed mixed with the run's

@@ -44,6 +44,11 @@
 //!                                                             # the real card, from its card file
 //! ```
 //!
+//! One row at a time, as at the rig, is `examples/experiment` (`cargo run
+//! --release --example experiment -- --cart 2 --kf 0,0,10,0.1 --setpoint
+//! 30mm`): the same `lab::tables::Experiment` this program runs each row of
+//! Tables 5 and 6 through, so it prints the batch's numbers.
+//!
 //! The program is the library's lab sections in order: each section runs
 //! its experiments on the backend ([`backend`]), calls the library's
 //! computation for it (`ctrlab::lab::tables`, `lab::ident::summarize`,

@@ -2,10 +2,9 @@
 //! `TABLE6` run, with what the identified model predicted for it.
 
 use ctrlab::Recording;
-use ctrlab::lab::protocol::{PERIOD, STEP_DURATION};
-use ctrlab::lab::tables::{GainTable, Prediction, RigOutcome, RigRun};
-use ctrlab::lab::{LabGains, MassSpring};
-use ctrlab::nalgebra::vector;
+use ctrlab::lab::MassSpring;
+use ctrlab::lab::protocol::PERIOD;
+use ctrlab::lab::tables::{GainTable, Prediction, RigRun};
 
 use crate::backend::{Backend, LoopTiming};
 
@@ -27,50 +26,41 @@ impl RigTable {
 }
 
 /// Runs every row of `table` on the rig (`runs/table{n}_row{i}.csv`,
-/// seeds 100 + i); the identified `model` says what to expect.
+/// seeds 100 + i); the identified `model` says what to expect. Each row is
+/// the library's `Experiment` (its controller, reference and metrics), the
+/// same path as `cargo run --example experiment` running it alone.
 pub fn run(
     backend: &Backend,
     model: &MassSpring,
     table: GainTable,
 ) -> Result<RigTable, Box<dyn std::error::Error>> {
     let volts_full_scale = backend.calibration().volts_full_scale;
-    let setpoint = table.setpoint_mm / 1e3;
     let mut runs = Vec::new();
     let mut stats = Vec::new();
     for (i, kf) in table.rows().into_iter().enumerate() {
+        let experiment = table
+            .experiment(i)
+            .ok_or("a table row without its experiment")?;
         let prediction = Prediction::of(model, kf, table.cart, PERIOD)?;
         let name = format!("table{}_row{}", table.number, i + 1);
-        let ctrl = LabGains::new(kf, table.cart).state_feedback()?;
-        let (outcome, rec) = match backend.experiment(
-            &name,
-            100 + i as u64,
-            ctrl,
-            |_| vector![setpoint],
-            STEP_DURATION,
-        )? {
-            Ok(out) => {
-                stats.push(out.stats);
-                let outcome = RigOutcome::classify(
-                    &out.recording,
-                    table.cart,
-                    table.setpoint_mm,
-                    volts_full_scale,
-                )?;
-                (outcome, out.recording)
-            }
-            Err(e) => {
-                let e = *e;
-                stats.push(e.stats);
-                (RigOutcome::halted(&e.recording, &e.error), e.recording)
-            }
-        };
+        let run = experiment.measure(
+            backend.experiment(
+                &name,
+                table.row_seed(i),
+                experiment.controller()?,
+                experiment.reference(),
+                experiment.duration,
+            )?,
+            volts_full_scale,
+        )?;
+        stats.push(run.stats);
         runs.push((
             RigRun {
                 kf,
                 prediction,
-                outcome,
+                outcome: run.outcome,
             },
-            rec,
+            run.recording,
         ));
     }
     Ok(RigTable {

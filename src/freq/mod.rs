@@ -55,7 +55,7 @@ pub use response::{
 };
 #[cfg(feature = "plot")]
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
-pub use svg::{FrequencyUnit, bode_svg, nyquist_svg};
+pub use svg::{FrequencyUnit, bode_marked_svg, bode_svg, nyquist_svg};
 pub use tf::TransferFunction;
 pub use zpk::Zpk;
 

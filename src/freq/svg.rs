@@ -10,7 +10,13 @@ use plotters::prelude::*;
 
 use super::response::{Bode, Nyquist};
 use crate::error::Error;
-use crate::plot::{MAX_POINTS, PlotError, axis, write_error};
+use plotters::coord::combinators::LogCoord;
+use plotters::coord::types::RangedCoordf64;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::plot::{
+    Along, MAX_POINTS, Mark, PlotError, Ticked, Ticks, axis, draw_strip, strip_height, write_error,
+};
 
 /// The unit of a Bode figure's frequency axis.
 ///
@@ -101,55 +107,129 @@ fn range(values: impl Iterator<Item = f64>, pad: f64) -> Result<(f64, f64), Erro
     })
 }
 
+/// Label font size, px (plotters' size).
+const FONT: f64 = 14.0;
+/// Label areas and margin, px.
+const X_AREA: u32 = 44;
+const Y_AREA: u32 = 72;
+const MARGIN: u32 = 12;
+
+/// A Bode panel's frame: x range, axis names, and whether the marks are
+/// labelled (in the top panel only).
+struct Frame<'a> {
+    x: (f64, f64),
+    y_label: &'a str,
+    x_label: &'a str,
+    /// The frequency unit's symbol, after a mark's value.
+    symbol: &'a str,
+    label_marks: bool,
+}
+
+/// One Bode panel: the curves over the marks (dashed verticals), with
+/// ticks spaced by their labels' size.
 fn panel(
     area: &DrawingArea<SVGBackend<'_>, Shift>,
     path: &Path,
-    caption: Option<&str>,
-    (x0, x1): (f64, f64),
-    y_label: &str,
-    x_label: &str,
+    frame: &Frame<'_>,
     curves: &[(&str, Vec<(f64, f64)>)],
+    marks: &[(&str, f64)],
 ) -> Result<(), PlotError> {
     let err = |e| write_error(path, e);
+    let (x0, x1) = frame.x;
     let (y0, y1) = range(curves.iter().flat_map(|(_, p)| p.iter().map(|q| q.1)), 0.05)?;
-    let mut builder = ChartBuilder::on(area);
-    if let Some(c) = caption {
-        builder.caption(c, ("sans-serif", 22));
-    }
-    let mut chart = builder
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+    let (w, h) = area.dim_in_pixel();
+    let xt = Ticks::log(x0, x1, f64::from(w - Y_AREA - 2 * MARGIN), FONT);
+    let yt = Ticks::linear(
+        y0,
+        y1,
+        f64::from(h - X_AREA - 2 * MARGIN),
+        FONT,
+        Along::Vertical,
+    );
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .x_label_area_size(X_AREA)
+        .y_label_area_size(Y_AREA)
+        .build_cartesian_2d(
+            Ticked::new(LogCoord::from((x0..x1).log_scale()), &xt),
+            Ticked::new(RangedCoordf64::from(y0..y1), &yt),
+        )
         .map_err(err)?;
     chart
         .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .label_style(("sans-serif", 14))
+        .x_desc(frame.x_label)
+        .y_desc(frame.y_label)
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
+        // The minor grid only a hint: dense decades must not read as a band.
+        .light_line_style(BLACK.mix(0.04))
+        .bold_line_style(BLACK.mix(0.15))
+        .label_style(("sans-serif", FONT))
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    for (i, (label, points)) in curves.iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+    for (i, (_, points)) in curves.iter().enumerate() {
         chart
             .draw_series(LineSeries::new(
                 points.iter().copied(),
-                color.stroke_width(2),
+                curve_color(i).stroke_width(curve_width(i, curves.len())),
             ))
-            .map_err(err)?
-            .label(*label)
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+            .map_err(err)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::LowerLeft)
-        .draw()
-        .map_err(err)?;
+    let font = TextStyle::from(("sans-serif", FONT).into_font());
+    for (k, &(label, f)) in marks.iter().enumerate() {
+        if !(f > x0 && f < x1) {
+            continue;
+        }
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(f, y0), (f, y1)],
+                6,
+                4,
+                BLACK.mix(0.7).stroke_width(1),
+            ))
+            .map_err(err)?;
+        if frame.label_marks {
+            // Alternately left and right of the line, so that two modes
+            // close together label away from each other.
+            let (px, py) = chart.backend_coord(&(f, y1));
+            let (bx, by) = area.get_base_pixel();
+            let (anchor, dx) = if k % 2 == 1 {
+                (HPos::Left, 5)
+            } else {
+                (HPos::Right, -5)
+            };
+            area.draw(&Text::new(
+                format!("{label}: {} {}", frequency_label(f), frame.symbol),
+                (px - bx + dx, py - by + 4),
+                font.pos(Pos::new(anchor, VPos::Top)),
+            ))
+            .map_err(err)?;
+        }
+    }
     Ok(())
+}
+
+/// A mark's frequency in the axis' unit, three significant figures.
+fn frequency_label(f: f64) -> String {
+    let decimals = (2.0 - f.abs().log10().floor()).clamp(0.0, 6.0) as usize;
+    format!("{f:.decimals$}")
+}
+
+/// The i-th curve's colour: Okabe–Ito, readable by colour-blind readers.
+fn curve_color(i: usize) -> RGBColor {
+    crate::plot::PALETTE[i % crate::plot::PALETTE.len()]
+}
+
+/// The i-th of n curves' stroke width: 3 px for the first down to 1 px for
+/// the last, so a curve drawn over an earlier one it follows closely
+/// leaves the earlier one's edges in sight.
+fn curve_width(i: usize, n: usize) -> u32 {
+    if n <= 1 {
+        2
+    } else {
+        3 - (2 * i / (n - 1)) as u32
+    }
 }
 
 /// Writes a Bode figure to an SVG file: magnitude (dB) above, unwrapped
@@ -184,6 +264,43 @@ pub fn bode_svg(
     unit: FrequencyUnit,
     curves: &[(&str, &Bode)],
 ) -> Result<(), PlotError> {
+    bode_marked_svg(path, title, unit, curves, &[])
+}
+
+/// [`bode_svg`] with frequencies marked (a mode, a crossover): a dashed
+/// vertical line across both panels at each `(label, ω)` (ω in rad/s,
+/// shown in `unit`), labelled with its name and frequency at the top of
+/// the magnitude panel. The curves are drawn in order, from 3 px wide for
+/// the first down to 1 px for the last, so one that follows another
+/// closely still shows; one legend, above the panels.
+///
+/// # Errors
+///
+/// As [`bode_svg`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Cart, MassSpring};
+/// use ctrlab::freq::{FrequencyUnit, bode, bode_marked_svg, logspace};
+///
+/// let plant = MassSpring::nominal().state_space(Cart::Two)?;
+/// let b = bode(&plant, &logspace(0.0, 3.0, 400)?)?;
+/// let path = std::env::temp_dir().join("ctrlab_bode_marked_doc.svg");
+/// let marks = [("mode 1", 20.0)];
+/// bode_marked_svg(&path, "Two-cart plant", FrequencyUnit::Hertz, &[("force to x2", &b)], &marks)?;
+/// let svg = std::fs::read_to_string(&path).unwrap();
+/// // 20 rad/s is 3.18 Hz.
+/// assert!(svg.contains("mode 1: 3.18 Hz"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn bode_marked_svg(
+    path: impl AsRef<Path>,
+    title: &str,
+    unit: FrequencyUnit,
+    curves: &[(&str, &Bode)],
+    marks: &[(&str, f64)],
+) -> Result<(), PlotError> {
     let path = path.as_ref();
     let scale = unit.scale();
     let keep = |b: &Bode, y: Vec<f64>| {
@@ -201,30 +318,39 @@ pub fn bode_svg(
         .iter()
         .map(|(l, b)| (*l, keep(b, b.phase_deg())))
         .collect();
+    let marks: Vec<(&str, f64)> = marks.iter().map(|&(l, w)| (l, w * scale)).collect();
     let (x0, x1) = range(mag.iter().flat_map(|(_, p)| p.iter().map(|q| q.0)), 0.0)?;
     let x0 = if x0 > 0.0 { x0 } else { x1 / 10.0 };
-    let root = SVGBackend::new(path, (960, 800)).into_drawing_area();
+    let entries: Vec<(&str, Mark)> = curves
+        .iter()
+        .enumerate()
+        .map(|(i, (l, _))| {
+            let w = curve_width(i, curves.len()).max(2);
+            (*l, Mark::Line(curve_color(i).to_rgba(), w))
+        })
+        .collect();
+    let root = SVGBackend::new(path, (960, 840)).into_drawing_area();
     let err = |e| write_error(path, e);
     root.fill(&WHITE).map_err(err)?;
-    let (top, bottom) = root.split_vertically(400);
-    panel(
-        &top,
-        path,
-        Some(title),
-        (x0, x1),
-        "magnitude (dB)",
-        unit.label(),
-        &mag,
-    )?;
-    panel(
-        &bottom,
-        path,
-        None,
-        (x0, x1),
-        "phase (deg)",
-        unit.label(),
-        &phase,
-    )?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let (legend, panels) = root.split_vertically(strip_height(&entries, 960, FONT));
+    draw_strip(&legend, &entries, FONT).map_err(err)?;
+    let half = panels.dim_in_pixel().1 / 2;
+    let (top, bottom) = panels.split_vertically(half);
+    let mut frame = Frame {
+        x: (x0, x1),
+        y_label: "magnitude (dB)",
+        x_label: unit.label(),
+        symbol: match unit {
+            FrequencyUnit::Hertz => "Hz",
+            FrequencyUnit::RadPerSecond => "rad/s",
+        },
+        label_marks: true,
+    };
+    panel(&top, path, &frame, &mag, &marks)?;
+    frame.y_label = "phase (deg)";
+    frame.label_marks = false;
+    panel(&bottom, path, &frame, &phase, &marks)?;
     root.present().map_err(err)?;
     Ok(())
 }
@@ -263,25 +389,55 @@ pub fn nyquist_svg(
     let all = || points.iter().flatten();
     let (x0, x1) = range(all().map(|p| p.0).chain([-1.0]), 0.05)?;
     let (y0, y1) = range(all().flat_map(|p| [p.1, -p.1]).chain([0.0]), 0.05)?;
-    let root = SVGBackend::new(path, crate::plot::SIZE).into_drawing_area();
+    let mut entries: Vec<(&str, Mark)> = curves
+        .iter()
+        .enumerate()
+        .map(|(i, (l, _))| (*l, Mark::Line(curve_color(i).to_rgba(), 2)))
+        .collect();
+    entries.push(("−1", Mark::Cross(RED.to_rgba())));
+    let size = crate::plot::SIZE;
+    let root = SVGBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(err)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d(x0..x1, y0..y1)
+    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let (legend, plot) = root.split_vertically(strip_height(&entries, size.0, FONT));
+    draw_strip(&legend, &entries, FONT).map_err(err)?;
+    let (w, h) = plot.dim_in_pixel();
+    let xt = Ticks::linear(
+        x0,
+        x1,
+        f64::from(w - Y_AREA - 2 * MARGIN),
+        FONT,
+        Along::Horizontal,
+    );
+    let yt = Ticks::linear(
+        y0,
+        y1,
+        f64::from(h - X_AREA - 2 * MARGIN),
+        FONT,
+        Along::Vertical,
+    );
+    let mut chart = ChartBuilder::on(&plot)
+        .margin(MARGIN)
+        .x_label_area_size(X_AREA)
+        .y_label_area_size(Y_AREA)
+        .build_cartesian_2d(
+            Ticked::new(RangedCoordf64::from(x0..x1), &xt),
+            Ticked::new(RangedCoordf64::from(y0..y1), &yt),
+        )
         .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc("Re G")
         .y_desc("Im G")
-        .label_style(("sans-serif", 14))
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
+        .bold_line_style(BLACK.mix(0.15))
+        .label_style(("sans-serif", FONT))
         .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(err)?;
-    for (i, ((label, _), p)) in curves.iter().zip(&points).enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+    for (i, p) in points.iter().enumerate() {
+        let color = curve_color(i);
         chart
             .draw_series(LineSeries::new(
                 p.iter().map(|&(x, y)| (x, -y)),
@@ -290,9 +446,7 @@ pub fn nyquist_svg(
             .map_err(err)?;
         chart
             .draw_series(LineSeries::new(p.iter().copied(), color.stroke_width(2)))
-            .map_err(err)?
-            .label(*label)
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+            .map_err(err)?;
     }
     chart
         .draw_series(std::iter::once(Cross::new(
@@ -300,16 +454,6 @@ pub fn nyquist_svg(
             6,
             RED.stroke_width(2),
         )))
-        .map_err(err)?
-        .label("−1")
-        .legend(|(x, y)| Cross::new((x + 10, y), 5, RED.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::LowerRight)
-        .draw()
         .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())

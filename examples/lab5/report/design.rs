@@ -77,8 +77,8 @@ impl Report {
             .collect::<Result<Vec<_>, ctrlab::Error>>()?;
         self.compare(
             "design.svg",
-            "Design: predicted and measured position (setpoint dashed) and voltage",
-            supply,
+            "Design: predicted and measured position, at rest in encoder counts, and voltage",
+            (supply, count * 1e3),
             &panels,
         )?;
         self.differences(backend, d);

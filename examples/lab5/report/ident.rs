@@ -219,15 +219,19 @@ impl Report {
         self.tables_3_and_4(s, truth)?;
         let first = ident.runs.first().ok_or("no identification run")?;
         let rec = &first.recording;
-        self.lines(
-            "identification.svg",
-            &format!("Identification run {}: positions", first.name),
-            ("t (s)", "position (mm)"),
-            &[
-                ("x1".into(), rec.time().to_vec(), mm(rec.channel("x1")?)),
-                ("x2".into(), rec.time().to_vec(), mm(rec.channel("x2")?)),
-            ],
+        let file = "identification.svg";
+        let title = format!("Identification run {}: positions and input", first.name);
+        super::figures::ident_svg(
+            &self.out.join(file),
+            &title,
+            rec.time(),
+            [&mm(rec.channel("x1")?), &mm(rec.channel("x2")?)],
+            (
+                rec.channel("u")?,
+                backend.map(|b| b.calibration().volts_full_scale),
+            ),
         )?;
+        self.link(file, &title);
         let [sf1, sf2] = s.coulomb;
         self.heading(3, "Identified state equations");
         self.add(&format!(

@@ -11,6 +11,7 @@
 //! - [`design`]: the Design section;
 //! - [`figures`]: lab5's own SVG figures.
 
+mod axes;
 mod design;
 mod figures;
 mod ident;
@@ -90,34 +91,47 @@ impl Report {
         Ok(path)
     }
 
-    /// Writes an SVG of line series (label, x, y) and links it.
+    /// Writes an SVG of line series (label, x, y) over dashed reference
+    /// lines (label, y) and links it.
     fn lines(
         &mut self,
         file: &str,
         title: &str,
-        (x_label, y_label): (&str, &str),
+        labels: (&str, &str),
         series: &[(String, Vec<f64>, Vec<f64>)],
+        references: &[(String, f64)],
     ) -> Result<(), Box<dyn std::error::Error>> {
-        use ctrlab::plot::{Series, responses_svg};
+        use ctrlab::plot::{Reference, Series, responses_with_references_svg};
         let s: Vec<Series<'_>> = series
             .iter()
             .map(|(label, x, y)| Series::new(label, x, y))
             .collect();
-        responses_svg(self.out.join(file), title, x_label, y_label, &s)?;
+        let r: Vec<Reference<'_>> = references
+            .iter()
+            .map(|(label, y)| Reference::new(label, *y))
+            .collect();
+        responses_with_references_svg(self.out.join(file), title, labels, &s, &r)?;
         self.link(file, title);
         Ok(())
     }
 
     /// Writes a Bode figure (magnitude in dB, phase in degrees, against Hz)
-    /// of the curves and links it.
+    /// of the curves, with marks (label, rad/s), and links it.
     fn bode(
         &mut self,
         file: &str,
         title: &str,
         curves: &[(&str, &Bode)],
+        marks: &[(&str, f64)],
     ) -> Result<(), Box<dyn std::error::Error>> {
-        use ctrlab::freq::{FrequencyUnit, bode_svg};
-        bode_svg(self.out.join(file), title, FrequencyUnit::Hertz, curves)?;
+        use ctrlab::freq::{FrequencyUnit, bode_marked_svg};
+        bode_marked_svg(
+            self.out.join(file),
+            title,
+            FrequencyUnit::Hertz,
+            curves,
+            marks,
+        )?;
         self.link(file, title);
         Ok(())
     }
@@ -142,16 +156,17 @@ impl Report {
         Ok(())
     }
 
-    /// Writes panels of overlaid runs (predicted and measured) and links
+    /// Writes panels of overlaid runs (predicted and measured), with the
+    /// drive's limits (V) and a zoom in counts (mm per count), and links
     /// the figure.
     fn compare(
         &mut self,
         file: &str,
         title: &str,
-        volts_full_scale: f64,
+        scales: (f64, f64),
         panels: &[ComparePanel],
     ) -> Result<(), Box<dyn std::error::Error>> {
-        figures::compare_svg(&self.out.join(file), title, volts_full_scale, panels)?;
+        figures::compare_svg(&self.out.join(file), title, scales, panels)?;
         self.link(file, title);
         Ok(())
     }

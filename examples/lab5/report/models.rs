@@ -295,22 +295,36 @@ impl Report {
         let measured = Bode::from_response(&r.measured.omega, &r.measured.response)?;
         let smoothed = Bode::from_response(&r.smoothed.omega, &r.smoothed.response)?;
         let simulated = Bode::from_response(&r.simulated.omega, &r.simulated.response)?;
+        // Drawn in this order, widest first: the noisy raw estimate under
+        // its smoothing, the models over the measurements, so each shows.
         let mut curves: Vec<(&str, &Bode)> = vec![
-            ("identified model, linear part", &r.model),
+            ("measured (ETFE)", &measured),
+            ("measured, smoothed (spa)", &smoothed),
             (
                 "identified model with friction, simulated (spa)",
                 &simulated,
             ),
-            ("measured (ETFE)", &measured),
-            ("measured, smoothed (spa)", &smoothed),
+            ("identified model, linear part", &r.model),
         ];
         if let Some(t) = &r.truth {
             curves.push(("truth's linear part (simulated rig)", t));
         }
+        // The modes where the rig shows them (its gain peaks), else the
+        // model's natural frequencies.
+        let marks: Vec<(&str, f64)> = ["mode 1", "mode 2"]
+            .into_iter()
+            .zip(&r.modes)
+            .filter_map(|(name, m)| {
+                m.measured_hz
+                    .or(m.model_hz)
+                    .map(|hz| (name, hz * std::f64::consts::TAU))
+            })
+            .collect();
         self.bode(
             "bode.svg",
             "u (V) to cart 2 position (m): identified model and measured response",
             &curves,
+            &marks,
         )
     }
 }

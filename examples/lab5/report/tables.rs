@@ -67,6 +67,7 @@ impl Report {
                     t.rows.iter().map(|r| r.x2_mm).collect(),
                 ),
             ],
+            &[],
         )
     }
 
@@ -128,6 +129,7 @@ impl Report {
             ),
             ("t (s)", "x2 (mm)"),
             &curves,
+            &[(format!("setpoint {} mm", t.setpoint_mm), t.setpoint_mm)],
         )
     }
 

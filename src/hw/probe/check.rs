@@ -5,9 +5,6 @@
 use super::{Counter, Drive, Hands, Latch, Operator, Probe, ProbeError, ProbeReport};
 use crate::hw::{ENCODER_CHANNELS, EppPort, PWM_CHANNELS, PortError};
 
-/// How long the carts get to come to rest, s.
-const SETTLE: f64 = 1.0;
-
 impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// Step 1 (the default probe): reads the given map's ID register twice,
     /// a moment apart; it must read the same constant, other than `0x00`
@@ -122,15 +119,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
              it clears them once (bit {:#04x}) to check the clear bit",
             latch.latch_bit, latch.control, latch.clear_bit
         ));
-        if !self.operator.confirm(
-            "Is the motor supply switched OFF (or the motor unplugged), and the e-stop at hand?",
-        ) {
-            return Err(ProbeError::Declined {
-                step: "the encoder step",
-            });
-        }
-        self.operator.hands(Hands::Off);
-        self.wait(SETTLE)?;
+        self.motor_off()?;
         let rest = self.map_counts(&latch)?;
         let mut channels = [0usize; 2];
         let mut counters = [Counter {

@@ -20,6 +20,22 @@ const SETTLE: f64 = 1.0;
 const PATTERNS: [u8; 5] = [0x0f, 0x71, 0x92, 0xa4, 0x48];
 
 impl<P: EppPort, O: Operator<P>> Probe<P, O> {
+    /// The encoder step's confirmation, shared by the confirmed map and the
+    /// blind scan: the operator confirms the motor cannot move (else
+    /// [`ProbeError::Declined`]), hands go off, and the carts settle for
+    /// [`SETTLE`] before the first read.
+    pub(super) fn motor_off(&mut self) -> Result<(), ProbeError> {
+        if !self.operator.confirm(
+            "Is the motor supply switched OFF (or the motor unplugged), and the e-stop at hand?",
+        ) {
+            return Err(ProbeError::Declined {
+                step: "the encoder step",
+            });
+        }
+        self.operator.hands(Hands::Off);
+        self.wait(SETTLE)
+    }
+
     /// Step 2 of the blind scan: with the motor supply off (the operator
     /// confirms), finds the
     /// control register and its latch bit, both carts' counters with their
@@ -42,15 +58,7 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
              find the counter latch it writes test bits to the card's write-only registers, so \
              the motor must not be able to move",
         );
-        if !self.operator.confirm(
-            "Is the motor supply switched OFF (or the motor unplugged), and the e-stop at hand?",
-        ) {
-            return Err(ProbeError::Declined {
-                step: "the encoder step",
-            });
-        }
-        self.operator.hands(Hands::Off);
-        self.wait(SETTLE)?;
+        self.motor_off()?;
         let still = snapshot(&mut self.port)?;
         self.operator.hands(Hands::Move(1));
         let interval = self.options.sample_interval;

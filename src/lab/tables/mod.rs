@@ -8,7 +8,10 @@
 //! - Tables 5 and 6 on the rig: the rows ([`TABLE5`], [`TABLE6`]), what the
 //!   identified model predicts for each ([`Prediction`]), how a run ended
 //!   ([`RigOutcome::classify`]), and what a group of rows says about its
-//!   gain ([`GroupEffect`]).
+//!   gain ([`GroupEffect`]);
+//! - one experiment, a row or any other gains, setpoint and duration:
+//!   [`Experiment`] → [`ExperimentRun`], the one path a row takes run
+//!   alone or in the batch ([`GainTable::experiment`]).
 //!
 //! The lab writes its tables in millimetres (setpoints, positions, errors)
 //! with gains per millimetre: fields in mm say so in their names (`_mm`),
@@ -28,6 +31,7 @@
 //! assert_eq!(TABLE5.setpoint_mm, 30.0);
 //! ```
 
+mod experiment;
 mod rig;
 mod simulated;
 
@@ -38,6 +42,7 @@ use nalgebra::Complex;
 
 use super::Cart;
 
+pub use experiment::{Experiment, ExperimentError, ExperimentRun, MAX_DURATION, ROW_SEEDS_FROM};
 pub use rig::{
     GroupEffect, Halt, OvershootTrend, Prediction, RigOutcome, RigRun, SATURATED_OSCILLATION,
 };
