@@ -8,7 +8,7 @@
 //! - Tables 5 and 6 on the rig: the rows ([`TABLE5`], [`TABLE6`]), what the
 //!   identified model predicts for each ([`Prediction`]), how a run ended
 //!   ([`RigOutcome::classify`]), and what a group of rows says about its
-//!   gain ([`GroupEffect`]);
+//!   gain over every row ([`GroupEffect`], [`Trend`]);
 //! - one experiment, a row or any other gains, setpoint and duration:
 //!   [`Experiment`] → [`ExperimentRun`], the one path a row takes run
 //!   alone or in the batch ([`GainTable::experiment`]).
@@ -34,6 +34,7 @@
 mod experiment;
 mod rig;
 mod simulated;
+mod trend;
 
 use std::fmt;
 use std::ops::Range;
@@ -44,12 +45,14 @@ use super::Cart;
 
 pub use experiment::{Experiment, ExperimentError, ExperimentRun, MAX_DURATION, ROW_SEEDS_FROM};
 pub use rig::{
-    GroupEffect, Halt, OvershootTrend, Prediction, RigOutcome, RigRun, SATURATED_OSCILLATION,
+    ERROR_NOISE, GroupEffect, Halt, OVERSHOOT_NOISE, Prediction, RigOutcome, RigRun,
+    SATURATED_OSCILLATION, SETTLING_NOISE,
 };
 pub use simulated::{
     FORCES, SimulatedStep, TABLE1_DURATION, TABLE1_STEP, TABLE2_DURATION, TABLE2_STEP, Table1,
     Table1Row, Table2, Table2Row, table1, table2,
 };
+pub use trend::{Noise, Trend};
 
 /// One entry of the lab's gain row `Kf = [Kf1 Kf2 Kf3 Kf4]`, on the state
 /// `[x1, x1', x2, x2']` in mm and mm/s.
