@@ -259,6 +259,9 @@ fn the_groups_of_rows_say_what_each_gain_does() {
     );
 }
 
+/// One metric of a step.
+type Figure = fn(&StepInfo) -> f64;
+
 /// The noise a trend is read against (`OVERSHOOT_NOISE`, `SETTLING_NOISE`,
 /// `ERROR_NOISE`): every settled row of Tables 5 and 6 run again on ten
 /// other seeds (each its own friction draw and encoder noise) reads as one
@@ -281,7 +284,7 @@ fn repeated_runs_of_a_row_spread_within_the_noise() {
                 continue;
             }
             repeated += 1;
-            let figures: [(fn(&StepInfo) -> f64, Noise); 3] = [
+            let figures: [(Figure, Noise); 3] = [
                 (|s| s.overshoot, OVERSHOOT_NOISE),
                 (|s| s.settling_time, SETTLING_NOISE),
                 (|s| s.steady_state_error.unwrap(), ERROR_NOISE),

@@ -340,12 +340,29 @@ impl ExperimentRun {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn drive(&self, volts_full_scale: f64) -> (f64, f64) {
-        let u = self.recording.channel("u").unwrap_or(&[]);
-        let peak = u.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-        let saturated = u
-            .iter()
-            .filter(|v| v.abs() >= 0.99 * volts_full_scale)
-            .count();
-        (peak, saturated as f64 / u.len().max(1) as f64)
+        drive(&self.recording, volts_full_scale)
     }
+}
+
+/// A recording's peak |u|, V, and the fraction of its samples (0–1) at or
+/// above 99 % of `volts_full_scale` (V); `(0, 0)` without a `u` channel.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// let u = vec![24.0, -24.0, 3.0, 0.0];
+/// let columns = vec![u, vec![0.0; 4], vec![0.0; 4], vec![0.0; 4], vec![0.0; 4]];
+/// let rec = Recording::from_columns(ctrlab::lab::schema(), vec![0.0, 0.002, 0.004, 0.006], columns)?;
+/// assert_eq!(ctrlab::lab::tables::drive(&rec, 24.0), (24.0, 0.5));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn drive(recording: &Recording, volts_full_scale: f64) -> (f64, f64) {
+    let u = recording.channel("u").unwrap_or(&[]);
+    let peak = u.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
+    let saturated = u
+        .iter()
+        .filter(|v| v.abs() >= 0.99 * volts_full_scale)
+        .count();
+    (peak, saturated as f64 / u.len().max(1) as f64)
 }

@@ -43,7 +43,9 @@ use nalgebra::Complex;
 
 use super::Cart;
 
-pub use experiment::{Experiment, ExperimentError, ExperimentRun, MAX_DURATION, ROW_SEEDS_FROM};
+pub use experiment::{
+    Experiment, ExperimentError, ExperimentRun, MAX_DURATION, ROW_SEEDS_FROM, drive,
+};
 pub use rig::{
     ERROR_NOISE, GroupEffect, Halt, OVERSHOOT_NOISE, Prediction, RigOutcome, RigRun,
     SATURATED_OSCILLATION, SETTLING_NOISE,
