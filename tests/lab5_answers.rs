@@ -146,17 +146,24 @@ fn answers_hold(report: &str) -> Result<(), String> {
                 between(line, "; steady-state error ", " mm;")?,
             ];
             let quoted: Vec<Vec<&str>> = quoted.iter().map(|q| q.split(", ").collect()).collect();
-            // The quoted series are the table's rows, in order.
-            let start = (0..=kf.len().saturating_sub(values.len()))
-                .find(|&s| (0..3).all(|m| cols[m][s..s + values.len()] == quoted[m][..]))
-                .ok_or(format!(
-                    "{name} (Table {n}): the series are not a run of the table's rows"
-                ))?;
-            for (j, v) in values.iter().enumerate() {
-                let cell = &kf[start + j];
-                if !cell.contains(&format!("{v}")) {
-                    return Err(format!("{name} = {v} is not row `{cell}`"));
-                }
+            // The quoted series are the table's rows, in order: the rows
+            // whose Kf has the varied entry at the quoted values.
+            let entry = num(name.trim_start_matches("Kf"))? as usize - 1;
+            let kf_at = |row: usize| -> Option<f64> {
+                kf[row]
+                    .trim_matches(['[', ']'])
+                    .split_whitespace()
+                    .nth(entry)?
+                    .parse()
+                    .ok()
+            };
+            if !(0..=kf.len().saturating_sub(values.len())).any(|s| {
+                (0..values.len()).all(|j| kf_at(s + j) == Some(values[j]))
+                    && (0..3).all(|m| cols[m][s..s + values.len()] == quoted[m][..])
+            }) {
+                return Err(format!(
+                    "{name} (Table {n}): the series are not the table's rows"
+                ));
             }
             // Each metric's claim, over the settled rows.
             let noises = [

@@ -302,3 +302,22 @@ fn repeated_runs_of_a_row_spread_within_the_noise() {
     }
     assert_eq!(repeated, 21);
 }
+
+/// A cart that ends where it started (Table 6's Kf1 = 0.2 on a jittered
+/// clock: its command inside the friction) is too slow, not a run without
+/// metrics.
+#[test]
+fn a_cart_that_never_moves_is_too_slow() {
+    let n = 1500;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * PERIOD).collect();
+    let columns = vec![
+        vec![3.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+    ];
+    let rec = Recording::from_columns(ctrlab::lab::schema(), t, columns).unwrap();
+    let outcome = RigOutcome::classify(&rec, Cart::One, 15.0, 24.0).unwrap();
+    assert_eq!(outcome, RigOutcome::TooSlow { y_end_mm: 0.0 });
+}

@@ -1,10 +1,11 @@
 //! Tables 1, 2, 5 and 6, and the answers on the effect of each gain.
 
+use ctrlab::lab::MassSpring;
 use ctrlab::lab::protocol::{PERIOD, STEP_DURATION};
 use ctrlab::lab::tables::{
-    ERROR_NOISE, Gain, GroupEffect, Halt, OVERSHOOT_NOISE, Prediction, RigOutcome, RigRun,
+    ERROR_NOISE, Gain, GroupEffect, Halt, Noise, OVERSHOOT_NOISE, Prediction, RigOutcome, RigRun,
     SATURATED_OSCILLATION, SETTLING_NOISE, TABLE1_DURATION, TABLE2, Table1, Table2, Trend,
-    kf_display, poles_display,
+    kf_display, linear_step, poles_display,
 };
 use ctrlab::{Recording, StepInfo};
 
@@ -227,7 +228,7 @@ impl Report {
                 c.info.overshoot,
             ));
         }
-        let n = |noise: ctrlab::lab::tables::Noise, unit: &str| {
+        let n = |noise: Noise, unit: &str| {
             format!(
                 "{:.0} % of the larger value, at least {} {unit}",
                 noise.relative * 100.0,
@@ -253,7 +254,7 @@ impl Report {
                 let runs = &t.runs[from..to];
                 let outcomes = t.outcomes();
                 let effect = GroupEffect::of(group, &outcomes[from..to]);
-                lines.push(effect_lines(&context, &effect, runs, t));
+                lines.push(effect_lines(&context, &effect, runs, t, &ident.model()));
             }
         }
         let all: Vec<_> = rig
@@ -487,6 +488,17 @@ fn slowest_real(p: &Prediction) -> Option<f64> {
         .reduce(f64::max)
 }
 
+/// A metric in a group's lines: its label, trend, unit, decimals, how to
+/// read it off a step, and its noise.
+type Metric = (
+    &'static str,
+    Option<Trend>,
+    &'static str,
+    usize,
+    fn(&StepInfo) -> f64,
+    Noise,
+);
+
 /// A group's lines: the series as the table has them, each metric's trend
 /// over every row with what explains a turn, and a conclusion.
 fn effect_lines(
@@ -494,6 +506,7 @@ fn effect_lines(
     e: &GroupEffect,
     runs: &[(RigRun, Recording)],
     t: &RigTable,
+    model: &MassSpring,
 ) -> String {
     let name = e.varied;
     let full = t.volts_full_scale;
@@ -537,7 +550,28 @@ fn effect_lines(
         .filter(|(_, st)| st.is_some())
         .map(|(v, _)| *v)
         .collect();
-    let turn_cause = |trend: &Trend| -> String {
+    // What the identified linear model (no drive limit, no friction) says
+    // of a metric over the settled rows from `from` on, where its sampled
+    // loop is stable.
+    let linear = |from: usize, figure: fn(&StepInfo) -> f64, noise: Noise| {
+        let mut points = Vec::new();
+        for ((run, _), gain) in settled_runs[from..].iter().zip(&settled[from..]) {
+            if run.prediction.is_stable()
+                && let Ok(step) = linear_step(model, run.kf, t.table.cart, t.table.setpoint_mm)
+            {
+                points.push((*gain, figure(&step.info)));
+            }
+        }
+        let values: Vec<f64> = points.iter().map(|(_, v)| *v).collect();
+        let rises = matches!(Trend::of(&values, noise), Some(Trend::Rises { .. }));
+        (points.len() >= 2).then_some((points, rises))
+    };
+    let turn_cause = |trend: &Trend,
+                      figure: fn(&StepInfo) -> f64,
+                      noise: Noise,
+                      d: usize,
+                      unit: &str|
+     -> String {
         let Some(i) = trend.turn() else {
             return String::new();
         };
@@ -551,12 +585,25 @@ fn effect_lines(
             .map(|(r, _)| slowest_real(&r.prediction))
             .collect();
         if after > before + 2.0 {
-            format!(
-                " The turn is the drive's limit: from {name} = {} on, the step asks more than ±{full} V and the drive sits there ({:.0}–{:.0} ms against at most {before:.0} ms before), so a higher gain no longer pushes harder; the linear model, which has no limit, keeps the trend going.",
+            let mut s = format!(
+                " The turn is the drive's limit: from {name} = {} on, the step asks more than ±{full} V and the drive sits there ({:.0}–{:.0} ms against at most {before:.0} ms before), so a higher gain no longer pushes harder.",
                 settled[i],
                 after,
                 settled_limit[i..].iter().copied().fold(0.0, f64::max)
-            )
+            );
+            let from = i.saturating_sub(1);
+            if let Some((points, rises)) = linear(from, figure, noise) {
+                let join = |f: &dyn Fn(&(f64, f64)) -> String| {
+                    points.iter().map(f).collect::<Vec<_>>().join(", ")
+                };
+                s += &format!(
+                    " The identified linear model, with no limit and no friction, gives {} {unit} at {name} = {}{} (where its sampled loop is stable).",
+                    join(&|(_, v)| format!("{v:.d$}")),
+                    join(&|(g, _)| g.to_string()),
+                    if rises { ": still rising" } else { "" }
+                );
+            }
+            s
         } else if let (Some(Some(a)), Some(Some(b))) = (slow.get(i), slow.last())
             && b > a
         {
@@ -568,17 +615,31 @@ fn effect_lines(
             String::new()
         }
     };
-    let metrics: [(&str, Option<Trend>, &str, usize); 3] = [
-        ("POT", e.overshoot, "%", 2),
-        ("settling time", e.settling_time, "s", 3),
-        ("steady-state error", e.steady_state_error, "mm", 2),
+    let metrics: [Metric; 3] = [
+        ("POT", e.overshoot, "%", 2, |i| i.overshoot, OVERSHOOT_NOISE),
+        (
+            "settling time",
+            e.settling_time,
+            "s",
+            3,
+            |i| i.settling_time,
+            SETTLING_NOISE,
+        ),
+        (
+            "steady-state error",
+            e.steady_state_error,
+            "mm",
+            2,
+            |i| i.steady_state_error.unwrap_or(f64::NAN),
+            ERROR_NOISE,
+        ),
     ];
-    for (label, trend, unit, d) in metrics {
+    for (label, trend, unit, d, figure, noise) in metrics {
         if let Some(trend) = trend {
             s += &format!(
                 "\n  - {label}: {}.{}",
                 trend_text(&trend, unit, name, &settled, d),
-                turn_cause(&trend)
+                turn_cause(&trend, figure, noise, d, unit)
             );
         }
     }
@@ -588,12 +649,13 @@ fn effect_lines(
             list(&e.not_settled)
         );
     }
-    s += &format!("\n  - **In short**: {}", conclusion(e));
+    let outcomes: Vec<RigOutcome> = runs.iter().map(|(r, _)| r.outcome.clone()).collect();
+    s += &format!("\n  - **In short**: {}", conclusion(e, &outcomes));
     s
 }
 
 /// What a group says about its gain, in one sentence.
-fn conclusion(e: &GroupEffect) -> String {
+fn conclusion(e: &GroupEffect, outcomes: &[RigOutcome]) -> String {
     let name = e.varied;
     let mut parts = Vec::new();
     match e.steady_state_error {
@@ -635,23 +697,73 @@ fn conclusion(e: &GroupEffect) -> String {
         }
         _ => {}
     }
-    if !e.not_settled.is_empty() {
-        let settled = e.settled();
-        let above = e
-            .not_settled
+    let settled = e.settled();
+    // The rows that did not settle, by where they lie against the settled
+    // ones, each with how it ended.
+    let unsettled: Vec<(f64, &RigOutcome)> = e
+        .values
+        .iter()
+        .zip(outcomes)
+        .filter(|(_, o)| !o.is_settled())
+        .map(|(v, o)| (*v, o))
+        .collect();
+    let how = |o: &RigOutcome| match o {
+        RigOutcome::TooSlow { .. } => "too slow",
+        RigOutcome::Oscillating { .. } => "oscillating",
+        RigOutcome::Diverged {
+            why: Halt::TravelLimit { .. },
+            ..
+        } => "diverged",
+        RigOutcome::Diverged {
+            why: Halt::Fault(_),
+            ..
+        } => "halted by a fault",
+        RigOutcome::Diverged { .. } | RigOutcome::Settled(_) => "without metrics",
+    };
+    let describe = |rows: &[&(f64, &RigOutcome)]| {
+        rows.iter()
+            .map(|(v, o)| format!("{name} = {v}: {}", how(o)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if settled.is_empty() && !unsettled.is_empty() {
+        parts.push(format!(
+            "no row settles with the gains it is held at ({})",
+            describe(&unsettled.iter().collect::<Vec<_>>())
+        ));
+    } else {
+        let lo = settled.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = settled.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let below: Vec<_> = unsettled.iter().filter(|(v, _)| *v < lo).collect();
+        let above: Vec<_> = unsettled.iter().filter(|(v, _)| *v > hi).collect();
+        let inside: Vec<_> = unsettled
             .iter()
-            .filter(|v| settled.iter().all(|s| *v > s))
-            .count();
-        if above > 0 {
+            .filter(|(v, _)| (lo..=hi).contains(v))
+            .collect();
+        if !below.is_empty() {
+            let cart_stays = below
+                .iter()
+                .all(|(_, o)| matches!(o, RigOutcome::TooSlow { .. }));
             parts.push(format!(
-                "too much of it loses the loop (not settled from {name} = {})",
-                e.not_settled[e.not_settled.len() - above]
+                "too little of it {} ({})",
+                if cart_stays {
+                    "does not move the cart against friction"
+                } else {
+                    "does not settle the loop"
+                },
+                describe(&below)
             ));
         }
-        if above < e.not_settled.len() {
+        if !above.is_empty() {
             parts.push(format!(
-                "too little of it does not move the cart (not settled at {name} = {})",
-                e.not_settled[0]
+                "too much of it loses the loop ({})",
+                describe(&above)
+            ));
+        }
+        if !inside.is_empty() {
+            parts.push(format!(
+                "between settled rows some do not settle ({})",
+                describe(&inside)
             ));
         }
     }

@@ -52,7 +52,7 @@ pub use rig::{
 };
 pub use simulated::{
     FORCES, SimulatedStep, TABLE1_DURATION, TABLE1_STEP, TABLE2_DURATION, TABLE2_STEP, Table1,
-    Table1Row, Table2, Table2Row, table1, table2,
+    Table1Row, Table2, Table2Row, linear_step, table1, table2,
 };
 pub use trend::{Noise, Trend};
 

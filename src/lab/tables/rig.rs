@@ -224,6 +224,11 @@ impl RigOutcome {
         Ok(match step_info(rec.time(), &y, &options) {
             Ok(info) => Self::Settled(info),
             Err(Error::NotSettled { .. }) => unsettled(&y, rec.channel("u")?, volts_full_scale),
+            // A cart that ends where it started (a command inside the
+            // friction) has no step to measure: too slow, not a failure.
+            Err(Error::InvalidData { reason, .. }) if reason.starts_with("no step") => {
+                unsettled(&y, rec.channel("u")?, volts_full_scale)
+            }
             Err(e) => Self::Diverged {
                 at: rec.time().last().copied().unwrap_or(0.0),
                 why: Halt::NoMetrics(e),

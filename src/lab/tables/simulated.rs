@@ -154,42 +154,68 @@ impl Table2 {
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn table2() -> Result<Table2, Error> {
-    let plant = MassSpring::nominal().state_space(TABLE2.cart)?;
+    let plant = MassSpring::nominal();
     let setpoint_mm = TABLE2.setpoint_mm;
     let mut rows = Vec::new();
     for kf in TABLE2.rows() {
         let cl = LabGains::new(kf, TABLE2.cart)
             .state_feedback()?
-            .closed_loop(&plant)?;
+            .closed_loop(&plant.state_space(TABLE2.cart)?)?;
         let poles = cl.poles()?;
-        if !cl.is_stable()? {
-            rows.push(Table2Row {
-                kf,
-                poles,
-                step: None,
-            });
-            continue;
-        }
-        let t = time_grid(TABLE2_DURATION, TABLE2_STEP)?;
-        let r = simulate(
-            &cl,
-            &t,
-            SVector::zeros(),
-            |_| vector![setpoint_mm / 1e3],
-            Solver::Zoh,
-        )?;
-        let y_mm: Vec<f64> = r.y.iter().map(|y| y[0] * 1e3).collect();
-        let options = StepInfoOptions {
-            final_value: Some(cl.dc_gain()?[(0, 0)] * setpoint_mm),
-            reference: Some(setpoint_mm),
-            ..Default::default()
+        let step = if cl.is_stable()? {
+            Some(linear_step(&plant, kf, TABLE2.cart, setpoint_mm)?)
+        } else {
+            None
         };
-        let info = step_info(&r.t, &y_mm, &options)?;
-        rows.push(Table2Row {
-            kf,
-            poles,
-            step: Some(SimulatedStep { info, t: r.t, y_mm }),
-        });
+        rows.push(Table2Row { kf, poles, step });
     }
     Ok(Table2 { setpoint_mm, rows })
+}
+
+/// The linear closed loop of `model` under the lab's gains `kf` (per mm)
+/// on `cart`, from rest toward `setpoint_mm` (mm): [`TABLE2_DURATION`]
+/// simulated exactly (ZOH) on a [`TABLE2_STEP`] grid, with its step
+/// metrics (mm; y∞ the closed loop's DC gain times the setpoint). Table 2
+/// on the nominal model; on an identified one, what the rig would do
+/// without a drive limit and without friction. Meaningful only for a
+/// stable loop.
+///
+/// # Errors
+///
+/// A non-finite gain or setpoint, an invalid model, or step metrics that
+/// fail (a loop that does not settle within the 3 s).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, MassSpring, tables::linear_step};
+/// let s = linear_step(&MassSpring::nominal(), [0.0, 0.0, 10.0, 0.1], Cart::Two, 30.0)?;
+/// assert!(s.info.overshoot < 10.0 && s.info.steady_state_error.unwrap() < 2.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub fn linear_step(
+    model: &MassSpring,
+    kf: [f64; 4],
+    cart: Cart,
+    setpoint_mm: f64,
+) -> Result<SimulatedStep, Error> {
+    let cl = LabGains::new(kf, cart)
+        .state_feedback()?
+        .closed_loop(&model.state_space(cart)?)?;
+    let t = time_grid(TABLE2_DURATION, TABLE2_STEP)?;
+    let r = simulate(
+        &cl,
+        &t,
+        SVector::zeros(),
+        |_| vector![setpoint_mm / 1e3],
+        Solver::Zoh,
+    )?;
+    let y_mm: Vec<f64> = r.y.iter().map(|y| y[0] * 1e3).collect();
+    let options = StepInfoOptions {
+        final_value: Some(cl.dc_gain()?[(0, 0)] * setpoint_mm),
+        reference: Some(setpoint_mm),
+        ..Default::default()
+    };
+    let info = step_info(&r.t, &y_mm, &options)?;
+    Ok(SimulatedStep { info, t: r.t, y_mm })
 }
