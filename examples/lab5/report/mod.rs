@@ -2,8 +2,9 @@
 //! (tables, text, the figures' links), echoed to stdout as it is written,
 //! and the figures as SVG. The sections compute; only this module formats.
 //!
-//! - [`tables`]: Tables 1, 2, 5 and 6, and the answers to the report's
-//!   questions;
+//! - [`tables`]: Tables 1, 2, 5 and 6;
+//! - [`answers`]: what each gain does over every row, the rows the model
+//!   got wrong, and the steady-state error;
 //! - [`ident`]: the identification runs, Tables 3 and 4, the identified
 //!   model and its uncertainty;
 //! - [`models`]: the Excitation, Validation and Frequency response
@@ -11,6 +12,7 @@
 //! - [`design`]: the Design section;
 //! - [`figures`]: lab5's own SVG figures.
 
+mod answers;
 mod axes;
 mod design;
 mod figures;
