@@ -182,17 +182,17 @@ enum Input {
 }
 
 /// The terminal the keys come from (crossterm's: stdin when it is one,
-/// else /dev/tty), watched for its hang-up before crossterm reads it:
+/// else /dev/tty), on Linux watched for its hang-up before crossterm reads it:
 /// crossterm's reader loops forever on a hung-up terminal (its reads of
 /// 0 bytes are no end to it), which would leave the process spinning after
 /// the run.
 struct Keys {
-    #[cfg(unix)]
+    #[cfg(target_os = "linux")]
     tty: Option<std::fs::File>,
 }
 
 impl Keys {
-    #[cfg(unix)]
+    #[cfg(target_os = "linux")]
     fn open() -> io::Result<Self> {
         use std::io::IsTerminal;
         let tty = if io::stdin().is_terminal() {
@@ -204,7 +204,7 @@ impl Keys {
     }
 
     /// Waits up to `timeout` for the terminal.
-    #[cfg(unix)]
+    #[cfg(target_os = "linux")]
     fn wait(&self, timeout: Duration) -> io::Result<Input> {
         use std::os::fd::AsRawFd;
         let fd = self.tty.as_ref().map_or(0, AsRawFd::as_raw_fd);
@@ -234,13 +234,14 @@ impl Keys {
         )
     }
 
-    // Elsewhere (Windows) crossterm's own wait.
-    #[cfg(not(unix))]
+    // Elsewhere crossterm's own wait (macOS's poll(2) has not always
+    // taken terminals, and this was tested on Linux only).
+    #[cfg(not(target_os = "linux"))]
     fn open() -> io::Result<Self> {
         Ok(Self {})
     }
 
-    #[cfg(not(unix))]
+    #[cfg(not(target_os = "linux"))]
     fn wait(&self, timeout: Duration) -> io::Result<Input> {
         Ok(if event::poll(timeout)? {
             Input::Ready
