@@ -177,7 +177,8 @@ enum Input {
     Nothing,
     /// Bytes to read: maybe a key.
     Ready,
-    /// Hung up: the terminal is gone.
+    /// Hung up: the terminal is gone (seen on Linux only).
+    #[cfg_attr(not(target_os = "linux"), allow(dead_code))]
     Gone,
 }
 
