@@ -7,6 +7,7 @@
 //! cargo run --release --example loop_timing                      # 10 s, normal scheduling
 //! cargo run --release --example loop_timing -- 60                # 60 s
 //! cargo run --release --example loop_timing -- 10 --rt-priority 80 --cpu 1
+//! cargo run --release --example loop_timing -- 30 --scope         # drawn live
 //! ```
 //!
 //! `--rt-priority N` runs the loop with SCHED_FIFO priority N and all memory
@@ -15,15 +16,43 @@
 //! real-time kernel: without SCHED_FIFO expect a p99 of tens of µs and
 //! millisecond outliers under load. The numbers say how much of the 2 ms
 //! period is left on a given PC.
+//!
+//! `--scope` draws the run live with the experiment's scope
+//! (examples/experiment/scope.rs, the same code), to measure what drawing
+//! costs the loop: q, Esc or Ctrl-C stop the run early, and the summary is
+//! printed once the terminal is restored. A run stopped early exits with
+//! status 1, as any run that does not complete.
 
-use ctrlab::hw::{Clock, LoopConfig, RealTime, run};
-use ctrlab::lab::LabGains;
-use ctrlab::lab::{Cart, SimulatedRig};
-use ctrlab::nalgebra::vector;
+#[path = "experiment/scope.rs"]
+mod scope;
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+use std::process::ExitCode;
+use std::rc::Rc;
+
+use ctrlab::Controller;
+use ctrlab::hw::{Clock, EppPort, LoopConfig, LoopStats, RealTime, RunError, StopSignal, run};
+use ctrlab::lab::tables::Experiment;
+use ctrlab::lab::{Cart, LabGains, MassSpringRig, SimulatedRig};
+use ctrlab::nalgebra::{SVector, vector};
+
+/// The loop measured: the lab's cart-2 law, to 30 mm.
+const KF: [f64; 4] = [0.0, 0.0, 10.0, 0.05];
+const SETPOINT_MM: f64 = 30.0;
+
+fn main() -> ExitCode {
+    match loop_timing() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("loop_timing: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn loop_timing() -> Result<(), Box<dyn std::error::Error>> {
     let mut seconds = 10.0;
     let mut realtime: Option<RealTime> = None;
+    let mut scope = false;
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
         match arg.as_str() {
@@ -42,8 +71,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     ..realtime.unwrap_or_default()
                 });
             }
+            "--scope" => scope = true,
             "-h" | "--help" => {
-                println!("usage: loop_timing [SECONDS] [--rt-priority N] [--cpu K]");
+                println!("usage: loop_timing [SECONDS] [--rt-priority N] [--cpu K] [--scope]");
                 return Ok(());
             }
             s => {
@@ -54,7 +84,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let rig = SimulatedRig::default().rig(&Clock::RealTime)?;
-    let ctrl = LabGains::new([0.0, 0.0, 10.0, 0.05], Cart::Two).state_feedback()?;
+    let ctrl = LabGains::new(KF, Cart::Two).state_feedback()?;
     let config = LoopConfig {
         duration: seconds,
         realtime,
@@ -64,7 +94,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..LoopConfig::default()
     };
     println!(
-        "running {seconds} s of the 2 ms loop on the wall clock, {}…",
+        "running {seconds} s of the 2 ms loop on the wall clock, {}{}…",
         match &realtime {
             Some(rt) => format!(
                 "SCHED_FIFO priority {}, memory locked{}",
@@ -72,14 +102,70 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 rt.cpu.map(|c| format!(", CPU {c}")).unwrap_or_default()
             ),
             None => "normal scheduling".to_owned(),
-        }
+        },
+        if scope { ", drawn live" } else { "" }
     );
-    match run(rig, ctrl, |_| vector![0.030], &Clock::RealTime, &config) {
-        Ok(out) => println!("{}", out.stats),
+    let reference = |_| vector![SETPOINT_MM * 1e-3];
+    let outcome = if scope {
+        scoped(rig, ctrl, reference, seconds, config)?
+    } else {
+        run(rig, ctrl, reference, &Clock::RealTime, &config).map(|out| out.stats)
+    };
+    match outcome {
+        Ok(stats) => println!("{stats}"),
         Err(e) => {
             println!("{}", e.stats);
-            return Err(e.into());
+            return Err(e.error.into());
         }
     }
     Ok(())
+}
+
+/// The run drawn by the experiment's scope: the controller tapped, the
+/// terminal taken before the run and given back before the summary.
+fn scoped(
+    rig: MassSpringRig<impl EppPort>,
+    ctrl: impl Controller<4, 1, 1>,
+    reference: impl FnMut(f64) -> SVector<f64, 1>,
+    seconds: f64,
+    config: LoopConfig,
+) -> Result<Result<LoopStats, Box<RunError>>, Box<dyn std::error::Error>> {
+    let cal = *rig.calibration();
+    // Also SIGTERM or SIGHUP stop the run, so the terminal is restored.
+    let stop = StopSignal::on_interrupt()?;
+    let (producer, consumer) = scope::queue();
+    let now = scope::Now::default();
+    let tap = scope::Tap::new(ctrl, producer, Rc::clone(&now));
+    let dropped = tap.dropped();
+    let frame = scope::Frame {
+        experiment: Experiment {
+            cart: Cart::Two,
+            gains: LabGains::new(KF, Cart::Two),
+            setpoint_mm: SETPOINT_MM,
+            duration: seconds,
+        },
+        volts_full_scale: cal.volts_full_scale,
+        travel_mm: cal.travel_limits[1] * 1e3,
+    };
+    let drawing = scope::Scope::start(consumer, stop.clone(), frame)
+        .map_err(|e| format!("--scope needs a terminal: {e}"))?;
+    let config = LoopConfig {
+        stop: Some(stop),
+        ..config
+    };
+    let outcome = run(
+        rig,
+        tap,
+        scope::timed(reference, now),
+        &Clock::RealTime,
+        &config,
+    );
+    if let Err(e) = drawing.finish() {
+        eprintln!("loop_timing: the scope failed ({e}); the measurement is whole");
+    }
+    let dropped = dropped.load(std::sync::atomic::Ordering::Relaxed);
+    if dropped > 0 {
+        println!("scope: {dropped} samples not drawn");
+    }
+    Ok(outcome.map(|out| out.stats))
 }

@@ -10,6 +10,9 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
+#[path = "common/example.rs"]
+mod example;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -128,24 +131,13 @@ fn a_dead_cart_2_encoder_halts_the_experiment_and_is_named() {
     assert!(*at < 0.1 && !run.recording.is_empty(), "{at}");
 }
 
-/// The experiment binary: `$EXPERIMENT`, else `examples/experiment` of
-/// this test's profile (`target/release/deps/experiment-…` →
-/// `target/release/examples/experiment`).
+/// The experiment binary: `$EXPERIMENT`, else this test's profile's.
 fn experiment_binary() -> PathBuf {
-    if let Some(path) = std::env::var_os("EXPERIMENT") {
-        return path.into();
-    }
-    let exe = std::env::current_exe().expect("the test's own path");
-    let profile = exe.ancestors().nth(2).expect("target/<profile>/deps/…");
-    let bin = profile
-        .join("examples")
-        .join(format!("experiment{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        bin.is_file(),
-        "{} is missing: cargo build --release --example experiment (or set EXPERIMENT)",
-        bin.display()
-    );
-    bin
+    example::example_binary(
+        "experiment",
+        "EXPERIMENT",
+        "cargo build --release --example experiment",
+    )
 }
 
 /// Runs the binary with `args`, its recordings into a fresh `out`.

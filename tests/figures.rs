@@ -16,6 +16,9 @@
 //! --release --example lab5`), run on a temporary directory.
 #![cfg(all(feature = "plot", feature = "lab"))]
 
+#[path = "common/example.rs"]
+mod example;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -502,20 +505,11 @@ fn the_crate_figures_have_no_colliding_text_and_every_legend_curve_in_sight() {
 
 /// The lab5 example's binary next to this test's (or `LAB5`).
 fn lab5_binary() -> PathBuf {
-    if let Some(path) = std::env::var_os("LAB5") {
-        return path.into();
-    }
-    let exe = std::env::current_exe().expect("the test's own path");
-    let profile = exe.ancestors().nth(2).expect("target/<profile>/deps/…");
-    let bin = profile
-        .join("examples")
-        .join(format!("lab5{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        bin.is_file(),
-        "{} is missing: cargo build --release --example lab5 (or set LAB5 or LAB5_FIGURES)",
-        bin.display()
-    );
-    bin
+    example::example_binary(
+        "lab5",
+        "LAB5",
+        "cargo build --release --example lab5, or set LAB5_FIGURES",
+    )
 }
 
 #[test]

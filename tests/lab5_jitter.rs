@@ -14,26 +14,15 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
+#[path = "common/example.rs"]
+mod example;
+
 use std::path::PathBuf;
 use std::process::Command;
 
-/// The lab5 binary: `$LAB5`, else `examples/lab5` of this test's profile
-/// (`target/release/deps/lab5_jitter-…` → `target/release/examples/lab5`).
+/// The lab5 binary: `$LAB5`, else this test's profile's.
 fn lab5_binary() -> PathBuf {
-    if let Some(path) = std::env::var_os("LAB5") {
-        return path.into();
-    }
-    let exe = std::env::current_exe().expect("the test's own path");
-    let profile = exe.ancestors().nth(2).expect("target/<profile>/deps/…");
-    let bin = profile
-        .join("examples")
-        .join(format!("lab5{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        bin.is_file(),
-        "{} is missing: cargo build --release --example lab5 (or set LAB5)",
-        bin.display()
-    );
-    bin
+    example::example_binary("lab5", "LAB5", "cargo build --release --example lab5")
 }
 
 /// Runs lab5 with `--jitter jitter` (on the ideal virtual clock when

@@ -8,7 +8,8 @@
 //! blocking. A drawing thread empties the queue about 20 times a second,
 //! draws with ratatui, and reads the keys: `q`, Esc or Ctrl-C (the terminal
 //! is in raw mode, so Ctrl-C is a key, not a signal) request the loop's
-//! stop, which halts the rig at its next tick.
+//! stop, which halts the rig at its next tick. A terminal that goes away
+//! (its window closed, its tmux killed) requests the stop too.
 
 use std::cell::Cell;
 use std::io;
@@ -149,11 +150,12 @@ impl Scope {
     /// The terminal cannot be taken (not a terminal): before the run, so
     /// nothing is driven without the scope asked for.
     pub fn start(samples: Consumer<Sample>, stop: StopSignal, frame: Frame) -> io::Result<Self> {
+        let keys = Keys::open()?;
         let mut terminal = ratatui::try_init()?;
         let done = Arc::new(AtomicBool::new(false));
         let finished = Arc::clone(&done);
         let thread = std::thread::spawn(move || {
-            let result = draw_until(&mut terminal, samples, &stop, &finished, frame);
+            let result = draw_until(&mut terminal, &keys, samples, &stop, &finished, frame);
             ratatui::try_restore()?;
             result
         });
@@ -169,8 +171,90 @@ impl Scope {
     }
 }
 
+/// What the terminal has for the scope after a wait.
+enum Input {
+    /// Nothing within the wait.
+    Nothing,
+    /// Bytes to read: maybe a key.
+    Ready,
+    /// Hung up: the terminal is gone (seen on Linux only).
+    #[cfg_attr(not(target_os = "linux"), allow(dead_code))]
+    Gone,
+}
+
+/// The terminal the keys come from (crossterm's: stdin when it is one,
+/// else /dev/tty), on Linux watched for its hang-up before crossterm reads it:
+/// crossterm's reader loops forever on a hung-up terminal (its reads of
+/// 0 bytes are no end to it), which would leave the process spinning after
+/// the run.
+struct Keys {
+    #[cfg(target_os = "linux")]
+    tty: Option<std::fs::File>,
+}
+
+impl Keys {
+    #[cfg(target_os = "linux")]
+    fn open() -> io::Result<Self> {
+        use std::io::IsTerminal;
+        let tty = if io::stdin().is_terminal() {
+            None
+        } else {
+            Some(std::fs::File::open("/dev/tty")?)
+        };
+        Ok(Self { tty })
+    }
+
+    /// Waits up to `timeout` for the terminal.
+    #[cfg(target_os = "linux")]
+    fn wait(&self, timeout: Duration) -> io::Result<Input> {
+        use std::os::fd::AsRawFd;
+        let fd = self.tty.as_ref().map_or(0, AsRawFd::as_raw_fd);
+        let mut poll = libc::pollfd {
+            fd,
+            events: libc::POLLIN,
+            revents: 0,
+        };
+        let ms = i32::try_from(timeout.as_millis()).unwrap_or(i32::MAX);
+        // SAFETY: one pollfd, valid for the call; the fd is open (stdin, or
+        // the file `self` holds).
+        if unsafe { libc::poll(&mut poll, 1, ms) } < 0 {
+            let e = io::Error::last_os_error();
+            return match e.kind() {
+                io::ErrorKind::Interrupted => Ok(Input::Nothing),
+                _ => Err(e),
+            };
+        }
+        Ok(
+            if poll.revents & (libc::POLLHUP | libc::POLLERR | libc::POLLNVAL) != 0 {
+                Input::Gone
+            } else if poll.revents & libc::POLLIN != 0 {
+                Input::Ready
+            } else {
+                Input::Nothing
+            },
+        )
+    }
+
+    // Elsewhere crossterm's own wait (macOS's poll(2) has not always
+    // taken terminals, and this was tested on Linux only).
+    #[cfg(not(target_os = "linux"))]
+    fn open() -> io::Result<Self> {
+        Ok(Self {})
+    }
+
+    #[cfg(not(target_os = "linux"))]
+    fn wait(&self, timeout: Duration) -> io::Result<Input> {
+        Ok(if event::poll(timeout)? {
+            Input::Ready
+        } else {
+            Input::Nothing
+        })
+    }
+}
+
 fn draw_until(
     terminal: &mut ratatui::DefaultTerminal,
+    keys: &Keys,
     mut samples: Consumer<Sample>,
     stop: &StopSignal,
     done: &AtomicBool,
@@ -191,14 +275,26 @@ fn draw_until(
         if last {
             return Ok(());
         }
-        if event::poll(FRAME)?
-            && let Event::Key(key) = event::read()?
-            && key.kind == KeyEventKind::Press
-        {
-            let ctrl_c =
-                key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL);
-            if ctrl_c || matches!(key.code, KeyCode::Char('q') | KeyCode::Esc) {
+        match keys.wait(FRAME)? {
+            Input::Nothing => {}
+            // Nobody can watch the run or stop it any more: stopped, as
+            // the SIGHUP of a closed terminal stops it.
+            Input::Gone => {
                 stop.request();
+                std::thread::sleep(FRAME);
+            }
+            Input::Ready => {
+                while event::poll(Duration::ZERO)? {
+                    if let Event::Key(key) = event::read()?
+                        && key.kind == KeyEventKind::Press
+                    {
+                        let ctrl_c = key.code == KeyCode::Char('c')
+                            && key.modifiers.contains(KeyModifiers::CONTROL);
+                        if ctrl_c || matches!(key.code, KeyCode::Char('q') | KeyCode::Esc) {
+                            stop.request();
+                        }
+                    }
+                }
             }
         }
     }
