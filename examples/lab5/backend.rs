@@ -27,6 +27,8 @@ pub struct Backend {
     pub stop: StopSignal,
     /// Where each run's CSV goes (`runs/` under it).
     pub out: PathBuf,
+    /// How many recordings this lab wrote, for the closing summary.
+    saved: std::rc::Rc<std::cell::Cell<usize>>,
     /// The identification input asked for: the card file's `[ident]` (or
     /// the lab's default) with `--ident-*` on top.
     pub ident: IdentInput,
@@ -48,6 +50,35 @@ pub enum BackendKind {
         port: PathBuf,
         config: Box<ctrlab::lab::RigConfig>,
     },
+}
+
+/// A run's names: its recording's file stem (`runs/{file}.csv`), which
+/// says what ran, and the key its jittered clock's schedule is drawn from
+/// (`--jitter`). The key is the run's name from before the recordings were
+/// named for what ran, so that the same `--jitter` still gives the same
+/// report.
+pub struct RunId {
+    pub file: String,
+    pub schedule: String,
+}
+
+impl RunId {
+    /// A run whose file stem is its schedule's key.
+    pub fn new(file: impl Into<String>) -> Self {
+        let file = file.into();
+        Self {
+            schedule: file.clone(),
+            file,
+        }
+    }
+
+    /// A run saved as `file` whose schedule is keyed by `schedule`.
+    pub fn keyed(file: impl Into<String>, schedule: impl Into<String>) -> Self {
+        Self {
+            file: file.into(),
+            schedule: schedule.into(),
+        }
+    }
 }
 
 /// The loop's timing over a section's runs (real-time or jittered runs).
@@ -107,6 +138,7 @@ impl Backend {
             realtime,
             stop,
             out: args.out.clone(),
+            saved: std::rc::Rc::default(),
             ident,
         })
     }
@@ -175,17 +207,18 @@ impl Backend {
             realtime: self.realtime,
             stop: self.stop.clone(),
             out: self.out.clone(),
+            saved: self.saved.clone(),
             ident: self.ident,
         }
     }
 
     /// One experiment from rest: `controller` against the rig for
     /// `duration` s with reference `reference(t)`, its recording saved as
-    /// `runs/{name}.csv`. The outer error is a set-up failure (or Ctrl-C),
-    /// the inner one the run's own (with its recording).
+    /// `runs/{id.file}.csv`. The outer error is a set-up failure (or
+    /// Ctrl-C), the inner one the run's own (with its recording).
     pub fn experiment(
         &self,
-        name: &str,
+        id: &RunId,
         seed: u64,
         controller: impl Controller<4, 1, 1>,
         reference: impl FnMut(f64) -> SVector<f64, 1>,
@@ -218,9 +251,9 @@ impl Backend {
                 let clock = match (real_time, jitter) {
                     (true, _) => Clock::RealTime,
                     (false, None) => Clock::Virtual(VirtualClock::new()),
-                    (false, Some(j)) => {
-                        Clock::Virtual(VirtualClock::new().with_jitter(run_schedule(j, name))?)
-                    }
+                    (false, Some(j)) => Clock::Virtual(
+                        VirtualClock::new().with_jitter(run_schedule(j, &id.schedule))?,
+                    ),
                 };
                 let rig = sim.rig(&clock)?;
                 run(rig, controller, reference, &clock, &loop_config)
@@ -238,7 +271,7 @@ impl Backend {
             Ok(out) => &out.recording,
             Err(e) => &e.recording,
         };
-        let path = self.save(name, recording)?;
+        let path = self.save(&id.file, recording)?;
         if let Err(e) = &outcome
             && let RigError::Fault(LoopFault::Interrupted { .. }) = e.error
         {
@@ -257,7 +290,13 @@ impl Backend {
         std::fs::create_dir_all(&dir)?;
         let path = dir.join(format!("{name}.csv"));
         recording.write_csv(&path)?;
+        self.saved.set(self.saved.get() + 1);
         Ok(path)
+    }
+
+    /// How many recordings this backend wrote.
+    pub fn recordings(&self) -> usize {
+        self.saved.get()
     }
 
     /// The loop's timing over `stats`, for real-time or jittered runs (on

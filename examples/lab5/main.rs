@@ -85,13 +85,13 @@ use std::time::Instant;
 
 use clap::Parser;
 use ctrlab::data::CsvOptions;
-use ctrlab::lab::SimulatedRig;
 use ctrlab::lab::ident::SimulationModel;
-use ctrlab::lab::tables::{RIG_TABLES, table1, table2};
+use ctrlab::lab::tables::{RIG_TABLES, Table2, table1, table2};
 use ctrlab::lab::validation::validate_models;
+use ctrlab::lab::{FrictionPlant, SimulatedRig};
 
 use backend::Backend;
-use report::Report;
+use report::{Part, Report, terminal};
 
 fn main() -> ExitCode {
     let args = cli::Args::parse();
@@ -100,9 +100,32 @@ fn main() -> ExitCode {
             println!("report written to {}", path.display());
             ExitCode::SUCCESS
         }
-        Err(e) => {
-            eprintln!("lab5: {e}");
+        Err(Stopped { error, report }) => {
+            eprintln!("lab5: {error}");
+            // What was measured before the stop is kept: say where.
+            if let Some(path) = report {
+                println!(
+                    "report written to {} (the lab stopped early)",
+                    path.display()
+                );
+            }
             ExitCode::FAILURE
+        }
+    }
+}
+
+/// Why lab5 did not finish, and where the report so far is (if it could
+/// be written).
+struct Stopped {
+    error: Box<dyn std::error::Error>,
+    report: Option<PathBuf>,
+}
+
+impl<E: Into<Box<dyn std::error::Error>>> From<E> for Stopped {
+    fn from(e: E) -> Self {
+        Self {
+            error: e.into(),
+            report: None,
         }
     }
 }
@@ -115,7 +138,7 @@ enum Mode<'a> {
     Logs(&'a Path, Option<f64>),
 }
 
-fn lab(args: &cli::Args) -> Result<PathBuf, Box<dyn std::error::Error>> {
+fn lab(args: &cli::Args) -> Result<PathBuf, Stopped> {
     let started = Instant::now();
     // The backend before anything is written: a bad truth or card file, or
     // a card that does not answer, stops here.
@@ -126,72 +149,179 @@ fn lab(args: &cli::Args) -> Result<PathBuf, Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&args.out)?;
     let mut report = Report::new(&args.out);
     let result = match &mode {
-        Mode::Rig(backend) => rig_sections(backend, &mut report),
-        Mode::Logs(dir, metres_per_count) => offline_sections(dir, *metres_per_count, &mut report),
+        Mode::Rig(backend) => rig_sections(backend, args.tables_only, &mut report),
+        Mode::Logs(dir, metres_per_count) => {
+            offline_sections(dir, *metres_per_count, args.tables_only, &mut report)
+        }
     };
     if let Err(e) = &result {
         // Keep what was measured: the report so far, with the reason.
         report.stopped_early(e.as_ref());
     }
-    report.run_time(started.elapsed().as_secs_f64());
-    let path = report.write()?;
-    result.map(|()| path)
+    let seconds = started.elapsed().as_secs_f64();
+    report.run_time(seconds);
+    let written = report.write();
+    if let Ok(path) = &written {
+        let recordings = match &mode {
+            Mode::Rig(backend) => Some(backend.recordings()),
+            Mode::Logs(..) => None,
+        };
+        let state = if result.is_ok() {
+            "finished"
+        } else {
+            "stopped early"
+        };
+        print!(
+            "\nLab 5 {state} in {seconds:.1} s:\n{}",
+            report.summary(path, recordings)
+        );
+    }
+    match (result, written) {
+        (Ok(()), Ok(path)) => Ok(path),
+        (Ok(()), Err(e)) => Err(e.into()),
+        (Err(error), written) => Err(Stopped {
+            error,
+            report: written.ok(),
+        }),
+    }
 }
 
-/// Every section on the rig: Tables 1 and 2 in simulation, the
-/// identification, excitation, validation and frequency response, Tables 5
-/// and 6, the design, and the answers.
-fn rig_sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn std::error::Error>> {
-    report.title("cargo run --release --example lab5");
-    report.table1(&table1()?)?;
-    let table2 = table2()?;
-    report.table2(&table2)?;
+/// Every section on the rig, in the order the computation needs: Tables 1
+/// and 2 in simulation, the identification, excitation, validation and
+/// frequency response, Tables 5 and 6 (on the identified model), the
+/// design, and the answers. The report puts Tables 1–6 and the answers
+/// first whatever this order ([`Part`]). With `tables_only` the further
+/// sections' runs are skipped; the others keep their seeds, so their
+/// numbers are the same.
+fn rig_sections(
+    backend: &Backend,
+    tables_only: bool,
+    report: &mut Report,
+) -> Result<(), Box<dyn std::error::Error>> {
+    report.title(&format!(
+        "cargo run --release --example lab5{}",
+        if tables_only { " -- --tables-only" } else { "" }
+    ));
+    let table2 = tables_1_and_2(report)?;
     let truth = backend.friction_truth();
     let (runs, source) = identification::rig_runs(backend)?;
     if let identification::Source::Rig { input, .. } = &source {
         report.identification_input(input, &runs);
+        report.progress(&format!(
+            "Identification input: {} at {:.2} V, {}",
+            input.input.signal, input.choice.volts, input.choice.reason
+        ));
     }
     let mut ident = identification::identify(runs, source)?;
     report.identification(Some(backend), &ident, truth.as_ref())?;
+    report.result(terminal::model_line(&ident));
     let volts = ident.volts();
+    // On a simulated card only (no run at the real rig); the answers use it.
     ident.equal_springs = identification::equal_springs(backend, volts)?;
     if let Some(e) = &ident.equal_springs {
         report.equal_springs(e);
     }
-    let excitation = excitation::section(backend, volts)?;
+    report.part(Part::Further);
+    report.unmodelled(backend, &ident)?;
+    if tables_only {
+        report.skipped(SKIPPED);
+    } else {
+        model_sections(backend, &ident, truth.as_ref(), report)?;
+    }
+    report.part(Part::Student);
+    let mut rig = Vec::new();
+    for table in RIG_TABLES {
+        let t = rig_tables::run(backend, &ident.model(), table)?;
+        report.rig_table_csv(&t)?;
+        report.rig_table(backend, &t)?;
+        report.result(terminal::rig_table_line(&t));
+        rig.push(t);
+    }
+    if !tables_only {
+        report.part(Part::Further);
+        let design = design::section(backend, &ident)?;
+        report.design(backend, &design)?;
+        report.progress(&format!(
+            "Design ({} cases): designed on the identified model, run and compared",
+            design.cases.len()
+        ));
+        report.part(Part::Student);
+    }
+    report.answer_model(Some(backend), &ident);
+    report.effects(&ident, &table2, &rig);
+    report.progress("Answers: written");
+    Ok(())
+}
+
+/// What the report says `--tables-only` left out.
+const SKIPPED: &str = "Skipped with `--tables-only`: the Excitation, Validation, Frequency response and Design sections and their runs (four inputs five times each, the multisine, the two designs). Run lab5 without `--tables-only` for them.";
+
+/// Tables 1 and 2 in simulation, each with its CSV; Table 2 is kept for
+/// the answers.
+fn tables_1_and_2(report: &mut Report) -> Result<Table2, Box<dyn std::error::Error>> {
+    let t1 = table1()?;
+    report.table1_csv(&t1)?;
+    report.table1(&t1)?;
+    report.progress(&terminal::table1_line(&t1));
+    let t2 = table2()?;
+    report.table2_csv(&t2)?;
+    report.table2(&t2)?;
+    report.progress(&terminal::table2_line(&t2));
+    Ok(t2)
+}
+
+/// The further sections on the identified models: excitation, validation
+/// on the excitation's fresh run, frequency response.
+fn model_sections(
+    backend: &Backend,
+    ident: &identification::Identification,
+    truth: Option<&FrictionPlant>,
+    report: &mut Report,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let excitation = excitation::section(backend, ident.volts())?;
     report.excitation(excitation.volts, &excitation.inputs);
+    report.progress(&format!(
+        "Excitation ({} inputs at {:.2} V): {} identified",
+        excitation.inputs.len(),
+        excitation.volts,
+        excitation
+            .inputs
+            .iter()
+            .filter(|i| i.outcome.is_ok())
+            .count()
+    ));
     let model = backend
         .sim()
         .map_or_else(SimulationModel::default, SimulatedRig::simulation_model);
     match &excitation.fresh {
-        Some(fresh) => {
+        Some((fresh, recording)) => {
             let v = validate_models(
                 &ident.summary,
                 &ident.recordings(),
-                fresh,
-                truth.as_ref(),
+                recording,
+                truth,
                 &model,
             )?;
             let first = ident.runs.first().ok_or("no identification run")?;
             report.validation(
                 &v,
-                (&first.name, excitation::FRESH_RUN),
+                (&first.name, &format!("runs/{fresh}.csv")),
                 &model,
-                truth.as_ref(),
+                truth,
             );
+            report.progress(&format!("Validation: on the fresh run {fresh}"));
         }
-        None => report.validation_not_possible(),
+        None => {
+            report.validation_not_possible();
+            report.progress("Validation: not possible (no fresh PRBS run)");
+        }
     }
-    report.frequency(&frequency::section(backend, &ident)?)?;
-    let mut rig = Vec::new();
-    for table in RIG_TABLES {
-        let t = rig_tables::run(backend, &ident.model(), table)?;
-        report.rig_table(backend, &t)?;
-        rig.push(t);
-    }
-    report.design(backend, &design::section(backend, &ident)?)?;
-    report.answer_model(Some(backend), &ident);
-    report.effects(&ident, &table2, &rig);
+    let frequency = frequency::section(backend, ident)?;
+    report.frequency(&frequency)?;
+    report.progress(match &frequency.response {
+        Ok(_) => "Frequency response (1 run): estimated",
+        Err(_) => "Frequency response (1 run): the run halted",
+    });
     Ok(())
 }
 
@@ -200,33 +330,43 @@ fn rig_sections(backend: &Backend, report: &mut Report) -> Result<(), Box<dyn st
 fn offline_sections(
     dir: &Path,
     metres_per_count: Option<f64>,
+    tables_only: bool,
     report: &mut Report,
 ) -> Result<(), Box<dyn std::error::Error>> {
     report.title(&format!(
-        "cargo run --release --example lab5 -- --logs {}",
-        dir.display()
+        "cargo run --release --example lab5 -- --logs {}{}",
+        dir.display(),
+        if tables_only { " --tables-only" } else { "" }
     ));
-    report.table1(&table1()?)?;
-    report.table2(&table2()?)?;
+    tables_1_and_2(report)?;
     let options = CsvOptions { metres_per_count };
     let (runs, source) = identification::log_runs(dir, &options)?;
     let ident = identification::identify(runs, source)?;
     report.identification(None, &ident, None)?;
-    match (ident.runs.first(), ident.runs.get(1)) {
-        (Some(first), Some(fresh)) => {
-            let model = SimulationModel::default();
-            let v = validate_models(
-                &ident.summary,
-                &ident.recordings(),
-                &fresh.recording,
-                None,
-                &model,
-            )?;
-            report.validation(&v, (&first.name, &fresh.name), &model, None);
+    report.result(terminal::model_line(&ident));
+    report.part(Part::Further);
+    if tables_only {
+        report.skipped("Skipped with `--tables-only`: the Validation section. Run lab5 without `--tables-only` for it.");
+    } else {
+        match (ident.runs.first(), ident.runs.get(1)) {
+            (Some(first), Some(fresh)) => {
+                let model = SimulationModel::default();
+                let v = validate_models(
+                    &ident.summary,
+                    &ident.recordings(),
+                    &fresh.recording,
+                    None,
+                    &model,
+                )?;
+                report.validation(&v, (&first.name, &fresh.name), &model, None);
+                report.progress(&format!("Validation: on the fresh run {}", fresh.name));
+            }
+            _ => report.validation_not_possible(),
         }
-        _ => report.validation_not_possible(),
     }
+    report.part(Part::Student);
     report.answer_model(None, &ident);
     report.offline_answers();
+    report.progress("Answers: written");
     Ok(())
 }
