@@ -32,7 +32,8 @@ use ctrlab::lab::protocol::PERIOD;
   cargo run --release --example lab5 --features ppdev -- --port /dev/parport0 --card card.toml"
 )]
 pub struct Args {
-    /// Where report.md, the SVGs and runs/*.csv go (created if missing)
+    /// Where report.md, the SVGs, tables/*.csv and runs/*.csv go (created
+    /// if missing)
     #[arg(long, value_name = "DIR", default_value = "target/lab5", value_parser = out_dir)]
     pub out: PathBuf,
     /// The simulated rig from a TOML file (see ctrlab::lab::SimulatedRig)

@@ -99,9 +99,9 @@ impl Identification {
 /// The lab's identification runs on the rig: the amplitude chosen from
 /// two probe runs (`runs/ident_probe1_square_2.00V.csv`; none with
 /// `--ident-fixed`), then [`IDENT_RUNS`] runs of the input at it, each
-/// saved under what ran (`runs/ident_square_4.78V_seed1.csv`). A probe the rig halts at a travel limit
-/// lowers the amplitude; any other fault in a probe stops here, named. A
-/// run the rig halts because the input was too big (a travel limit, the
+/// saved under what ran (`runs/ident_square_4.78V_seed1.csv`). A probe
+/// the rig halts at a travel limit lowers the amplitude; any other fault
+/// in a probe stops here, named. A run the rig halts because the input was too big (a travel limit, the
 /// drive saturated) is kept in [`RigInput::failed`] and the others go on;
 /// any other fault, set-up failures and Ctrl-C stop here.
 pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::error::Error>> {

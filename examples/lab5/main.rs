@@ -25,15 +25,41 @@
 //! identified model with its uncertainty, and the validation from every
 //! `*.csv` in `DIR` (the rig sections need a rig and are skipped).
 //!
-//! Writes `report.md`, one SVG per table and every run's recording as CSV
-//! (`runs/`) into `--out DIR` (default `target/lab5`). Ctrl-C halts the rig,
-//! keeps the run's recording and the report so far; so do SIGTERM, a closed
-//! terminal (SIGHUP), Ctrl-\\ (SIGQUIT) and Ctrl-Z (SIGTSTP), which stops the
-//! run rather than suspending lab5 with the motor on.
+//! Writes into `--out DIR` (default `target/lab5`):
+//!
+//! - `report.md`: the title and a contents list; the student's part
+//!   (Tables 1 and 2, the identification input and runs with Tables 3 and
+//!   4, the identified state equations and their uncertainty, Tables 5
+//!   and 6, the answers); then "Further sections" (what the identification
+//!   does not recover, excitation, validation, frequency response, design).
+//!   The sections run in the order the computation needs (the
+//!   identification first: Tables 5 and 6 predict from it); the report is
+//!   collected in its two parts ([`report::Part`]) and written in this
+//!   order, so the runs, their seeds and numbers are those of any order.
+//!   `--tables-only` skips the further sections' runs and says so;
+//! - one SVG per table and section, written as each section finishes;
+//! - `tables/`: every table as CSV (`table1.csv` … `table6.csv`, and
+//!   `model.csv`, the identified parameters), units in the headers, linked
+//!   under each table;
+//! - `runs/`: every run's recording as CSV, named for what ran:
+//!   `ident_square_8.00V_seed1.csv` (signal, peak, seed),
+//!   `ident_probe1_square_2.00V.csv`, `excite_prbs_8.00V_seed1.csv`,
+//!   `table5_cart2_kf_0_0_10_0.1_to_30mm.csv` (the table and
+//!   `lab::tables::Experiment`'s name, as `examples/experiment` saves it),
+//!   `frequency_multisine.csv`, `design_cart1_rig.csv`.
+//!
+//! The terminal gets a line per section as it finishes and a short summary
+//! at the end: Tables 5 and 6 by outcome, the identified parameters, and
+//! where the report, figures, tables and recordings are. Ctrl-C halts the
+//! rig, keeps the run's recording and the report so far (and says where);
+//! so do SIGTERM, a closed terminal (SIGHUP), Ctrl-\\ (SIGQUIT) and Ctrl-Z
+//! (SIGTSTP), which stops the run rather than suspending lab5 with the
+//! motor on.
 //!
 //! ```text
 //! cargo run --release --example lab5
 //! cargo run --release --example lab5 -- --out my_report      # elsewhere
+//! cargo run --release --example lab5 -- --tables-only        # Tables 1–6 and the answers only
 //! cargo run --release --example lab5 -- --truth truth.toml   # another simulated rig
 //! cargo run --release --example lab5 -- --logs my_runs        # Tables 3 and 4 from my CSV logs
 //! cargo run --release --example lab5 -- --ident-signal prbs --ident-volts 6   # another input
@@ -54,7 +80,7 @@
 //! computation for it (`ctrlab::lab::tables`, `lab::ident::summarize`,
 //! `lab::excitation`, `lab::validation`, `lab::frequency`, `lab::lqi`) and
 //! returns a typed result, which the one renderer ([`report`]) turns into
-//! Markdown and figures as soon as it is there. The command line is
+//! Markdown, figures and CSV tables as soon as it is there. The command line is
 //! [`cli::Args`]: every argument is checked before anything runs.
 //!
 //! The real card needs its card file (`--card`, a `ctrlab::lab::RigConfig`,
