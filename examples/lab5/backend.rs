@@ -342,7 +342,13 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
                 crate::card::load(port, args.card.as_deref(), args.no_watchdog_acknowledged)?;
             println!(
                 "{}",
-                card_plan(port, file, &config, &args.ident_input(config.ident))
+                card_plan(
+                    port,
+                    file,
+                    &config,
+                    &args.ident_input(config.ident),
+                    args.tables_only
+                )
             );
             let id = crate::card::check_id(port, &config)?;
             println!(
@@ -373,6 +379,7 @@ fn card_plan(
     card: &std::path::Path,
     config: &ctrlab::lab::RigConfig,
     ident: &IdentInput,
+    tables_only: bool,
 ) -> String {
     use ctrlab::lab::ident_input::{PROBE_DURATION, PROBE_FRACTIONS, TRAVEL_FRACTION};
     let cal = &config.calibration;
@@ -386,9 +393,8 @@ fn card_plan(
          port: {port}\n\
          card file: {card}\n\
          {what}\
-         runs: {probes}5 open-loop runs of 5 s with a {signal} of {ident_volts}, 20 more of 5 s \
-         comparing inputs of the same peak (square wave, PRBS, multisine, chirp), then 26 closed-loop \
-         runs of 3 s (24 for Tables 5 and 6, 2 for the Design section's LQI) saturated at ±{full} V, 3 s pauses between runs; each run \
+         runs: {probes}5 open-loop runs of 5 s with a {signal} of {ident_volts}, {further}\
+         saturated at ±{full} V, 3 s pauses between runs; each run \
          halts the motor at the first fault (travel limit, bus fault, stall, a dead cart-2 encoder, \
          the drive held at its limit, timing, Ctrl-C and the other stop signals).\n\
          Nothing has been written to the card. Next: open the port and read the ID register \
@@ -398,6 +404,14 @@ fn card_plan(
         full = cal.volts_full_scale,
         id = config.map.id,
         signal = ident.signal,
+        further = if tables_only {
+            "then 24 closed-loop runs of 3 s for Tables 5 and 6 (--tables-only: no excitation, \
+             frequency response or design runs)"
+        } else {
+            "20 more of 5 s comparing inputs of the same peak (square wave, PRBS, multisine, \
+             chirp), a multisine for the frequency response, then 26 closed-loop runs of 3 s \
+             (24 for Tables 5 and 6, 2 for the Design section's LQI)"
+        },
         probes = if ident.scale_to_travel {
             format!(
                 "2 probe runs of {PROBE_DURATION} s at {} and {} V, ",
