@@ -205,10 +205,15 @@ fn lab(args: &cli::Args) -> Result<PathBuf, Stopped> {
     match (result, written) {
         (Ok(()), Ok(path)) => Ok(path),
         (Ok(()), Err(e)) => Err(e.into()),
-        (Err(error), written) => Err(Stopped {
-            error,
-            report: written.ok(),
-        }),
+        (Err(error), written) => {
+            if let Err(e) = &written {
+                eprintln!("lab5: the report could not be written either: {e}");
+            }
+            Err(Stopped {
+                error,
+                report: written.ok(),
+            })
+        }
     }
 }
 
