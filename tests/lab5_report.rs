@@ -140,9 +140,209 @@ fn the_lab5_report_renders_every_section_with_numbers_and_figures() {
         );
         assert!(dir.join(figure).is_file(), "{figure} not written");
     }
+    // Recordings are named for what ran: the identification's signal, peak
+    // and seed; a table row as examples/experiment names it.
+    let runs: Vec<String> = std::fs::read_dir(dir.join("runs"))
+        .expect("runs/ is written")
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     assert!(
-        dir.join("runs/ident_1.csv").is_file() && dir.join("runs/design_cart1_rig.csv").is_file()
+        runs.iter()
+            .any(|n| n.starts_with("ident_square_") && n.ends_with("V_seed1.csv")),
+        "{runs:?}"
     );
+    for file in [
+        "table5_cart2_kf_0_0_10_0.1_to_30mm.csv",
+        "table6_cart1_kf_1_0.01_0_0_to_15mm.csv",
+        "design_cart1_rig.csv",
+    ] {
+        assert!(runs.iter().any(|n| n == file), "no runs/{file} in {runs:?}");
+    }
+    the_tables_are_written_as_csv(&report, dir);
+    the_lab_comes_before_the_further_sections(&report);
+}
+
+/// A CSV record's fields (quoted fields unquoted, `""` as `"`).
+fn fields(line: &str) -> Vec<String> {
+    let (mut out, mut field, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut field)),
+            (c, _) => field.push(c),
+        }
+    }
+    out.push(field);
+    out
+}
+
+/// Every table is in `tables/` as CSV, linked under its Markdown table:
+/// units in the header, a row per Markdown row (Tables 3 and 4 split the
+/// `mean ± sd` row in two), the same numbers, and each rig run's
+/// recording named.
+fn the_tables_are_written_as_csv(report: &str, dir: &Path) {
+    let tables = tables(report);
+    for (heading, file, extra, columns) in [
+        (
+            "Table 1",
+            "table1.csv",
+            0,
+            &["F_N", "x1_sim_mm", "x2_exact_mm"][..],
+        ),
+        (
+            "Table 2",
+            "table2.csv",
+            0,
+            &[
+                "kf1_N_per_mm",
+                "pole1_re_per_s",
+                "POT_pct",
+                "settling_time_s",
+                "steady_state_error_mm",
+            ],
+        ),
+        (
+            "Table 3",
+            "table3.csv",
+            1,
+            &[
+                "k12_lab_N_per_m",
+                "k1_separate_N_per_m",
+                "coulomb1_separate_N",
+            ],
+        ),
+        (
+            "Table 4",
+            "table4.csv",
+            1,
+            &[
+                "K_lab_N_per_V",
+                "b2_separate_N_s_per_m",
+                "coulomb2_separate_N",
+            ],
+        ),
+        (
+            "The identified model and its uncertainty",
+            "model.csv",
+            0,
+            &["parameter", "unit", "mean"],
+        ),
+        (
+            "Table 5",
+            "table5.csv",
+            0,
+            &[
+                "kf1_V_per_mm",
+                "outcome",
+                "y_inf_mm",
+                "POT_pct",
+                "settling_time_s",
+                "steady_state_error_mm",
+                "recording",
+            ],
+        ),
+        (
+            "Table 6",
+            "table6.csv",
+            0,
+            &[
+                "kf4_V_per_mm",
+                "outcome",
+                "POT_pct",
+                "steady_state_error_mm",
+                "recording",
+            ],
+        ),
+    ] {
+        assert!(
+            report.contains(&format!("(tables/{file})")),
+            "{file} not linked"
+        );
+        let text = std::fs::read_to_string(dir.join("tables").join(file))
+            .unwrap_or_else(|e| panic!("tables/{file}: {e}"));
+        let mut lines = text.lines();
+        let header = fields(lines.next().unwrap());
+        for c in columns {
+            assert!(
+                header.iter().any(|h| h == c),
+                "{file}: no {c} in {header:?}"
+            );
+        }
+        let rows: Vec<Vec<String>> = lines.map(fields).collect();
+        let markdown = table(&tables, heading);
+        assert_eq!(
+            rows.len(),
+            markdown.len() - 1 + extra,
+            "{file} against `{heading}`"
+        );
+        for row in &rows {
+            assert_eq!(row.len(), header.len(), "{file}: {row:?}");
+        }
+        if !file.starts_with("table5") && !file.starts_with("table6") {
+            continue;
+        }
+        // The rig tables: the Markdown's metrics, at its precision; none
+        // where the run did not settle, the outcome saying why.
+        let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+        let md_outcome = markdown[0].iter().position(|h| h == "outcome").unwrap();
+        for (row, md) in rows.iter().zip(&markdown[1..]) {
+            assert!(
+                md[md_outcome].starts_with(row[col("outcome")].as_str())
+                    || row[col("outcome")] == "oscillating",
+                "{row:?} against {md:?}"
+            );
+            let pot = &row[col("POT_pct")];
+            if md[md_outcome] == "settled" {
+                let value: f64 = pot.parse().unwrap();
+                assert_eq!(format!("{value:.2}"), md[md_outcome + 3], "{file}: {row:?}");
+            } else {
+                assert!(
+                    pot.is_empty() && row[col("settling_time_s")].is_empty(),
+                    "{row:?}"
+                );
+            }
+            let recording = dir.join(&row[col("recording")]);
+            assert!(recording.is_file(), "{}", recording.display());
+        }
+    }
+}
+
+/// Tables 1–6 and the answers come first, the further sections after
+/// their own heading, whatever order the sections ran in.
+fn the_lab_comes_before_the_further_sections(report: &str) {
+    let at = |heading: &str| {
+        report
+            .find(&format!("\n{heading}"))
+            .unwrap_or_else(|| panic!("no `{heading}`"))
+    };
+    let order = [
+        "## Contents",
+        "## Table 1",
+        "## Table 2",
+        "### Table 3",
+        "### Table 4",
+        "## Table 5",
+        "## Table 6",
+        "## Answers to the report's questions",
+        "## Further sections",
+        "## Excitation",
+        "## Validation",
+        "## Frequency response",
+        "## Design",
+    ];
+    for pair in order.windows(2) {
+        assert!(
+            at(pair[0]) < at(pair[1]),
+            "`{}` after `{}`",
+            pair[0],
+            pair[1]
+        );
+    }
 }
 
 /// The lighter-damped rig of `tests/data/lighter_rig.toml`, where the lab's

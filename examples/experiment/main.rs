@@ -132,11 +132,10 @@ fn simulated(
     );
     if let Some((table, row)) = experiment.table_row() {
         println!(
-            "Table {}, row {} (lab5's runs/table{}_row{}.csv)",
+            "Table {}, row {} (lab5's runs/table{}_{experiment}.csv)",
             table.number,
             row + 1,
-            table.number,
-            row + 1
+            table.number
         );
     }
     let config = LoopConfig {

@@ -27,6 +27,8 @@ pub struct Backend {
     pub stop: StopSignal,
     /// Where each run's CSV goes (`runs/` under it).
     pub out: PathBuf,
+    /// How many recordings this lab wrote, for the closing summary.
+    saved: std::rc::Rc<std::cell::Cell<usize>>,
     /// The identification input asked for: the card file's `[ident]` (or
     /// the lab's default) with `--ident-*` on top.
     pub ident: IdentInput,
@@ -48,6 +50,35 @@ pub enum BackendKind {
         port: PathBuf,
         config: Box<ctrlab::lab::RigConfig>,
     },
+}
+
+/// A run's names: its recording's file stem (`runs/{file}.csv`), which
+/// says what ran, and the key its jittered clock's schedule is drawn from
+/// (`--jitter`). The key is the run's name from before the recordings were
+/// named for what ran, so that the same `--jitter` still gives the same
+/// report.
+pub struct RunId {
+    pub file: String,
+    pub schedule: String,
+}
+
+impl RunId {
+    /// A run whose file stem is its schedule's key.
+    pub fn new(file: impl Into<String>) -> Self {
+        let file = file.into();
+        Self {
+            schedule: file.clone(),
+            file,
+        }
+    }
+
+    /// A run saved as `file` whose schedule is keyed by `schedule`.
+    pub fn keyed(file: impl Into<String>, schedule: impl Into<String>) -> Self {
+        Self {
+            file: file.into(),
+            schedule: schedule.into(),
+        }
+    }
 }
 
 /// The loop's timing over a section's runs (real-time or jittered runs).
@@ -107,6 +138,7 @@ impl Backend {
             realtime,
             stop,
             out: args.out.clone(),
+            saved: std::rc::Rc::default(),
             ident,
         })
     }
@@ -175,17 +207,18 @@ impl Backend {
             realtime: self.realtime,
             stop: self.stop.clone(),
             out: self.out.clone(),
+            saved: self.saved.clone(),
             ident: self.ident,
         }
     }
 
     /// One experiment from rest: `controller` against the rig for
     /// `duration` s with reference `reference(t)`, its recording saved as
-    /// `runs/{name}.csv`. The outer error is a set-up failure (or Ctrl-C),
-    /// the inner one the run's own (with its recording).
+    /// `runs/{id.file}.csv`. The outer error is a set-up failure (or
+    /// Ctrl-C), the inner one the run's own (with its recording).
     pub fn experiment(
         &self,
-        name: &str,
+        id: &RunId,
         seed: u64,
         controller: impl Controller<4, 1, 1>,
         reference: impl FnMut(f64) -> SVector<f64, 1>,
@@ -218,9 +251,9 @@ impl Backend {
                 let clock = match (real_time, jitter) {
                     (true, _) => Clock::RealTime,
                     (false, None) => Clock::Virtual(VirtualClock::new()),
-                    (false, Some(j)) => {
-                        Clock::Virtual(VirtualClock::new().with_jitter(run_schedule(j, name))?)
-                    }
+                    (false, Some(j)) => Clock::Virtual(
+                        VirtualClock::new().with_jitter(run_schedule(j, &id.schedule))?,
+                    ),
                 };
                 let rig = sim.rig(&clock)?;
                 run(rig, controller, reference, &clock, &loop_config)
@@ -238,7 +271,7 @@ impl Backend {
             Ok(out) => &out.recording,
             Err(e) => &e.recording,
         };
-        let path = self.save(name, recording)?;
+        let path = self.save(&id.file, recording)?;
         if let Err(e) = &outcome
             && let RigError::Fault(LoopFault::Interrupted { .. }) = e.error
         {
@@ -257,7 +290,13 @@ impl Backend {
         std::fs::create_dir_all(&dir)?;
         let path = dir.join(format!("{name}.csv"));
         recording.write_csv(&path)?;
+        self.saved.set(self.saved.get() + 1);
         Ok(path)
+    }
+
+    /// How many recordings this backend wrote.
+    pub fn recordings(&self) -> usize {
+        self.saved.get()
     }
 
     /// The loop's timing over `stats`, for real-time or jittered runs (on
@@ -303,7 +342,13 @@ fn kind(args: &Args) -> Result<BackendKind, Box<dyn std::error::Error>> {
                 crate::card::load(port, args.card.as_deref(), args.no_watchdog_acknowledged)?;
             println!(
                 "{}",
-                card_plan(port, file, &config, &args.ident_input(config.ident))
+                card_plan(
+                    port,
+                    file,
+                    &config,
+                    &args.ident_input(config.ident),
+                    args.tables_only
+                )
             );
             let id = crate::card::check_id(port, &config)?;
             println!(
@@ -334,6 +379,7 @@ fn card_plan(
     card: &std::path::Path,
     config: &ctrlab::lab::RigConfig,
     ident: &IdentInput,
+    tables_only: bool,
 ) -> String {
     use ctrlab::lab::ident_input::{PROBE_DURATION, PROBE_FRACTIONS, TRAVEL_FRACTION};
     let cal = &config.calibration;
@@ -347,9 +393,8 @@ fn card_plan(
          port: {port}\n\
          card file: {card}\n\
          {what}\
-         runs: {probes}5 open-loop runs of 5 s with a {signal} of {ident_volts}, 20 more of 5 s \
-         comparing inputs of the same peak (square wave, PRBS, multisine, chirp), then 26 closed-loop \
-         runs of 3 s (24 for Tables 5 and 6, 2 for the Design section's LQI) saturated at ±{full} V, 3 s pauses between runs; each run \
+         runs: {probes}5 open-loop runs of 5 s with a {signal} of {ident_volts}, {further}\
+         saturated at ±{full} V, 3 s pauses between runs; each run \
          halts the motor at the first fault (travel limit, bus fault, stall, a dead cart-2 encoder, \
          the drive held at its limit, timing, Ctrl-C and the other stop signals).\n\
          Nothing has been written to the card. Next: open the port and read the ID register \
@@ -359,6 +404,14 @@ fn card_plan(
         full = cal.volts_full_scale,
         id = config.map.id,
         signal = ident.signal,
+        further = if tables_only {
+            "then 24 closed-loop runs of 3 s for Tables 5 and 6 (--tables-only: no excitation, \
+             frequency response or design runs)"
+        } else {
+            "20 more of 5 s comparing inputs of the same peak (square wave, PRBS, multisine, \
+             chirp), a multisine for the frequency response, then 26 closed-loop runs of 3 s \
+             (24 for Tables 5 and 6, 2 for the Design section's LQI)"
+        },
         probes = if ident.scale_to_travel {
             format!(
                 "2 probe runs of {PROBE_DURATION} s at {} and {} V, ",

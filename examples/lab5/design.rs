@@ -14,7 +14,7 @@ use ctrlab::lab::protocol::PERIOD;
 use ctrlab::lab::{MassSpring, SimulatedRig};
 use ctrlab::nalgebra::vector;
 
-use crate::backend::Backend;
+use crate::backend::{Backend, RunId};
 use crate::identification::Identification;
 
 /// One case's design, its run on the rig, and how they compare.
@@ -68,7 +68,7 @@ pub fn section(
         let n = cart.number();
         backend.save(&format!("design_cart{n}_predicted"), &design.predicted)?;
         let outcome = backend.experiment(
-            &format!("design_cart{n}_rig"),
+            &RunId::new(format!("design_cart{n}_rig")),
             200 + n as u64,
             design.lqi.controller,
             move |_| vector![setpoint],

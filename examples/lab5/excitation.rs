@@ -9,23 +9,31 @@ use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_RUNS, M1, M2, PERIOD};
 use ctrlab::nalgebra::vector;
 use ctrlab::signal::Signal;
 
-use crate::backend::Backend;
+use crate::backend::{Backend, RunId};
 
-/// Every input's result, and the first PRBS run's recording: a run the
-/// Validation section's models have not seen.
+/// Every input's result, and the first PRBS run's name and recording: a
+/// run the Validation section's models have not seen.
 pub struct Excitation {
     /// The inputs' peak, V: the identification's amplitude.
     pub volts: f64,
     pub inputs: Vec<InputResult>,
-    pub fresh: Option<Recording>,
+    pub fresh: Option<(String, Recording)>,
 }
 
-/// The name of the fresh run's recording.
-pub const FRESH_RUN: &str = "runs/excite_1_1.csv";
+/// An input's kind in a recording's name.
+fn kind(input: &Input) -> &'static str {
+    match input {
+        Input::Square(_) => "square",
+        Input::Prbs(_) => "prbs",
+        Input::Multisine(_) => "multisine",
+        Input::Chirp(_) => "chirp",
+    }
+}
 
 /// Every input [`IDENT_RUNS`] times at `volts` peak (the identification's
-/// amplitude; recordings `runs/excite_{i}_{seed}`), up to the first run
-/// that fails.
+/// amplitude; recordings named for the input, its peak and the run's seed:
+/// `runs/excite_prbs_4.78V_seed1.csv`), up to the first run that fails.
+/// The first PRBS run is the fresh run the Validation section uses.
 pub fn section(backend: &Backend, volts: f64) -> Result<Excitation, Box<dyn std::error::Error>> {
     let truth = backend.friction_truth();
     let mut results = Vec::new();
@@ -37,8 +45,12 @@ pub fn section(backend: &Backend, volts: f64) -> Result<Excitation, Box<dyn std:
         let mut estimates: Vec<MassSpringEstimate> = Vec::new();
         let mut failure = None;
         for seed in 1..=IDENT_RUNS {
+            let id = RunId::keyed(
+                format!("excite_{}_{volts:.2}V_seed{seed}", kind(&input)),
+                format!("excite_{i}_{seed}"),
+            );
             let outcome = backend.experiment(
-                &format!("excite_{i}_{seed}"),
+                &id,
                 seed,
                 ctrlab::OpenLoop,
                 |t| vector![input.value(t)],
@@ -51,7 +63,7 @@ pub fn section(backend: &Backend, volts: f64) -> Result<Excitation, Box<dyn std:
                         Err(e) => failure = Some(Failure::NotIdentified(e)),
                     }
                     if matches!(input, Input::Prbs(_)) && seed == 1 {
-                        fresh = Some(out.recording);
+                        fresh = Some((id.file, out.recording));
                     }
                 }
                 Err(e) => failure = Some(Failure::Halted(e.error.to_string())),

@@ -8,7 +8,7 @@ use ctrlab::lab::protocol::{IDENT_VOLTS, PERIOD};
 use ctrlab::nalgebra::vector;
 use ctrlab::signal::{Multisine, Signal};
 
-use crate::backend::Backend;
+use crate::backend::{Backend, RunId};
 use crate::identification::Identification;
 
 /// The multisine run and its estimates, or why the run halted.
@@ -26,7 +26,7 @@ pub fn section(
 ) -> Result<Frequency, Box<dyn std::error::Error>> {
     let multisine = frequency::multisine(IDENT_VOLTS)?;
     let rec = match backend.experiment(
-        "frequency_multisine",
+        &RunId::new("frequency_multisine"),
         1,
         OpenLoop,
         |t| vector![multisine.value(t)],

@@ -17,7 +17,7 @@ use ctrlab::nalgebra::vector;
 use ctrlab::signal::{Signal, SquareWave};
 use ctrlab::{OpenLoop, Recording};
 
-use crate::backend::{Backend, LoopTiming};
+use crate::backend::{Backend, LoopTiming, RunId};
 
 /// One identification run: its name (the CSV file's stem) and recording.
 pub struct Run {
@@ -97,11 +97,11 @@ impl Identification {
 }
 
 /// The lab's identification runs on the rig: the amplitude chosen from
-/// two probe runs (`runs/ident_probe_{n}.csv`; none with `--ident-fixed`),
-/// then [`IDENT_RUNS`] runs of the input at it, each saved as
-/// `runs/ident_{seed}.csv`. A probe the rig halts at a travel limit
-/// lowers the amplitude; any other fault in a probe stops here, named. A
-/// run the rig halts because the input was too big (a travel limit, the
+/// two probe runs (`runs/ident_probe1_square_2.00V.csv`; none with
+/// `--ident-fixed`), then [`IDENT_RUNS`] runs of the input at it, each
+/// saved under what ran (`runs/ident_square_4.78V_seed1.csv`). A probe
+/// the rig halts at a travel limit lowers the amplitude; any other fault
+/// in a probe stops here, named. A run the rig halts because the input was too big (a travel limit, the
 /// drive saturated) is kept in [`RigInput::failed`] and the others go on;
 /// any other fault, set-up failures and Ctrl-C stop here.
 pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::error::Error>> {
@@ -116,8 +116,12 @@ pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::er
                 // The runs' own signal (a multisine's lines are the run's
                 // harmonics), for the probe's length.
                 let input = ident.input(volts, IDENT_DURATION)?;
+                let id = RunId::keyed(
+                    format!("ident_probe{n}_{}_{volts:.2}V", ident.signal.name()),
+                    format!("ident_probe_{n}"),
+                );
                 let outcome = backend.experiment(
-                    &format!("ident_probe_{n}"),
+                    &id,
                     100 + n,
                     OpenLoop,
                     |t| vector![input.value(t)],
@@ -132,9 +136,17 @@ pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::er
         AmplitudeChoice::fixed(ident.volts, limits)
     };
     let input = ident.input(choice.volts, IDENT_DURATION)?;
+    // The runs' names say what ran: the signal, its peak and the seed.
+    let name = |seed: u64| {
+        format!(
+            "ident_{}_{:.2}V_seed{seed}",
+            ident.signal.name(),
+            choice.volts
+        )
+    };
     let collected = IdentRuns::collect(1..=IDENT_RUNS, |seed| {
         let outcome = backend.experiment(
-            &format!("ident_{seed}"),
+            &RunId::keyed(name(seed), format!("ident_{seed}")),
             seed,
             OpenLoop,
             |t| vector![input.value(t)],
@@ -155,7 +167,7 @@ pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::er
         .completed
         .into_iter()
         .map(|r| Run {
-            name: format!("ident_{}", r.seed),
+            name: name(r.seed),
             recording: r.recording,
         })
         .collect();
@@ -163,7 +175,7 @@ pub fn rig_runs(backend: &Backend) -> Result<(Vec<Run>, Source), Box<dyn std::er
         .halted
         .into_iter()
         .map(|h| FailedRun {
-            name: format!("ident_{}", h.seed),
+            name: name(h.seed),
             error: h.error.to_string(),
             ran: h.recording.time().last().copied().unwrap_or(0.0),
             peaks: peaks(&h.recording).unwrap_or([f64::NAN; 2]),
@@ -272,7 +284,10 @@ pub fn equal_springs(
     let out = backend
         .with_sim(card)
         .experiment(
-            "ident_equal_springs",
+            &RunId::keyed(
+                format!("ident_equal_springs_square_{volts:.2}V"),
+                "ident_equal_springs",
+            ),
             99,
             OpenLoop,
             |t| vector![wave.value(t)],

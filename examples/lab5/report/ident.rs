@@ -74,7 +74,7 @@ impl Report {
         );
         if choice.reason != Reason::Fixed {
             text += &format!(
-                " Two probe runs of {PROBE_DURATION} s came first (`runs/ident_probe_*.csv`), at a quarter and half of it (the second lowered if the first said so). Each cart's peak at a higher amplitude is predicted as the larger of the line through the two probes' peaks (friction takes a fixed force off the small one) and the line through the origin and the larger probe (`lab::ident_input::predict`)."
+                " Two probe runs of {PROBE_DURATION} s came first (`runs/ident_probe*.csv`), at a quarter and half of it (the second lowered if the first said so). Each cart's peak at a higher amplitude is predicted as the larger of the line through the two probes' peaks (friction takes a fixed force off the small one) and the line through the origin and the larger probe (`lab::ident_input::predict`)."
             );
         }
         text += &format!(" **Chosen: {:.2} V**, {}.", choice.volts, choice.reason);
@@ -174,10 +174,12 @@ impl Report {
         let intro = match (&ident.source, backend) {
             (Source::Rig { timing, input }, Some(backend)) => {
                 let mut intro = format!(
-                    "{IDENT_RUNS} open-loop runs on {}: {}, {IDENT_DURATION} s at T = {} ms, through `MassSpringRig` → `Pc104` → the card (recordings in `runs/ident_*.csv`).",
+                    "{IDENT_RUNS} open-loop runs on {}: {}, {IDENT_DURATION} s at T = {} ms, through `MassSpringRig` → `Pc104` → the card (recordings in `runs/ident_{}_{:.2}V_seed*.csv`).",
                     describe(backend),
                     signal_text(&input.input, input.choice.volts),
-                    PERIOD * 1e3
+                    PERIOD * 1e3,
+                    input.input.signal.name(),
+                    input.choice.volts
                 );
                 if !input.failed.is_empty() {
                     intro += &format!(
@@ -246,12 +248,8 @@ impl Report {
             "Open-loop poles: {}.\n",
             poles_display(&sys.poles()?)
         ));
+        self.model_csv(s, truth)?;
         self.uncertainty(s, truth);
-        if let Some(sim) = backend.and_then(Backend::sim)
-            && sim.unmodelled != Unmodelled::NONE
-        {
-            self.not_recovered(sim, ident)?;
-        }
         Ok(())
     }
 
@@ -334,6 +332,7 @@ impl Report {
             ]);
         }
         let t = truth.map(FrictionPlant::truth);
+        self.table3_csv(s, truth)?;
         self.heading(3, "Table 3: springs and friction of cart 1");
         self.table(
             &[
@@ -387,6 +386,7 @@ impl Report {
                 },
             ],
         )?;
+        self.table4_csv(s, truth)?;
         self.heading(3, "Table 4: motor gain and friction of cart 2");
         self.table(
             &[

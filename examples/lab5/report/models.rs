@@ -97,7 +97,7 @@ impl Report {
     pub fn excitation(&mut self, volts: f64, results: &[InputResult]) {
         self.heading(2, "Excitation: which input identifies best");
         self.add(&format!(
-            "The same identification (separate springs, Coulomb friction, Central scheme) from four inputs of the same peak ({volts:.2} V, the identification's) and length ({IDENT_DURATION} s), {IDENT_RUNS} runs each (recordings in `runs/excite_*.csv`). The square wave puts its power on a few odd harmonics of 2.5 Hz; the PRBS spreads it flat to 11 Hz; the multisine puts it exactly on 50 lines from 0.2 to 10 Hz; the chirp sweeps 0.2–10 Hz once, the same time per octave.\n"
+            "The same identification (separate springs, Coulomb friction, Central scheme) from four inputs of the same peak ({volts:.2} V, the identification's) and length ({IDENT_DURATION} s), {IDENT_RUNS} runs each (recordings in `runs/excite_{{square,prbs,multisine,chirp}}_{volts:.2}V_seed*.csv`). The square wave puts its power on a few odd harmonics of 2.5 Hz; the PRBS spreads it flat to 11 Hz; the multisine puts it exactly on 50 lines from 0.2 to 10 Hz; the chirp sweeps 0.2–10 Hz once, the same time per octave.\n"
         ));
         let mut rows = Vec::new();
         for r in results {

@@ -6,13 +6,30 @@ use ctrlab::lab::ident::{MassSpringEstimate, Options, SEPARATE_SPRINGS, Spread, 
 use ctrlab::lab::protocol::{M1, M2};
 
 use super::{Report, pct};
+use crate::backend::Backend;
 use crate::identification::Identification;
 
 impl Report {
+    /// "What the identification does not recover", on a simulated rig
+    /// with unmodelled effects (nothing otherwise): a further section,
+    /// computed from the identification runs without runs of its own.
+    pub fn unmodelled(
+        &mut self,
+        backend: &Backend,
+        ident: &Identification,
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        match backend.sim() {
+            Some(sim) if sim.unmodelled != ctrlab::lab::Unmodelled::NONE => {
+                self.not_recovered(sim, ident)
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// On a simulated rig with unmodelled effects: each parameter against
     /// the card's truth, what the model does not fit, and cart 2's mass
     /// fitted instead of given.
-    pub(super) fn not_recovered(
+    fn not_recovered(
         &mut self,
         sim: &SimulatedRig,
         ident: &Identification,
@@ -22,7 +39,7 @@ impl Report {
         let s = &ident.summary;
         let a = &s.average;
         let [sf1, sf2] = s.coulomb;
-        self.heading(3, "What the identification does not recover");
+        self.heading(2, "What the identification does not recover");
         self.add(&format!(
             "The simulated card has what real rigs have and the model does not (its `[unmodelled]` table): cart 2's effective mass is m2 + J/r² = {} + {:.3} = {m2:.3} kg (the motor's rotor through the pinion), while the identification is told the weighed {M2} kg; the drive gives no force below {:.2} V and {:.2} V less above it (deadband); the Coulomb and breakaway forces vary by ±{:.0} % along the rail over {:.0} mm; and each run's friction is drawn from its seed with σ = {:.0} %. Against the card's truth (the Coulomb forces' nominal values, the mean of the draws):\n",
             t.m2,
