@@ -251,7 +251,7 @@ fn the_tables_are_written_as_csv(report: &str, dir: &Path) {
             "table6.csv",
             0,
             &[
-                "kf4_V_per_mm",
+                "kf4_V_s_per_mm",
                 "outcome",
                 "POT_pct",
                 "steady_state_error_mm",

@@ -31,8 +31,18 @@ fn opt(v: Option<f64>) -> String {
 }
 
 /// The four gains' columns: `kf1_{unit}` … `kf4_{unit}`.
+/// The gains' columns: `unit` per mm on the positions (Kf1, Kf3) and per
+/// mm/s on the speeds (Kf2, Kf4), e.g. `kf1_V_per_mm`, `kf2_V_s_per_mm`.
 fn kf_header(unit: &str) -> Vec<String> {
-    (1..=4).map(|i| format!("kf{i}_{unit}")).collect()
+    (1..=4)
+        .map(|i| {
+            if i % 2 == 0 {
+                format!("kf{i}_{unit}_s_per_mm")
+            } else {
+                format!("kf{i}_{unit}_per_mm")
+            }
+        })
+        .collect()
 }
 
 /// The four poles' columns, real and imaginary parts, 1/s.
@@ -166,7 +176,7 @@ impl Report {
     /// Table 2 as `tables/table2.csv`: the gains act on a force (the
     /// nominal model's K = 1), so N per mm.
     pub fn table2_csv(&mut self, t: &Table2) -> Result<(), Box<dyn std::error::Error>> {
-        let mut header = kf_header("N_per_mm");
+        let mut header = kf_header("N");
         header.extend(poles_header("pole"));
         header.extend(
             [
@@ -204,7 +214,7 @@ impl Report {
 
     /// Table 5 or 6 as `tables/table{n}.csv`, each row with its recording.
     pub fn rig_table_csv(&mut self, t: &RigTable) -> Result<(), Box<dyn std::error::Error>> {
-        let mut header = kf_header("V_per_mm");
+        let mut header = kf_header("V");
         header.extend(["predicted", "spectral_radius"].map(String::from));
         header.extend(poles_header("pole"));
         header.extend(
