@@ -52,6 +52,30 @@ pub enum Error {
         /// The operation that needed the inverse (`"Tustin discretisation"`, …).
         operation: &'static str,
     },
+    /// A Lyapunov, Stein (discrete Lyapunov) or Sylvester equation has no
+    /// unique solution: two eigenvalues of its coefficients satisfy the
+    /// equation's singularity condition to working precision (`λ + μ = 0`
+    /// for `A X + X B = C` and the continuous Lyapunov equation, an
+    /// eigenvalue of `A` on the imaginary axis for instance; `λ μ = 1` for
+    /// the discrete one, an eigenvalue on the unit circle).
+    #[error(
+        "{equation} has no unique solution: eigenvalues {lambda_re} + {lambda_im}i and \
+         {mu_re} + {mu_im}i give {condition}"
+    )]
+    SingularEquation {
+        /// The equation (`"continuous Lyapunov equation"`, …).
+        equation: &'static str,
+        /// Real part of the first eigenvalue `λ` (of `A`).
+        lambda_re: f64,
+        /// Imaginary part of `λ`.
+        lambda_im: f64,
+        /// Real part of the second eigenvalue `μ` (of `Aᵀ`, or of `B`).
+        mu_re: f64,
+        /// Imaginary part of `μ`.
+        mu_im: f64,
+        /// The condition they meet (`"λ + μ = 0"` or `"λ μ = 1"`).
+        condition: &'static str,
+    },
     /// A computation produced a non-finite result from finite input (overflow,
     /// typically a time step far too large for the model's dynamics).
     #[error("{operation} overflowed to a non-finite result")]
@@ -315,6 +339,7 @@ impl Error {
             | Error::OutOfRange { .. }
             | Error::InvalidPole { .. } => ErrorKind::InvalidInput,
             Error::Singular { .. }
+            | Error::SingularEquation { .. }
             | Error::Overflow { .. }
             | Error::PoleNotPlaced { .. }
             | Error::NoConvergence { .. }

@@ -31,7 +31,9 @@
 //! Analysis and design:
 //!
 //! - [`analysis`]: poles, stability, DC gain, damping, controllability and
-//!   observability.
+//!   observability; Lyapunov and Sylvester equations
+//!   ([`lyap`](analysis::lyap), [`dlyap`](analysis::dlyap),
+//!   [`sylvester`](analysis::sylvester)).
 //! - [`design`]: the [`Controller`] trait (measurements and reference in,
 //!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
 //!   [`acker`], [`place`], [`lqr`], [`dlqr`], Riccati solvers that scale

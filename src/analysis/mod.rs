@@ -1,5 +1,6 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
-//! controllability / observability with a numerical rank test.
+//! controllability / observability with a numerical rank test; Lyapunov
+//! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`]).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
@@ -27,11 +28,13 @@
 mod controllability;
 mod dyn_state_space;
 mod gain;
+mod lyapunov;
 mod poles;
 mod stability;
 mod state_space;
 
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
+pub use lyapunov::{Lyapunov, SquareMatrix, SylvesterOperands, dlyap, lyap, sylvester};
 pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
 
