@@ -19,6 +19,7 @@ mod common;
 
 use ctrlab::Error;
 use ctrlab::analysis::{dlyap, lyap, sylvester};
+use ctrlab::signal::Rng;
 use nalgebra::{DMatrix, SMatrix, dmatrix, matrix};
 use proptest::prelude::*;
 use serde_json::Value;
@@ -235,6 +236,38 @@ fn singular(result: Result<impl std::fmt::Debug, Error>) -> (f64, f64, f64, f64,
             ..
         }) => (lambda_re, lambda_im, mu_re, mu_im, condition),
         other => panic!("expected SingularEquation, got {other:?}"),
+    }
+}
+
+/// Repeated, non-defective eigenvalues under a rotation
+/// (`Q diag(−1, −2, −1, …) Qᵀ`), and a rotated Jordan chain: nalgebra's
+/// Schur iteration stalls on some of the former (seed 4, n = 9, and seed
+/// 21, n = 26, even with 200 iterations per dimension), and the EISPACK
+/// iteration with exceptional shifts takes over.
+#[test]
+fn repeated_eigenvalues_are_solved() {
+    for seed in 0..25u64 {
+        let mut rng = Rng::new(seed);
+        let n = 5 + (seed as usize % 40);
+        let g = DMatrix::from_fn(n, n, |_, _| rng.gaussian());
+        let rotation = g.qr().q();
+        let d = DMatrix::from_fn(n, n, |i, j| match (i == j, i % 2) {
+            (true, 0) => -1.0,
+            (true, _) => -2.0,
+            _ => 0.0,
+        });
+        let mut chain = DMatrix::from_fn(n, n, |i, j| f64::from(u8::from(j == i + 1)));
+        chain.fill_diagonal(-1.0);
+        let q = DMatrix::identity(n, n);
+        for a in [
+            &rotation * d * rotation.transpose(),
+            &rotation * chain * rotation.transpose(),
+        ] {
+            let sol = lyap(&a, &q).unwrap_or_else(|e| panic!("seed {seed}, n = {n}: {e}"));
+            assert!(sol.residual < 1e-12, "seed {seed}: {:e}", sol.residual);
+            let sol = dlyap(&(&a * 0.4), &q).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+            assert!(sol.residual < 1e-12, "seed {seed}: {:e}", sol.residual);
+        }
     }
 }
 

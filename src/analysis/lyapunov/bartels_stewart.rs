@@ -7,10 +7,12 @@
 
 use nalgebra::{Complex, DMatrix};
 
+use super::francis;
 use crate::error::Error;
 
-/// Iteration cap of the Schur decomposition, per matrix dimension.
-const ITERATIONS_PER_DIM: usize = 200;
+/// Iteration cap of each Schur iteration, per matrix dimension (at least
+/// ten dimensions): LAPACK's `dlahqr` allows 30.
+const ITERATIONS_PER_DIM: usize = 30;
 
 /// Singularity threshold, in units of `n ε` times the scale of the
 /// eigenvalues: two eigenvalues closer than this to the equation's
@@ -31,16 +33,17 @@ pub(super) struct Schur {
 /// The real Schur decomposition of a square, finite `a`.
 pub(super) fn schur(a: &DMatrix<f64>) -> Result<Schur, Error> {
     let n = a.nrows();
-    let iterations = ITERATIONS_PER_DIM * n.max(1);
+    let iterations = ITERATIONS_PER_DIM * n.max(10);
     let failed = Error::NoConvergence {
         operation: "Schur decomposition",
         iterations,
     };
-    let (u, mut t) = a
-        .clone()
-        .try_schur(f64::EPSILON, iterations)
-        .ok_or(failed.clone())?
-        .unpack();
+    // nalgebra's Francis iteration first; where it stalls (it has no
+    // exceptional shifts), EISPACK's with them.
+    let (u, mut t) = match a.clone().try_schur(f64::EPSILON, iterations) {
+        Some(s) => s.unpack(),
+        None => francis::schur(a, iterations).ok_or(failed.clone())?,
+    };
     let mut blocks = Vec::with_capacity(n);
     let mut eigenvalues = Vec::with_capacity(n);
     let mut i = 0;

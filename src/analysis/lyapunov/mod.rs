@@ -4,6 +4,7 @@
 //! of its solution.
 
 mod bartels_stewart;
+mod francis;
 
 use nalgebra::{Complex, DMatrix, SMatrix};
 
@@ -20,7 +21,9 @@ use bartels_stewart::{Condition, Schur, quasi_stein, quasi_sylvester, schur, sin
 /// # Algorithm
 ///
 /// Bartels and Stewart (1972): a real Schur decomposition `A = U S Uᵀ`
-/// (nalgebra's Francis QR, capped at 200 iterations per dimension), the
+/// (nalgebra's Francis QR, and where it stalls, as it can on repeated
+/// eigenvalues, EISPACK's `hqr2` with its exceptional shifts; each capped
+/// at `30 max(n, 10)` iterations, LAPACK's `dlahqr` cap), the
 /// equation rewritten for `Y = Uᵀ X U` with the quasi-triangular `S`, and
 /// `Y` found block by block by back-substitution (LAPACK's `dtrsyl`; for
 /// the discrete equation SLICOT's `SB03MX` ordering), each 1×1 or 2×2
