@@ -4,7 +4,7 @@
 //! plain numbers; the frequency tools on every model type; and the text of
 //! each `Display`.
 
-use ctrlab::analysis::Poles;
+use ctrlab::analysis::{Poles, dlyap, lyap, sylvester};
 use ctrlab::design::{acker, dlqe, dlqi, dlqr, lqe, lqi, lqr, place, place_observer};
 use ctrlab::freq::{TransferFunction, TransferMatrix, Zpk, bandwidth, stability_margins};
 use ctrlab::integrate::{Integrator, Rk4};
@@ -63,6 +63,33 @@ fn lqr_and_dlqr_agree_across_sizes() {
     assert!(matches!(
         dlqr(&dd, &heap(&q), &DMatrix::identity(2, 2)),
         Err(Error::DimensionMismatch { matrix: "R", .. })
+    ));
+}
+
+#[test]
+fn lyapunov_equations_agree_across_sizes() {
+    // The plant's controllability Gramians, continuous and ZOH at 2 ms.
+    let plant = two_carts();
+    let (a, b) = (*plant.a(), *plant.b());
+    let q = b * b.transpose();
+    let f = lyap(&a, &q).unwrap();
+    let d = lyap(&heap(&a), &heap(&q)).unwrap();
+    assert_eq!(f.x.as_slice(), d.x.as_slice());
+    assert_eq!(f.residual, d.residual);
+    let fd = plant.discretize(0.002, Discretization::Zoh).unwrap();
+    let (ad, bd) = (*fd.a(), *fd.b());
+    let qd = bd * bd.transpose();
+    let f = dlyap(&ad, &qd).unwrap();
+    let d = dlyap(&heap(&ad), &heap(&qd)).unwrap();
+    assert_eq!(f.x.as_slice(), d.x.as_slice());
+    // Sylvester with different sizes: A 4 × 4, B 1 × 1, C 4 × 1.
+    let f = sylvester(&a, &matrix![3.0], &b).unwrap();
+    let d = sylvester(&heap(&a), &heap(&matrix![3.0]), &heap(&b)).unwrap();
+    assert_eq!(f.x.as_slice(), d.x.as_slice());
+    // A Q of the wrong size is an error at run time only.
+    assert!(matches!(
+        lyap(&heap(&a), &DMatrix::identity(3, 3)),
+        Err(Error::DimensionMismatch { matrix: "Q", .. })
     ));
 }
 
