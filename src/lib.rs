@@ -33,7 +33,8 @@
 //! - [`analysis`]: poles, stability, DC gain, damping, controllability and
 //!   observability; Lyapunov and Sylvester equations
 //!   ([`lyap`](analysis::lyap), [`dlyap`](analysis::dlyap),
-//!   [`sylvester`](analysis::sylvester)).
+//!   [`sylvester`](analysis::sylvester), and the Gramian's factor
+//!   [`lyapchol`](analysis::lyapchol)).
 //! - [`design`]: the [`Controller`] trait (measurements and reference in,
 //!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
 //!   [`acker`], [`place`], [`lqr`], [`dlqr`], Riccati solvers that scale

@@ -18,7 +18,7 @@
 mod common;
 
 use ctrlab::Error;
-use ctrlab::analysis::{dlyap, lyap, sylvester};
+use ctrlab::analysis::{dlyap, lyap, lyapchol, sylvester};
 use ctrlab::signal::Rng;
 use nalgebra::{DMatrix, SMatrix, dmatrix, matrix};
 use proptest::prelude::*;
@@ -159,6 +159,75 @@ fn sylvester_agrees_with_scipy() {
         worst = worst.max(diff);
     }
     println!("sylvester: largest difference from SciPy {worst:.1e}");
+}
+
+/// `B` with `B Bᵀ = Q` for a symmetric positive semidefinite `Q`.
+fn square_root(q: &DMatrix<f64>) -> DMatrix<f64> {
+    let e = q.clone().symmetric_eigen();
+    let d = e.eigenvalues.map(|l| l.max(0.0).sqrt());
+    &e.eigenvectors * DMatrix::from_diagonal(&d)
+}
+
+/// Hammarling's factor against SciPy's `X` on every stable case whose `Q`
+/// is semidefinite (all but SciPy's own cases): `Rᵀ R` to `X_AGREEMENT`.
+#[test]
+fn lyapchol_agrees_with_scipy() {
+    let data = common::fixture("lyapunov_fixtures.json");
+    let mut worst: f64 = 0.0;
+    for case in data["lyap"].as_array().unwrap() {
+        let name = case["name"].as_str().unwrap();
+        if name.starts_with("scipy_") {
+            continue;
+        }
+        let (a, q, scipy_x) = (dm(&case["a"]), dm(&case["q"]), dm(&case["x"]));
+        let b = square_root(&q);
+        let r = lyapchol(&a, &b).unwrap_or_else(|e| panic!("lyapchol {name}: {e}"));
+        let f = &r.factor;
+        let diff = rel_diff(&(f.transpose() * f), &scipy_x);
+        println!(
+            "lyapchol {name}: RᵀR vs SciPy's X {diff:.1e}, residual {:.1e}",
+            r.residual
+        );
+        assert!(diff < X_AGREEMENT, "lyapchol {name}: {diff:e}");
+        assert!(r.residual < 1e-13, "lyapchol {name}: {:e}", r.residual);
+        for j in 0..f.ncols() {
+            assert!(f[(j, j)] >= 0.0);
+            for i in j + 1..f.nrows() {
+                assert_eq!(f[(i, j)], 0.0, "{name}: not upper triangular");
+            }
+        }
+        worst = worst.max(diff);
+    }
+    println!("lyapchol: largest difference from SciPy {worst:.1e}");
+}
+
+#[test]
+fn lyapchol_closed_forms_and_refusals() {
+    // a x + x a + b² = 0: x = −b² / (2a), r = |b| / √(−2a).
+    let r = lyapchol(&matrix![-2.0], &matrix![3.0]).unwrap();
+    assert!((r.factor[(0, 0)] - 1.5).abs() < 1e-15);
+    // Two inputs, fixed size: B is 2 × 3.
+    let a = matrix![-1.0, 0.5; 0.0, -3.0];
+    let b = matrix![1.0, 0.0, 2.0; 0.5, 1.0, 0.0];
+    let r = lyapchol(&a, &b).unwrap();
+    let x = lyap(&a, &(b * b.transpose())).unwrap().x;
+    assert!((r.factor.transpose() * r.factor - x).amax() < 1e-14);
+    // No input: X = 0.
+    let none = lyapchol(&(-DMatrix::identity(2, 2)), &DMatrix::zeros(2, 0)).unwrap();
+    assert_eq!(none.factor, DMatrix::zeros(2, 2));
+    // Unstable, and on the imaginary axis: refused.
+    assert!(matches!(
+        lyapchol(&matrix![0.5, 0.0; 0.0, -1.0], &matrix![1.0; 1.0]),
+        Err(Error::Unstable { re, .. }) if re == 0.5
+    ));
+    assert!(matches!(
+        lyapchol(&matrix![0.0, 1.0; -4.0, 0.0], &matrix![0.0; 1.0]),
+        Err(Error::Unstable { .. })
+    ));
+    assert!(matches!(
+        lyapchol(&DMatrix::identity(2, 2), &DMatrix::zeros(3, 1)),
+        Err(Error::DimensionMismatch { matrix: "B", .. })
+    ));
 }
 
 #[test]
@@ -387,6 +456,12 @@ proptest! {
             / (2.0 * a.norm() * x.x.norm() + q.norm()).max(f64::MIN_POSITIVE);
         prop_assert!(r < 1e-10 && x.residual < 1e-10, "{r:e} {:e}", x.residual);
         prop_assert_eq!(&x.x, &x.x.transpose());
+        // Hammarling's factor of the same X (Q = G Gᵀ).
+        let g = DMatrix::from_column_slice(n, n, &w[..n * n]);
+        let f = lyapchol(&a, &g).unwrap();
+        prop_assert!(f.residual < 1e-10, "{:e}", f.residual);
+        let xf = f.factor.transpose() * &f.factor;
+        prop_assert!((&xf - &x.x).amax() <= 1e-10 * x.x.amax(), "{xf} {}", x.x);
 
         // Spectral radius below `radius` (the ∞-norm bounds it).
         let m = DMatrix::from_column_slice(n, n, &v[..n * n]);
@@ -420,6 +495,8 @@ proptest! {
         let (f, d) = (lyap(&fa, &fq).unwrap(), lyap(&a, &q).unwrap());
         prop_assert_eq!(f.x.as_slice(), d.x.as_slice());
         prop_assert_eq!(f.residual, d.residual);
+        let (f, d) = (lyapchol(&fa, &fq).unwrap(), lyapchol(&a, &q).unwrap());
+        prop_assert_eq!(f.factor.as_slice(), d.factor.as_slice());
         let (f, d) = (dlyap(&(fa * 0.1), &fq).unwrap(), dlyap(&(&a * 0.1), &q).unwrap());
         prop_assert_eq!(f.x.as_slice(), d.x.as_slice());
         let c = SMatrix::<f64, 7, 3>::from_column_slice(&w[..21]);

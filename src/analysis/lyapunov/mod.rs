@@ -1,10 +1,12 @@
 //! Lyapunov and Sylvester equations, continuous and discrete, for
 //! fixed-size (`SMatrix`) and run-time-sized (`DMatrix`) matrices alike:
 //! [`lyap`], [`dlyap`] and [`sylvester`], each with the relative residual
-//! of its solution.
+//! of its solution, and [`lyapchol`], Hammarling's Cholesky factor of a
+//! stable continuous equation's solution.
 
 mod bartels_stewart;
 mod francis;
+mod hammarling;
 
 use nalgebra::{Complex, DMatrix, SMatrix};
 
@@ -271,6 +273,116 @@ where
     let (x, residual) = sylvester_dyn(&a, &b, &c)?;
     Ok(Lyapunov {
         x: A::Rhs::from_heap(x),
+        residual,
+    })
+}
+
+/// The Cholesky factor of a stable continuous Lyapunov equation's
+/// solution, from [`lyapchol`], and how well `X = Rᵀ R` satisfies the
+/// equation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LyapunovFactor<R> {
+    /// `R`, upper triangular with a non-negative diagonal, `X = Rᵀ R`
+    /// (MATLAB's `lyapchol` convention).
+    pub factor: R,
+    /// Relative residual of `A X + X Aᵀ + B Bᵀ = 0` at `X = Rᵀ R`, as
+    /// [`Lyapunov::residual`].
+    pub residual: f64,
+}
+
+/// The pairs [`lyapchol`] takes: `A` an `SMatrix<f64, N, N>` and `B` an
+/// `SMatrix<f64, N, M>`, or both `DMatrix<f64>`. Sealed.
+pub trait FactorOperands<B: sealed::Matrix>: SquareMatrix {}
+
+impl<const N: usize, const M: usize> FactorOperands<SMatrix<f64, N, M>> for SMatrix<f64, N, N> {}
+impl FactorOperands<DMatrix<f64>> for DMatrix<f64> {}
+
+/// The Cholesky factor `R` of the solution of `A X + X Aᵀ + B Bᵀ = 0`
+/// for a stable `A` (`X = Rᵀ R`, `R` upper triangular): MATLAB's
+/// `lyapchol(A, B)`; `X` is then the controllability Gramian of `(A, B)`.
+///
+/// Hammarling's method (1982) on the complex Schur form of `A` (the real
+/// one of [`lyap`], each 2×2 block split by a rotation), `O(n³ + n² m)`
+/// for `B` `n × m`: the factor is found directly, without forming `B Bᵀ`
+/// or `X`, so it keeps its accuracy where `X` is nearly singular (a
+/// Gramian of a nearly uncontrollable model), which factoring
+/// [`lyap`]'s `X` would not.
+///
+/// # Errors
+///
+/// [`Error::DimensionMismatch`] for a non-square `A` or a `B` with
+/// another number of rows (run-time sizes only); [`Error::NonFinite`];
+/// [`Error::Unstable`] naming an eigenvalue of `A` with a non-negative
+/// real part, [`Error::SingularEquation`] for a stable one within
+/// rounding of the imaginary axis (as [`lyap`]); [`Error::NoConvergence`] if the Schur iteration fails;
+/// [`Error::Overflow`] if `R` does not fit in `f64`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::analysis::{lyap, lyapchol};
+/// use ctrlab::nalgebra::matrix;
+///
+/// // A lightly damped mode (ωn = 10 rad/s, ζ = 0.3), force input.
+/// let a = matrix![0.0, 1.0; -100.0, -6.0];
+/// let b = matrix![0.0; 1.0];
+/// let r = lyapchol(&a, &b)?;
+/// let x = lyap(&a, &(b * b.transpose()))?.x;
+/// assert!((r.factor.transpose() * r.factor - x).amax() < 1e-15);
+/// assert_eq!(r.factor[(1, 0)], 0.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+#[doc(alias = "hammarling")]
+pub fn lyapchol<A, B>(a: &A, b: &B) -> Result<LyapunovFactor<A>, Error>
+where
+    A: FactorOperands<B>,
+    B: sealed::Matrix,
+{
+    const OPERATION: &str = "Lyapunov factor (lyapchol)";
+    let (a, b) = (a.to_heap(), b.to_heap());
+    let n = a.nrows();
+    check_shape("A", &a, n, n)?;
+    check_shape("B", &b, n, b.ncols())?;
+    check_finite_dyn("A", &a)?;
+    check_finite_dyn("B", &b)?;
+    if n == 0 || b.ncols() == 0 {
+        return Ok(LyapunovFactor {
+            factor: A::from_heap(DMatrix::zeros(n, n)),
+            residual: 0.0,
+        });
+    }
+    // Scaled by 4^k and 2^j (exact): R scales by 2^j / 2^k.
+    let mut alpha = pow2_floor(a.amax());
+    if (alpha.log2() as i64) % 2 != 0 {
+        alpha *= 2.0;
+    }
+    let beta = pow2_floor(b.amax());
+    let (a, b) = (a / alpha, b / beta);
+    let s = schur(&a)?;
+    // (The Schur form's entries are finite.)
+    if let Some(p) = s.eigenvalues.iter().find(|p| p.re >= 0.0) {
+        return Err(Error::Unstable {
+            operation: OPERATION,
+            re: p.re * alpha,
+            im: p.im * alpha,
+        });
+    }
+    if let Some(pair) = singular_pair(&s, &s, Condition::Sum) {
+        return Err(refuse(
+            "continuous Lyapunov equation A X + X Aᵀ + B Bᵀ = 0",
+            "λ + μ = 0",
+            pair,
+            alpha,
+        ));
+    }
+    let r = hammarling::factor(&s, &b);
+    let x = r.transpose() * &r;
+    let bb = &b * b.transpose();
+    let (ax, xat) = (&a * &x, &x * a.transpose());
+    let res = (&ax + &xat + &bb).norm();
+    let residual = relative(res, &[ax.norm(), xat.norm(), bb.norm()]);
+    Ok(LyapunovFactor {
+        factor: A::from_heap(unscale(r, beta, alpha.sqrt(), OPERATION)?),
         residual,
     })
 }
