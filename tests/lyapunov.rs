@@ -201,6 +201,29 @@ fn lyapchol_agrees_with_scipy() {
     println!("lyapchol: largest difference from SciPy {worst:.1e}");
 }
 
+/// A nearly uncontrollable model: modes at −1 and −2 rad/s, the second
+/// driven 1e-10 as hard, seen through a rotation. The Gramian's smallest
+/// eigenvalue is 1e-20 / 36 (its square root 1e-10 / 6), far below the
+/// rounding errors of `X` (about ε ‖X‖ = 1e-16), so no factor of a
+/// computed `X` can hold it; Hammarling's `R` does, to its own rounding
+/// errors relative to the direction (ε ‖R‖ / σ_min ≈ 7e-6; measured
+/// 3.3e-6).
+#[test]
+fn lyapchol_keeps_a_nearly_uncontrollable_direction() {
+    let (c, s) = (0.6, 0.8);
+    let rot = matrix![c, -s; s, c];
+    let a = rot * matrix![-1.0, 0.0; 0.0, -2.0] * rot.transpose();
+    let b = rot * matrix![1.0; 1e-10];
+    let r = lyapchol(&a, &b).unwrap().factor;
+    let sv = r.singular_values();
+    let smallest = sv.min();
+    assert!(
+        (smallest - 1e-10 / 6.0).abs() < 3e-5 * 1e-10 / 6.0,
+        "{smallest:e}"
+    );
+    assert!((sv.max() - 0.5f64.sqrt()).abs() < 1e-14);
+}
+
 #[test]
 fn lyapchol_closed_forms_and_refusals() {
     // a x + x a + b² = 0: x = −b² / (2a), r = |b| / √(−2a).
