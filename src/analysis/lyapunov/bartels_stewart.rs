@@ -297,7 +297,8 @@ pub(super) fn quasi_sylvester(
 /// Solves `S Y Sᵀ − Y + F = 0` in place (`f` becomes `Y`), `S`
 /// quasi-upper-triangular with diagonal blocks `blocks`: the columns of
 /// `Y` block by block from the last, each by back-substitution over the
-/// row blocks (SLICOT's `SB03MX` ordering, `O(N³)` in all).
+/// row blocks (Barraud's 1977 analogue of Bartels–Stewart, `O(N³)` in
+/// all).
 pub(super) fn quasi_stein(s: &DMatrix<f64>, blocks: &[(usize, usize)], f: &mut DMatrix<f64>) {
     let n = s.nrows();
     let mut w = DMatrix::<f64>::zeros(n, 2);

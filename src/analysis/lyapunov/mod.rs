@@ -28,7 +28,7 @@ use bartels_stewart::{Condition, Schur, quasi_stein, quasi_sylvester, schur, sin
 /// at `30 max(n, 10)` iterations, LAPACK's `dlahqr` cap), the
 /// equation rewritten for `Y = Uᵀ X U` with the quasi-triangular `S`, and
 /// `Y` found block by block by back-substitution (LAPACK's `dtrsyl`; for
-/// the discrete equation SLICOT's `SB03MX` ordering), each 1×1 or 2×2
+/// the discrete equation its analogue, Barraud 1977), each 1×1 or 2×2
 /// diagonal block a Kronecker system of at most four unknowns solved by
 /// Gaussian elimination with complete pivoting. `O(N³)` in all, no
 /// unbounded iteration. The data are first scaled by powers of two (exact),
