@@ -2,7 +2,8 @@
 //! [`TransferMatrix`], [`Zpk`]) and their conversions to and from state
 //! space (`ss2tf`, `tf2ss`), invariant zeros, frequency responses
 //! ([`FrequencyResponse`], [`Bode`], [`Nyquist`]), [`stability_margins`]
-//! and [`bandwidth`], and (feature `plot`) Bode and Nyquist figures.
+//! and [`bandwidth`], Padé approximations of a delay ([`pade`]), and
+//! (feature `plot`) Bode and Nyquist figures.
 //!
 //! Units: angular frequencies `ω` in rad/s everywhere (`frequency_hz`
 //! converts to Hz), magnitudes absolute or in dB (`20 log₁₀`), phases in
@@ -40,6 +41,7 @@ mod kernel;
 mod margins;
 mod matrix;
 mod models;
+mod pade;
 mod poly;
 mod response;
 #[cfg(feature = "plot")]
@@ -50,6 +52,7 @@ mod zpk;
 
 pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stability_margins};
 pub use matrix::TransferMatrix;
+pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};
 pub use response::{
     Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
 };
