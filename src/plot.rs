@@ -26,7 +26,7 @@ use plotters::prelude::*;
 mod legend;
 mod ticks;
 
-pub(crate) use legend::{Mark, draw_strip, strip_height};
+pub(crate) use legend::{Mark, titled_with_legend};
 pub(crate) use ticks::Ticked;
 pub use ticks::{Along, Ticks};
 
@@ -372,10 +372,7 @@ pub fn responses_with_references_svg(
     );
     let plot_err = |e| write_error(path, e);
     let root = SVGBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(plot_err)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(plot_err)?;
-    let (legend, plot) = root.split_vertically(strip_height(&entries, SIZE.0, LABEL_FONT));
-    draw_strip(&legend, &entries, LABEL_FONT).map_err(plot_err)?;
+    let plot = titled_with_legend(&root, title, &entries, LABEL_FONT).map_err(plot_err)?;
     let (w, h) = plot.dim_in_pixel();
     let xt = Ticks::linear(
         x0,

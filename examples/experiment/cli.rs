@@ -10,6 +10,8 @@ use ctrlab::lab::protocol::STEP_DURATION;
 use ctrlab::lab::tables::{Experiment, TABLE5, TABLE6};
 use ctrlab::lab::{Cart, LabGains};
 
+use crate::paths::{existing_file, out_dir};
+
 /// One closed-loop experiment of Lab 5, as a student runs it: the lab's
 /// law u = Kf (G r − x_mm) on one cart, from rest to a setpoint. Prints
 /// the metrics (POT, settling time, steady-state error, peak, outcome) and
@@ -209,24 +211,6 @@ fn seconds(s: &str) -> Result<f64, String> {
         ));
     }
     Ok(value)
-}
-
-/// `--out`: a directory, or a path that does not exist yet.
-fn out_dir(s: &str) -> Result<PathBuf, String> {
-    let path = PathBuf::from(s);
-    if path.exists() && !path.is_dir() {
-        return Err(format!("`{s}` exists and is not a directory"));
-    }
-    Ok(path)
-}
-
-/// A file that exists.
-fn existing_file(s: &str) -> Result<PathBuf, String> {
-    let path = PathBuf::from(s);
-    if !path.is_file() {
-        return Err(format!("`{s}` is not a readable file"));
-    }
-    Ok(path)
 }
 
 #[cfg(test)]

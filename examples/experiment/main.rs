@@ -34,6 +34,8 @@
 #[path = "../lab5/card.rs"]
 mod card;
 mod cli;
+#[path = "../lab5/paths.rs"]
+mod paths;
 mod scope;
 
 use std::path::PathBuf;

@@ -8,6 +8,8 @@ use ctrlab::hw::Jitter;
 use ctrlab::lab::ident_input::{IdentInput, IdentSignal};
 use ctrlab::lab::protocol::PERIOD;
 
+use crate::paths::{existing_file, out_dir};
+
 /// The whole of Lab 5 (state feedback control of the two-cart rig): every
 /// table, the identification, validation, frequency response and design,
 /// written to DIR/report.md with its figures and every run's recording.
@@ -193,24 +195,6 @@ fn jitter(s: &str) -> Result<Jitter, String> {
         .validate()
         .map_err(|e| format!("{}: {}", e.key(), e.reason()))?;
     Ok(jitter)
-}
-
-/// `--out`: a directory, or a path that does not exist yet.
-fn out_dir(s: &str) -> Result<PathBuf, String> {
-    let path = PathBuf::from(s);
-    if path.exists() && !path.is_dir() {
-        return Err(format!("`{s}` exists and is not a directory"));
-    }
-    Ok(path)
-}
-
-/// A file that exists.
-fn existing_file(s: &str) -> Result<PathBuf, String> {
-    let path = PathBuf::from(s);
-    if !path.is_file() {
-        return Err(format!("`{s}` is not a readable file"));
-    }
-    Ok(path)
 }
 
 /// A directory that exists.

@@ -102,6 +102,7 @@ mod design;
 mod excitation;
 mod frequency;
 mod identification;
+mod paths;
 mod report;
 mod rig_tables;
 

@@ -15,7 +15,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::plot::{
-    Along, MAX_POINTS, Mark, PlotError, Ticked, Ticks, axis, draw_strip, strip_height, write_error,
+    Along, MAX_POINTS, Mark, PlotError, Ticked, Ticks, axis, titled_with_legend, write_error,
 };
 
 /// The unit of a Bode figure's frequency axis.
@@ -331,10 +331,7 @@ pub fn bode_marked_svg(
         .collect();
     let root = SVGBackend::new(path, (960, 840)).into_drawing_area();
     let err = |e| write_error(path, e);
-    root.fill(&WHITE).map_err(err)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
-    let (legend, panels) = root.split_vertically(strip_height(&entries, 960, FONT));
-    draw_strip(&legend, &entries, FONT).map_err(err)?;
+    let panels = titled_with_legend(&root, title, &entries, FONT).map_err(err)?;
     let half = panels.dim_in_pixel().1 / 2;
     let (top, bottom) = panels.split_vertically(half);
     let mut frame = Frame {
@@ -397,10 +394,7 @@ pub fn nyquist_svg(
     entries.push(("−1", Mark::Cross(RED.to_rgba())));
     let size = crate::plot::SIZE;
     let root = SVGBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
-    let (legend, plot) = root.split_vertically(strip_height(&entries, size.0, FONT));
-    draw_strip(&legend, &entries, FONT).map_err(err)?;
+    let plot = titled_with_legend(&root, title, &entries, FONT).map_err(err)?;
     let (w, h) = plot.dim_in_pixel();
     let xt = Ticks::linear(
         x0,

@@ -51,6 +51,23 @@ pub(crate) fn strip_height(entries: &[(&str, Mark)], width_px: u32, font_px: f64
     (n as f64 * 1.6 * font_px + 0.6 * font_px).ceil() as u32
 }
 
+/// Fills `root` white, writes `title` across its top and draws the legend
+/// strip of `entries` under it; returns the area left for the axes
+/// (`root` is still the one to `present`).
+pub(crate) fn titled_with_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    entries: &[(&str, Mark)],
+    font_px: f64,
+) -> Result<DrawingArea<DB, plotters::coord::Shift>, DrawingAreaErrorKind<DB::ErrorType>> {
+    root.fill(&WHITE)?;
+    let width = root.dim_in_pixel().0;
+    let root = root.titled(title, ("sans-serif", 22))?;
+    let (legend, plot) = root.split_vertically(strip_height(entries, width, font_px));
+    draw_strip(&legend, entries, font_px)?;
+    Ok(plot)
+}
+
 /// Draws the strip in `area` (as tall as [`strip_height`]), entries
 /// centred row by row.
 pub(crate) fn draw_strip<DB: DrawingBackend>(

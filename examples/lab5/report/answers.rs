@@ -49,7 +49,9 @@ impl Report {
             n(SETTLING_NOISE, "s"),
             n(ERROR_NOISE, "mm"),
         ));
+        let model = ident.model();
         for t in rig {
+            let outcomes = t.outcomes();
             for (group, range) in t.table.group_ranges() {
                 let held: String = group
                     .held()
@@ -59,10 +61,9 @@ impl Report {
                 let context = format!("{}{held}, Table {}", group.varied.acts_on(), t.table.number);
                 let from = range.start.min(t.runs.len());
                 let to = range.end.min(t.runs.len());
-                let runs = &t.runs[from..to];
-                let outcomes = t.outcomes();
-                let effect = GroupEffect::of(group, &outcomes[from..to]);
-                lines.push(effect_lines(&context, &effect, runs, t, &ident.model()));
+                let (runs, outcomes) = (&t.runs[from..to], &outcomes[from..to]);
+                let effect = GroupEffect::of(group, outcomes);
+                lines.push(effect_lines(&context, &effect, (runs, outcomes), t, &model));
             }
         }
         let all: Vec<_> = rig
@@ -264,7 +265,7 @@ type Metric = (
 fn effect_lines(
     context: &str,
     e: &GroupEffect,
-    runs: &[(RigRun, Recording)],
+    (runs, outcomes): (&[(RigRun, Recording)], &[RigOutcome]),
     t: &RigTable,
     model: &MassSpring,
 ) -> String {
@@ -409,8 +410,7 @@ fn effect_lines(
             list(&e.not_settled)
         );
     }
-    let outcomes: Vec<RigOutcome> = runs.iter().map(|(r, _)| r.outcome.clone()).collect();
-    s += &format!("\n  - **In short**: {}", conclusion(e, &outcomes));
+    s += &format!("\n  - **In short**: {}", conclusion(e, outcomes));
     s
 }
 

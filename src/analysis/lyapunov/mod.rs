@@ -157,17 +157,7 @@ impl SylvesterOperands<DMatrix<f64>> for DMatrix<f64> {
 #[doc(alias = "solve_continuous_lyapunov")]
 #[doc(alias = "lyapunov")]
 pub fn lyap<M: SquareMatrix>(a: &M, q: &M) -> Result<Lyapunov<M>, Error> {
-    let (a, q) = (a.to_heap(), q.to_heap());
-    let n = a.nrows();
-    check_shape("A", &a, n, n)?;
-    check_shape("Q", &q, n, n)?;
-    check_finite_dyn("A", &a)?;
-    check_finite_dyn("Q", &q)?;
-    let (x, residual) = continuous(&a, &q)?;
-    Ok(Lyapunov {
-        x: M::from_heap(x),
-        residual,
-    })
+    square_equation(a, q, continuous)
 }
 
 /// Discrete Lyapunov (Stein) equation `A X Aᵀ − X + Q = 0`: its solution
@@ -206,13 +196,22 @@ pub fn lyap<M: SquareMatrix>(a: &M, q: &M) -> Result<Lyapunov<M>, Error> {
 #[doc(alias = "solve_discrete_lyapunov")]
 #[doc(alias = "stein")]
 pub fn dlyap<M: SquareMatrix>(a: &M, q: &M) -> Result<Lyapunov<M>, Error> {
+    square_equation(a, q, discrete)
+}
+
+/// A solver on the heap: `(A, Q)` to `(X, relative residual)`.
+type Solver = fn(&DMatrix<f64>, &DMatrix<f64>) -> Result<(DMatrix<f64>, f64), Error>;
+
+/// [`lyap`] and [`dlyap`]: `A` and `Q` checked (square, the same size,
+/// finite), then `solve` on the heap, the solution back in `M`.
+fn square_equation<M: SquareMatrix>(a: &M, q: &M, solve: Solver) -> Result<Lyapunov<M>, Error> {
     let (a, q) = (a.to_heap(), q.to_heap());
     let n = a.nrows();
     check_shape("A", &a, n, n)?;
     check_shape("Q", &q, n, n)?;
     check_finite_dyn("A", &a)?;
     check_finite_dyn("Q", &q)?;
-    let (x, residual) = discrete(&a, &q)?;
+    let (x, residual) = solve(&a, &q)?;
     Ok(Lyapunov {
         x: M::from_heap(x),
         residual,
