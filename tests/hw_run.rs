@@ -680,3 +680,71 @@ fn a_panic_in_the_final_halt_is_an_error_that_keeps_the_recording() {
     }
     assert_eq!(err.recording.len(), 10, "every sample of the run is kept");
 }
+
+/// Real-time settings no Linux thread can take are refused by name before
+/// the loop starts, nothing written to the card: a CPU beyond a CPU set's
+/// 1024 (libc's bounds-checked `CPU_SET` used to abort the process) and a
+/// spin longer than the period (`Duration::MAX` used to overflow the clock).
+#[test]
+fn impossible_real_time_settings_are_refused_by_name_before_the_loop() {
+    use ctrlab::hw::RealTime;
+    use std::time::Duration;
+    let cases = [
+        (
+            "cpu",
+            RealTime {
+                cpu: Some(1024),
+                ..RealTime::default()
+            },
+        ),
+        (
+            "cpu",
+            RealTime {
+                cpu: Some(usize::MAX),
+                ..RealTime::default()
+            },
+        ),
+        (
+            "spin",
+            RealTime {
+                spin: Duration::MAX,
+                ..RealTime::default()
+            },
+        ),
+        (
+            "spin",
+            RealTime {
+                spin: Duration::from_millis(3),
+                ..RealTime::default()
+            },
+        ),
+        (
+            "priority",
+            RealTime {
+                priority: 0,
+                ..RealTime::default()
+            },
+        ),
+    ];
+    for (key, rt) in cases {
+        let (clock, mut rig) = sim_rig(ideal());
+        let cfg = LoopConfig {
+            duration: 0.01,
+            realtime: Some(rt),
+            ..LoopConfig::default()
+        };
+        let err = run(
+            &mut rig,
+            OpenLoop,
+            |_| vector![0.0],
+            &Clock::Virtual(clock),
+            &cfg,
+        )
+        .unwrap_err();
+        match &err.error {
+            RigError::Config(c) => assert_eq!(c.key(), key, "{rt:?}: {}", err.error),
+            other => panic!("{rt:?}: not a configuration error: {other}"),
+        }
+        assert!(err.recording.is_empty(), "{rt:?}: the loop ran");
+    }
+}

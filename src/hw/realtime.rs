@@ -65,6 +65,61 @@ impl Default for RealTime {
     }
 }
 
+/// The CPUs a `cpu_set_t` can name: glibc's `CPU_SETSIZE`.
+const CPU_SET_SIZE: usize = 1024;
+
+impl RealTime {
+    /// Checks the settings against the loop's `period` (s), before
+    /// anything runs: [`run`](super::run) calls it first.
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Invalid`](super::ConfigError::Invalid) naming the
+    /// field: `priority` outside 1–99, `cpu` at or beyond 1024 (what a
+    /// Linux CPU set can name), `spin` longer than the period (the loop
+    /// would never sleep).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::RealTime;
+    /// use std::time::Duration;
+    /// assert!(RealTime::default().validate(0.002).is_ok());
+    /// let bad = RealTime { cpu: Some(1024), ..RealTime::default() };
+    /// assert_eq!(bad.validate(0.002).unwrap_err().key(), "cpu");
+    /// let bad = RealTime { spin: Duration::MAX, ..RealTime::default() };
+    /// assert_eq!(bad.validate(0.002).unwrap_err().key(), "spin");
+    /// ```
+    pub fn validate(&self, period: f64) -> Result<(), super::ConfigError> {
+        use super::ConfigError;
+        if !(1..=99).contains(&self.priority) {
+            return Err(ConfigError::invalid(
+                "priority",
+                f64::from(self.priority),
+                "SCHED_FIFO priority must be within 1–99",
+            ));
+        }
+        if let Some(cpu) = self.cpu
+            && cpu >= CPU_SET_SIZE
+        {
+            return Err(ConfigError::invalid(
+                "cpu",
+                cpu as f64,
+                "must be below 1024, the CPUs a Linux CPU set can name",
+            ));
+        }
+        // Compared in seconds: Duration::MAX is finite as f64 (1.8e19 s).
+        if self.spin.as_secs_f64() > period {
+            return Err(ConfigError::invalid(
+                "spin",
+                self.spin.as_secs_f64(),
+                "must be at most the loop's period (s): the loop would never sleep",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// What [`enter`] changed, restored on drop.
 #[derive(Debug)]
 pub(crate) struct Guard {
@@ -110,7 +165,7 @@ pub(crate) fn enter(rt: &RealTime) -> Result<Guard, RigError> {
     };
     if let Some(cpu) = rt.cpu {
         // SAFETY: cpu_set_t is plain data; CPU_ZERO/CPU_SET write within it
-        // (CPU_SET ignores a cpu beyond its bit count); sched_[gs]etaffinity
+        // (CPU_SET only for a cpu within its bit count); sched_[gs]etaffinity
         // read and write exactly size_of::<cpu_set_t>() bytes of sets we own.
         let applied = unsafe {
             let mut old: libc::cpu_set_t = std::mem::zeroed();
@@ -118,8 +173,13 @@ pub(crate) fn enter(rt: &RealTime) -> Result<Guard, RigError> {
             let ok = libc::sched_getaffinity(0, size, &mut old) == 0;
             let mut set: libc::cpu_set_t = std::mem::zeroed();
             libc::CPU_ZERO(&mut set);
-            libc::CPU_SET(cpu, &mut set);
-            if ok && cpu < 8 * size && libc::sched_setaffinity(0, size, &set) == 0 {
+            // libc's CPU_SET indexes a fixed array and panics past its end,
+            // which cannot unwind out of this thread: check first.
+            let fits = cpu < 8 * size;
+            if fits {
+                libc::CPU_SET(cpu, &mut set);
+            }
+            if ok && fits && libc::sched_setaffinity(0, size, &set) == 0 {
                 Some(old)
             } else {
                 None
@@ -188,7 +248,8 @@ impl Drop for Guard {
 /// clock `Instant` reads), so a late wake-up does not shift later ticks.
 pub(crate) fn sleep_until(deadline: Instant, spin: Duration) {
     let now = Instant::now();
-    if deadline > now + spin {
+    // checked: a spin as long as Duration::MAX must not overflow the clock.
+    if now.checked_add(spin).is_some_and(|wake| deadline > wake) {
         sleep_absolute(deadline - spin, now);
     }
     while Instant::now() < deadline {

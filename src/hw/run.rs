@@ -267,6 +267,9 @@ where
                 "must be at least the rig's period (half the watchdog timeout by default)",
             ));
         }
+        if let Some(rt) = &config.realtime {
+            rt.validate(period)?;
+        }
         Ok(ticks)
     });
     let realtime = match (checked, &config.realtime) {
