@@ -4,6 +4,8 @@
 //! modules built on them). Every variant carries the context needed to act on it:
 //! which parameter, which matrix entry, which operation.
 
+use crate::readable::Readable;
+
 /// Everything that can go wrong in `ctrlab`'s numeric code.
 ///
 /// The enum is `#[non_exhaustive]`: later releases add variants without a
@@ -25,7 +27,7 @@
 pub enum Error {
     /// A scalar parameter is out of its valid range (a non-positive mass, a
     /// negative spring, a non-positive time step, …).
-    #[error("invalid parameter `{name}` = {value}: {reason}")]
+    #[error("invalid parameter `{name}` = {}: {reason}", Readable(*.value))]
     InvalidParameter {
         /// The parameter's name as it appears in the API (`"m1"`, `"dt"`, …).
         name: &'static str,
@@ -35,7 +37,7 @@ pub enum Error {
         reason: &'static str,
     },
     /// A matrix handed to a constructor has a NaN or infinite entry.
-    #[error("matrix {matrix} has a non-finite entry {value} at row {row}, column {col}")]
+    #[error("matrix {matrix} has a non-finite entry {} at row {row}, column {col}", Readable(*.value))]
     NonFinite {
         /// Which matrix (`"A"`, `"B"`, `"C"`, `"D"`).
         matrix: &'static str,
@@ -106,7 +108,7 @@ pub enum Error {
     },
     /// A model is unstable where a stable one is needed (step metrics of a
     /// model, a Riccati solution that does not stabilise).
-    #[error("{operation}: unstable pole {re} + {im}i")]
+    #[error("{operation}: unstable pole {} + {}i", Readable(*.re), Readable(*.im))]
     Unstable {
         /// The operation that needed stability.
         operation: &'static str,

@@ -162,6 +162,7 @@ pub mod nalgebra;
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
 pub mod plot;
 pub mod prelude;
+mod readable;
 pub mod signal;
 pub mod sim;
 

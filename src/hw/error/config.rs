@@ -1,5 +1,7 @@
 //! [`ConfigError`]: a configuration value is invalid, named by its key.
 
+use crate::readable::Readable;
+
 /// The category of a [`ConfigError`].
 ///
 /// `#[non_exhaustive]`: match with a wildcard arm.
@@ -47,7 +49,7 @@ pub enum ConfigErrorKind {
 #[non_exhaustive]
 pub enum ConfigError {
     /// A value outside what it may be on its own.
-    #[error("invalid configuration `{key}` = {value}: {reason}")]
+    #[error("invalid configuration `{key}` = {}: {reason}", Readable(*.value))]
     Invalid {
         /// The field's key (see [`ConfigError`]).
         key: String,
@@ -57,7 +59,7 @@ pub enum ConfigError {
         reason: &'static str,
     },
     /// A value that clashes with another setting (named in the reason).
-    #[error("conflicting configuration `{key}` = {value}: {reason}")]
+    #[error("conflicting configuration `{key}` = {}: {reason}", Readable(*.value))]
     Conflict {
         /// The field's key (see [`ConfigError`]): of two that clash, the
         /// one checked last.

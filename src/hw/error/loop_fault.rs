@@ -1,5 +1,7 @@
 //! [`LoopFault`]: what the control loop halted the rig for.
 
+use crate::readable::Readable;
+
 /// The category of a [`LoopFault`].
 ///
 /// `#[non_exhaustive]`: match with a wildcard arm.
@@ -56,7 +58,7 @@ pub enum LoopFaultKind {
 pub enum LoopFault {
     /// A moving part (an axis: one of the lab's carts) left its software
     /// travel limit; the rig was halted first.
-    #[error("axis {axis} at {position} m is beyond its travel limit ±{limit} m; rig halted")]
+    #[error("axis {axis} at {} m is beyond its travel limit ±{} m; rig halted", Readable(*.position), Readable(*.limit))]
     TravelLimit {
         /// Which axis, counted from 1 (the lab: cart 1 or 2).
         axis: usize,
@@ -68,7 +70,8 @@ pub enum LoopFault {
     /// Too many timing faults (overruns and skipped deadlines) within a
     /// window of time.
     #[error(
-        "control loop lost its timing: {faults} timing faults (overruns or skipped deadlines) within {window} s at t = {at:.4} s, period {period} s; rig halted"
+        "control loop lost its timing: {faults} timing faults (overruns or skipped deadlines) within {} s at t = {at:.4} s, period {} s; rig halted",
+        Readable(*.window), Readable(*.period)
     )]
     TimingFaults {
         /// Faults counted in the window when the loop gave up.
@@ -85,7 +88,8 @@ pub enum LoopFault {
     /// with a stale command; without a watchdog, nothing would stop a motor
     /// left at its last command.
     #[error(
-        "{what} took {gap:.4} s at t = {at:.4} s, longer than the {limit:.4} s allowed (half the watchdog timeout, 25 periods on a card without one, or `LoopConfig::max_gap`); rig halted"
+        "{what} took {gap:.4} s at t = {at:.4} s, longer than the {} s allowed (half the watchdog timeout, 25 periods on a card without one, or `LoopConfig::max_gap`); rig halted",
+        Readable(*.limit)
     )]
     Gap {
         /// What took too long (`"the interval between two samples"`,
@@ -122,7 +126,8 @@ pub enum LoopFault {
     /// An encoder moved further in one sample than the rig can physically
     /// move: a bus or counter fault (a flipped bit), not a measurement.
     #[error(
-        "bus fault: encoder {channel} implies {speed:.3} m/s (limit {limit} m/s): {counts} counts in {interval:.4} s; rig halted"
+        "bus fault: encoder {channel} implies {speed:.3} m/s (limit {} m/s): {counts} counts in {interval:.4} s; rig halted",
+        Readable(*.limit)
     )]
     BusFault {
         /// The encoder channel.
@@ -175,7 +180,8 @@ pub enum LoopFault {
     /// that cannot reach its reference, or a measurement that is wrong,
     /// pushing with everything it has.
     #[error(
-        "the drive stayed at its limit (±{volts} V) for {seconds:.3} s, the {limit} s allowed (calibration `max_saturation_time`): the controller cannot reach its reference or a measurement is wrong; rig halted"
+        "the drive stayed at its limit (±{} V) for {seconds:.3} s, the {} s allowed (calibration `max_saturation_time`): the controller cannot reach its reference or a measurement is wrong; rig halted",
+        Readable(*.volts), Readable(*.limit)
     )]
     Saturated {
         /// The drive's limit, V (magnitude).

@@ -1,5 +1,6 @@
 //! [`PortError`]: talking to the card failed or was refused.
 
+use crate::readable::Readable;
 use std::fmt;
 
 /// Which of the three EPP primitives a failed cycle was.
@@ -133,7 +134,7 @@ pub enum PortError {
     },
     /// A command is out of range or not finite: the driver refuses it
     /// (nothing is written).
-    #[error("invalid {what}{}: {value} (limit {limit})", channel_suffix(*.channel))]
+    #[error("invalid {what}{}: {} (limit {})", channel_suffix(*.channel), Readable(*.value), Readable(*.limit))]
     InvalidCommand {
         /// What was commanded (`"voltage"`, `"PWM duty"`, `"PWM channel"`, …).
         what: &'static str,

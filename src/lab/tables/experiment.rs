@@ -4,6 +4,7 @@
 //! ([`GainTable::experiment`]), so a row run alone and the same row run in
 //! the batch go through the same controller, reference and metrics.
 
+use crate::readable::Readable;
 use std::fmt;
 
 use nalgebra::SVector;
@@ -106,7 +107,7 @@ pub struct Experiment {
 #[non_exhaustive]
 pub enum ExperimentError {
     /// A gain is NaN or infinite.
-    #[error("{name} = {value} is not a finite number")]
+    #[error("{name} = {} is not a finite number", Readable(*.value))]
     Gain {
         /// `"Kf1"` … `"Kf4"`, `"G1"` … `"G4"`.
         name: String,
@@ -116,7 +117,7 @@ pub enum ExperimentError {
     /// The setpoint is not finite, or beyond [`TRAVEL_FRACTION`] of the
     /// cart's travel limit.
     #[error(
-        "setpoint {setpoint_mm} mm is not within ±{max_mm} mm, 60 % of cart {cart}'s travel (±{limit_mm} mm): the response overshoots, and the rig halts at its travel limit"
+        "setpoint {} mm is not within ±{max_mm} mm, 60 % of cart {cart}'s travel (±{limit_mm} mm): the response overshoots, and the rig halts at its travel limit", Readable(*.setpoint_mm)
     )]
     Setpoint {
         /// The cart, 1 or 2.
@@ -129,7 +130,7 @@ pub enum ExperimentError {
         limit_mm: f64,
     },
     /// The duration is not finite, not positive, or above [`MAX_DURATION`].
-    #[error("duration {0} s must be > 0 and at most {MAX_DURATION} s")]
+    #[error("duration {} s must be > 0 and at most {MAX_DURATION} s", Readable(*.0))]
     Duration(f64),
 }
 

@@ -1,0 +1,50 @@
+//! Error messages print numbers readably: an extreme value as `1e300`, not
+//! its 301 digits (issue 28: `Chirp::new(1, 1, 1e300, 1, Linear)`'s message
+//! was 398 characters, lab5's `max_gap = 0.000…` 300 digits).
+
+use ctrlab::signal::{Chirp, Sweep};
+
+/// Every message here names its number in at most this many characters
+/// (the longest, the loop's configuration conflict, is ~110).
+const SHORT: usize = 160;
+
+#[test]
+fn a_sweep_over_too_many_cycles_names_its_frequency_in_exponent_form() {
+    let message = Chirp::new(1.0, 1.0, 1e300, 1.0, Sweep::Linear)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("`f1` = 1e300"), "{message}");
+    assert!(message.len() <= SHORT, "{} characters: {message}", message.len());
+}
+
+#[test]
+fn a_tiny_parameter_is_not_printed_as_zeros() {
+    let message = Chirp::new(1.0, 1e-300, 1.0, -1.0, Sweep::Linear)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("`duration` = -1"), "{message}");
+    let message = Chirp::new(1.0, -1e-300, 1.0, 1.0, Sweep::Linear)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("-1e-300"), "{message}");
+    assert!(message.len() <= SHORT, "{message}");
+}
+
+#[cfg(feature = "lab")]
+#[test]
+fn a_gap_limit_of_1e_300_reads_as_1e_300() {
+    use ctrlab::OpenLoop;
+    use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
+    use ctrlab::lab::SimulatedRig;
+    use nalgebra::vector;
+    let clock = VirtualClock::new();
+    let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone())).unwrap();
+    let cfg = LoopConfig {
+        max_gap: Some(1e-300),
+        ..LoopConfig::default()
+    };
+    let err = run(rig, OpenLoop, |_| vector![0.0], &Clock::Virtual(clock), &cfg).unwrap_err();
+    let message = err.error.to_string();
+    assert!(message.contains("`max_gap` = 1e-300"), "{message}");
+    assert!(message.len() <= SHORT, "{} characters: {message}", message.len());
+}
