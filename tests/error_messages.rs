@@ -14,7 +14,11 @@ fn a_sweep_over_too_many_cycles_names_its_frequency_in_exponent_form() {
         .unwrap_err()
         .to_string();
     assert!(message.contains("`f1` = 1e300"), "{message}");
-    assert!(message.len() <= SHORT, "{} characters: {message}", message.len());
+    assert!(
+        message.len() <= SHORT,
+        "{} characters: {message}",
+        message.len()
+    );
 }
 
 #[test]
@@ -38,13 +42,26 @@ fn a_gap_limit_of_1e_300_reads_as_1e_300() {
     use ctrlab::lab::SimulatedRig;
     use nalgebra::vector;
     let clock = VirtualClock::new();
-    let rig = SimulatedRig::default().rig(&Clock::Virtual(clock.clone())).unwrap();
+    let rig = SimulatedRig::default()
+        .rig(&Clock::Virtual(clock.clone()))
+        .unwrap();
     let cfg = LoopConfig {
         max_gap: Some(1e-300),
         ..LoopConfig::default()
     };
-    let err = run(rig, OpenLoop, |_| vector![0.0], &Clock::Virtual(clock), &cfg).unwrap_err();
+    let err = run(
+        rig,
+        OpenLoop,
+        |_| vector![0.0],
+        &Clock::Virtual(clock),
+        &cfg,
+    )
+    .unwrap_err();
     let message = err.error.to_string();
     assert!(message.contains("`max_gap` = 1e-300"), "{message}");
-    assert!(message.len() <= SHORT, "{} characters: {message}", message.len());
+    assert!(
+        message.len() <= SHORT,
+        "{} characters: {message}",
+        message.len()
+    );
 }

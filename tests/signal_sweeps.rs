@@ -150,7 +150,74 @@ fn bad_multisines_and_chirps_are_refused_by_name() {
     assert_eq!(name(chirp(1.0, 2.0, -1.0).unwrap_err()), "duration");
 }
 
+/// Issue 28: a logarithmic sweep from 1e-300 Hz to 1e10 Hz was accepted
+/// and NaN everywhere (`f1 / f0` overflows). Its phase is the closed form
+/// `2π T (f(t) − f0) / ln(f1 / f0)` with `f(t) = f0 (f1 / f0)^(t/T)`.
+#[test]
+fn a_sweep_over_310_decades_is_finite_and_follows_its_closed_form() {
+    let (f0, f1, big_t) = (1e-300, 1e10, 1.0);
+    let c = Chirp::new(1.0, f0, f1, big_t, Sweep::Logarithmic).unwrap();
+    let ln_k = 10.0 * 10f64.ln() + 300.0 * 10f64.ln();
+    for t in [0.0, 1e-3, 0.5, 0.9, 0.999, 1.0] {
+        let f = 10f64.powf(-300.0 + 310.0 * t / big_t);
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(f64::MIN_POSITIVE);
+        assert!(
+            rel(c.frequency(t), f) < 1e-12,
+            "f({t}) = {}, expected {f}",
+            c.frequency(t)
+        );
+        let phase = std::f64::consts::TAU * big_t * (f - f0) / ln_k;
+        assert!(
+            rel(c.phase(t), phase) < 1e-12 || c.phase(t) == phase,
+            "φ({t}) = {}, expected {phase}",
+            c.phase(t)
+        );
+        assert!(c.value(t).is_finite());
+    }
+}
+
+/// Issue 28: a multisine with a period of 1e308 was NaN at 5e307
+/// (`2π t` overflows before the division by the period).
+#[test]
+fn a_multisine_with_a_period_near_f64_max_is_its_cosine() {
+    let ms = Multisine::new(1.0, 1e308, [1], Phases::Schroeder).unwrap();
+    // Half a period: cos(π + φ1), with Schroeder's φ1 = 0.
+    assert!((ms.value(5e307) + 1.0).abs() < 1e-12, "{}", ms.value(5e307));
+    assert!((ms.value(0.0) - 1.0).abs() < 1e-15);
+}
+
+/// Positive frequencies from 1e-300 to 1e300 Hz, log-uniform.
+fn frequency() -> impl Strategy<Value = f64> {
+    (-300.0f64..300.0).prop_map(|e| 10f64.powf(e))
+}
+
 proptest! {
+    /// Over the whole range of f64: a sweep is refused or finite everywhere.
+    #[test]
+    fn any_accepted_sweep_is_finite(
+        f0 in frequency(), f1 in frequency(), d in frequency(), log in any::<bool>(),
+        s in 0.0f64..=1.0,
+    ) {
+        let sweep = if log { Sweep::Logarithmic } else { Sweep::Linear };
+        if let Ok(c) = Chirp::new(1.0, f0, f1, d, sweep) {
+            let t = s * d;
+            prop_assert!(c.value(t).is_finite(), "value({t})");
+            prop_assert!(c.phase(t).is_finite() && c.frequency(t).is_finite(), "phase/frequency({t})");
+            let (lo, hi) = (f0.min(f1), f0.max(f1));
+            let f = c.frequency(t);
+            prop_assert!(f >= lo * (1.0 - 1e-12) && f <= hi * (1.0 + 1e-12), "f({t}) = {f} outside [{lo}, {hi}]");
+        }
+    }
+
+    /// Periods from 1e-300 to 1e300 s: an accepted multisine is finite.
+    #[test]
+    fn any_accepted_multisine_is_finite(p in frequency(), s in 0.0f64..4.0, first in 1u32..100) {
+        if let Ok(ms) = Multisine::new(1.0, p, [first, first + 1], Phases::Schroeder) {
+            prop_assert!(ms.value(s * p).is_finite());
+            prop_assert!(ms.peak().is_finite());
+        }
+    }
+
     #[test]
     fn chirps_are_finite_and_bounded_everywhere(
         a in -1e6f64..1e6, f0 in 0.0f64..1e3, f1 in 1e-3f64..1e3, d in 1e-3f64..1e4,

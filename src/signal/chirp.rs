@@ -156,12 +156,24 @@ impl Chirp {
         match self.sweep {
             Sweep::Linear => TAU * t * (f0 + (f1 - f0) * t / (2.0 * big_t)),
             Sweep::Logarithmic => {
-                let ln_k = (f1 / f0).ln();
-                if ln_k == 0.0 {
+                let k = f1 / f0;
+                if k == 1.0 {
                     TAU * f0 * t
-                } else {
+                } else if k.is_finite() && k > 0.0 {
                     // k^(t/T) − 1 through exp_m1, exact as k → 1.
+                    let ln_k = k.ln();
                     TAU * f0 * big_t * (ln_k * t / big_t).exp_m1() / ln_k
+                } else {
+                    // f1 / f0 beyond f64 (1e-300 Hz to 1e10 Hz): the same
+                    // phase, T (f(t) − f0) / ln k, from logarithms.
+                    let ln_k = f1.ln() - f0.ln();
+                    let x = ln_k * t / big_t;
+                    let grown = if x.abs() < 1.0 {
+                        f0 * x.exp_m1()
+                    } else {
+                        (f0.ln() + x).exp() - f0
+                    };
+                    TAU * big_t * grown / ln_k
                 }
             }
         }
@@ -184,7 +196,15 @@ impl Chirp {
         let s = t / self.duration;
         match self.sweep {
             Sweep::Linear => self.f0 + (self.f1 - self.f0) * s,
-            Sweep::Logarithmic => self.f0 * (self.f1 / self.f0).powf(s),
+            Sweep::Logarithmic => {
+                let k = self.f1 / self.f0;
+                if k.is_finite() && k > 0.0 {
+                    self.f0 * k.powf(s)
+                } else {
+                    // f1 / f0 beyond f64: interpolate the logarithms.
+                    (self.f0.ln() * (1.0 - s) + self.f1.ln() * s).exp()
+                }
+            }
         }
     }
 

@@ -282,7 +282,8 @@ impl Signal for Multisine {
         } else {
             0.0
         };
-        let w = TAU * t / self.period;
+        // t / period first: TAU t overflows for a period near f64::MAX.
+        let w = TAU * (t / self.period);
         let sum: f64 = self
             .harmonics
             .iter()
