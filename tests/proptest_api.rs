@@ -174,9 +174,14 @@ proptest! {
     fn sampled_simulation(
         a in matrix::<2, 2>(finite()), period in wild(), duration in wild(), max_substep in wild(),
         delay in wild(), gain in wild(), reference in wild(),
+        saturation in wild(), input_q in wild(), q in wild(), noise in wild(),
     ) {
         let Ok(plant) = StateSpace::continuous(a, SMatrix::<f64, 2, 1>::from_element(1.0), SMatrix::<f64, 1, 2>::from_element(1.0), SMatrix::zeros()) else { return Ok(()) };
-        let config = SampledConfig::<1, 2> { max_substep, input_delay: delay, ..SampledConfig::new(period, duration) };
+        let config = SampledConfig::<1, 2> {
+            max_substep, input_delay: delay, saturation: [saturation], input_quantisation: [input_q],
+            quantisation: [q, q], noise: [noise, 0.0],
+            ..SampledConfig::new(period, duration)
+        };
         // Bounded work: at most 2000 periods and 64 sub-steps each.
         let Ok(n) = config.validate() else { return Ok(()) };
         if n > 2000 || period / max_substep > 64.0 { return Ok(()) }
@@ -186,6 +191,9 @@ proptest! {
             for ch in ["u", "y1", "y2"] {
                 prop_assert!(finite_all(rec.channel(ch).unwrap()));
             }
+            // The docs' promise: |u| within the saturation, to rounding.
+            let u_max = rec.channel("u").unwrap().iter().fold(0.0f64, |m, u| m.max(u.abs()));
+            prop_assert!(u_max <= saturation * (1.0 + 1e-12), "|u| = {u_max} > {saturation}");
         }
     }
 

@@ -98,7 +98,8 @@ pub struct SampledConfig<const M: usize, const P: usize> {
     /// `f64::INFINITY` for none).
     pub saturation: [f64; M],
     /// Resolution of each input after saturation (a PWM duty step in
-    /// volts), `u ← q round(u / q)` (≥ 0; 0 for none).
+    /// volts), `u ← q round(u / q)` (≥ 0; 0 for none), kept within the
+    /// saturation (to rounding): a step that rounds past it is taken back.
     pub input_quantisation: [f64; M],
     /// Resolution of each measurement, `y ← q round(y / q)` (≥ 0; 0 for
     /// none), applied after the noise.
@@ -274,7 +275,8 @@ impl<const M: usize, const P: usize> SampledConfig<M, P> {
 /// `"x0"` for a non-finite initial state, `"period"` when the controller was
 /// designed for another period ([`Controller::period`]), `"input"` for a
 /// non-finite controller output or `"reference"` for a non-finite
-/// reference (with the value); [`Error::Overflow`] when the plant's state
+/// reference, `"measurement"` for a non-finite measurement from the
+/// sensor (with the value); [`Error::Overflow`] when the plant's state
 /// stops being finite (it diverged).
 ///
 /// # Examples
@@ -342,14 +344,18 @@ where
     for k in 0..samples {
         let t = k as f64 * period;
         let mut y = sensor.measure(t, &x);
+        if let Some(&v) = y.iter().find(|v| !v.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "measurement",
+                value: v,
+                reason: "the sensor's measurement must be finite",
+            });
+        }
         for i in 0..P {
             if config.noise[i] > 0.0 {
                 y[i] += config.noise[i] * rng.gaussian();
             }
-            let q = config.quantisation[i];
-            if q > 0.0 {
-                y[i] = q * (y[i] / q).round();
-            }
+            y[i] = quantise(y[i], config.quantisation[i]);
         }
         let r = reference(t);
         if let Some(&v) = r.iter().find(|v| !v.is_finite()) {
@@ -369,11 +375,8 @@ where
                 });
             }
             let limit = config.saturation[i];
-            u[i] = u[i].clamp(-limit, limit);
             let q = config.input_quantisation[i];
-            if q > 0.0 {
-                u[i] = q * (u[i] / q).round();
-            }
+            u[i] = quantise_within(u[i].clamp(-limit, limit), q, limit);
         }
         controller.applied(&u);
         recording.push_vectors(t, &u, &y)?;
@@ -396,6 +399,33 @@ where
         }
     }
     Ok(recording)
+}
+
+/// `v` on the grid of step `q` (`q round(v / q)`; `q = 0` for none). When
+/// `v / q` overflows (a step of 1e-310) the grid is finer than f64 at `v`,
+/// and `v` is on it.
+fn quantise(v: f64, q: f64) -> f64 {
+    let steps = (v / q).round();
+    if q > 0.0 && steps.is_finite() {
+        q * steps
+    } else {
+        v
+    }
+}
+
+/// [`quantise`], one step back toward 0 when rounding steps past `limit`
+/// (±1 in steps of 0.4 rounds 1 to 1.2, and applies 0.8). The product's own
+/// rounding (0.1 × 3 = 0.30000000000000004 for a limit of 0.3) is not a step.
+fn quantise_within(v: f64, q: f64, limit: f64) -> f64 {
+    let steps = (v / q).round();
+    if !(q > 0.0 && steps.is_finite()) {
+        return v;
+    }
+    if (q * steps).abs() > limit * (1.0 + 1e-12) {
+        q * (steps - steps.signum())
+    } else {
+        q * steps
+    }
 }
 
 /// Integrates `plant` over `[t, t + span]` with the input `u` held, in equal
