@@ -445,7 +445,7 @@ fn file_round_trip_and_writer_refusals() {
 
 #[test]
 fn from_columns_refuses_inconsistent_columns() {
-    let schema = Schema::numbered(1, 2);
+    let schema = Schema::numbered(1, 2).unwrap();
     let t = vec![0.0, 0.1, 0.2];
     let ok = Recording::from_columns(
         schema.clone(),

@@ -45,7 +45,7 @@ pub use self::csv::{CsvError, CsvErrorKind, CsvOptions, KNOWN_UNITS};
 ///
 /// ```
 /// # use ctrlab::data::{MAX_JITTER, Recording, Schema};
-/// let mut rec = Recording::new(Schema::numbered(1, 1));
+/// let mut rec = Recording::new(Schema::numbered(1, 1)?);
 /// for k in 0..10 {
 ///     rec.push(k as f64 * 0.002, &[0.0], &[0.0])?;
 /// }
@@ -56,6 +56,19 @@ pub use self::csv::{CsvError, CsvErrorKind, CsvOptions, KNOWN_UNITS};
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub const MAX_JITTER: f64 = 0.01;
+
+/// The most channels [`Schema::numbered`] makes: far above any rig's
+/// (the lab's has 5), far below what would exhaust memory.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::data::{MAX_CHANNELS, Schema};
+/// assert!(Schema::numbered(MAX_CHANNELS, 1).is_err());
+/// assert!(Schema::numbered(1 << 40, 0).is_err());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
+pub const MAX_CHANNELS: usize = 1 << 16;
 
 /// One recorded signal's name and unit.
 ///
@@ -115,10 +128,11 @@ impl std::fmt::Display for Channel {
 /// ```
 /// use ctrlab::data::{Channel, Schema};
 ///
-/// let s = Schema::numbered(1, 2);
+/// let s = Schema::numbered(1, 2)?;
 /// assert_eq!(s.inputs()[0].name, "u");
 /// assert_eq!(s.measurements()[1].name, "y2");
 /// assert!(Schema::new(vec![Channel::new("u", "V")], vec![Channel::new("u", "m")]).is_err());
+/// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Schema {
@@ -150,8 +164,8 @@ impl Schema {
             name: name.to_string(),
             reason: reason.to_string(),
         };
-        let all: Vec<&Channel> = inputs.iter().chain(&measurements).collect();
-        for (i, c) in all.iter().enumerate() {
+        let mut seen = std::collections::HashSet::with_capacity(inputs.len() + measurements.len());
+        for c in inputs.iter().chain(&measurements) {
             if c.name.is_empty() {
                 return Err(bad(&c.name, "a channel needs a name"));
             }
@@ -168,7 +182,8 @@ impl Schema {
                     "names and units cannot hold , ; \" [ ] or control characters",
                 ));
             }
-            if all[..i].iter().any(|d| d.name == c.name) {
+            // A set, not a scan of the names before: linear in the channels.
+            if !seen.insert(c.name.as_str()) {
                 return Err(bad(&c.name, "the name is used twice"));
             }
         }
@@ -186,11 +201,41 @@ impl Schema {
     ///
     /// ```
     /// # use ctrlab::data::Schema;
-    /// let s = Schema::numbered(2, 1);
+    /// let s = Schema::numbered(2, 1)?;
     /// let names: Vec<_> = s.channels().map(|c| c.name.as_str()).collect();
     /// assert_eq!(names, ["u1", "u2", "y"]);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
-    pub fn numbered(m: usize, p: usize) -> Self {
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] named `"channels"` for more than
+    /// [`MAX_CHANNELS`] channels in all (1 << 40 of them would exhaust
+    /// memory).
+    pub fn numbered(m: usize, p: usize) -> Result<Self, Error> {
+        match m.checked_add(p) {
+            Some(n) if n <= MAX_CHANNELS => Ok(Self::numbered_within(m, p)),
+            _ => Err(Error::InvalidParameter {
+                name: "channels",
+                value: m as f64 + p as f64,
+                reason: "more inputs and measurements than data::MAX_CHANNELS",
+            }),
+        }
+    }
+
+    /// [`numbered`](Self::numbered) for sizes known small: the const
+    /// generic `M`, `P` of a model or rig, checked at compile time.
+    pub(crate) fn numbered_const<const M: usize, const P: usize>() -> Self {
+        const {
+            assert!(
+                M + P <= MAX_CHANNELS,
+                "more channels than data::MAX_CHANNELS"
+            )
+        };
+        Self::numbered_within(M, P)
+    }
+
+    fn numbered_within(m: usize, p: usize) -> Self {
         let names = |prefix: &str, n: usize| -> Vec<Channel> {
             if n == 1 {
                 vec![Channel::new(prefix, "")]
@@ -212,7 +257,8 @@ impl Schema {
     ///
     /// ```
     /// # use ctrlab::data::Schema;
-    /// assert_eq!(Schema::numbered(3, 0).inputs().len(), 3);
+    /// assert_eq!(Schema::numbered(3, 0)?.inputs().len(), 3);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn inputs(&self) -> &[Channel] {
         &self.inputs
@@ -224,7 +270,8 @@ impl Schema {
     ///
     /// ```
     /// # use ctrlab::data::Schema;
-    /// assert_eq!(Schema::numbered(1, 4).measurements()[3].name, "y4");
+    /// assert_eq!(Schema::numbered(1, 4)?.measurements()[3].name, "y4");
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn measurements(&self) -> &[Channel] {
         &self.measurements
@@ -236,7 +283,8 @@ impl Schema {
     ///
     /// ```
     /// # use ctrlab::data::Schema;
-    /// assert_eq!(Schema::numbered(1, 1).channels().count(), 2);
+    /// assert_eq!(Schema::numbered(1, 1)?.channels().count(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn channels(&self) -> impl Iterator<Item = &Channel> {
         self.inputs.iter().chain(&self.measurements)
@@ -248,7 +296,8 @@ impl Schema {
     ///
     /// ```
     /// # use ctrlab::data::Schema;
-    /// assert_eq!(Schema::numbered(1, 4).len(), 5);
+    /// assert_eq!(Schema::numbered(1, 4)?.len(), 5);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn len(&self) -> usize {
         self.inputs.len() + self.measurements.len()
@@ -260,7 +309,8 @@ impl Schema {
     ///
     /// ```
     /// # use ctrlab::data::Schema;
-    /// assert!(Schema::numbered(0, 0).is_empty());
+    /// assert!(Schema::numbered(0, 0)?.is_empty());
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_empty(&self) -> bool {
         self.len() == 0
@@ -272,8 +322,9 @@ impl Schema {
     ///
     /// ```
     /// # use ctrlab::data::Schema;
-    /// assert_eq!(Schema::numbered(1, 2).position("y2"), Some(2));
-    /// assert_eq!(Schema::numbered(1, 2).position("x"), None);
+    /// assert_eq!(Schema::numbered(1, 2)?.position("y2"), Some(2));
+    /// assert_eq!(Schema::numbered(1, 2)?.position("x"), None);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn position(&self, name: &str) -> Option<usize> {
         self.channels().position(|c| c.name == name)
@@ -301,7 +352,7 @@ impl Schema {
 /// use ctrlab::data::{Recording, Schema};
 /// use ctrlab::nalgebra::vector;
 ///
-/// let mut rec = Recording::with_capacity(Schema::numbered(1, 2), 2);
+/// let mut rec = Recording::with_capacity(Schema::numbered(1, 2)?, 2);
 /// rec.push_vectors(0.0, &vector![1.0], &vector![0.0, 0.0])?;
 /// rec.push_vectors(0.002, &vector![1.0], &vector![0.001, 0.002])?;
 /// assert_eq!(rec.len(), 2);
@@ -325,28 +376,39 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let rec = Recording::new(Schema::numbered(1, 1));
+    /// let rec = Recording::new(Schema::numbered(1, 1)?);
     /// assert!(rec.is_empty());
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn new(schema: Schema) -> Self {
         Self::with_capacity(schema, 0)
     }
 
     /// An empty recording of `schema` with room for `n` samples in every
-    /// column, so that pushing the first `n` does not allocate.
+    /// column, so that pushing the first `n` does not allocate. `n` is a
+    /// hint: room the allocator refuses (`usize::MAX` samples) is not
+    /// reserved, and the columns grow as samples come.
     ///
     /// # Examples
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let rec = Recording::with_capacity(Schema::numbered(1, 4), 5000);
+    /// let rec = Recording::with_capacity(Schema::numbered(1, 4)?, 5000);
     /// assert!(rec.capacity() >= 5000);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn with_capacity(schema: Schema, n: usize) -> Self {
-        let columns = (0..schema.len()).map(|_| Vec::with_capacity(n)).collect();
+        // A hint: a capacity the allocator refuses (usize::MAX) is not
+        // reserved, and the columns grow as samples come.
+        let column = || {
+            let mut v = Vec::new();
+            let _ = v.try_reserve_exact(n);
+            v
+        };
+        let columns = (0..schema.len()).map(|_| column()).collect();
         Self {
             schema,
-            t: Vec::with_capacity(n),
+            t: column(),
             columns,
         }
     }
@@ -364,9 +426,9 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let rec = Recording::from_columns(Schema::numbered(1, 1), vec![0.0, 0.1], vec![vec![1.0, 1.0], vec![0.0, 0.5]])?;
+    /// let rec = Recording::from_columns(Schema::numbered(1, 1)?, vec![0.0, 0.1], vec![vec![1.0, 1.0], vec![0.0, 0.5]])?;
     /// assert_eq!(rec.channel("y")?, &[0.0, 0.5]);
-    /// assert!(Recording::from_columns(Schema::numbered(1, 1), vec![0.0, 0.1], vec![vec![1.0]]).is_err());
+    /// assert!(Recording::from_columns(Schema::numbered(1, 1)?, vec![0.0, 0.1], vec![vec![1.0]]).is_err());
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn from_columns(
@@ -414,7 +476,8 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// assert_eq!(Recording::new(Schema::numbered(2, 3)).schema().len(), 5);
+    /// assert_eq!(Recording::new(Schema::numbered(2, 3)?).schema().len(), 5);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn schema(&self) -> &Schema {
         &self.schema
@@ -426,7 +489,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// rec.push(0.0, &[0.0], &[0.0])?;
     /// assert_eq!(rec.len(), 1);
     /// # Ok::<(), ctrlab::Error>(())
@@ -441,7 +504,8 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// assert!(Recording::new(Schema::numbered(1, 1)).is_empty());
+    /// assert!(Recording::new(Schema::numbered(1, 1)?).is_empty());
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
@@ -453,7 +517,8 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// assert!(Recording::with_capacity(Schema::numbered(1, 1), 10).capacity() >= 10);
+    /// assert!(Recording::with_capacity(Schema::numbered(1, 1)?, 10).capacity() >= 10);
+    /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn capacity(&self) -> usize {
         self.columns
@@ -468,7 +533,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// rec.push(0.5, &[0.0], &[0.0])?;
     /// assert_eq!(rec.time(), &[0.5]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -484,7 +549,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// rec.push(0.5, &[0.0], &[0.0])?;
     /// rec.time_mut()[0] = 0.0;
     /// assert_eq!(rec.time(), &[0.0]);
@@ -505,7 +570,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// rec.push(0.0, &[2.0], &[0.1])?;
     /// assert_eq!(rec.channel("u")?, &[2.0]);
     /// assert!(rec.channel("x1").is_err());
@@ -527,7 +592,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// rec.push(0.0, &[2.0], &[0.1])?;
     /// rec.channel_mut("y")?[0] += 0.05;
     /// assert_eq!(rec.channel("y")?, &[0.1 + 0.05]);
@@ -554,7 +619,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// rec.push(0.0, &[2.0], &[0.1])?;
     /// assert_eq!(rec.input(0), Some(&[2.0][..]));
     /// assert_eq!(rec.input(1), None);
@@ -570,7 +635,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// rec.push(0.0, &[2.0], &[0.1])?;
     /// assert_eq!(rec.measurement(0), Some(&[0.1][..]));
     /// assert_eq!(rec.measurement(1), None);
@@ -594,7 +659,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
-    /// let mut rec = Recording::new(Schema::numbered(1, 2));
+    /// let mut rec = Recording::new(Schema::numbered(1, 2)?);
     /// rec.push(0.0, &[1.5], &[0.010, 0.020])?;
     /// assert_eq!(rec.channel("y2")?, &[0.020]);
     /// assert!(rec.push(0.1, &[1.5], &[0.0]).is_err());
@@ -635,7 +700,7 @@ impl Recording {
     /// ```
     /// # use ctrlab::data::{Recording, Schema};
     /// # use ctrlab::nalgebra::vector;
-    /// let mut rec = Recording::with_capacity(Schema::numbered(1, 4), 1);
+    /// let mut rec = Recording::with_capacity(Schema::numbered(1, 4)?, 1);
     /// rec.push_vectors(0.0, &vector![1.0], &vector![0.001, 0.01, 0.002, 0.02])?;
     /// assert_eq!(rec.channel("y2")?, &[0.01]);
     /// # Ok::<(), ctrlab::Error>(())
@@ -693,7 +758,7 @@ impl Recording {
     ///
     /// ```
     /// # use ctrlab::{Error, data::{Recording, Schema}};
-    /// let mut rec = Recording::new(Schema::numbered(1, 1));
+    /// let mut rec = Recording::new(Schema::numbered(1, 1)?);
     /// for k in 0..10 {
     ///     rec.push(k as f64 * 0.002, &[0.0], &[0.0])?;
     /// }

@@ -64,6 +64,18 @@ pub use zpk::Zpk;
 
 use crate::error::Error;
 
+/// The most frequencies [`logspace`] makes (2^24, 128 MiB): a Bode plot
+/// needs hundreds.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{MAX_FREQUENCIES, logspace};
+/// assert!(logspace(0.0, 1.0, MAX_FREQUENCIES + 1).is_err());
+/// assert!(logspace(0.0, 1.0, usize::MAX).is_err());
+/// ```
+pub const MAX_FREQUENCIES: usize = 1 << 24;
+
 /// `n` frequencies spaced evenly in log scale from `10^start` to
 /// `10^stop` (NumPy's and MATLAB's `logspace`): the usual grid for a Bode
 /// plot, in rad/s when used as `ω`. `n = 1` gives `[10^start]`, `n = 0`
@@ -72,7 +84,8 @@ use crate::error::Error;
 /// # Errors
 ///
 /// [`Error::InvalidParameter`] for a non-finite decade, or one whose power
-/// of ten overflows or underflows to zero (|decade| > 307).
+/// of ten overflows or underflows to zero (|decade| > 307), or `n` above
+/// [`MAX_FREQUENCIES`].
 ///
 /// # Examples
 ///
@@ -85,6 +98,13 @@ use crate::error::Error;
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn logspace(start: f64, stop: f64, n: usize) -> Result<Vec<f64>, Error> {
+    if n > MAX_FREQUENCIES {
+        return Err(Error::InvalidParameter {
+            name: "n",
+            value: n as f64,
+            reason: "more frequencies than freq::MAX_FREQUENCIES",
+        });
+    }
     for (name, v) in [("start", start), ("stop", stop)] {
         if !(v.is_finite() && v.abs() <= 307.0) {
             return Err(Error::InvalidParameter {

@@ -87,7 +87,7 @@ pub trait Rig<const M: usize, const P: usize> {
     /// # Ok::<(), ctrlab::hw::RigError>(())
     /// ```
     fn schema(&self) -> Schema {
-        Schema::numbered(M, P)
+        Schema::numbered_const::<M, P>()
     }
 
     /// Forgets the previous sample, so the next [`read`](Self::read) starts

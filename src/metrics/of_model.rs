@@ -226,7 +226,7 @@ fn channels<D: Domain>(
 /// use ctrlab::metrics::{StepInfoOptions, step_info_channel};
 ///
 /// // A first-order rise to 1 with τ = 0.1 s, sampled every 10 ms.
-/// let mut rec = Recording::new(Schema::numbered(1, 1));
+/// let mut rec = Recording::new(Schema::numbered(1, 1)?);
 /// for k in 0..300 {
 ///     let t = k as f64 * 0.01;
 ///     rec.push(t, &[1.0], &[1.0 - (-t / 0.1).exp()])?;

@@ -333,7 +333,7 @@ where
     let schema = config
         .schema
         .clone()
-        .unwrap_or_else(|| Schema::numbered(M, P));
+        .unwrap_or_else(Schema::numbered_const::<M, P>);
     let mut recording = Recording::with_capacity(schema, samples);
     let mut rng = Rng::new(config.seed);
     controller.reset();

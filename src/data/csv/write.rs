@@ -63,7 +63,7 @@ impl Recording {
     /// ```
     /// # use ctrlab::Recording;
     /// # use ctrlab::data::Schema;
-    /// let mut rec = Recording::new(Schema::numbered(1, 2));
+    /// let mut rec = Recording::new(Schema::numbered(1, 2)?);
     /// for k in 0..6 {
     ///     rec.push(k as f64 * 0.002, &[1.0], &[1e-4 * k as f64, 2e-4 * k as f64])?;
     /// }

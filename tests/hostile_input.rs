@@ -1,6 +1,8 @@
-//! Error messages print numbers readably: an extreme value as `1e300`, not
-//! its 301 digits (issue 28: `Chirp::new(1, 1, 1e300, 1, Linear)`'s message
-//! was 398 characters, lab5's `max_gap = 0.000…` 300 digits).
+//! Issue 28's hostile inputs that are not one module's: error messages
+//! print numbers readably (an extreme value as `1e300`, not its 301 digits:
+//! `Chirp::new(1, 1, 1e300, 1, Linear)`'s message was 398 characters,
+//! lab5's `max_gap = 0.000…` 300 digits), and sizes no machine holds are
+//! refused or taken as hints, never a panic or an aborting allocation.
 
 use ctrlab::signal::{Chirp, Sweep};
 
@@ -64,4 +66,19 @@ fn a_gap_limit_of_1e_300_reads_as_1e_300() {
         "{} characters: {message}",
         message.len()
     );
+}
+
+/// Sizes no machine holds are refused, or taken as hints, without a
+/// "capacity overflow" panic or an aborting allocation (issue 28).
+#[test]
+fn impossible_sizes_are_refused_or_hints_never_a_panic() {
+    use ctrlab::data::{MAX_CHANNELS, Recording, Schema};
+    use ctrlab::freq::logspace;
+    assert!(logspace(0.0, 1.0, usize::MAX).is_err());
+    assert!(Schema::numbered(1 << 40, 0).is_err());
+    assert!(Schema::numbered(usize::MAX, usize::MAX).is_err());
+    assert_eq!(Schema::numbered(MAX_CHANNELS - 1, 1).unwrap().len(), MAX_CHANNELS);
+    let mut rec = Recording::with_capacity(Schema::numbered(1, 1).unwrap(), usize::MAX);
+    rec.push(0.0, &[1.0], &[2.0]).unwrap();
+    assert_eq!(rec.len(), 1);
 }
