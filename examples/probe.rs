@@ -63,10 +63,17 @@ fn parse() -> Result<Args, String> {
         volts: None,
     };
     let mut it = std::env::args().skip(1);
-    let number = |v: Option<String>, name: &str| -> Result<f64, String> {
-        v.ok_or(format!("{name} needs a value"))?
-            .parse()
-            .map_err(|e| format!("{name}: {e}"))
+    // Checked here, before anything is probed or pulsed: a bad value would
+    // otherwise surface only when the card file is written, at the end.
+    let number = |v: Option<String>, name: &str, unit: &str| -> Result<f64, String> {
+        let text = v.ok_or(format!("{name} needs a value"))?;
+        match text.parse::<f64>() {
+            Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+            Ok(_) => Err(format!(
+                "{name} {text}: must be a finite number > 0, {unit}"
+            )),
+            Err(e) => Err(format!("{name} {text}: {e}")),
+        }
     };
     while let Some(arg) = it.next() {
         match arg.as_str() {
@@ -76,12 +83,19 @@ fn parse() -> Result<Args, String> {
             "--scan" => args.scan = true,
             "--out" => args.out = it.next().ok_or("--out needs a file")?.into(),
             "--metres-per-count" => {
-                args.metres_per_count = Some(number(it.next(), "--metres-per-count")?);
+                args.metres_per_count = Some(number(it.next(), "--metres-per-count", "m")?);
             }
-            "--volts" => args.volts = Some(number(it.next(), "--volts")?),
+            "--volts" => args.volts = Some(number(it.next(), "--volts", "V")?),
             "-h" | "--help" => return Err(USAGE.to_owned()),
             other => return Err(format!("unknown argument {other}\n{USAGE}")),
         }
+    }
+    if args.out.is_dir() {
+        return Err(format!(
+            "--out {}: is a directory; give the card file's path (e.g. {}/card.toml)",
+            args.out.display(),
+            args.out.display()
+        ));
     }
     if args.simulated == args.port.is_some() {
         return Err(format!(
@@ -276,6 +290,20 @@ fn main() {
     if let Some(v) = args.volts {
         base.volts_full_scale = v;
     }
+    // The card file is checked as it is read; the arguments over it are
+    // checked together with it, still before anything is probed.
+    if let Err(e) = base.validate() {
+        eprintln!("the calibration with --metres-per-count and --volts: {e}");
+        std::process::exit(2);
+    }
+    let dir = args.out.parent().filter(|d| !d.as_os_str().is_empty());
+    if let Some(Err(e)) = dir.map(std::fs::create_dir_all) {
+        eprintln!(
+            "--out {}: cannot create its directory: {e}",
+            args.out.display()
+        );
+        std::process::exit(2);
+    }
     let port_options = card.map(|c| c.port).unwrap_or_default();
     let mut options = ProbeOptions {
         scan: args.scan,
@@ -318,11 +346,6 @@ fn main() {
         config.calibration.volts_full_scale,
         config.calibration.travel_limits
     );
-    let dir = args.out.parent().filter(|d| !d.as_os_str().is_empty());
-    if let Some(Err(e)) = dir.map(std::fs::create_dir_all) {
-        eprintln!("cannot create {}: {e}", args.out.display());
-        std::process::exit(1);
-    }
     if let Err(e) = config.write_toml(&args.out) {
         eprintln!("cannot write the card file: {e}");
         std::process::exit(1);

@@ -278,7 +278,7 @@ fn report(
     run: &ExperimentRun,
     full_scale: f64,
 ) -> Result<Ended, Box<dyn std::error::Error>> {
-    std::fs::create_dir_all(&args.out)?;
+    paths::prepare_out(&args.out, &[], &[])?;
     let path: PathBuf = args.out.join(format!("{experiment}.csv"));
     run.recording.write_csv(&path)?;
     let dash = || "–".to_string();

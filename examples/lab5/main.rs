@@ -173,7 +173,7 @@ fn lab(args: &cli::Args) -> Result<PathBuf, Stopped> {
         Some(dir) => Mode::Logs(dir, args.metres_per_count),
         None => Mode::Rig(Box::new(Backend::new(args)?)),
     };
-    std::fs::create_dir_all(&args.out)?;
+    paths::prepare_out(&args.out, &["runs", "tables"], &["report.md"])?;
     let mut report = Report::new(&args.out);
     let result = match &mode {
         Mode::Rig(backend) => rig_sections(backend, args.tables_only, &mut report),

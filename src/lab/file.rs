@@ -169,7 +169,7 @@ fn shown(key: &str, value: f64) -> String {
     if hex && (0.0..=255.0).contains(&value) && value.fract() == 0.0 {
         format!("{:#04x}", value as u8)
     } else {
-        value.to_string()
+        crate::readable::Readable(value).to_string()
     }
 }
 

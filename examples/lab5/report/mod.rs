@@ -188,7 +188,9 @@ impl Report {
     /// Writes `report.md`; returns its path.
     pub fn write(&self) -> std::io::Result<PathBuf> {
         let path = self.out.join("report.md");
-        std::fs::write(&path, self.markdown())?;
+        std::fs::write(&path, self.markdown()).map_err(|e| {
+            std::io::Error::new(e.kind(), format!("cannot write `{}`: {e}", path.display()))
+        })?;
         Ok(path)
     }
 
