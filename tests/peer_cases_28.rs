@@ -4,9 +4,9 @@
 //! `tests/data/gen_peer_cases_28.py`) at the tolerances of python-control's
 //! own tests, quoted at each check.
 
-use ctrlab::Discretization;
 use ctrlab::freq::{TransferFunction, stability_margins};
-use nalgebra::Complex;
+use ctrlab::{Discretization, DynStateSpace};
+use nalgebra::{Complex, DMatrix};
 use serde_json::Value;
 
 fn fixtures() -> Value {
@@ -15,6 +15,17 @@ fn fixtures() -> Value {
 
 fn floats(v: &Value) -> Vec<f64> {
     serde_json::from_value(v.clone()).unwrap()
+}
+
+fn complexes(v: &Value) -> Vec<Complex<f64>> {
+    let pairs: Vec<[f64; 2]> = serde_json::from_value(v.clone()).unwrap();
+    pairs.iter().map(|p| Complex::new(p[0], p[1])).collect()
+}
+
+fn matrix(v: &Value) -> DMatrix<f64> {
+    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).unwrap();
+    let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
+    DMatrix::from_fn(r, c, |i, j| rows[i][j])
 }
 
 fn rel(got: f64, want: f64) -> f64 {
@@ -81,5 +92,56 @@ fn discrete_margins_gh523b() {
             delay.margin
         );
         println!("{route}: {m:?}");
+    }
+}
+
+/// `test_tf2ss_unstable` (python-control issue #935): the poles of the
+/// 16-state realisation against the transfer function's,
+/// `assert_allclose(tf_poles, ss_poles, rtol=1e-4)` after sorting.
+#[test]
+fn tf2ss_unstable_poles() {
+    let f = &fixtures()["tf2ss_unstable"];
+    let rtol = f["rtol"].as_f64().unwrap();
+    assert_eq!(rtol, 1e-4);
+    let g = TransferFunction::continuous(&floats(&f["num"]), &floats(&f["den"])).unwrap();
+    let sys = g.to_state_space().unwrap();
+    assert_eq!(sys.states(), 16);
+    // ctrlab's realisation is SciPy's.
+    for (ours, key) in [
+        (sys.a(), "a"),
+        (sys.b(), "b"),
+        (sys.c(), "c"),
+        (sys.d(), "d"),
+    ] {
+        let want = matrix(&f[key]);
+        let scale = want.amax().max(f64::MIN_POSITIVE);
+        assert!((ours - &want).amax() <= 1e-15 * scale, "{key}");
+    }
+    // A model built from SciPy's matrices: the same poles.
+    let scipy_sys = DynStateSpace::continuous(
+        matrix(&f["a"]),
+        matrix(&f["b"]),
+        matrix(&f["c"]),
+        matrix(&f["d"]),
+    )
+    .unwrap();
+    let tf_poles = complexes(&f["tf_poles"]);
+    let ss_poles = complexes(&f["ss_poles"]);
+    for (what, got) in [
+        ("ss poles", sys.poles().unwrap()),
+        ("SciPy's ss poles", scipy_sys.poles().unwrap()),
+    ] {
+        assert!(got.iter().all(|p| p.re < 0.0), "{what}: {got:?}");
+        for (want_name, want) in [("tf poles", &tf_poles), ("NumPy's ss poles", &ss_poles)] {
+            // NumPy's sort: by real part, then imaginary.
+            assert_eq!(got.len(), want.len());
+            for (g, w) in got.iter().zip(want.iter()) {
+                // assert_allclose: |actual - desired| <= rtol |desired|.
+                assert!(
+                    (g - w).norm() <= rtol * w.norm(),
+                    "{what} vs {want_name}: {g} vs {w}"
+                );
+            }
+        }
     }
 }
