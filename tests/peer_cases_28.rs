@@ -4,7 +4,7 @@
 //! `tests/data/gen_peer_cases_28.py`) at the tolerances of python-control's
 //! own tests, quoted at each check.
 
-use ctrlab::freq::{TransferFunction, stability_margins};
+use ctrlab::freq::{BodeOptions, TransferFunction, WrapPhase, bode, bode_with, stability_margins};
 use ctrlab::{Discretization, DynStateSpace};
 use nalgebra::{Complex, DMatrix};
 use serde_json::Value;
@@ -144,4 +144,63 @@ fn tf2ss_unstable_poles() {
             }
         }
     }
+}
+
+fn options(case: &Value) -> BodeOptions {
+    BodeOptions {
+        initial_phase: case["initial_phase"].as_f64(),
+        wrap_phase: match &case["wrap_phase"] {
+            Value::Null => WrapPhase::Unwrap,
+            Value::Bool(false) => WrapPhase::Unwrap,
+            Value::Bool(true) => WrapPhase::Wrap,
+            v => WrapPhase::AtLeast(v.as_f64().unwrap()),
+        },
+    }
+}
+
+/// `test_initial_phase` (`abs(phase[0] - expected) < 0.1`), `test_phase_wrap`
+/// and `test_phase_wrap_multiple_systems` (`min(phase) >= min_phase`,
+/// `max(phase) <= max_phase`), and python-control's phases themselves.
+#[test]
+fn bode_phase_conventions() {
+    let f = &fixtures()["phase"];
+    let omega = floats(&f["omega"]);
+    let tol = f["initial_phase_tolerance"].as_f64().unwrap();
+    for case in f["cases"].as_array().unwrap() {
+        let name = case["name"].as_str().unwrap();
+        let g = TransferFunction::continuous(&floats(&case["num"]), &floats(&case["den"])).unwrap();
+        let b = bode_with(&g, &omega, &options(case)).unwrap();
+        if let Some(expected) = case["expected"].as_f64() {
+            assert!(
+                (b.phase[0] - expected).abs() < tol,
+                "{name}: {}",
+                b.phase[0]
+            );
+        }
+        if let (Some(lo), Some(hi)) = (case["min_phase"].as_f64(), case["max_phase"].as_f64()) {
+            assert!(
+                b.phase.iter().all(|&p| p >= lo && p <= hi),
+                "{name}: {:?}",
+                b.phase
+            );
+        }
+        let want = floats(&case["phase"]);
+        for (p, w) in b.phase.iter().zip(&want) {
+            assert!(
+                (p - w).abs() <= 1e-12 * w.abs().max(1.0),
+                "{name}: {p} vs {w}"
+            );
+        }
+    }
+}
+
+/// The crate's `bode` keeps its own start (the principal value at the
+/// first frequency): 1/s³ at +90°, where python-control starts at −270°.
+#[test]
+fn bode_keeps_its_principal_value_start() {
+    let g = TransferFunction::continuous(&[1.0], &[1.0, 0.0, 0.0, 0.0]).unwrap();
+    let b = bode(&g, &[0.1, 1.0]).unwrap();
+    assert!((b.phase[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    let d = bode_with(&g, &[0.1, 1.0], &BodeOptions::default()).unwrap();
+    assert!((d.phase[0] + 1.5 * std::f64::consts::PI).abs() < 1e-12);
 }
