@@ -204,3 +204,18 @@ fn bode_keeps_its_principal_value_start() {
     let d = bode_with(&g, &[0.1, 1.0], &BodeOptions::default()).unwrap();
     assert!((d.phase[0] + 1.5 * std::f64::consts::PI).abs() < 1e-12);
 }
+
+/// A static gain: no state, as python-control's `tf2ss`; SciPy's `tf2ss`
+/// adds one (A = B = C = [[0]]), which the docs state.
+#[test]
+fn static_gain_realisation() {
+    let f = &fixtures()["static_gain"];
+    let g = TransferFunction::continuous(&floats(&f["num"]), &floats(&f["den"])).unwrap();
+    let sys = g.to_state_space().unwrap();
+    let pc = &f["python_control"];
+    assert_eq!(sys.states() as u64, pc["states"].as_u64().unwrap());
+    assert_eq!(sys.d(), &matrix(&pc["d"]));
+    let scipy = &f["scipy"];
+    assert_eq!(matrix(&scipy["a"]), DMatrix::zeros(1, 1));
+    assert_eq!(sys.d(), &matrix(&scipy["d"]));
+}
