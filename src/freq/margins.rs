@@ -56,7 +56,7 @@ enum Crossing {
 /// The frequencies `ω ≥ 0` (rad/s) of a crossing, ascending.
 fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f64>, Error> {
     let (num, den) = (g.num(), g.den());
-    let mut w = match period_of(&g.domain()) {
+    let w = match period_of(&g.domain()) {
         None => {
             let (nr, ni) = jw_parts(num);
             let (dr, di) = jw_parts(den);
@@ -107,33 +107,58 @@ fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f
         }
     };
     let period = period_of(&g.domain());
-    for w in w.iter_mut() {
-        *w = polish(*w, |w| {
-            let v = g.evaluate(point(period, w)).ok()?;
-            let f = match kind {
-                Crossing::RealAxis => v.im / v.norm(),
-                Crossing::Magnitude(level) => (v.norm() / level).ln(),
-            };
-            f.is_finite().then_some(f)
-        });
-    }
+    let mut w: Vec<f64> = w
+        .into_iter()
+        .filter_map(|w| {
+            polish(w, |w| {
+                let v = g.evaluate(point(period, w)).ok()?;
+                let f = match kind {
+                    Crossing::RealAxis => v.im / v.norm(),
+                    Crossing::Magnitude(level) => (v.norm() / level).ln(),
+                };
+                f.is_finite().then_some(f)
+            })
+        })
+        .collect();
     w.sort_by(f64::total_cmp);
-    w.dedup();
+    // Two inaccurate roots may polish to the same crossing.
+    w.dedup_by(|b, a| (*b - *a).abs() <= SAME_CROSSING * a.abs().max(b.abs()));
     Ok(w)
 }
 
+/// Two polished crossings this close (relative) are one.
+const SAME_CROSSING: f64 = 1e-9;
+
+/// A residual (relative: `Im G / |G|`, or `ln(|G| / level)`) this small
+/// marks a crossing checked on the response itself; evaluating an
+/// ill-conditioned transfer function near `z = 1` is itself only good to
+/// ~1e-9 relative (gh-523 b: 1.1e-9 at the converged crossing).
+const ON_CROSSING: f64 = 1e-6;
+
+/// A root whose residual, polished or not, stays above this is no crossing
+/// (gh-523 b's spurious root: `ln |L| = −0.145`).
+const OFF_CROSSING: f64 = 1e-4;
+
 /// A crossing frequency refined by secant steps on the exact residual `f`
-/// (the polynomial's roots carry the rounding of its coefficients, ~1e-9
-/// relative near |z| = 1): at most 16 steps, kept only if the residual
-/// shrinks and the frequency moves by under 0.1 %.
-fn polish(w: f64, f: impl Fn(f64) -> Option<f64>) -> f64 {
+/// (at most 16). The polynomial's roots carry the rounding of its
+/// coefficients: ~1e-9 relative near |z| = 1 in general, but whole
+/// percents for a discrete loop whose `|N|²` is many orders below `|D|²`
+/// on the circle (python-control's "numerical inaccuracy in 'poly'" case,
+/// where it falls back to interpolated frequency data): there the root is
+/// only a starting point. The refined frequency is kept if its residual
+/// shrank and either it moved by under 0.1 % or its residual is below
+/// [`ON_CROSSING`] (a crossing checked on the response, however far the
+/// root was from it). A root whose residual stays above [`OFF_CROSSING`]
+/// either way is no crossing and is dropped (`None`); a root where `f`
+/// cannot be evaluated (a pole on the axis) is kept as it is.
+fn polish(w: f64, f: impl Fn(f64) -> Option<f64>) -> Option<f64> {
     if w == 0.0 {
-        return w; // exact: the real-axis polynomial is odd in ω
+        return Some(w); // exact: the real-axis polynomial is odd in ω
     }
-    let Some(f_start) = f(w) else { return w };
+    let Some(f_start) = f(w) else { return Some(w) };
     let (mut w0, mut f0) = (w, f_start);
     let mut w1 = w * (1.0 + 1e-7);
-    let Some(mut f1) = f(w1) else { return w };
+    let Some(mut f1) = f(w1) else { return Some(w) };
     for _ in 0..16 {
         if f1 == f0 || f1 == 0.0 {
             break;
@@ -150,11 +175,17 @@ fn polish(w: f64, f: impl Fn(f64) -> Option<f64>) -> f64 {
     } else {
         (w0, f0)
     };
-    if best.is_finite() && f_best.abs() <= f_start.abs() && (best - w).abs() <= 1e-3 * w.abs() {
-        best
+    let near = (best - w).abs() <= 1e-3 * w.abs();
+    let (w, f_w) = if best.is_finite()
+        && best > 0.0
+        && f_best.abs() <= f_start.abs()
+        && (near || f_best.abs() <= ON_CROSSING)
+    {
+        (best, f_best)
     } else {
-        w
-    }
+        (w, f_start)
+    };
+    (f_w.abs() <= OFF_CROSSING).then_some(w)
 }
 
 /// The gain margin and the phase crossover frequency it is read at.

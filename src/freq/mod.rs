@@ -42,6 +42,7 @@ mod margins;
 mod matrix;
 mod models;
 mod pade;
+mod phase;
 mod poly;
 mod response;
 #[cfg(feature = "plot")]
@@ -53,6 +54,7 @@ mod zpk;
 pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stability_margins};
 pub use matrix::TransferMatrix;
 pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};
+pub use phase::{BodeOptions, WrapPhase, bode_with};
 pub use response::{
     Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
 };

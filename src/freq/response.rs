@@ -308,8 +308,10 @@ impl FrequencyResponse {
 /// `unwrap` does (each step brought within ±π), so a grid too coarse for a
 /// fast phase change can unwrap by the wrong turn. python-control's `bode`
 /// unwraps the same way and then shifts the whole curve by a multiple of
-/// 360° to start within (−360°, 0°] (its default `initial_phase`); compare phases
-/// modulo 360°.
+/// 360° to start within 180° of −180° (its default `initial_phase`), so
+/// 1/s³ starts at +90° here and at −270° there; [`bode_with`](super::bode_with)
+/// with [`BodeOptions`](super::BodeOptions) applies python-control's
+/// conventions (`initial_phase`, `wrap_phase`).
 ///
 /// # Examples
 ///
@@ -552,7 +554,7 @@ pub fn nyquist(sys: &impl FrequencyDomain, omega: &[f64]) -> Result<Nyquist, Err
     siso(sys.frequency_response(omega)?)?.nyquist(0, 0)
 }
 
-fn siso(r: FrequencyResponse) -> Result<FrequencyResponse, Error> {
+pub(crate) fn siso(r: FrequencyResponse) -> Result<FrequencyResponse, Error> {
     if r.outputs == 1 && r.inputs == 1 {
         Ok(r)
     } else {

@@ -324,6 +324,13 @@ impl<D: Domain> TransferFunction<D> {
     /// `B = e₁`, `D = b₀` (the numerator's `sⁿ` coefficient) and
     /// `C = [b₁ − b₀ a₁, …, bₙ − b₀ aₙ]`.
     ///
+    /// A static gain (`n = 0`) is the exception: it has no state here, as
+    /// in python-control's `tf2ss` (0.10.2: `tf2ss(tf([2], [1]))` has
+    /// `States (0)` and `D = [[2]]`), where SciPy's `tf2ss([2], [1])`
+    /// returns one state, `A = B = C = [[0]]`, `D = [[2]]` (a pole at 0
+    /// that is neither controllable nor observable). The transfer function
+    /// is the same; only the state count differs.
+    ///
     /// # Errors
     ///
     /// [`Error::InvalidData`] (`"num"`) for an improper transfer function;
@@ -340,6 +347,10 @@ impl<D: Domain> TransferFunction<D> {
     /// assert_eq!(sys.a(), &dmatrix![-3.0, -2.0; 1.0, 0.0]);
     /// assert_eq!(sys.c(), &dmatrix![1.0, 3.0]);
     /// assert!(TransferFunction::continuous(&[1.0, 0.0], &[1.0])?.to_state_space().is_err());
+    ///
+    /// // A static gain: no state (python-control), where SciPy adds one.
+    /// let k = TransferFunction::continuous(&[2.0], &[1.0])?.to_state_space()?;
+    /// assert_eq!((k.states(), k.d()[(0, 0)]), (0, 2.0));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     #[doc(alias = "tf2ss")]

@@ -1,5 +1,6 @@
 //! Eigenvalues of small dense matrices (up to [`SMALL`] rows) on the stack:
-//! balancing by powers of two, reduction to Hessenberg form by stabilised
+//! balancing (isolated eigenvalues permuted out, the rest scaled by powers
+//! of two, as LAPACK's `dgebal`), reduction to Hessenberg form by stabilised
 //! elimination, and the Francis double-shift QR iteration (EISPACK's
 //! `balanc`, `elmhes` and `hqr`, as in *Numerical Recipes*, §11.5–11.6).
 //!
@@ -107,18 +108,62 @@ fn eigenvalues_and_sweeps(
         .then_some(sweeps)
 }
 
-/// Similarity scaling by powers of two (exact) so that each row and the
-/// matching column have comparable norms: the eigenvalues then come out
-/// with an error relative to the balanced matrix's norm, not to that of an
-/// arbitrarily scaled one (LAPACK's `dgeev` balances by default too).
+/// Swaps rows and columns `i` and `j` of the leading `n × n` (a
+/// permutation similarity).
+fn swap(w: &mut Work, n: usize, i: usize, j: usize) {
+    if i == j {
+        return;
+    }
+    for k in 1..=n {
+        let (p, q) = (w.at(i, k), w.at(j, k));
+        w.set(i, k, q);
+        w.set(j, k, p);
+    }
+    for k in 1..=n {
+        let (p, q) = (w.at(k, i), w.at(k, j));
+        w.set(k, i, q);
+        w.set(k, j, p);
+    }
+}
+
+/// EISPACK `balanc`'s (and LAPACK `dgebal`'s) permutation: rows with no
+/// off-diagonal entry in the active columns go to the bottom, then columns
+/// with none in the active rows to the left; each isolates its diagonal
+/// entry as an eigenvalue. The active block, `low..=igh` (1-based).
+fn isolate(w: &mut Work, n: usize) -> (usize, usize) {
+    let (mut low, mut igh) = (1, n);
+    while let Some(i) = (1..=igh)
+        .rev()
+        .find(|&i| (1..=igh).all(|j| j == i || w.at(i, j) == 0.0))
+    {
+        swap(w, n, i, igh);
+        if igh == 1 {
+            return (1, 0);
+        }
+        igh -= 1;
+    }
+    while let Some(j) = (low..=igh).find(|&j| (low..=igh).all(|i| i == j || w.at(i, j) == 0.0)) {
+        swap(w, n, j, low);
+        low += 1;
+    }
+    (low, igh)
+}
+
+/// Isolated eigenvalues permuted out of the way ([`isolate`]), then
+/// similarity scaling of the rest by powers of two (exact) so that each
+/// row and the matching column have comparable norms: the eigenvalues
+/// then come out with an error relative to the balanced matrix's norm,
+/// not to that of an arbitrarily scaled one (LAPACK's `dgeev` balances by
+/// default too, with the same two steps).
 fn balance(w: &mut Work, n: usize) {
     const RADIX: f64 = 2.0;
     const SQRDX: f64 = RADIX * RADIX;
+    let (low, igh) = isolate(w, n);
     for _ in 0..BALANCE_SWEEPS {
         let mut done = true;
-        for i in 1..=n {
+        for i in low..=igh {
             let (mut c, mut r) = (0.0, 0.0);
-            for j in 1..=n {
+            for j in low..=igh {
                 if j != i {
                     c += w.at(j, i).abs();
                     r += w.at(i, j).abs();

@@ -216,3 +216,29 @@ fn refuses_what_it_cannot_do() {
         &mut out
     ));
 }
+
+#[test]
+fn an_isolated_eigenvalue_is_permuted_out_and_exact() {
+    // Row 0 has no off-diagonal entry: −1e-8 is an eigenvalue of this
+    // matrix whatever the rest, which is six orders larger. Permuted to
+    // the bottom (as LAPACK's `dgebal` does), it is read off exactly;
+    // scaled with the rest, it came out with an error relative to 1e6.
+    #[rustfmt::skip]
+    let a = [
+        -1e-8, 1e6, 1e-6,
+        0.0, -1.0, 1e-6,
+        0.0, 1e6, -2.0,
+    ];
+    let e = eig(&a, 3);
+    assert!(e.contains(&Complex::new(-1e-8, 0.0)), "{e:?}");
+    let mut w = Work {
+        a: [0.0; (SMALL + 1) * (SMALL + 1)],
+    };
+    for j in 1..=3 {
+        for i in 1..=3 {
+            w.set(i, j, a[(j - 1) * 3 + (i - 1)]);
+        }
+    }
+    assert_eq!(isolate(&mut w, 3), (1, 2));
+    assert_eq!((w.at(3, 1), w.at(3, 2), w.at(3, 3)), (0.0, 0.0, -1e-8));
+}
