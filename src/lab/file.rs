@@ -2,6 +2,7 @@
 //! files, [`RigConfig`](super::RigConfig)'s card files) and their error,
 //! [`FileError`]: a fault says the path, the line and the dotted key.
 
+use crate::readable::Readable;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -169,7 +170,7 @@ fn shown(key: &str, value: f64) -> String {
     if hex && (0.0..=255.0).contains(&value) && value.fract() == 0.0 {
         format!("{:#04x}", value as u8)
     } else {
-        crate::readable::Readable(value).to_string()
+        Readable(value).to_string()
     }
 }
 
@@ -352,7 +353,7 @@ fn field_error(
 ) -> FileError {
     let path = e.path().to_string();
     let table = (path != ".").then_some(path);
-    let message = e.inner().message().trim_end().to_owned();
+    let message = readable_literals(e.inner().message().trim_end());
     let line = |key: &str| span(text, e.inner()).or_else(|| line_of(text, key));
     let missing = message
         .strip_prefix("missing field `")
@@ -383,6 +384,23 @@ fn field_error(
             message,
         },
     }
+}
+
+/// serde's message with each quoted number (`` `0.000…02` ``, every digit
+/// of a float) printed readably (`` `2e-308` ``).
+fn readable_literals(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    for (i, part) in message.split('`').enumerate() {
+        if i > 0 {
+            out.push('`');
+        }
+        // Odd parts are inside backticks.
+        match part.parse::<f64>() {
+            Ok(x) if i % 2 == 1 && part.len() > 24 => out += &Readable(x).to_string(),
+            _ => out += part,
+        }
+    }
+    out
 }
 
 /// The one-based line where dotted `key` (`card.map.encoder[2]`, `period`)

@@ -96,9 +96,19 @@ impl SimulatedRig {
         self.check_timing()?;
         self.check_counts()?;
         self.ident.validate().map_err(|e| e.in_table("ident"))?;
-        self.ident
-            .check_drive(cal.volts_full_scale)
-            .map_err(|e| e.in_table("ident"))
+        self.ident.check_drive(cal.volts_full_scale).map_err(|e| {
+            // With [ident] left out the conflict is the full scale's, the
+            // key the file has.
+            if self.ident == crate::lab::ident_input::IdentInput::default() {
+                ConfigError::conflict(
+                    "calibration.volts_full_scale",
+                    cal.volts_full_scale,
+                    "below the identification's drive (`ident.volts`, 8 V by default): raise it, or set a lower `volts` under [ident]",
+                )
+            } else {
+                e.in_table("ident")
+            }
+        })
     }
 
     /// A [`SimulatedCardConfig::validate`](crate::hw::SimulatedCardConfig::validate) error under the key of the
