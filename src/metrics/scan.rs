@@ -109,6 +109,7 @@ fn extremes_and_outside(y: &[f64], yf: f64, band: f64) -> (f64, f64, Option<usiz
 
 /// Whether all of `t` and `y` (equal lengths) are finite and `t` strictly
 /// increases, in one branch-free pass.
+#[allow(clippy::eq_op)] // `x − x` is the finiteness test, on purpose.
 pub(super) fn all_valid(t: &[f64], y: &[f64]) -> bool {
     let Some((&t0, later)) = t.split_first() else {
         return true;
