@@ -90,7 +90,10 @@
 
 mod matlab;
 mod of_model;
+mod scan;
 mod step_info;
+#[cfg(test)]
+mod step_info_reference;
 
 use crate::error::Error;
 pub use crate::error::SettleFailure;

@@ -1,12 +1,13 @@
 //! [`step_info`]: the figures of sampled data.
 
-use super::{Definition, SettleFailure, StepInfo, StepInfoOptions};
+use super::{Definition, SettleFailure, StepInfo, StepInfoOptions, scan};
 use crate::error::Error;
 
 /// Step-response figures of sampled data `y` at times `t` (s, strictly
 /// increasing), under the definitions `options.definition` names (see the
 /// [module docs](super#definitions)); crossing times are interpolated. One
-/// pass over the data for each figure; allocates nothing.
+/// pass over the samples (with a check of them before it), plus early-exit
+/// searches through the transient; allocates nothing.
 ///
 /// # Errors
 ///
@@ -68,12 +69,8 @@ pub(super) fn measure(
             reason: "step metrics need at least 3 samples",
         });
     }
-    // Branch-free scans first (they vectorise); locate the culprit only
-    // when there is one.
-    let y_ok = y.iter().fold(true, |ok, v| ok & v.is_finite());
-    let t_ok = t.iter().fold(true, |ok, v| ok & v.is_finite())
-        && t.windows(2).fold(true, |ok, w| ok & (w[1] > w[0]));
-    if !y_ok || !t_ok {
+    // One branch-free scan first; locate the culprit only when there is one.
+    if !scan::all_valid(t, y) {
         return Err(locate_bad_sample(t, y));
     }
 
@@ -87,15 +84,20 @@ pub(super) fn measure(
         ((options.final_window * n as f64).ceil() as usize).clamp(1, n)
     };
     let window_start = n - window;
+    let half = window / 2;
+    // The estimated final value and the trend check's two half means.
+    let means = (options.final_value.is_none() && window >= 2)
+        .then(|| scan::window_means(&y[window_start..], half));
     let y0 = match (options.initial_value, matlab) {
         (Some(v), _) => v,
         (None, true) => 0.0,
         (None, false) => y[0],
     };
-    let yf = match (options.final_value, matlab) {
-        (Some(v), _) => v,
-        (None, true) => y[n - 1],
-        (None, false) => mean(&y[window_start..]),
+    let yf = match (options.final_value, matlab, means) {
+        (Some(v), _, _) => v,
+        (None, true, _) => y[n - 1],
+        (None, false, Some([all, _, _])) => all,
+        (None, false, None) => mean(&y[window_start..]),
     };
     let delta = yf - y0;
     if !delta.is_finite() {
@@ -117,13 +119,10 @@ pub(super) fn measure(
         window_start: t[window_start] - t0,
         cause: settle_failure(y, yf, window_start),
     };
-    if options.final_value.is_none() && window >= 2 {
+    if let Some([_, first, second]) = means {
         // An estimated final value cannot reveal a response still creeping
         // towards its end (it moves with it), so also ask for no trend: the
         // two halves of the final window agree to a quarter of the band.
-        let half = window / 2;
-        let first = mean(&y[window_start..window_start + half]);
-        let second = mean(&y[n - half..]);
         // Halved before subtracting: the difference of two finite means
         // can overflow, and then the response certainly trends.
         if (0.5 * second - 0.5 * first).abs() > 0.125 * band {
@@ -133,19 +132,27 @@ pub(super) fn measure(
     // Progress along the step, 0 at y₀ and 1 at y∞.
     let progress = |v: f64| (v - y0) / delta;
 
-    // Extremes by branch-free folds (all samples are finite by now): the
-    // peak, the undershoot and the largest error all come from them.
-    let extremes = |ys: &[f64]| {
-        ys.iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(v), hi.max(v))
-            })
+    // Rise: first crossings of the two levels, searched first (the
+    // settling extremes start at the upper one) and reported after the
+    // settling figures, whose errors come first.
+    let (lo, hi) = options.rise_limits;
+    let cross = |level: f64, from: usize| -> Option<(usize, f64)> {
+        let i = scan::first_where(y, from, |v| progress(v) >= level)?;
+        if i == 0 || progress(y[i - 1]) >= level || crossings == Crossings::AtSamples {
+            return Some((i, t[i]));
+        }
+        let target = y0 + level * delta;
+        Some((i, crossing(t[i - 1], y[i - 1], t[i], y[i], target)))
     };
-    let (y_min, y_max) = extremes(y);
+    let rise_lo = cross(lo, 0);
+    let rise_hi = rise_lo.and_then(|(i_lo, _)| cross(hi, i_lo));
 
-    // The last sample of y[..end] with |y − y∞| above `threshold`.
-    let last_outside =
-        |threshold: f64, end: usize| y[..end].iter().rposition(|&v| (v - yf).abs() > threshold);
+    // The one pass over all samples: the extremes (the peak, the
+    // undershoot and the largest error come from them), those from the
+    // upper rise level on, and the last sample outside the band.
+    let sweep = scan::sweep(y, rise_hi.map_or(n, |(i, _)| i), yf, band);
+    let (y_min, y_max) = (sweep.min, sweep.max);
+
     // When |y − y∞| enters [0, threshold] for good: after the last sample
     // outside, `j`, which must come before the final window.
     let settles = |j: Option<usize>, threshold: f64| -> Result<f64, Error> {
@@ -171,7 +178,7 @@ pub(super) fn measure(
         }
         Ok(ts)
     };
-    let j_settled = last_outside(band, n);
+    let j_settled = sweep.last_outside;
     let settling_time = settles(j_settled, band)?;
     // Largest error, halved so that it cannot overflow (y∞ was checked
     // against y₀, not against every sample).
@@ -186,24 +193,15 @@ pub(super) fn measure(
     } else {
         n
     };
-    let transient_time = settles(last_outside(transient_band, end), transient_band)?;
+    let j_transient = scan::last_where(&y[..end], |v| (v - yf).abs() > transient_band);
+    let transient_time = settles(j_transient, transient_band)?;
 
-    // Rise: first crossings of the two levels.
-    let (lo, hi) = options.rise_limits;
-    let cross = |level: f64, from: usize| -> Option<(usize, f64)> {
-        let i = (from..n).find(|&i| progress(y[i]) >= level)?;
-        if i == 0 || progress(y[i - 1]) >= level || crossings == Crossings::AtSamples {
-            return Some((i, t[i]));
-        }
-        let target = y0 + level * delta;
-        Some((i, crossing(t[i - 1], y[i - 1], t[i], y[i], target)))
-    };
-    let (i_lo, t_lo) = cross(lo, 0).ok_or(Error::InvalidData {
+    let (_, t_lo) = rise_lo.ok_or(Error::InvalidData {
         what: "y",
         index: n,
         reason: "response never reaches the lower rise level",
     })?;
-    let (i_hi, t_hi) = cross(hi, i_lo).ok_or(Error::InvalidData {
+    let (_, t_hi) = rise_hi.ok_or(Error::InvalidData {
         what: "y",
         index: n,
         reason: "response never reaches the upper rise level",
@@ -217,29 +215,20 @@ pub(super) fn measure(
         (y_min, y_max)
     };
     // MATLAB's peak is the largest |y − y₀|, which may lie the wrong way.
-    let peak = if matlab {
-        (along - y0).abs().max((wrong_way - y0).abs())
+    let (peak, peak_i) = if matlab {
+        let peak = (along - y0).abs().max((wrong_way - y0).abs());
+        (peak, scan::first_where(y, 0, |v| (v - y0).abs() == peak))
     } else {
-        along
+        (along, scan::first_where(y, 0, |v| v == along))
     };
-    let peak_i = y
-        .iter()
-        .position(|&v| {
-            if matlab {
-                (v - y0).abs() == peak
-            } else {
-                v == peak
-            }
-        })
-        .unwrap_or(0);
+    let peak_i = peak_i.unwrap_or(0);
     let (peak_p, min_p) = (progress(along), progress(wrong_way));
-    let (s_min, s_max) = extremes(&y[i_hi..]);
     let info = StepInfo {
         rise_time: t_hi - t_lo,
         settling_time,
         transient_time,
-        settling_min: s_min,
-        settling_max: s_max,
+        settling_min: sweep.tail_min,
+        settling_max: sweep.tail_max,
         overshoot: (100.0 * (peak_p - 1.0)).max(0.0),
         // Written out so that no undershoot is +0, never -0 (printed "-0").
         undershoot: if min_p < 0.0 { -100.0 * min_p } else { 0.0 },
@@ -254,7 +243,7 @@ pub(super) fn measure(
 
 /// Every figure must be a finite number: a peak a googol of steps away,
 /// or times spanning more than `f64::MAX` seconds, are errors, not `inf`.
-fn check_measured(info: &StepInfo) -> Result<(), Error> {
+pub(super) fn check_measured(info: &StepInfo) -> Result<(), Error> {
     let figures = [
         (info.rise_time, "step metrics: rise time overflows"),
         (info.settling_time, "step metrics: settling time overflows"),
@@ -286,7 +275,7 @@ fn check_measured(info: &StepInfo) -> Result<(), Error> {
 /// Mean of finite samples that cannot overflow: the plain sum when it is
 /// finite (the common case, and bit-for-bit the straightforward mean), else
 /// the sum of the samples divided first.
-fn mean(y: &[f64]) -> f64 {
+pub(super) fn mean(y: &[f64]) -> f64 {
     let n = y.len() as f64;
     let sum = y.iter().sum::<f64>();
     if sum.is_finite() {
@@ -302,7 +291,7 @@ fn mean(y: &[f64]) -> f64 {
 /// without decay [`SettleFailure::Oscillating`], anything else (a decaying
 /// error) [`SettleFailure::TooShort`].
 #[cold]
-fn settle_failure(y: &[f64], yf: f64, window_start: usize) -> SettleFailure {
+pub(super) fn settle_failure(y: &[f64], yf: f64, window_start: usize) -> SettleFailure {
     let window = &y[window_start..];
     let half = window.len() / 2;
     // Largest deviation from yf, halved so that it cannot overflow.
@@ -343,7 +332,7 @@ fn settle_failure(y: &[f64], yf: f64, window_start: usize) -> SettleFailure {
 
 /// The first non-finite sample or non-increasing time, as an error.
 #[cold]
-fn locate_bad_sample(t: &[f64], y: &[f64]) -> Error {
+pub(super) fn locate_bad_sample(t: &[f64], y: &[f64]) -> Error {
     if let Some(i) = y.iter().position(|v| !v.is_finite()) {
         return Error::InvalidData {
             what: "y",
@@ -368,7 +357,7 @@ fn locate_bad_sample(t: &[f64], y: &[f64]) -> Error {
 
 /// Time at which the segment from `(ta, ya)` to `(tb, yb)` reaches `level`.
 #[inline]
-fn crossing(ta: f64, ya: f64, tb: f64, yb: f64, level: f64) -> f64 {
+pub(super) fn crossing(ta: f64, ya: f64, tb: f64, yb: f64, level: f64) -> f64 {
     let dy = yb - ya;
     if dy == 0.0 {
         return tb;
