@@ -68,20 +68,29 @@ impl Fast {
         let mut rows = 0;
         while rows < limit {
             let rest = &bytes[at..];
-            let Some(end) = memchr::memchr(b'\n', rest) else {
-                return (at, rows as u64, Stop::Partial);
+            let used = match self.quick(rest) {
+                Some(used) => used,
+                None => {
+                    let Some(end) = memchr::memchr(b'\n', rest) else {
+                        return (at, rows as u64, Stop::Partial);
+                    };
+                    let line = match &rest[..end] {
+                        [line @ .., b'\r'] => line,
+                        line => line,
+                    };
+                    if !self.row(line) {
+                        return (at, rows as u64, Stop::Unusual);
+                    }
+                    end + 1
+                }
             };
-            let line = match &rest[..end] {
-                [line @ .., b'\r'] => line,
-                line => line,
-            };
-            if !self.row(line) || !self.increases(cols) {
+            if !self.increases(cols) {
                 return (at, rows as u64, Stop::Unusual);
             }
             for (col, &column) in cols.iter_mut().zip(&self.columns) {
                 col.push(self.row[column]);
             }
-            at += end + 1;
+            at += used;
             rows += 1;
         }
         (at, rows as u64, Stop::Limit)
@@ -95,6 +104,48 @@ impl Fast {
             Some(&before) => now > before && (now - before).is_finite(),
             None => true,
         }
+    }
+
+    /// Reads the row at the start of `bytes` into `self.row`, in SI, when
+    /// every field is a plain number and the line ends in `\n` or `\r\n`:
+    /// the usual row, read without looking for its end first. Returns its
+    /// length with the line break; `None` leaves the row to [`row`](Self::row).
+    #[inline]
+    fn quick(&mut self, bytes: &[u8]) -> Option<usize> {
+        let width = self.row.len();
+        let mut at = 0;
+        for column in 0..width {
+            let (value, n) = plain(bytes.get(at..)?, self.decimal_comma)?;
+            self.row[column] = self.scaled(column, value)?;
+            at += n;
+            let next = *bytes.get(at)?;
+            if column + 1 < width {
+                if next != self.separator {
+                    return None;
+                }
+                at += 1;
+            } else if next == b'\n' {
+                return Some(at + 1);
+            } else if next == b'\r' && bytes.get(at + 1) == Some(&b'\n') {
+                return Some(at + 2);
+            }
+        }
+        None
+    }
+
+    /// Column `column`'s `value` in SI, as the general path converts it;
+    /// `None` when not finite.
+    #[inline(always)]
+    fn scaled(&self, column: usize, value: f64) -> Option<f64> {
+        let (divisor, factor) = self.scales[column];
+        // Dividing or multiplying by 1 changes no bit, and is skipped.
+        let value = if divisor == 1.0 {
+            value
+        } else {
+            value / divisor
+        };
+        let value = if factor == 1.0 { value } else { value * factor };
+        value.is_finite().then_some(value)
     }
 
     /// Reads a line (without its line break) into `self.row`, in SI; false
@@ -118,18 +169,9 @@ impl Fast {
                     }
                 }
             };
-            let (divisor, factor) = self.scales[column];
-            // As the general path: dividing or multiplying by 1 changes
-            // no bit, and is skipped.
-            let value = if divisor == 1.0 {
-                value
-            } else {
-                value / divisor
-            };
-            let value = if factor == 1.0 { value } else { value * factor };
-            if !value.is_finite() {
+            let Some(value) = self.scaled(column, value) else {
                 return false;
-            }
+            };
             self.row[column] = value;
             // The last column must end the line, any other a separator.
             match rest.get(used) {

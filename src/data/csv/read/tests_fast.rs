@@ -184,3 +184,27 @@ fn errors_in_fast_rows_name_the_same_line_and_column() {
         }
     }
 }
+
+#[test]
+fn the_fast_path_reads_clean_rows_itself() {
+    // So that the comparisons above are not of the general path with itself.
+    let slot = |index, divisor| Slot {
+        index,
+        divisor,
+        factor: 1.0,
+        name: "c",
+    };
+    let slots = [slot(0, 1.0), slot(1, 1.0), slot(2, 1000.0), slot(3, 1000.0)];
+    for (sep, decimal, newline) in [(',', '.', "\n"), (';', ',', "\r\n"), ('\t', ',', "\n")] {
+        let text = clean(sep, decimal, newline, 3000);
+        let rows = &text.as_bytes()[text.find(newline).unwrap() + newline.len()..];
+        let mut fast = fast::Fast::new(&slots, 4, sep as u8, decimal == ',');
+        let mut cols = vec![Vec::new(); 4];
+        let got = fast.rows(rows, &mut cols, usize::MAX);
+        assert_eq!(got, (rows.len(), 3000, fast::Stop::Partial));
+        // A comment stops it where it is.
+        let commented = [rows, b"# end\n"].concat();
+        let got = fast.rows(&commented, &mut vec![Vec::new(); 4], usize::MAX);
+        assert_eq!(got, (rows.len(), 3000, fast::Stop::Unusual));
+    }
+}
