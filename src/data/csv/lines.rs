@@ -5,6 +5,8 @@
 //! [`Lines`] hands out the file's lines in place, in its own buffer, each
 //! with its number and what it is; the reader feeds the content lines to the
 //! CSV tokenizer and skips the others, so a line number is the file's own.
+//! The reader's fast path reads whole rows from what is buffered
+//! ([`Lines::pending`]) and hands them out in one step ([`Lines::skip`]).
 
 use std::io::{self, Read};
 use std::ops::Range;
