@@ -5,6 +5,8 @@
 //! [`Lines`] hands out the file's lines in place, in its own buffer, each
 //! with its number and what it is; the reader feeds the content lines to the
 //! CSV tokenizer and skips the others, so a line number is the file's own.
+//! The reader's fast path reads whole rows from what is buffered
+//! ([`Lines::pending`]) and hands them out in one step ([`Lines::skip`]).
 
 use std::io::{self, Read};
 use std::ops::Range;
@@ -101,6 +103,35 @@ impl<R: Read> Lines<R> {
     /// How many bytes of the source have been handed out or skipped.
     pub(super) fn consumed(&self) -> u64 {
         self.dropped + self.pos as u64
+    }
+
+    /// What is read and not handed out yet, for the reader's fast path
+    /// (the `\n` of a `\r\n` already handed out dropped): `None` before
+    /// the first line, or after a `\r` at the end of what is read, whose
+    /// `\n` may come next ([`next`](Self::next) drops it).
+    pub(super) fn pending(&mut self) -> Option<&[u8]> {
+        if self.after_cr && self.pos < self.end {
+            self.after_cr = false;
+            if self.buf[self.pos] == b'\n' {
+                self.pos += 1;
+            }
+        }
+        (self.started && !self.after_cr).then(|| &self.buf[self.pos..self.end])
+    }
+
+    /// Hands out the first `bytes` of [`pending`](Self::pending): `lines`
+    /// whole lines, each ending in `\n`.
+    pub(super) fn skip(&mut self, bytes: usize, lines: u64) {
+        self.pos += bytes;
+        self.line += lines;
+    }
+
+    /// Reads more of the source after what is pending; false at its end.
+    pub(super) fn more(&mut self) -> io::Result<bool> {
+        if !self.eof {
+            self.refill()?;
+        }
+        Ok(!self.eof)
     }
 
     /// Moves what is not handed out yet to the front of the buffer, growing

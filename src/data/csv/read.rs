@@ -1,18 +1,20 @@
-//! Reading a [`Recording`] from CSV: one pass over the bytes. The lines of
-//! the log ([`Lines`]) are told apart as they come, comment and blank lines
-//! skipped; content lines go to `csv-core`'s tokenizer, which splits them
-//! into fields (quotes included), except a row without a quote, split at
-//! the separator in place as the tokenizer would; each field is trimmed and
-//! parsed from its bytes (one UTF-8 check a row), and only the header is
-//! read as text.
+//! Reading a [`Recording`] from CSV: one pass over the bytes. Rows as a
+//! logger writes them (one line each, plain numbers) are read straight from
+//! the buffer ([`fast`]); anything else, and every error, goes through the
+//! general path: the lines of the log ([`Lines`]) told apart as they come,
+//! comment and blank lines skipped; content lines go to `csv-core`'s
+//! tokenizer, which splits them into fields (quotes included), except a row
+//! without a quote, split at the separator in place as the tokenizer would
+//! ([`records`]); each field is trimmed and parsed from its bytes (one
+//! UTF-8 check a row), and only the header is read as text.
 
 use std::io::Read;
 use std::path::Path;
 
-use csv_core::ReadRecordResult;
-
+use self::fast::{Fast, Stop};
+use self::records::{Records, field_text, trim};
 use super::header::{Scale, parse_header};
-use super::lines::{Kind, Line, Lines, separator, without_break};
+use super::lines::{Kind, Lines, separator, without_break};
 use super::value::{self, BadValue};
 use super::{CsvError, CsvOptions, csv_error, is_input_name};
 use crate::data::{Channel, Recording, Schema};
@@ -26,220 +28,6 @@ struct Slot<'a> {
     divisor: f64,
     factor: f64,
     name: &'a str,
-}
-
-/// The records of a log: its content lines, fed one by one to `csv-core`,
-/// which splits them into fields. A record is one line, or more when a
-/// quoted field holds a line break; comment and blank lines are skipped
-/// wherever they are, so the tokenizer sees what the reader before the
-/// port to `csv-core` gave the `csv` crate: content lines, each ending in a
-/// line break. A row without a quote (the usual row) is split at the
-/// separator in place ([`split`]): the same fields, a tenth fewer
-/// instructions a row, no copy.
-struct Records<R> {
-    lines: Lines<R>,
-    core: csv_core::Reader,
-    separator: u8,
-    /// The tokenizer's output: fields back to back, and where each ends.
-    fields: Vec<u8>,
-    ends: Vec<usize>,
-    /// The current record: where its bytes are (`None`: the first `out`
-    /// bytes of `fields`; else a line, in `lines`), and where each of its
-    /// fields is in them.
-    line: Option<std::ops::Range<usize>>,
-    out: usize,
-    bounds: Vec<(usize, usize)>,
-}
-
-impl<R: Read> Records<R> {
-    fn new(lines: Lines<R>, separator: u8) -> Self {
-        Self {
-            lines,
-            core: csv_core::ReaderBuilder::new().delimiter(separator).build(),
-            separator,
-            fields: vec![0; 1024],
-            ends: vec![0; 64],
-            line: None,
-            out: 0,
-            bounds: Vec::new(),
-        }
-    }
-
-    /// The next content line, or `None` at the end.
-    fn content_line(&mut self) -> std::io::Result<Option<Line>> {
-        loop {
-            match self.lines.next()? {
-                Some(line) if line.kind != Kind::Content => {}
-                other => return Ok(other),
-            }
-        }
-    }
-
-    /// Reads the next record, starting with `first` when given (a content
-    /// line already read); returns the file's line it starts on, or `None`
-    /// at the end.
-    fn next(&mut self, mut first: Option<Line>) -> std::io::Result<Option<u64>> {
-        let at_header = first.is_some();
-        let (mut out, mut end) = (0, 0);
-        let mut start = None;
-        loop {
-            let line = match first.take() {
-                Some(line) => Some(line),
-                None => self.content_line()?,
-            };
-            let Some(line) = line else {
-                // The end of the input: a last record without a line break.
-                loop {
-                    let (res, _, _, n) =
-                        self.core
-                            .read_record(&[], &mut self.fields[out..], &mut self.ends[end..]);
-                    end += n;
-                    match res {
-                        ReadRecordResult::Record => {
-                            self.tokenized(end, out);
-                            return Ok(Some(start.unwrap_or(self.lines.line())));
-                        }
-                        ReadRecordResult::OutputEndsFull => grow(&mut self.ends),
-                        ReadRecordResult::OutputFull => grow(&mut self.fields),
-                        ReadRecordResult::End | ReadRecordResult::InputEmpty => return Ok(None),
-                    }
-                }
-            };
-            if start.is_none() && !at_header {
-                let range = line.range.start..line.range.end - usize::from(line.has_break);
-                if split(
-                    self.lines.bytes(range.clone()),
-                    self.separator,
-                    &mut self.bounds,
-                ) {
-                    self.line = Some(range);
-                    return Ok(Some(line.number));
-                }
-            }
-            start.get_or_insert(line.number);
-            let bytes = self.lines.bytes(line.range);
-            let mut input = bytes;
-            loop {
-                let (res, nin, nout, n) =
-                    self.core
-                        .read_record(input, &mut self.fields[out..], &mut self.ends[end..]);
-                input = &input[nin..];
-                out += nout;
-                end += n;
-                match res {
-                    ReadRecordResult::InputEmpty => break,
-                    ReadRecordResult::OutputFull => grow(&mut self.fields),
-                    ReadRecordResult::OutputEndsFull => grow(&mut self.ends),
-                    ReadRecordResult::Record => {
-                        self.tokenized(end, out);
-                        return Ok(Some(start.unwrap_or(line.number)));
-                    }
-                    ReadRecordResult::End => return Ok(None),
-                }
-            }
-            // A line break in a quoted field: the tokenizer copied a `\r`
-            // where the file has `\r` or `\r\n`; it stands for `\n`, as
-            // any line break.
-            if bytes.last() == Some(&b'\r') && out > 0 && self.fields[out - 1] == b'\r' {
-                self.fields[out - 1] = b'\n';
-            }
-        }
-    }
-
-    /// Takes the record the tokenizer wrote: `len` fields in `out` bytes.
-    fn tokenized(&mut self, len: usize, out: usize) {
-        self.bounds.clear();
-        let mut from = 0;
-        for &end in &self.ends[..len] {
-            self.bounds.push((from, end));
-            from = end;
-        }
-        self.line = None;
-        self.out = out;
-    }
-
-    /// The number of fields of the current record.
-    fn len(&self) -> usize {
-        self.bounds.len()
-    }
-
-    /// The current record's bytes.
-    #[inline(always)]
-    fn bytes(&self) -> &[u8] {
-        match &self.line {
-            Some(range) => self.lines.bytes(range.clone()),
-            None => &self.fields[..self.out],
-        }
-    }
-
-    /// Where field `i` of the current record is in its bytes.
-    #[inline(always)]
-    fn bounds(&self, i: usize) -> std::ops::Range<usize> {
-        let (start, end) = self.bounds[i];
-        start..end
-    }
-
-    /// Field `i` of the current record, as found (quotes removed).
-    fn field(&self, i: usize) -> &[u8] {
-        &self.bytes()[self.bounds(i)]
-    }
-
-    /// The current record's bytes as text, when they are UTF-8.
-    #[inline(always)]
-    fn text(&self) -> Option<&str> {
-        std::str::from_utf8(self.bytes()).ok()
-    }
-
-    /// The current record's fields as found, joined by `separator`.
-    fn joined(&self, separator: u8) -> String {
-        let fields: Vec<String> = (0..self.len())
-            .map(|i| String::from_utf8_lossy(self.field(i)).into_owned())
-            .collect();
-        fields.join(&(separator as char).to_string())
-    }
-}
-
-/// Splits a line (without its line break) at `separator` into `bounds`,
-/// unless it holds a quote: then returns false, and the tokenizer reads it.
-/// Without a quote, and a content line holds no line break, the tokenizer
-/// would find exactly these fields; this is the same split in one pass
-/// over the line, without copying it.
-fn split(line: &[u8], separator: u8, bounds: &mut Vec<(usize, usize)>) -> bool {
-    bounds.clear();
-    let mut from = 0;
-    for (at, &b) in line.iter().enumerate() {
-        if b == separator {
-            bounds.push((from, at));
-            from = at + 1;
-        } else if b == b'"' {
-            return false;
-        }
-    }
-    bounds.push((from, line.len()));
-    true
-}
-
-/// Doubles a buffer of the tokenizer's output.
-fn grow<T: Default + Clone>(buf: &mut Vec<T>) {
-    let n = buf.len().max(16);
-    buf.resize(2 * n, T::default());
-}
-
-/// `text` trimmed as `str::trim` trims it, at once when it starts and ends
-/// with a printable ASCII character (a number does).
-#[inline(always)]
-fn trim(text: &str) -> &str {
-    match text.as_bytes() {
-        [a, .., z] if a.is_ascii_graphic() && z.is_ascii_graphic() => text,
-        [a] if a.is_ascii_graphic() => text,
-        _ => text.trim(),
-    }
-}
-
-/// A field's text, trimmed as `str::trim` trims it (Unicode whitespace),
-/// or `None` when its bytes are not UTF-8.
-fn field_text(raw: &[u8]) -> Option<&str> {
-    std::str::from_utf8(raw).ok().map(trim)
 }
 
 /// Reads the values of the current row (of the right width, on line
@@ -338,6 +126,18 @@ fn estimate_rows(size: u64, consumed: u64, rows: usize, bytes: u64, width: usize
 /// After how many rows the columns are sized from the file's length.
 const ESTIMATE_AFTER: usize = 256;
 
+/// Reserves room in `cols` for the rows a file of `size` bytes has left,
+/// from the first rows (`bytes` long, from byte `start`).
+fn size_columns(cols: &mut [Vec<f64>], size: Option<u64>, bytes: u64, start: u64, width: usize) {
+    let (Some(size), Some(rows)) = (size, cols.first().map(Vec::len)) else {
+        return;
+    };
+    let more = estimate_rows(size, start + bytes, rows, bytes, width);
+    for col in cols {
+        col.reserve(more);
+    }
+}
+
 impl Recording {
     /// Reads a recording from a CSV file; see [`from_reader`](Self::from_reader)
     /// for the format.
@@ -388,7 +188,7 @@ impl Recording {
             .map_err(|e| CsvError::io(format!("opening {}", path.display()), e))?;
         // The file's length sizes the columns once (0 for a pipe: unknown).
         let size = file.metadata().ok().map(|m| m.len()).filter(|&n| n > 0);
-        read(file, options, size, Some(path))
+        read(file, options, size, Some(path), true)
     }
 
     /// Reads a recording from CSV text with the default [`CsvOptions`]: any
@@ -511,7 +311,7 @@ impl Recording {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn from_reader_with(reader: impl Read, options: &CsvOptions) -> Result<Self, CsvError> {
-        read(reader, options, None, None)
+        read(reader, options, None, None, true)
     }
 }
 
@@ -532,6 +332,7 @@ fn read<R: Read>(
     options: &CsvOptions,
     size: Option<u64>,
     path: Option<&Path>,
+    fast_path: bool,
 ) -> Result<Recording, CsvError> {
     options.check()?;
     let mut lines = Lines::new(reader);
@@ -687,7 +488,41 @@ fn read<R: Read>(
     let rows_start = records.lines.consumed();
     // The first interval that overflows: (line, previous time, time).
     let mut overflow: Option<(u64, f64, f64)> = None;
+    let mut fast = Fast::new(&slots, width, separator, decimal_comma);
+    // Whether the columns are sized (or cannot be: the length is unknown).
+    let mut sized = size.is_none();
     loop {
+        if fast_path && let Some(pending) = records.lines.pending() {
+            // Up to the row after which the columns are sized, then all.
+            let limit = match ESTIMATE_AFTER.checked_sub(cols[0].len()) {
+                Some(left) if !sized && left > 0 => left,
+                _ => usize::MAX,
+            };
+            let (bytes, lines, stop) = fast.rows(pending, &mut cols, limit);
+            if lines > 0 {
+                records.lines.skip(bytes, lines);
+                last = records.lines.line();
+            }
+            if !sized && cols[0].len() >= ESTIMATE_AFTER {
+                size_columns(
+                    &mut cols,
+                    size,
+                    records.lines.consumed() - rows_start,
+                    rows_start,
+                    width,
+                );
+                sized = true;
+            }
+            match stop {
+                Stop::Limit => continue,
+                Stop::Partial => match records.lines.more() {
+                    Ok(true) => continue,
+                    Ok(false) => {}
+                    Err(e) => return Err(io(&records, e)),
+                },
+                Stop::Unusual => {}
+            }
+        }
         match records.next(None) {
             Ok(Some(line)) => last = line,
             Ok(None) => break,
@@ -727,14 +562,15 @@ fn read<R: Read>(
                 overflow = Some((last, before, now));
             }
         }
-        if let Some(size) = size
-            && t.len() == ESTIMATE_AFTER
-        {
-            let consumed = records.lines.consumed();
-            let more = estimate_rows(size, consumed, t.len(), consumed - rows_start, width);
-            for col in &mut cols {
-                col.reserve(more);
-            }
+        if !sized && t.len() >= ESTIMATE_AFTER {
+            size_columns(
+                &mut cols,
+                size,
+                records.lines.consumed() - rows_start,
+                rows_start,
+                width,
+            );
+            sized = true;
         }
     }
 
@@ -763,5 +599,9 @@ fn read<R: Read>(
     })
 }
 
+mod fast;
+mod records;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_fast;

@@ -1,6 +1,8 @@
 //! The reader's internals: splitting, trimming, row estimates.
 
+use super::records::split;
 use super::*;
+use csv_core::ReadRecordResult;
 
 #[test]
 fn fields_are_trimmed_as_str_trim_trims() {
