@@ -126,3 +126,22 @@ fn bode_figures_of_subnormal_frequencies_return() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `LeastSquares::new(usize::MAX)` and `with_capacity(2, usize::MAX)`
+/// panicked ("capacity overflow"); the sizes are hints now, and a problem
+/// that cannot have more rows than parameters says so when solved.
+#[test]
+fn least_squares_of_impossible_sizes_refuse_instead_of_panicking() {
+    use ctrlab::Error;
+    use ctrlab::ident::LeastSquares;
+    let mut huge = LeastSquares::new(usize::MAX);
+    assert_eq!(huge.parameters(), usize::MAX);
+    assert!(huge.push_row(&[1.0], 1.0).is_err());
+    assert!(matches!(huge.solve(), Err(Error::TooFewSamples { .. })));
+    let mut tall = LeastSquares::with_capacity(2, usize::MAX);
+    for k in 0..10 {
+        tall.push_row(&[1.0, k as f64], 1.0 + 2.0 * k as f64).unwrap();
+    }
+    let fit = tall.solve().unwrap();
+    assert!((fit.theta[0] - 1.0).abs() < 1e-12 && (fit.theta[1] - 2.0).abs() < 1e-12);
+}

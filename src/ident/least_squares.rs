@@ -60,7 +60,12 @@ pub const DEFAULT_MAX_CONDITION: f64 = 1e10;
 /// ```
 #[derive(Debug, Clone)]
 pub struct LeastSquares {
-    /// Regressor columns, each one `Vec` of rows.
+    /// The number of parameters, `θ`'s length.
+    parameters: usize,
+    /// The rows each column has room for when it is made.
+    capacity: usize,
+    /// Regressor columns, each one `Vec` of rows: `parameters` of them, or
+    /// none until the first row when the allocator refused them up front.
     columns: Vec<Vec<f64>>,
     /// Right-hand side.
     rhs: Vec<f64>,
@@ -145,15 +150,39 @@ impl LeastSquares {
     /// assert_eq!(ls.parameters(), 2);
     /// ```
     pub fn with_capacity(parameters: usize, rows: usize) -> Self {
-        Self {
-            columns: (0..parameters).map(|_| Vec::with_capacity(rows)).collect(),
-            rhs: Vec::with_capacity(rows),
+        let mut rhs = Vec::new();
+        // Hints: room the allocator refuses (usize::MAX rows or
+        // parameters) is not reserved, instead of a capacity-overflow panic.
+        let _ = rhs.try_reserve_exact(rows);
+        let mut ls = Self {
+            parameters,
+            capacity: rows,
+            columns: Vec::new(),
+            rhs,
             max_condition: DEFAULT_MAX_CONDITION,
             covariance: Covariance::Classical,
             segment_starts: Vec::new(),
             work: Vec::new(),
             hac: Workspace::default(),
+        };
+        ls.make_columns();
+        ls
+    }
+
+    /// Makes the `parameters` columns, each with room for `capacity` rows,
+    /// unless they exist or the allocator refuses them.
+    fn make_columns(&mut self) {
+        if self.columns.len() == self.parameters
+            || self.columns.try_reserve_exact(self.parameters).is_err()
+        {
+            return;
         }
+        let capacity = self.capacity;
+        self.columns.extend((0..self.parameters).map(|_| {
+            let mut column = Vec::new();
+            let _ = column.try_reserve_exact(capacity);
+            column
+        }));
     }
 
     /// Sets how the covariance of `θ̂` is estimated (default
@@ -278,7 +307,7 @@ impl LeastSquares {
     /// assert_eq!(LeastSquares::new(4).parameters(), 4);
     /// ```
     pub fn parameters(&self) -> usize {
-        self.columns.len()
+        self.parameters
     }
 
     /// Number of rows pushed so far.
@@ -332,13 +361,14 @@ impl LeastSquares {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn push_row(&mut self, phi: &[f64], lambda: f64) -> Result<(), Error> {
-        if phi.len() != self.columns.len() {
+        if phi.len() != self.parameters {
             return Err(Error::InvalidParameter {
                 name: "phi",
                 value: phi.len() as f64,
                 reason: "regressor row length must equal the number of parameters",
             });
         }
+        self.make_columns();
         for (col, &v) in self.columns.iter_mut().zip(phi) {
             col.push(v);
         }
@@ -366,7 +396,7 @@ impl LeastSquares {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn push_columns(&mut self, columns: &[&[f64]], lambda: &[f64]) -> Result<(), Error> {
-        if columns.len() != self.columns.len() {
+        if columns.len() != self.parameters {
             return Err(Error::InvalidParameter {
                 name: "columns",
                 value: columns.len() as f64,
@@ -380,6 +410,7 @@ impl LeastSquares {
                 reason: "every column must be as long as lambda",
             });
         }
+        self.make_columns();
         for (col, new) in self.columns.iter_mut().zip(columns) {
             col.extend_from_slice(new);
         }
@@ -411,6 +442,15 @@ impl LeastSquares {
     /// ```
     pub fn solve(&mut self) -> Result<LeastSquaresFit, Error> {
         let (m, p) = (self.rows(), self.parameters());
+        // Before sizing anything by `p`: a problem with no more rows than
+        // parameters has no solution to give (and `m (p + 1)` may overflow).
+        if m <= p || p == 0 {
+            return Err(Error::TooFewSamples {
+                what: "least squares (more rows than parameters)",
+                needed: p.saturating_add(1).max(2),
+                got: m,
+            });
+        }
         self.work.clear();
         self.work.reserve(m * (p + 1));
         for col in &self.columns {
