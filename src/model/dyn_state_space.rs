@@ -178,8 +178,8 @@ impl DynStateSpace<Discrete> {
     /// # use ctrlab::nalgebra::{dmatrix, dvector};
     /// let sys = DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], 0.01)?;
     /// assert_eq!(sys.advance(&dvector![2.0], &dvector![1.0])?, dvector![2.0]);
-    /// // 0.5 · 1e308 + 1e308 exceeds f64::MAX: refused, not Ok([inf]).
-    /// let err = sys.advance(&dvector![1e308], &dvector![1e308]).unwrap_err();
+    /// // 0.5 · 1e308 + 1.5e308 exceeds f64::MAX: refused, not Ok([inf]).
+    /// let err = sys.advance(&dvector![1e308], &dvector![1.5e308]).unwrap_err();
     /// assert!(matches!(err, Error::Overflow { .. }));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
