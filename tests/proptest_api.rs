@@ -7,9 +7,12 @@
 // Built on the two-cart lab (its plant, simulated rig or card).
 #![cfg(feature = "lab")]
 
-use ctrlab::design::{StateFeedback, acker, dlqr, lqr};
+use ctrlab::design::{
+    AntiWindup, EstimatorForm, IntegralFeedback, Observer, StateFeedback, acker, care, dare, dlqr,
+    lqr,
+};
 use ctrlab::discretize::expm;
-use ctrlab::ident::{LeastSquares, Rls};
+use ctrlab::ident::{LeastSquares, Rls, etfe, spa};
 use ctrlab::lab::ident::{Options, Scheme, Spread, SpringModel, average, identify, identify_with};
 use ctrlab::metrics::step_info_channel;
 use ctrlab::metrics::{Definition, step_info_mimo};
@@ -18,9 +21,10 @@ use ctrlab::sim::{
     step_response, time_grid,
 };
 use ctrlab::{
-    Discretization, MassSpring, Recording, StateSpace, StepInfoOptions, step_info, step_info_of,
+    Controller, Discretization, DynStateSpace, MassSpring, Recording, StateSpace, StepInfoOptions,
+    step_info, step_info_of,
 };
-use nalgebra::{Complex, DMatrix, SMatrix, SVector};
+use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector};
 use proptest::prelude::*;
 
 /// Any f64, weighted towards the values that break numeric code.
@@ -381,6 +385,89 @@ proptest! {
                     let _ = step_info_channel(&rec, "y", &StepInfoOptions::default());
                 }
             }
+        }
+    }
+}
+
+// Issue 28: observers and integral action, run-time-sized models, the
+// Riccati equations and the spectral estimates.
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn observers(
+        a in matrix::<2, 2>(wild()), b in matrix::<2, 1>(wild()), c in matrix::<1, 2>(wild()),
+        d in wild(), l in matrix::<2, 1>(wild()), current in any::<bool>(), y in -1.0..1.0f64,
+    ) {
+        let Ok(model) = StateSpace::discrete(a, b, c, SMatrix::from_element(d), 0.01) else { return Ok(()) };
+        let form = if current { EstimatorForm::Current } else { EstimatorForm::Predictor };
+        if let Ok(mut obs) = Observer::new(&model, l, form) {
+            // Accepted: the first estimate of a unit-sized measurement is
+            // finite (it was NaN for A⁻¹ L = 1e9 / 1e-300).
+            let estimate = obs.correct(&SVector::from_element(y));
+            prop_assert!(finite_all(estimate.as_slice()), "{:?}", estimate);
+        }
+    }
+
+    #[test]
+    fn integral_action(
+        a in wild(), b in wild(), c in wild(), d in wild(), dt in 0.001..10.0f64,
+        gain in matrix::<1, 2>(wild()), tracking in wild(), deadband in wild(), back in any::<bool>(),
+    ) {
+        let one = |v: f64| SMatrix::<f64, 1, 1>::from_element(v);
+        let Ok(plant) = StateSpace::discrete(one(a), one(b), one(c), one(d), dt) else { return Ok(()) };
+        let anti_windup = if back { AntiWindup::BackCalculation { tracking, deadband } } else { AntiWindup::None };
+        if let Ok(mut ctl) = IntegralFeedback::new(&plant, &gain, anti_windup) {
+            // Accepted: at rest it stays finite (T D = 10 · 1e308 and
+            // K_z⁺ = 1 / 1e-310 made NaN of zeros; a nonzero signal may
+            // overflow on gains of 1e300 legitimately).
+            for _ in 0..3 {
+                let u = ctl.update(&SVector::zeros(), &SVector::zeros());
+                prop_assert!(finite_all(u.as_slice()), "{:?}", u);
+                ctl.applied(&SVector::zeros());
+                prop_assert!(finite_all(ctl.integrators().as_slice()), "{:?}", ctl.integrators());
+            }
+        }
+    }
+
+    #[test]
+    fn run_time_models(
+        a in matrix::<2, 2>(wild()), b in matrix::<2, 1>(wild()), c in matrix::<1, 2>(wild()),
+        d in wild(), x in matrix::<2, 1>(wild()), u in wild(),
+    ) {
+        let heap = |m: &[f64], r: usize, k: usize| DMatrix::from_column_slice(r, k, m);
+        let Ok(sys) = DynStateSpace::discrete(heap(a.as_slice(), 2, 2), heap(b.as_slice(), 2, 1),
+            heap(c.as_slice(), 1, 2), heap(&[d], 1, 1), 0.01) else { return Ok(()) };
+        let (x, u) = (DVector::from_column_slice(x.as_slice()), DVector::from_element(1, u));
+        if let Ok(next) = sys.advance(&x, &u) { prop_assert!(finite_all(next.as_slice()), "{}", next); }
+        if let Ok(y) = sys.output(&x, &u) { prop_assert!(finite_all(y.as_slice()), "{}", y); }
+    }
+
+    #[test]
+    fn riccati_equations(
+        a in matrix::<2, 2>(wild()), b in matrix::<2, 1>(wild()), q in matrix::<2, 2>(wild()),
+        r in wild(), discrete in any::<bool>(),
+    ) {
+        let heap = |m: &[f64], r: usize, k: usize| DMatrix::from_column_slice(r, k, m);
+        let q = q + q.transpose(); // symmetric (when finite) so that it gets past the checks
+        let (a, b, q, r) = (heap(a.as_slice(), 2, 2), heap(b.as_slice(), 2, 1), heap(q.as_slice(), 2, 2), heap(&[r], 1, 1));
+        let sol = if discrete { dare(&a, &b, &q, &r) } else { care(&a, &b, &q, &r) };
+        if let Ok(sol) = sol {
+            prop_assert!(finite_all(sol.gain.as_slice()), "{}", sol.gain);
+            prop_assert!(finite_all(sol.riccati.as_slice()), "{}", sol.riccati);
+            prop_assert!(finite_c(sol.poles.as_slice()), "{:?}", sol.poles);
+        }
+    }
+
+    #[test]
+    fn spectral_estimates(
+        u in proptest::collection::vec(wild(), 0..40), y in proptest::collection::vec(wild(), 0..40),
+        dt in wild(), lag in proptest::option::of(0usize..50), omega in proptest::collection::vec(wild(), 0..4),
+    ) {
+        let n = u.len().min(y.len());
+        for g in [etfe(&u[..n], &y[..n], dt), spa(&u[..n], &y[..n], dt, lag, &omega)].into_iter().flatten() {
+            prop_assert!(finite_all(&g.omega), "{:?}", g.omega);
+            prop_assert!(finite_c(&g.response), "{:?}", g.response);
         }
     }
 }

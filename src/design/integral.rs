@@ -8,6 +8,7 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 use super::IntegralAction;
 #[cfg(doc)]
 use super::lqr::{dlqr, lqr};
+use super::observer::finite;
 use crate::design::Controller;
 use crate::error::{Error, check_finite};
 use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, Token, period_of};
@@ -266,6 +267,11 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
                         iterations: 0,
                     })?;
                 let back = SMatrix::<f64, I, M>::from_fn(|i, j| pinv[(i, j)] * period / tracking);
+                let back = finite(
+                    back,
+                    "anti-windup back-calculation (T / T_t) K_z⁺ (the integral gain K_z is \
+                     too small to invert)",
+                )?;
                 (back, deadband)
             }
         };
@@ -274,7 +280,10 @@ impl<const N: usize, const M: usize, const I: usize> IntegralLaw<N, M, I> {
             kz,
             back,
             deadband,
-            feedthrough: d * period,
+            feedthrough: finite(
+                d * period,
+                "integral action: T D (the integrated outputs' feedthrough D, times the period)",
+            )?,
             period,
             z: SVector::zeros(),
             asked: SVector::zeros(),
@@ -388,7 +397,9 @@ impl<const N: usize, const M: usize, const I: usize> IntegralFeedback<N, M, I> {
     /// [`Error::NonFinite`] naming `"K"` for a non-finite gain;
     /// [`Error::InvalidParameter`] named `"tracking"` for a back-calculation
     /// time constant that is not finite or shorter than the period,
-    /// `"deadband"` for a negative or non-finite dead band.
+    /// `"deadband"` for a negative or non-finite dead band;
+    /// [`Error::Overflow`] if `T D_i` overflows, or the back-calculation
+    /// gain `(T / T_t) K_z⁺` does (an integral gain too small to invert).
     ///
     /// # Examples
     ///

@@ -38,7 +38,14 @@ use crate::model::{Continuous, Discrete, Token, display};
 /// W = I + G H,  E ← E W⁻¹ E,  G ← G + E W⁻¹ G Eᵀ,  H ← H + Eᵀ H W⁻¹ E
 /// ```
 ///
-/// and `H → X` quadratically. The continuous equation
+/// and `H → X` quadratically, `E → 0`. The doubling stops when a step
+/// changes `H` by less than 1e-15 of its norm *and* `‖E‖ ≤ 1e-3`: with
+/// weights decades apart (`Q = diag(1e9, 1e-9)`) the part of `H` along the
+/// lightly weighted mode starts below that step size and grows while `E`
+/// does, so a settled `H` alone is not convergence. `W` is nonsingular
+/// (every eigenvalue at least 1 for `G`, `H` positive semidefinite) however
+/// ill-conditioned it gets meanwhile, and is refused only for a zero pivot.
+/// The continuous equation
 /// `Aᵀ X + X A − X B R⁻¹ Bᵀ X + Q = 0` is first mapped to that form by the
 /// Cayley transform of its Hamiltonian with a shift `γ > 0`
 /// (`A_γ = A − γ I`, `W_γ = A_γᵀ + Q A_γ⁻¹ G`, `E₀ = I + 2γ W_γ⁻ᵀ`,

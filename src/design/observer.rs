@@ -105,7 +105,8 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
     /// # Errors
     ///
     /// [`Error::NonFinite`] naming `"L"` for a non-finite gain;
-    /// [`Error::Unstable`] if `A − L C` has a pole on or outside the unit
+    /// [`Error::Overflow`] if `A − L C`, `B − L D` or (current form) `A⁻¹ L`
+    /// overflows; [`Error::Unstable`] if `A − L C` has a pole on or outside the unit
     /// circle (the estimate would not converge); for
     /// [`EstimatorForm::Current`], [`Error::InvalidMatrix`] named `"D"`
     /// unless `D = 0`, and [`Error::Singular`] for a singular `A`.
@@ -129,7 +130,14 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
         form: EstimatorForm,
     ) -> Result<Self, Error> {
         check_finite("L", &gain)?;
-        let error_dynamics = model.a() - gain * model.c();
+        let error_dynamics = finite(
+            model.a() - gain * model.c(),
+            "observer: A − L C (the gain L overflows the error dynamics)",
+        )?;
+        let input_path = finite(
+            model.b() - gain * model.d(),
+            "observer: B − L D (the gain L overflows the input path)",
+        )?;
         let poles = eigenvalues(&error_dynamics)?;
         if let Some(p) = first_unstable(&poles, &error_dynamics, Some(model.dt())) {
             return Err(Error::Unstable {
@@ -148,7 +156,10 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
                                  the estimate)",
                     });
                 }
-                Lu::new(model.a(), "current estimator (A⁻¹ L)")?.solve(&gain)
+                finite(
+                    Lu::new(model.a(), "current estimator (A⁻¹ L)")?.solve(&gain),
+                    "current estimator: A⁻¹ L (the gain L is too large for this A)",
+                )?
             }
         };
         Ok(Self {
@@ -156,7 +167,7 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
             gain,
             correction,
             error_dynamics,
-            input_path: model.b() - gain * model.d(),
+            input_path,
             form,
             prior: SVector::zeros(),
             corrected_from: SVector::zeros(),
@@ -278,5 +289,18 @@ impl<const N: usize, const M: usize, const P: usize> Observer<N, M, P> {
         self.prior = SVector::zeros();
         self.corrected_from = SVector::zeros();
         self.measured = SVector::zeros();
+    }
+}
+
+/// `m` if every entry is finite, else [`Error::Overflow`] of `operation`
+/// (the factors were checked finite: only the product can have overflowed).
+pub(crate) fn finite<const R: usize, const C: usize>(
+    m: SMatrix<f64, R, C>,
+    operation: &'static str,
+) -> Result<SMatrix<f64, R, C>, Error> {
+    if m.iter().all(|v| v.is_finite()) {
+        Ok(m)
+    } else {
+        Err(Error::Overflow { operation })
     }
 }

@@ -92,7 +92,9 @@ impl<const N: usize, const M: usize, const Q: usize, const I: usize>
     /// # Errors
     ///
     /// [`Error::NonFinite`] naming `"K"` or `"H"`; [`Error::InvalidParameter`]
-    /// named `"tracking"` or `"deadband"` as [`IntegralFeedback::new`](crate::design::IntegralFeedback::new).
+    /// named `"tracking"` or `"deadband"`, and [`Error::Overflow`] (of
+    /// `T H D` or the back-calculation gain), as
+    /// [`IntegralFeedback::new`](crate::design::IntegralFeedback::new).
     ///
     /// # Examples
     ///

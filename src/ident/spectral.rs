@@ -6,6 +6,7 @@ use nalgebra::Complex;
 use rustfft::FftPlanner;
 
 use crate::error::{Error, check_dt};
+use crate::kernels::reduce::pow2_floor;
 
 /// Bins of the ETFE whose input amplitude is below this fraction of the
 /// largest (−60 dB) are left out: the input did not excite them, so the
@@ -117,6 +118,12 @@ fn check_data(u: &[f64], y: &[f64], dt: f64) -> Result<(), Error> {
     Ok(())
 }
 
+/// A power of two near the largest magnitude in `v` (1 for all zeros):
+/// dividing by it is exact and leaves the largest entry in `[1, 2)`.
+fn magnitude(v: &[f64]) -> f64 {
+    pow2_floor(v.iter().fold(0.0f64, |m, x| m.max(x.abs())))
+}
+
 /// The empirical transfer-function estimate `Ĝ(ω_k) = Y(ω_k) / U(ω_k)`, the
 /// ratio of the discrete Fourier transforms of output and input (MATLAB's
 /// `etfe` without smoothing; Ljung, *System Identification*, §6.3).
@@ -161,8 +168,12 @@ pub fn etfe(u: &[f64], y: &[f64], dt: f64) -> Result<FrequencyEstimate, Error> {
     check_data(u, y, dt)?;
     let n = u.len();
     let fft = FftPlanner::<f64>::new().plan_fft_forward(n);
-    let mut uf: Vec<Complex<f64>> = u.iter().map(|&v| Complex::new(v, 0.0)).collect();
-    let mut yf: Vec<Complex<f64>> = y.iter().map(|&v| Complex::new(v, 0.0)).collect();
+    // Each signal divided by a power of two near its largest magnitude
+    // (exact): the transform of ±1e308 would overflow. `G` is undone by
+    // their ratio below.
+    let (su, sy) = (magnitude(u), magnitude(y));
+    let mut uf: Vec<Complex<f64>> = u.iter().map(|&v| Complex::new(v / su, 0.0)).collect();
+    let mut yf: Vec<Complex<f64>> = y.iter().map(|&v| Complex::new(v / sy, 0.0)).collect();
     fft.process(&mut uf);
     fft.process(&mut yf);
     let bins = 1..=n / 2;
@@ -181,7 +192,7 @@ pub fn etfe(u: &[f64], y: &[f64], dt: f64) -> Result<FrequencyEstimate, Error> {
     };
     for k in bins {
         if uf[k].norm() >= ETFE_MIN_INPUT * peak {
-            let g = yf[k] / uf[k];
+            let g = yf[k] / uf[k] * (sy / su);
             let w = base * k as f64;
             if !(g.re.is_finite() && g.im.is_finite() && w.is_finite()) {
                 return Err(Error::Overflow {
@@ -214,7 +225,8 @@ pub fn etfe(u: &[f64], y: &[f64], dt: f64) -> Result<FrequencyEstimate, Error> {
 /// # Errors
 ///
 /// As [`etfe`]; also [`Error::InvalidParameter`] (`"lag"`) for `M = 0` or
-/// `M ≥ N`, (`"omega"`) for a negative or non-finite frequency, and
+/// `M ≥ N`, (`"omega"`) for a negative or non-finite frequency or one whose
+/// `ω·dt·M` overflows, and
 /// [`Error::InvalidData`] (`"u"`) where the input's smoothed spectrum is not
 /// positive at a requested frequency (no input power there).
 ///
@@ -261,6 +273,21 @@ pub fn spa(
             reason: "frequencies must be finite and >= 0 rad/s",
         });
     }
+    if let Some(&w) = omega.iter().find(|w| !(**w * dt * m as f64).is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: "omega",
+            value: w,
+            reason: "ω·dt·lag overflows: the frequency is far beyond the Nyquist frequency \
+                     of this dt",
+        });
+    }
+    // The signals divided by powers of two near their largest magnitudes
+    // (exact), so their products cannot overflow; `G` is undone by their
+    // ratio below.
+    let (su, sy) = (magnitude(u), magnitude(y));
+    let u: Vec<f64> = u.iter().map(|v| v / su).collect();
+    let y: Vec<f64> = y.iter().map(|v| v / sy).collect();
+    let (u, y) = (u.as_slice(), y.as_slice());
     // Covariances at lags −M … M (R̂_yu is not symmetric; R̂_u is).
     let cross = |a: &[f64], b: &[f64], tau: usize| -> f64 {
         a[tau..].iter().zip(b).map(|(x, y)| x * y).sum::<f64>() / n as f64
@@ -298,7 +325,7 @@ pub fn spa(
                 reason: "the input's smoothed spectrum is not positive at a requested frequency",
             });
         }
-        let g = phi_yu / phi_u;
+        let g = phi_yu / phi_u * (sy / su);
         if !(g.re.is_finite() && g.im.is_finite()) {
             return Err(Error::Overflow {
                 operation: "spectral estimate (spa)",

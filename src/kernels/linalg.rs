@@ -48,6 +48,28 @@ where
     /// Factors `a`; refuses a matrix whose smallest pivot is negligible
     /// against its largest (`≤ N·ε·max`), i.e. singular to working precision.
     pub(crate) fn new(a: &OMatrix<f64, N, N>, operation: &'static str) -> Result<Self, Error> {
+        Self::with_pivot_ratio(a, operation, f64::EPSILON)
+    }
+
+    /// Factors `a`, refusing only a zero or non-finite pivot: for a matrix
+    /// nonsingular by construction however ill-conditioned (the doubling's
+    /// `I + G H` with `G`, `H` positive semidefinite has every eigenvalue
+    /// at least 1), where the solves stay accurate in the directions that
+    /// matter and a pivot ratio below `N·ε` is no sign of singularity.
+    pub(crate) fn structurally(
+        a: &OMatrix<f64, N, N>,
+        operation: &'static str,
+    ) -> Result<Self, Error> {
+        Self::with_pivot_ratio(a, operation, 0.0)
+    }
+
+    /// Factors `a`, refusing a smallest pivot at or below `N·ratio` times
+    /// the largest.
+    fn with_pivot_ratio(
+        a: &OMatrix<f64, N, N>,
+        operation: &'static str,
+        ratio: f64,
+    ) -> Result<Self, Error> {
         let mut lu = a.clone();
         let (dim, _) = lu.shape_generic();
         let n = dim.value();
@@ -87,7 +109,7 @@ where
                 }
             }
         }
-        if n > 0 && min_pivot <= (n as f64) * f64::EPSILON * max_pivot {
+        if n > 0 && min_pivot <= (n as f64) * ratio * max_pivot {
             return Err(Error::Singular { operation });
         }
         Ok(Self { lu, perm })

@@ -168,20 +168,27 @@ impl DynStateSpace<Discrete> {
     /// # Errors
     ///
     /// [`Error::LengthMismatch`] if `x` does not have `n` entries or `u`
-    /// does not have `m`.
+    /// does not have `m`; [`Error::InvalidData`] naming `x` or `u` for a
+    /// non-finite entry; [`Error::Overflow`] if the next state does.
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::DynStateSpace;
+    /// # use ctrlab::{DynStateSpace, Error};
     /// # use ctrlab::nalgebra::{dmatrix, dvector};
     /// let sys = DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], 0.01)?;
     /// assert_eq!(sys.advance(&dvector![2.0], &dvector![1.0])?, dvector![2.0]);
+    /// // 0.5 · 1e308 + 1.5e308 exceeds f64::MAX: refused, not Ok([inf]).
+    /// let err = sys.advance(&dvector![1e308], &dvector![1.5e308]).unwrap_err();
+    /// assert!(matches!(err, Error::Overflow { .. }));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn advance(&self, x: &DVector<f64>, u: &DVector<f64>) -> Result<DVector<f64>, Error> {
         self.check_vectors(x, u)?;
-        Ok(&self.a * x + &self.b * u)
+        finite_result(
+            &self.a * x + &self.b * u,
+            "DynStateSpace::advance (A x + B u)",
+        )
     }
 }
 
@@ -308,21 +315,28 @@ impl<D: Domain> DynStateSpace<D> {
     /// # Errors
     ///
     /// [`Error::LengthMismatch`] if `x` does not have `n` entries or `u`
-    /// does not have `m`.
+    /// does not have `m`; [`Error::InvalidData`] naming `x` or `u` for a
+    /// non-finite entry; [`Error::Overflow`] if the output does.
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::DynStateSpace;
+    /// # use ctrlab::{DynStateSpace, Error};
     /// # use ctrlab::nalgebra::{dmatrix, dvector};
     /// let sys = DynStateSpace::continuous(dmatrix![-2.0], dmatrix![4.0], dmatrix![3.0], dmatrix![0.5])?;
     /// assert_eq!(sys.output(&dvector![1.0], &dvector![2.0])?, dvector![4.0]);
     /// assert!(sys.output(&dvector![1.0, 0.0], &dvector![2.0]).is_err());
+    /// // 3 · 1e308 exceeds f64::MAX: refused, not Ok([inf]).
+    /// let err = sys.output(&dvector![1e308], &dvector![0.0]).unwrap_err();
+    /// assert!(matches!(err, Error::Overflow { .. }));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn output(&self, x: &DVector<f64>, u: &DVector<f64>) -> Result<DVector<f64>, Error> {
         self.check_vectors(x, u)?;
-        Ok(&self.c * x + &self.d * u)
+        finite_result(
+            &self.c * x + &self.d * u,
+            "DynStateSpace::output (C x + D u)",
+        )
     }
 
     fn check_vectors(&self, x: &DVector<f64>, u: &DVector<f64>) -> Result<(), Error> {
@@ -339,6 +353,15 @@ impl<D: Domain> DynStateSpace<D> {
                 expected: self.inputs(),
                 found: u.len(),
             });
+        }
+        for (what, v) in [("x", x), ("u", u)] {
+            if let Some(index) = v.iter().position(|e| !e.is_finite()) {
+                return Err(Error::InvalidData {
+                    what,
+                    index,
+                    reason: "must be finite",
+                });
+            }
         }
         Ok(())
     }
@@ -434,6 +457,16 @@ impl<const N: usize, const M: usize, const P: usize, D: Domain> TryFrom<DynState
 
     fn try_from(sys: DynStateSpace<D>) -> Result<Self, Error> {
         Self::try_from(&sys)
+    }
+}
+
+/// `v` if every entry is finite, else [`Error::Overflow`] of `operation`
+/// (finite inputs and matrices, so only the products can have overflowed).
+fn finite_result(v: DVector<f64>, operation: &'static str) -> Result<DVector<f64>, Error> {
+    if v.iter().all(|e| e.is_finite()) {
+        Ok(v)
+    } else {
+        Err(Error::Overflow { operation })
     }
 }
 

@@ -13,8 +13,14 @@ use crate::kernels::linalg::Lu;
 /// Doubling steps allowed; quadratic convergence needs far fewer (about
 /// `log2` of the ratio of the fastest to the slowest closed-loop mode, +6).
 pub(super) const MAX_ITERATIONS: usize = 100;
-/// Stop when a doubling step changes `H` by less than this, relative.
+/// Stop when a doubling step changes `H` by less than this, relative…
 const STEP_RTOL: f64 = 1e-15;
+/// …and `‖E‖` is below this: every mode contracts, so no direction of `H`
+/// is still growing. A small step alone is not convergence: `H` along a
+/// mode with a tiny weight (`Q = diag(1e9, 1e-9)`) starts below
+/// `STEP_RTOL ‖H‖` and grows by `‖E‖²` a step until the mode is stabilised
+/// (with `‖E‖` above 1, growing, meanwhile).
+const E_TOL: f64 = 1e-3;
 /// Sign-function steps allowed for one Lyapunov solve; with norm scaling
 /// the iteration needs about 10–20, even for a condition number of 1e12.
 const SIGN_ITERATIONS: usize = 60;
@@ -118,9 +124,13 @@ where
 /// W = I + G H,  E ← E W⁻¹ E,  G ← G + E W⁻¹ G Eᵀ,  H ← H + Eᵀ H W⁻¹ E
 /// ```
 ///
-/// returning `H` at convergence and the steps taken. One LU of `W` and
-/// solves for `W⁻¹ E`, `W⁻¹ G` per step; the products go to buffers
-/// allocated once.
+/// returning `H` at convergence and the steps taken. Converged means a
+/// step below [`STEP_RTOL`] with `‖E‖` below [`E_TOL`] (`E` tends to zero
+/// exactly when the solution is stabilising); if `E` never gets there
+/// (a mode on the stability boundary, or one `H` never sees, where `E`
+/// overflows) but `H` has stopped changing, the last settled `H` is
+/// returned and the caller's stability check names the mode. One LU of `W` and solves for `W⁻¹ E`,
+/// `W⁻¹ G` per step; the products go to buffers allocated once.
 pub(super) fn sda<N: Dim>(
     mut e: Square<N>,
     mut g: Square<N>,
@@ -134,13 +144,23 @@ where
     let mut w = Square::<N>::zeros_generic(dim, dim);
     let mut tmp = Square::<N>::zeros_generic(dim, dim);
     let mut h_next = Square::<N>::zeros_generic(dim, dim);
+    let mut settled = false;
     for it in 1..=MAX_ITERATIONS {
-        // W = I + G H: nonsingular for G, H positive semidefinite.
+        // W = I + G H: nonsingular for G, H positive semidefinite (every
+        // eigenvalue at least 1), however ill-conditioned; while a mode of
+        // tiny weight is being stabilised G H grows to 1e18 and more, and
+        // a pivot-ratio test would refuse it (an indefinite H that makes W
+        // singular shows as a zero or non-finite pivot, or a non-finite H).
         w.gemm(1.0, &g, &h, 0.0);
         for i in 0..n {
             w[(i, i)] += 1.0;
         }
-        let w_lu = Lu::new(&w, "Riccati doubling (I + G H)")?;
+        let w_lu = match Lu::structurally(&w, "Riccati doubling (I + G H)") {
+            Ok(lu) => lu,
+            // G H non-finite: as an overflowing H below.
+            Err(_) if settled => return Ok((h, it - 1)),
+            Err(e) => return Err(e),
+        };
         let (w_e, w_g) = (w_lu.solve(&e), w_lu.solve(&g));
         // H + Eᵀ (H W⁻¹ E)
         tmp.gemm(1.0, &h, &w_e, 0.0);
@@ -156,17 +176,25 @@ where
         std::mem::swap(&mut e, &mut tmp);
         let step = fro_diff(&h_next, &h);
         std::mem::swap(&mut h, &mut h_next);
-        // Only H must stay finite: E (and G) may grow without bound on a
-        // mode the input cannot reach while H still converges, and the
-        // caller's stability check then names that mode.
+        // E (and G) may grow on a mode that is not stabilised yet. On one
+        // that H never sees (unreachable, or of zero weight) they overflow
+        // and H with them: an H that had settled before is returned, and
+        // the caller's stability check (or `explain`) names that mode.
         if !finite(&h) {
+            if settled {
+                return Ok((h_next, it - 1));
+            }
             return Err(Error::Overflow {
                 operation: "Riccati doubling",
             });
         }
-        if step <= STEP_RTOL * fro(&h) {
+        settled = step <= STEP_RTOL * fro(&h);
+        if settled && fro(&e) <= E_TOL {
             return Ok((h, it));
         }
+    }
+    if settled {
+        return Ok((h, MAX_ITERATIONS));
     }
     Err(Error::NoConvergence {
         operation: "Riccati doubling",

@@ -414,8 +414,9 @@ fn mismatch(first: &MassSpringEstimate, other: &MassSpringEstimate) -> Option<Mi
 /// with cart 2's mass or the Coulomb forces fitted where the first run did
 /// not (or the reverse): their parameters mean different things.
 /// [`AverageError::Data`] with [`Error::TooFewSamples`] for fewer than two
-/// runs (a sample standard deviation needs two), [`Error::Overflow`] for a
-/// spread beyond `f64::MAX`.
+/// runs (a sample standard deviation needs two), [`Error::InvalidParameter`]
+/// naming `m1` or `m2` for a run's mass that is not finite and positive,
+/// [`Error::Overflow`] for a spread beyond `f64::MAX`.
 ///
 /// # Examples
 ///
@@ -446,6 +447,21 @@ pub fn average(runs: &[MassSpringEstimate]) -> Result<MassSpringAverage, Average
         }
         .into());
     };
+    // A mass that is not a mass would otherwise be copied into the
+    // average (m1), or read as runs identified with different masses (NaN
+    // differs from itself).
+    for r in runs {
+        for (name, value) in [("m1", r.m1), ("m2", r.m2)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidParameter {
+                    name,
+                    value,
+                    reason: "a run's cart mass must be finite and > 0, kg",
+                }
+                .into());
+            }
+        }
+    }
     if let Some((run, what)) = runs
         .iter()
         .enumerate()

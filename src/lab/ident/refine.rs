@@ -16,6 +16,7 @@ use super::simulation::{Run, SimulationModel};
 use crate::data::Recording;
 use crate::error::Error;
 use crate::kernels::lm::{self, LeastSquaresProblem, Settings};
+use crate::kernels::reduce::pow2_floor;
 use crate::lab::MassSpring;
 
 /// Largest lag of the residual tests, samples.
@@ -117,18 +118,26 @@ impl Run<'_> {
         let mut fit = [0.0; 2];
         let mut rms = [0.0; 2];
         for (cart, measured) in [self.x1, self.x2].into_iter().enumerate() {
-            let mean = measured.iter().sum::<f64>() / n as f64;
+            // Both divided by a power of two near their largest magnitude
+            // (exact), so that no square overflows: a position of 1e200 m
+            // is a poor fit, not a NaN one.
+            let scale = pow2_floor((0..n).fold(0.0f64, |m, k| {
+                m.max(measured[k].abs()).max(sim[k][cart].abs())
+            }));
+            let mean = measured.iter().map(|v| v / scale).sum::<f64>() / n as f64;
             let (mut err, mut spread) = (0.0, 0.0);
             for k in 0..n {
-                err += (measured[k] - sim[k][cart]).powi(2);
-                spread += (measured[k] - mean).powi(2);
+                err += ((measured[k] - sim[k][cart]) / scale).powi(2);
+                spread += (measured[k] / scale - mean).powi(2);
             }
+            // √err / √spread, not √(err / spread): the quotient of the
+            // roots cannot overflow for a subnormal spread.
             fit[cart] = if spread > 0.0 {
-                100.0 * (1.0 - (err / spread).sqrt())
+                100.0 * (1.0 - err.sqrt() / spread.sqrt())
             } else {
                 0.0
             };
-            rms[cart] = (err / n as f64).sqrt();
+            rms[cart] = (err / n as f64).sqrt() * scale;
         }
         let e: Vec<f64> = (0..n).map(|k| self.x2[k] - sim[k][1]).collect();
         Validation {
@@ -144,6 +153,14 @@ impl Run<'_> {
 /// normalised by both signals' energies after removing their means.
 fn correlation_test(a: &[f64], b: &[f64], first: usize) -> ResidualTest {
     let n = a.len();
+    // Each signal divided by a power of two near its largest magnitude
+    // (exact; ρ does not change), so that no energy overflows.
+    let scaled = |s: &[f64]| {
+        let scale = pow2_floor(s.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+        s.iter().map(|v| v / scale).collect::<Vec<f64>>()
+    };
+    let (a, b) = (scaled(a), scaled(b));
+    let (a, b) = (a.as_slice(), b.as_slice());
     let mean = |s: &[f64]| s.iter().sum::<f64>() / n as f64;
     let (ma, mb) = (mean(a), mean(b));
     let energy = |s: &[f64], m: f64| s.iter().map(|v| (v - m).powi(2)).sum::<f64>();
