@@ -3,9 +3,58 @@
 //! `Ok` holds finite numbers that are right; where a result cannot be
 //! represented the call refuses with a typed error naming the operation.
 
-use ctrlab::DynStateSpace;
-use ctrlab::freq::FrequencyDomain;
+use ctrlab::freq::{FrequencyDomain, TransferFunction, Zpk};
+use ctrlab::{DynStateSpace, Error};
 use nalgebra::{Complex, dmatrix};
+
+/// `A = −1, B = C = 1e200`: `G = 1e400 / (s + 1)` is not representable
+/// (its coefficient overflows); `ss2tf` returned `G ≡ 0` (the Markov
+/// parameter `C B` overflowing to inf, then judged "zero to rounding"
+/// against an infinite scale) and `ss2zpk` gain 0.
+#[test]
+fn ss2tf_of_an_overflowing_markov_parameter_refuses() {
+    let sys = DynStateSpace::continuous(
+        dmatrix![-1.0],
+        dmatrix![1e200],
+        dmatrix![1e200],
+        dmatrix![0.0],
+    )
+    .unwrap();
+    match TransferFunction::from_state_space(&sys) {
+        Err(Error::Overflow { operation }) => assert!(operation.contains("ss2tf"), "{operation}"),
+        other => panic!("ss2tf: {other:?}"),
+    }
+    assert!(matches!(
+        Zpk::from_state_space(&sys),
+        Err(Error::Overflow { .. })
+    ));
+    // 1e220 / s² (a double integrator): C A B = 0 exactly, C B² overflow.
+    let sys = DynStateSpace::continuous(
+        dmatrix![0.0, 0.0; 1.0, 0.0],
+        dmatrix![1e220; 0.0],
+        dmatrix![0.0, 1e220],
+        dmatrix![0.0],
+    )
+    .unwrap();
+    assert!(matches!(
+        TransferFunction::from_state_space(&sys),
+        Err(Error::Overflow { .. })
+    ));
+    assert!(matches!(
+        Zpk::from_state_space(&sys),
+        Err(Error::Overflow { .. })
+    ));
+    // The representable neighbour still converts: 1e300 / (s + 1).
+    let sys = DynStateSpace::continuous(
+        dmatrix![-1.0],
+        dmatrix![1e150],
+        dmatrix![1e150],
+        dmatrix![0.0],
+    )
+    .unwrap();
+    let g = TransferFunction::from_state_space(&sys).unwrap();
+    assert!((g.num()[0] / 1e300 - 1.0).abs() < 1e-15, "{:?}", g.num());
+}
 
 /// `A = diag(−1e160, −1)`, `B = [1; 0]`, `C = [1e160, 1]`:
 /// `G = 1e160 / (s + 1e160)`, `G(j) ≈ 1`.
