@@ -86,3 +86,14 @@ fn frequency_response_of_a_widely_scaled_model() {
         "evaluate: {e}"
     );
 }
+
+/// `tf([1e300], [1e-300, 1])`: the gain `1e600` is not a float; the zpk
+/// form must refuse, not return an infinite gain.
+#[test]
+fn tf2zpk_refuses_an_overflowing_gain() {
+    let g = TransferFunction::continuous(&[1e300], &[1e-300, 1.0]).unwrap();
+    match Zpk::from_transfer_function(&g) {
+        Err(Error::Overflow { operation }) => assert!(operation.contains("tf2zpk"), "{operation}"),
+        other => panic!("tf2zpk: {other:?}"),
+    }
+}
