@@ -3,7 +3,7 @@
 //! `Ok` holds finite numbers that are right; where a result cannot be
 //! represented the call refuses with a typed error naming the operation.
 
-use ctrlab::freq::{FrequencyDomain, TransferFunction, Zpk};
+use ctrlab::freq::{FrequencyDomain, TransferFunction, Zpk, bandwidth, stability_margins};
 use ctrlab::{DynStateSpace, Error};
 use nalgebra::{Complex, dmatrix};
 
@@ -96,4 +96,19 @@ fn tf2zpk_refuses_an_overflowing_gain() {
         Err(Error::Overflow { operation }) => assert!(operation.contains("tf2zpk"), "{operation}"),
         other => panic!("tf2zpk: {other:?}"),
     }
+}
+
+/// A discrete model with `dt = 1e-310` (subnormal): its Nyquist frequency
+/// `π/dt` overflows; `bandwidth` returned `Ok(Some(inf))`.
+#[test]
+fn bandwidth_of_a_subnormal_period_is_finite_or_refused() {
+    let g = TransferFunction::discrete(&[0.5], &[1.0, -0.5], 1e-310).unwrap();
+    // The -3 dB crossing of 0.5/(z − 0.5) is at θ = 1.3 rad, ω = 1.3e310.
+    match bandwidth(&g, -3.0) {
+        Err(Error::Overflow { operation }) => assert!(operation.contains("θ / dt"), "{operation}"),
+        other => panic!("bandwidth: {other:?}"),
+    }
+    // The margins of 2/z likewise: its phase crossing is at θ = π.
+    let l = TransferFunction::discrete(&[2.0], &[1.0, 0.0], 1e-310).unwrap();
+    assert!(matches!(stability_margins(&l), Err(Error::Overflow { .. })));
 }
