@@ -112,3 +112,63 @@ fn bandwidth_of_a_subnormal_period_is_finite_or_refused() {
     let l = TransferFunction::discrete(&[2.0], &[1.0, 0.0], 1e-310).unwrap();
     assert!(matches!(stability_margins(&l), Err(Error::Overflow { .. })));
 }
+
+fn rel(got: f64, want: f64) -> f64 {
+    (got - want).abs() / want.abs()
+}
+
+#[test]
+fn ss2tf_keeps_widely_scaled_poles() {
+    let sys = wide_model();
+    let g = Zpk::from_state_space(&sys).unwrap();
+    let mut poles: Vec<f64> = g.poles().iter().map(|p| p.re).collect();
+    poles.sort_by(f64::total_cmp);
+    assert_eq!(poles.len(), 2);
+    assert!(
+        rel(poles[0], -1e160) < 1e-15 && rel(poles[1], -1.0) < 1e-15,
+        "{poles:?}"
+    );
+    let tf = TransferFunction::from_state_space(&sys).unwrap();
+    let d = tf.den();
+    assert_eq!(d.len(), 3);
+    assert!(
+        rel(d[1], 1e160) < 1e-15 && rel(d[2], 1e160) < 1e-15,
+        "{d:?}"
+    );
+    assert!(rel(tf.dc_gain().unwrap(), 1.0) < 1e-15);
+}
+
+/// `A = diag(−1e8, −1e-9)`: the state-space DC gain is 1e9 (from the slow
+/// state), but `ss2tf` snapped −1e-9 to 0 (within `n ε ‖A‖_F` = 4e-8)
+/// and its `dc_gain` refused a "pole at s = 0".
+#[test]
+fn ss2tf_keeps_a_slow_pole_beside_a_fast_one() {
+    let sys = DynStateSpace::continuous(
+        dmatrix![-1e8, 0.0; 0.0, -1e-9],
+        dmatrix![1.0; 1.0],
+        dmatrix![0.0, 1.0],
+        dmatrix![0.0],
+    )
+    .unwrap();
+    let want = sys.dc_gain().unwrap()[(0, 0)];
+    assert!(rel(want, 1e9) < 1e-15);
+    let tf = TransferFunction::from_state_space(&sys).unwrap();
+    assert!(rel(tf.den()[2], 1e-1) < 1e-15, "{:?}", tf.den());
+    assert!(rel(tf.dc_gain().unwrap(), 1e9) < 1e-12);
+    let zpk = Zpk::from_state_space(&sys).unwrap();
+    assert!(rel(zpk.dc_gain().unwrap(), 1e9) < 1e-12);
+    // An integrator stays an integrator: exact zeros in A still snap.
+    let int = DynStateSpace::continuous(
+        dmatrix![-1e8, 0.0; 1.0, 0.0],
+        dmatrix![1.0; 0.0],
+        dmatrix![0.0, 1.0],
+        dmatrix![0.0],
+    )
+    .unwrap();
+    assert!(
+        TransferFunction::from_state_space(&int)
+            .unwrap()
+            .dc_gain()
+            .is_err()
+    );
+}

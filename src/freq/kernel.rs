@@ -16,7 +16,7 @@
 use nalgebra::{Complex, DMatrix};
 
 use crate::error::Error;
-use crate::kernels::reduce::pow2_floor;
+use crate::kernels::reduce::{pow2_floor, real_over};
 
 type C64 = Complex<f64>;
 
@@ -483,19 +483,6 @@ impl Pivoted {
         }
         Ok(())
     }
-}
-
-/// `β / t` for a complex `t ≠ 0`, `t` first scaled by a power of two
-/// (exactly) so that `|t|²` can neither overflow nor underflow: the
-/// textbook `β conj(t) / |t|²`, num-complex's division too, squares `|t|`
-/// and returned 0 for `|t| ≈ 1e160` (issue 28). Rounded as the unscaled
-/// formula wherever that one is finite.
-#[inline(always)]
-fn real_over(beta: f64, tr: f64, ti: f64) -> (f64, f64) {
-    let f = pow2_floor(tr.abs().max(ti.abs()));
-    let (r, i) = (tr / f, ti / f);
-    let size = r * r + i * i;
-    ((beta * r / size) / f, (-(beta * i) / size) / f)
 }
 
 fn singular() -> Error {

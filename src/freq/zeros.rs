@@ -160,8 +160,9 @@ fn zero_dynamics(
         if j > 0 {
             ca = &ca * a;
         }
-        let norm = ca.norm();
-        let f = if norm > 0.0 { 1.0 / norm } else { 1.0 };
+        // Scaled by a power of two: the norm of an entry of 1e160 is no
+        // longer infinite (which made this block row zero).
+        let f = 1.0 / pow2_floor(ca.amax());
         o.rows_mut(j * m, m).copy_from(&(&ca * f));
     }
     let projector_rhs = l.clone().lu().solve(&ca).ok_or(Error::Singular {

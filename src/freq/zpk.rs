@@ -336,8 +336,8 @@ impl<D: Domain> Zpk<D> {
     }
 
     /// The zero-pole-gain form of a SISO state-space model (`ss2zpk`): the
-    /// poles are the eigenvalues of `A` (within `n ε ‖A‖_F` of zero put at
-    /// zero, as in [`TransferFunction::from_state_space`]), the zeros its invariant zeros
+    /// poles are the eigenvalues of `A` (those within rounding of zero put
+    /// at zero, as in [`TransferFunction::from_state_space`]), the zeros its invariant zeros
     /// (nothing cancelled), the gain `D` or the first non-zero Markov
     /// parameter `C A^k B`.
     ///
