@@ -71,7 +71,12 @@ impl<D: Domain> DynStateSpace<D> {
     /// reduction (SLICOT `TB01PD`'s method, which python-control calls with
     /// Slycot): a singular value in a staircase step counts as non-zero
     /// above `tol`, by default `n² ε max(‖A‖_F, ‖B‖_F, ‖C‖_F)` for the
-    /// original `n` in both steps, `TB01PD`'s default. The result's states are
+    /// original `n` in both steps, `TB01PD`'s default. That default is
+    /// tight: in a model formed by floating-point products (a rotated
+    /// realisation) a coupling that is rounding, amplified by a small
+    /// singular value of an earlier staircase step, can reach 50 ε ‖A‖ and
+    /// keep a state; pass a larger `tol` (say `1e-10` times the model's
+    /// size) for such models. The result's states are
     /// orthogonal combinations of the original ones; `D` and the domain are
     /// kept.
     ///
