@@ -16,7 +16,7 @@
 use nalgebra::{Complex, DMatrix};
 
 use crate::error::Error;
-use crate::kernels::reduce::pow2_floor;
+use crate::kernels::reduce::{pow2_floor, real_over};
 
 type C64 = Complex<f64>;
 
@@ -178,7 +178,8 @@ impl Evaluator {
             if !ok || t == C64::new(0.0, 0.0) || !(t.re.is_finite() && t.im.is_finite()) {
                 return self.pivoted.eval(s, out);
             }
-            let scale = C64::new(col.beta, 0.0) / t;
+            let (sr, si) = real_over(col.beta, t.re, t.im);
+            let scale = C64::new(sr, si);
             for i in 0..p {
                 let mut acc = C64::new(0.0, 0.0);
                 for (k, xk) in x.iter().enumerate() {
@@ -300,14 +301,12 @@ fn lanes_column(
         }
     }
     let (tr, ti) = lanes_row(h, n, 0, s, xr, xi);
-    // β / t, as num-complex divides (β + 0i) by t.
+    // β / t, as `eval` divides.
     let mut scale_re = [0.0; LANES];
     let mut scale_im = [0.0; LANES];
     for q in 0..LANES {
         bad[q] |= (tr[q] == 0.0 && ti[q] == 0.0) || !(tr[q].is_finite() && ti[q].is_finite());
-        let norm_sqr = tr[q] * tr[q] + ti[q] * ti[q];
-        scale_re[q] = (col.beta * tr[q] + 0.0 * ti[q]) / norm_sqr;
-        scale_im[q] = (0.0 * tr[q] - col.beta * ti[q]) / norm_sqr;
+        (scale_re[q], scale_im[q]) = real_over(col.beta, tr[q], ti[q]);
     }
     for (i, &d) in d.iter().enumerate().take(p) {
         let mut acc_re = [0.0; LANES];
@@ -436,17 +435,11 @@ impl Pivoted {
                 }
             }
             let pivot = w[k + k * n];
-            let size = pivot.norm_sqr();
-            if size == 0.0 {
+            if pivot == C64::new(0.0, 0.0) {
                 return Err(singular());
             }
-            // conj(p) / |p|²; |p|² under- or overflows only for a pivot
-            // beyond 1e±154, where the division is done in full.
-            inv[k] = if size.is_finite() && size >= f64::MIN_POSITIVE {
-                pivot.conj() * (1.0 / size)
-            } else {
-                C64::new(1.0, 0.0) / pivot
-            };
+            let (ir, ii) = real_over(1.0, pivot.re, pivot.im);
+            inv[k] = C64::new(ir, ii);
             if k + 1 == n {
                 break;
             }

@@ -102,8 +102,20 @@ fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f
                 // Upper half circle, z = −1 (ω = π/dt) included whichever
                 // sign rounding gave its imaginary part.
                 .filter(|z| (z.norm() - 1.0).abs() < tol && z.im >= -1e-12)
-                .map(|z| z.im.max(0.0).atan2(z.re) / dt)
-                .collect()
+                .map(|z| {
+                    // ω = θ / dt overflows for a subnormal period
+                    // (dt = 1e-310: every crossing but ω = 0 is beyond
+                    // f64); refused, not returned as ∞.
+                    let w = z.im.max(0.0).atan2(z.re) / dt;
+                    if w.is_finite() {
+                        Ok(w)
+                    } else {
+                        Err(Error::Overflow {
+                            operation: "discrete crossing frequency (θ / dt)",
+                        })
+                    }
+                })
+                .collect::<Result<Vec<_>, _>>()?
         }
     };
     let period = period_of(&g.domain());
@@ -299,7 +311,8 @@ pub struct DelayMargin {
 /// with several inputs or outputs; the errors of
 /// [`TransferFunction::from_state_space`] for a state-space model; the
 /// errors of the polynomial root computations ([`Error::Overflow`],
-/// [`Error::NoConvergence`]).
+/// [`Error::NoConvergence`]); [`Error::Overflow`] for a discrete model
+/// whose crossing frequency `θ/dt` is beyond `f64` (a subnormal `dt`).
 ///
 /// # Examples
 ///
@@ -414,8 +427,10 @@ pub struct Margins {
 /// [`Error::InvalidParameter`] (`"dbdrop"`) unless it is finite and
 /// negative; [`Error::DimensionMismatch`] named `"D"` for a model with
 /// several inputs or outputs; [`Error::Singular`] for an infinite DC gain
-/// (python-control returns `nan`); the errors of
-/// [`TransferFunction::from_state_space`] and of the root computations.
+/// (python-control returns `nan`); [`Error::Overflow`] for a discrete
+/// model whose crossing frequency `θ/dt` is beyond `f64` (a subnormal
+/// `dt`); the errors of [`TransferFunction::from_state_space`] and of the
+/// root computations.
 ///
 /// # Examples
 ///

@@ -233,14 +233,18 @@ impl<D: Domain> TransferMatrix<D> {
         Ok(out)
     }
 
-    /// A state-space realisation: each entry realised by
-    /// [`TransferFunction::to_state_space`] and the realisations connected
-    /// in parallel (block-diagonal `A`). Not minimal: the states are the
-    /// sum of the entries' denominator degrees.
+    /// A minimal state-space realisation: each entry realised by
+    /// [`TransferFunction::to_state_space`], the realisations connected in
+    /// parallel (block-diagonal `A`), and the states neither controllable
+    /// nor observable removed by [`DynStateSpace::minimal_realization`] (default
+    /// tolerance). Entries sharing a denominator share their states:
+    /// `[1/(s+1), 1/(s+2); 1/(s+1), 1/(s+2)]` has 2 states, not 4, as
+    /// python-control's `tf2ss` (Slycot `td04ad`, also minimal) gives.
     ///
     /// # Errors
     ///
-    /// As [`TransferFunction::to_state_space`].
+    /// As [`TransferFunction::to_state_space`] and
+    /// [`DynStateSpace::minimal_realization`].
     ///
     /// # Examples
     ///
@@ -248,7 +252,8 @@ impl<D: Domain> TransferMatrix<D> {
     /// # use ctrlab::freq::{TransferFunction, TransferMatrix};
     /// let g = TransferFunction::continuous(&[1.0], &[1.0, 1.0])?;
     /// let sys = TransferMatrix::new(vec![vec![g.clone(), g]])?.to_state_space()?;
-    /// assert_eq!((sys.states(), sys.inputs(), sys.outputs()), (2, 2, 1));
+    /// // One state: both inputs drive the same lag.
+    /// assert_eq!((sys.states(), sys.inputs(), sys.outputs()), (1, 2, 1));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     #[doc(alias = "tf2ss")]
@@ -273,7 +278,8 @@ impl<D: Domain> TransferMatrix<D> {
             d[(i, j)] = part.d()[(0, 0)];
             at += s;
         }
-        DynStateSpace::from_computed(a, b, c, d, self.entries[0].domain(), "tf2ss")
+        DynStateSpace::from_computed(a, b, c, d, self.entries[0].domain(), "tf2ss")?
+            .minimal_realization(None)
     }
 
     pub(crate) fn entries(&self) -> &[TransferFunction<D>] {

@@ -40,6 +40,7 @@
 mod kernel;
 mod margins;
 mod matrix;
+mod minreal;
 mod models;
 mod pade;
 mod phase;

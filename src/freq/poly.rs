@@ -36,7 +36,7 @@ pub(crate) fn eval_ratio(num: &[f64], den: &[f64], s: Complex<f64>) -> Option<Co
         if d == Complex::new(0.0, 0.0) {
             return None;
         }
-        return Some(eval(num, s) / d);
+        return Some(div(eval(num, s), d));
     }
     let w = s.inv();
     let rev = |p: &[f64]| {
@@ -52,7 +52,16 @@ pub(crate) fn eval_ratio(num: &[f64], den: &[f64], s: Complex<f64>) -> Option<Co
     }
     // num(s)/den(s) = s^(deg num − deg den) · rev_num(1/s) / rev_den(1/s).
     let excess = num.len() as i32 - den.len() as i32;
-    Some(rev(num) / d * s.powi(excess))
+    Some(div(rev(num), d) * s.powi(excess))
+}
+
+/// `a / b` for `b ≠ 0`, `b` first scaled by a power of two (exactly) so
+/// that `|b|²` can neither overflow nor underflow: num-complex's division
+/// squares `|b|`, and `1e160 / 1e160` came out NaN (issue 28).
+pub(crate) fn div(a: Complex<f64>, b: Complex<f64>) -> Complex<f64> {
+    let f = pow2_floor(b.re.abs().max(b.im.abs()));
+    let b = b / f;
+    a * b.conj() / b.norm_sqr() / f
 }
 
 /// The product of two polynomials.

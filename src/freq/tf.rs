@@ -5,8 +5,9 @@ use nalgebra::{Complex, DMatrix};
 
 use super::poly;
 use super::zeros::siso_numerator;
-use crate::analysis::eigenvalues_dyn;
+use crate::analysis::{eigenvalues_dyn, rank};
 use crate::error::{Error, check_dt};
+use crate::kernels::reduce::pow2_floor;
 use crate::model::{Continuous, Discrete, Domain, DynStateSpace, StateSpace, period_of};
 
 /// A finite evaluation point, or [`Error::InvalidParameter`] named `"s"`
@@ -391,7 +392,11 @@ impl<D: Domain> TransferFunction<D> {
     /// The transfer function of a SISO state-space model, `ss2tf`: the
     /// denominator is the characteristic polynomial `det(sI − A)` (monic,
     /// degree `n`, nothing cancelled, as SciPy's `ss2tf`; eigenvalues
-    /// within `n ε ‖A‖_F` of zero, rounding, are put at zero), the numerator
+    /// within `n ε ‖A‖_F` of zero, rounding, are put at zero, at most as
+    /// many as `A` is rank-deficient once its rows and columns are
+    /// equilibrated, so `diag(−1e8, −1e-9)` keeps its pole at −1e-9,
+    /// where SciPy 1.17.1's `ss2tf` gives den `[1, 1e8, 0.1]` too),
+    /// the numerator
     /// `gain · ∏(s − zᵢ)` with the model's invariant zeros and its leading
     /// coefficient (`D`, or the first non-zero Markov parameter
     /// `C A^k B`).
@@ -399,7 +404,9 @@ impl<D: Domain> TransferFunction<D> {
     /// # Errors
     ///
     /// [`Error::DimensionMismatch`] (`"D"`) unless the model has one input
-    /// and one output; the errors of the eigenvalue computations.
+    /// and one output; [`Error::Overflow`] if a coefficient is not a finite
+    /// number (`A = −1`, `B = C = 1e200`: `1e400 / (s + 1)`); the errors of
+    /// the eigenvalue computations.
     ///
     /// # Examples
     ///
@@ -430,26 +437,64 @@ impl<D: Domain> TransferFunction<D> {
 }
 
 /// `det(sI − A)` from the eigenvalues of `A`, those within rounding of
-/// zero (`|λ| ≤ n ε ‖A‖_F`, below the eigenvalue solver's backward error)
-/// set to exactly zero, so that an integrator's constant term is exactly
-/// zero and its DC gain an error, not 1e18.
+/// zero set to exactly zero ([`snapped_poles`]), so that an integrator's
+/// constant term is exactly zero and its DC gain an error, not 1e18.
 pub(crate) fn characteristic<D: Domain>(sys: &DynStateSpace<D>) -> Result<Vec<f64>, Error> {
     Ok(poly::from_roots(&snapped_poles(sys)?))
 }
 
-/// The eigenvalues of `A`, those within rounding of zero set to zero.
+/// The eigenvalues of `A`, those within rounding of zero set to zero: at
+/// most as many as `A` is rank-deficient after its rows and columns are
+/// equilibrated by powers of two (exactly), the smallest ones, each only if
+/// `|λ| ≤ n ε ‖A‖_F` (below the eigenvalue solver's backward error; the
+/// norm formed without overflow).
+///
+/// The rank test keeps a small eigenvalue of a well-scaled block:
+/// `diag(−1e8, −1e-9)` has `n ε ‖A‖_F = 4e-8`, and `−1e-9` was put at
+/// zero (a pole at `s = 0`, where the DC gain is 1e9); equilibrated it is
+/// the identity, of full rank. And `‖A‖_F` of an entry of 1e160 was
+/// infinite, which put every pole at zero.
 pub(crate) fn snapped_poles<D: Domain>(sys: &DynStateSpace<D>) -> Result<Vec<Complex<f64>>, Error> {
-    let tol = sys.states() as f64 * f64::EPSILON * sys.a().norm();
-    Ok(eigenvalues_dyn(sys.a())?
-        .into_iter()
-        .map(|p| {
-            if p.norm() <= tol {
-                Complex::new(0.0, 0.0)
-            } else {
-                p
-            }
-        })
-        .collect())
+    let a = sys.a();
+    let mut poles = eigenvalues_dyn(a)?;
+    let n = a.nrows();
+    if n == 0 {
+        return Ok(poles);
+    }
+    let deficiency = n - rank(&equilibrated(a), None)?;
+    let tol = n as f64 * f64::EPSILON * safe_norm(a);
+    let mut by_size: Vec<usize> = (0..poles.len()).collect();
+    by_size.sort_by(|&x, &y| poles[x].norm().total_cmp(&poles[y].norm()));
+    for &i in by_size.iter().take(deficiency) {
+        if poles[i].norm() <= tol {
+            poles[i] = Complex::new(0.0, 0.0);
+        }
+    }
+    Ok(poles)
+}
+
+/// `‖M‖_F` without overflow or underflow: `max |mᵢⱼ| · ‖M / max‖_F`.
+pub(crate) fn safe_norm(m: &DMatrix<f64>) -> f64 {
+    let big = m.amax();
+    if big == 0.0 || !big.is_finite() {
+        return big;
+    }
+    big * (m / big).norm()
+}
+
+/// `A` with every non-zero row, then every non-zero column, divided by the
+/// power of two at or below its largest entry (exact).
+fn equilibrated(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let mut m = a.clone();
+    for i in 0..m.nrows() {
+        let f = pow2_floor(m.row(i).amax());
+        m.row_mut(i).unscale_mut(f);
+    }
+    for j in 0..m.ncols() {
+        let f = pow2_floor(m.column(j).amax());
+        m.column_mut(j).unscale_mut(f);
+    }
+    m
 }
 
 /// The `(output, input)` entry of a model's transfer matrix over `den`.

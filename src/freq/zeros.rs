@@ -18,36 +18,83 @@ use nalgebra::{Complex, DMatrix};
 
 use crate::analysis::{eigenvalues_dyn, rank};
 use crate::error::Error;
+use crate::kernels::reduce::pow2_floor;
 
 /// Markov parameters `C A^k B` with their rounding scale `|C| |A|^k |B|`:
 /// the index `k` (relative degree − 1) and the matrix of the first one not
 /// zero to rounding (every entry within `64 (n + 1) ε` of its scale, the
 /// bound on the rounding of forming the product), or `None` if all of the
 /// first `n` are zero (the transfer matrix is `D`).
+///
+/// `A^k B` and its scale carry a common power-of-two factor (exact), so
+/// neither overflows while the test is made (`B = 1e220` with `C A B` of
+/// 1e440 was judged zero against an infinite scale, giving `G ≡ 0`).
+///
+/// # Errors
+///
+/// [`Error::Overflow`] if the first non-zero Markov parameter itself is not
+/// a finite number, or its scale overflows.
 fn first_markov(
     a: &DMatrix<f64>,
     b: &DMatrix<f64>,
     c: &DMatrix<f64>,
-) -> Option<(usize, DMatrix<f64>)> {
+) -> Result<Option<(usize, DMatrix<f64>)>, Error> {
+    let overflow = Error::Overflow {
+        operation: "ss2tf (Markov parameter C A^k B)",
+    };
     let n = a.nrows();
     let tol = 64.0 * (n as f64 + 1.0) * f64::EPSILON;
     let abs_a = a.abs();
     let abs_c = c.abs();
     let (mut x, mut w) = (b.clone(), b.abs());
+    // x = 2^(−e) A^k B, w = 2^(−e) |A|^k |B|.
+    let mut e: i32 = 0;
     for k in 0..n {
+        let f = pow2_floor(w.amax());
+        if !f.is_finite() {
+            return Err(overflow);
+        }
+        x /= f;
+        w /= f;
+        e += exponent(f);
         let markov = c * &x;
         let scale = &abs_c * &w;
+        if markov.iter().chain(scale.iter()).any(|v| !v.is_finite()) {
+            return Err(overflow);
+        }
         let nonzero = markov
             .iter()
             .zip(scale.iter())
             .any(|(m, s)| m.abs() > tol * s);
         if nonzero {
-            return Some((k, markov));
+            let markov = markov.map(|m| times_pow2(m, e));
+            if markov.iter().any(|v| !v.is_finite()) {
+                return Err(overflow);
+            }
+            return Ok(Some((k, markov)));
         }
         x = a * x;
         w = &abs_a * w;
     }
-    None
+    Ok(None)
+}
+
+/// The exponent of a power of two (normal or `f64::MIN_POSITIVE`).
+fn exponent(f: f64) -> i32 {
+    ((f.to_bits() >> 52) & 0x7ff) as i32 - 1023
+}
+
+/// `m · 2^e`, in steps that cannot overflow or underflow on the way.
+fn times_pow2(mut m: f64, mut e: i32) -> f64 {
+    while e > 1000 {
+        m *= 2f64.powi(1000);
+        e -= 1000;
+    }
+    while e < -1000 {
+        m *= 2f64.powi(-1000);
+        e += 1000;
+    }
+    m * 2f64.powi(e)
 }
 
 /// The invariant zeros of `(A, B, C, D)`, sorted by real then imaginary
@@ -77,7 +124,7 @@ pub(crate) fn invariant_zeros(
         })?;
         eigenvalues_dyn(&(a - b * k))?
     } else if d.iter().all(|&v| v == 0.0) {
-        match first_markov(a, b, c) {
+        match first_markov(a, b, c)? {
             // G ≡ 0: every s is a zero of the pencil's normal rank; none
             // is reported (python-control's QZ reports an arbitrary set).
             None => Vec::new(),
@@ -113,8 +160,9 @@ fn zero_dynamics(
         if j > 0 {
             ca = &ca * a;
         }
-        let norm = ca.norm();
-        let f = if norm > 0.0 { 1.0 / norm } else { 1.0 };
+        // Scaled by a power of two: the norm of an entry of 1e160 is no
+        // longer infinite (which made this block row zero).
+        let f = 1.0 / pow2_floor(ca.amax());
         o.rows_mut(j * m, m).copy_from(&(&ca * f));
     }
     let projector_rhs = l.clone().lu().solve(&ca).ok_or(Error::Singular {
@@ -198,7 +246,7 @@ pub(crate) fn siso_numerator(
     if dv != 0.0 {
         return Ok((invariant_zeros(a, &b, &c, &d)?, dv));
     }
-    match first_markov(a, &b, &c) {
+    match first_markov(a, &b, &c)? {
         None => Ok((Vec::new(), 0.0)),
         Some((k, l)) => Ok((zero_dynamics(a, &b, &c, k, &l)?, l[(0, 0)])),
     }

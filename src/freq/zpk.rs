@@ -303,30 +303,41 @@ impl<D: Domain> Zpk<D> {
     ///
     /// # Errors
     ///
-    /// The errors of [`TransferFunction::poles`].
+    /// The errors of [`TransferFunction::poles`]; [`Error::Overflow`] if
+    /// the gain is not a finite number (`1e300 / 1e-300`).
     ///
     /// # Examples
     ///
     /// ```
-    /// # use ctrlab::freq::{TransferFunction, Zpk};
+    /// use ctrlab::{Error, freq::{TransferFunction, Zpk}};
+    ///
     /// let g = Zpk::from_transfer_function(&TransferFunction::continuous(&[2.0, 6.0], &[1.0, 3.0, 2.0])?)?;
     /// assert_eq!(g.gain(), 2.0);
     /// assert!((g.zeros()[0].re + 3.0).abs() < 1e-12);
+    /// // A gain of 1e600 is refused.
+    /// let big = TransferFunction::continuous(&[1e300], &[1e-300, 1.0])?;
+    /// assert!(matches!(Zpk::from_transfer_function(&big), Err(Error::Overflow { .. })));
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     #[doc(alias = "tf2zpk")]
     pub fn from_transfer_function(tf: &TransferFunction<D>) -> Result<Self, Error> {
+        let gain = tf.num()[0] / tf.den()[0];
+        if !gain.is_finite() {
+            return Err(Error::Overflow {
+                operation: "tf2zpk (gain num₀ / den₀)",
+            });
+        }
         Ok(Self {
             zeros: tf.zeros()?,
             poles: tf.poles()?,
-            gain: tf.num()[0] / tf.den()[0],
+            gain,
             domain: tf.domain(),
         })
     }
 
     /// The zero-pole-gain form of a SISO state-space model (`ss2zpk`): the
-    /// poles are the eigenvalues of `A` (within `n ε ‖A‖_F` of zero put at
-    /// zero, as in [`TransferFunction::from_state_space`]), the zeros its invariant zeros
+    /// poles are the eigenvalues of `A` (those within rounding of zero put
+    /// at zero, as in [`TransferFunction::from_state_space`]), the zeros its invariant zeros
     /// (nothing cancelled), the gain `D` or the first non-zero Markov
     /// parameter `C A^k B`.
     ///

@@ -129,6 +129,19 @@ pub(crate) fn pow2_floor(x: f64) -> f64 {
     if s == 0.0 { f64::MIN_POSITIVE } else { s }
 }
 
+/// `β / t` for a complex `t ≠ 0`, `t` first scaled by a power of two
+/// (exactly) so that `|t|²` can neither overflow nor underflow: the
+/// textbook `β conj(t) / |t|²`, num-complex's division too, squares `|t|`
+/// and returned 0 for `|t| ≈ 1e160` (issue 28). Rounded as the unscaled
+/// formula wherever that one is finite.
+#[inline(always)]
+pub(crate) fn real_over(beta: f64, tr: f64, ti: f64) -> (f64, f64) {
+    let f = pow2_floor(tr.abs().max(ti.abs()));
+    let (r, i) = (tr / f, ti / f);
+    let size = r * r + i * i;
+    ((beta * r / size) / f, (-(beta * i) / size) / f)
+}
+
 /// Index of the first non-finite value, if any. The fast path is one
 /// vectorised pass (`0 · x` is NaN exactly for NaN and ±∞).
 #[inline]
