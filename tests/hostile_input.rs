@@ -140,7 +140,8 @@ fn least_squares_of_impossible_sizes_refuse_instead_of_panicking() {
     assert!(matches!(huge.solve(), Err(Error::TooFewSamples { .. })));
     let mut tall = LeastSquares::with_capacity(2, usize::MAX);
     for k in 0..10 {
-        tall.push_row(&[1.0, k as f64], 1.0 + 2.0 * k as f64).unwrap();
+        tall.push_row(&[1.0, k as f64], 1.0 + 2.0 * k as f64)
+            .unwrap();
     }
     let fit = tall.solve().unwrap();
     assert!((fit.theta[0] - 1.0).abs() < 1e-12 && (fit.theta[1] - 2.0).abs() < 1e-12);
