@@ -133,7 +133,9 @@ pub(crate) struct Guard {
     locked: bool,
 }
 
-/// Applies `rt` to the calling thread; the guard undoes it.
+/// Applies `rt` to the calling thread; the guard undoes it. `rt` was
+/// checked by [`RealTime::validate`] (priority 1–99, Linux's SCHED_FIFO
+/// range) before the loop started.
 #[cfg(target_os = "linux")]
 pub(crate) fn enter(rt: &RealTime) -> Result<Guard, RigError> {
     // SAFETY: sched_getscheduler and sched_getparam only read the calling
@@ -145,18 +147,6 @@ pub(crate) fn enter(rt: &RealTime) -> Result<Guard, RigError> {
             param
         })
     };
-    // SAFETY: both take a policy constant and touch no memory.
-    let min = unsafe { libc::sched_get_priority_min(libc::SCHED_FIFO) };
-    // SAFETY: as above.
-    let max = unsafe { libc::sched_get_priority_max(libc::SCHED_FIFO) };
-    if !(min..=max).contains(&rt.priority) {
-        return Err(super::ConfigError::invalid(
-            "priority",
-            f64::from(rt.priority),
-            "SCHED_FIFO priority must be within 1–99",
-        )
-        .into());
-    }
     let mut guard = Guard {
         policy,
         param,
