@@ -54,6 +54,20 @@ fn controllable_basis(a: &DMatrix<f64>, b: &DMatrix<f64>, tol: f64) -> Result<DM
     Ok(q.columns(0, start).into_owned())
 }
 
+/// `minreal`'s `tol`, when given, is finite and non-negative: `reason`
+/// says what it measures (shared by the state-space and transfer-function
+/// forms).
+pub(crate) fn check_tolerance(tol: Option<f64>, reason: &'static str) -> Result<(), Error> {
+    match tol {
+        Some(t) if !(t.is_finite() && t >= 0.0) => Err(Error::InvalidParameter {
+            name: "tol",
+            value: t,
+            reason,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// SLICOT `TB01PD`'s default tolerance (python-control's `minreal` with
 /// Slycot, `tol = 0`), `n² ε`, relative to the model's size
 /// `max(‖A‖_F, ‖B‖_F, ‖C‖_F)`; `n` the original state count, used in
@@ -103,15 +117,7 @@ impl<D: Domain> DynStateSpace<D> {
     /// ```
     #[doc(alias = "minreal")]
     pub fn minimal_realization(&self, tol: Option<f64>) -> Result<Self, Error> {
-        if let Some(t) = tol
-            && !(t.is_finite() && t >= 0.0)
-        {
-            return Err(Error::InvalidParameter {
-                name: "tol",
-                value: t,
-                reason: "the rank tolerance must be finite and non-negative",
-            });
-        }
+        check_tolerance(tol, "the rank tolerance must be finite and non-negative")?;
         if self.states() == 0 {
             return Ok(self.clone());
         }

@@ -32,7 +32,7 @@ mod controllability;
 mod dyn_state_space;
 mod gain;
 mod lyapunov;
-mod minreal;
+pub(crate) mod minreal;
 mod poles;
 mod stability;
 mod state_space;

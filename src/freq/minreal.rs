@@ -40,15 +40,10 @@ impl<D: Domain> TransferFunction<D> {
     /// ```
     #[doc(alias = "minreal")]
     pub fn minimal_realization(&self, tol: Option<f64>) -> Result<Self, Error> {
-        if let Some(t) = tol
-            && !(t.is_finite() && t >= 0.0)
-        {
-            return Err(Error::InvalidParameter {
-                name: "tol",
-                value: t,
-                reason: "the cancellation tolerance must be finite and non-negative",
-            });
-        }
+        crate::analysis::minreal::check_tolerance(
+            tol,
+            "the cancellation tolerance must be finite and non-negative",
+        )?;
         let zeros = self.zeros()?;
         let mut poles = self.poles()?;
         let gain = self.num()[0] / self.den()[0];
