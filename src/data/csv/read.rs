@@ -126,10 +126,23 @@ fn estimate_rows(size: u64, consumed: u64, rows: usize, bytes: u64, width: usize
 /// After how many rows the columns are sized from the file's length.
 const ESTIMATE_AFTER: usize = 256;
 
-/// Reserves room in `cols` for the rows a file of `size` bytes has left,
-/// from the first rows (`bytes` long, from byte `start`).
-fn size_columns(cols: &mut [Vec<f64>], size: Option<u64>, bytes: u64, start: u64, width: usize) {
-    let (Some(size), Some(rows)) = (size, cols.first().map(Vec::len)) else {
+/// Once `cols` hold [`ESTIMATE_AFTER`] rows (`sized` still false), reserves
+/// room for the rows a file of `size` bytes has left, from the first rows
+/// (`bytes` long, from byte `start`), and sets `sized`.
+fn size_columns(
+    sized: &mut bool,
+    cols: &mut [Vec<f64>],
+    size: Option<u64>,
+    bytes: u64,
+    start: u64,
+    width: usize,
+) {
+    let rows = cols.first().map_or(0, Vec::len);
+    if *sized || rows < ESTIMATE_AFTER {
+        return;
+    }
+    *sized = true;
+    let Some(size) = size else {
         return;
     };
     let more = estimate_rows(size, start + bytes, rows, bytes, width);
@@ -503,16 +516,14 @@ fn read<R: Read>(
                 records.lines.skip(bytes, lines);
                 last = records.lines.line();
             }
-            if !sized && cols[0].len() >= ESTIMATE_AFTER {
-                size_columns(
-                    &mut cols,
-                    size,
-                    records.lines.consumed() - rows_start,
-                    rows_start,
-                    width,
-                );
-                sized = true;
-            }
+            size_columns(
+                &mut sized,
+                &mut cols,
+                size,
+                records.lines.consumed() - rows_start,
+                rows_start,
+                width,
+            );
             match stop {
                 Stop::Limit => continue,
                 Stop::Partial => match records.lines.more() {
@@ -562,16 +573,14 @@ fn read<R: Read>(
                 overflow = Some((last, before, now));
             }
         }
-        if !sized && t.len() >= ESTIMATE_AFTER {
-            size_columns(
-                &mut cols,
-                size,
-                records.lines.consumed() - rows_start,
-                rows_start,
-                width,
-            );
-            sized = true;
-        }
+        size_columns(
+            &mut sized,
+            &mut cols,
+            size,
+            records.lines.consumed() - rows_start,
+            rows_start,
+            width,
+        );
     }
 
     let rows = cols[0].len();
