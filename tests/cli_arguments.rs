@@ -18,6 +18,7 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use example::example_binary;
+use proptest::prelude::*;
 
 fn lab5(args: &[&str]) -> Output {
     let bin = example_binary("lab5", "LAB5", "cargo build --release --example lab5");
@@ -148,4 +149,198 @@ fn a_bad_truth_file_or_calibration_stops_lab5_at_once_naming_it() {
     refused(&output, "--metres-per-count");
     assert!(!PathBuf::from(out).exists(), "lab5 wrote before refusing");
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A value that no numeric argument accepts or a random one; extremes
+/// weighted (NaN, ±inf, ±0, subnormal, ±1e308) as the reproducers.
+fn number() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        prop::sample::select(vec![
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            0.0,
+            -0.0,
+            5e-324,
+            -5e-324,
+            1e-310,
+            1e308,
+            -1e308,
+            f64::MAX,
+        ]),
+        any::<f64>(),
+        -1e4..1e4f64,
+    ]
+}
+
+/// `x` as a user might type it: Rust's `{}` (every digit) or `{:e}`.
+fn typed(x: f64) -> impl Strategy<Value = String> {
+    prop_oneof![Just(format!("{x}")), Just(format!("{x:e}"))]
+}
+
+/// Text that is not a number (nor a signal's name, nor a seed).
+fn garbage() -> impl Strategy<Value = String> {
+    prop_oneof![
+        Just(String::new()),
+        Just("1e".to_owned()),
+        Just("0x10".to_owned()),
+        Just("1,,2".to_owned()),
+        Just("½".to_owned()),
+        Just(" 3".to_owned()),
+        "[a-zA-Z%#/;é]{1,6}[0-9]{0,2}",
+    ]
+    .prop_filter("not a number", |s| s.trim().parse::<f64>().is_err())
+}
+
+/// One argument of lab5's that its own check (the library's validation,
+/// not the binary's parser) refuses: (flag, value, extra arguments it needs).
+fn bad_lab5_argument() -> impl Strategy<Value = (&'static str, String, Vec<String>)> {
+    use ctrlab::hw::Jitter;
+    use ctrlab::lab::ident_input::{IdentInput, IdentSignal};
+    let logs = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/logs/lab5").to_owned();
+    let volts = prop_oneof![
+        number()
+            .prop_filter("a valid voltage", |&volts| {
+                IdentInput {
+                    volts,
+                    ..IdentInput::default()
+                }
+                .validate()
+                .is_err()
+            })
+            .prop_flat_map(typed),
+        garbage(),
+    ]
+    .prop_map(|v| ("--ident-volts", v, vec![]));
+    let half_period = prop_oneof![
+        number()
+            .prop_filter("a valid half period", |&half_period| {
+                IdentInput {
+                    half_period,
+                    ..IdentInput::default()
+                }
+                .validate()
+                .is_err()
+            })
+            .prop_flat_map(typed),
+        garbage(),
+    ]
+    .prop_map(|v| ("--ident-half-period", v, vec![]));
+    let jitter = prop_oneof![
+        (any::<u64>(), number(), number(), number(), number())
+            .prop_filter("a valid schedule", |&(seed, a, b, c, d)| {
+                let j = Jitter {
+                    seed,
+                    late_fraction: a,
+                    max_late: b,
+                    stall_fraction: c,
+                    stall: d,
+                };
+                j.validate().is_err()
+            })
+            .prop_map(|(seed, a, b, c, d)| format!("{seed},{a},{b},{c},{d}")),
+        garbage(),
+        prop::sample::select(vec!["-1", "1.5", "1,2", "1,0.1,0.1,0.1"]).prop_map(str::to_owned),
+    ]
+    .prop_map(|v| ("--jitter", v, vec![]));
+    let priority = prop_oneof![
+        any::<i64>()
+            .prop_filter("in 1–99", |p| !(1..=99).contains(p))
+            .prop_map(|p| p.to_string()),
+        number()
+            .prop_flat_map(typed)
+            .prop_filter("an integer", |s| s.parse::<i64>().is_err()),
+        garbage(),
+    ]
+    .prop_map(|v| ("--rt-priority", v, vec![]));
+    let metres = prop_oneof![
+        number()
+            .prop_filter("a valid length", |&m| !(m.is_finite() && m > 0.0))
+            .prop_flat_map(typed),
+        garbage(),
+    ]
+    .prop_map(move |v| {
+        (
+            "--metres-per-count",
+            v,
+            vec!["--logs".to_owned(), logs.clone()],
+        )
+    });
+    let signal = garbage()
+        .prop_filter("a signal's name", |s| s.parse::<IdentSignal>().is_err())
+        .prop_map(|v| ("--ident-signal", v, vec![]));
+    prop_oneof![volts, half_period, jitter, priority, metres, signal]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Any argument its check refuses stops lab5 at once (clap's usage
+    /// error, 2), naming the argument, with no panic, nothing run and no
+    /// output directory made; with the value after `=` or as the next word,
+    /// before or after the other arguments.
+    #[test]
+    #[ignore = "runs the lab5 binary; .ci/run builds it first"]
+    fn lab5_refuses_every_bad_argument_before_running(
+        (flag, value, extra) in bad_lab5_argument(),
+        joined in any::<bool>(),
+        first in any::<bool>(),
+        tables_only in any::<bool>(),
+    ) {
+        let dir = scratch("lab5_prop");
+        let out = dir.join("out");
+        let mut args: Vec<String> = Vec::new();
+        let mut bad = if joined {
+            vec![format!("{flag}={value}")]
+        } else {
+            vec![flag.to_owned(), value.clone()]
+        };
+        bad.extend(extra);
+        let mut rest = vec!["--out".to_owned(), out.to_str().unwrap().to_owned()];
+        if tables_only {
+            rest.push("--tables-only".to_owned());
+        }
+        if first {
+            args.extend(bad);
+            args.extend(rest);
+        } else {
+            args.extend(rest);
+            args.extend(bad);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let output = lab5(&refs);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        prop_assert_eq!(output.status.code(), Some(2), "{:?}: {}", args, stderr);
+        prop_assert!(stderr.contains(flag), "{:?}: `{}` not named: {}", args, flag, stderr);
+        prop_assert!(!stderr.contains("panicked"), "{:?}: {}", args, stderr);
+        prop_assert!(output.stdout.is_empty(), "{:?} ran", args);
+        prop_assert!(!out.exists(), "{:?} made {}", args, out.display());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The probe refuses a bad `--volts` or `--metres-per-count` before it
+    /// pulses anything, naming the argument and the value, writing no card
+    /// file.
+    #[test]
+    #[ignore = "runs the probe binary; .ci/run builds it first"]
+    fn probe_refuses_every_bad_number_before_probing(
+        volts in any::<bool>(),
+        value in prop_oneof![
+            number().prop_filter("valid", |&x| !(x.is_finite() && x > 0.0)).prop_flat_map(typed),
+            garbage().prop_filter("a flag", |s| !s.is_empty()),
+        ],
+    ) {
+        let dir = scratch("probe_prop");
+        let out = dir.join("card.toml");
+        let flag = if volts { "--volts" } else { "--metres-per-count" };
+        let args = ["--simulated", flag, value.as_str(), "--out", out.to_str().unwrap()];
+        let output = probe(&args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        prop_assert!(!output.status.success(), "{:?} accepted", args);
+        prop_assert!(stderr.contains(&format!("{flag} {value}")), "{:?}: {}", args, stderr);
+        prop_assert!(!stderr.contains("panicked"), "{:?}: {}", args, stderr);
+        prop_assert!(output.stdout.is_empty(), "{:?} ran", args);
+        prop_assert!(!out.exists(), "{:?} wrote the card file", args);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -53,11 +53,12 @@ pub struct Args {
         long,
         value_name = "SEED[,...]",
         value_parser = jitter,
+        allow_hyphen_values = true,
         conflicts_with_all = ["real_time", "port"]
     )]
     pub jitter: Option<Jitter>,
     /// Run the loop with SCHED_FIFO priority N, memory locked (Linux)
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(i32).range(1..=99))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(i32).range(1..=99), allow_hyphen_values = true)]
     pub rt_priority: Option<i32>,
     /// Run the rig sections on the real PC104 card on this parallel port
     /// (feature `ppdev`); needs --card
@@ -84,7 +85,7 @@ pub struct Args {
     pub logs: Option<PathBuf>,
     /// With --logs: the encoders' calibration, m per count, for positions
     /// logged in counts
-    #[arg(long, value_name = "M", value_parser = positive_metres, requires = "logs")]
+    #[arg(long, value_name = "M", value_parser = positive_metres, allow_hyphen_values = true, requires = "logs")]
     pub metres_per_count: Option<f64>,
     /// The identification input's signal: square (the lab's), prbs or
     /// multisine [default: square, or the card or truth file's [ident] signal]
@@ -93,10 +94,10 @@ pub struct Args {
     /// The identification input's peak voltage asked for, V: lowered to
     /// keep both carts within 60 % of their travel (from two short probe
     /// runs) unless --ident-fixed [default: 8, or the card or truth file's]
-    #[arg(long, value_name = "V", value_parser = ident_volts, allow_negative_numbers = true, conflicts_with = "logs")]
+    #[arg(long, value_name = "V", value_parser = ident_volts, allow_hyphen_values = true, conflicts_with = "logs")]
     pub ident_volts: Option<f64>,
     /// The square wave's half period, s [default: 0.2, or the card or truth file's]
-    #[arg(long, value_name = "S", value_parser = ident_half_period, conflicts_with = "logs")]
+    #[arg(long, value_name = "S", value_parser = ident_half_period, allow_hyphen_values = true, conflicts_with = "logs")]
     pub ident_half_period: Option<f64>,
     /// Run the identification input at --ident-volts as is: no probe runs,
     /// no scaling to the travel (a run that hits a travel limit is
