@@ -5,8 +5,11 @@
 //! lab5 ran everything and lost the report; `probe --volts nan` pulsed the
 //! motor, then blamed "TOML line 18" of a file the user never wrote).
 //!
+//! Proptests then throw every kind of bad value at lab5's, experiment's and
+//! probe's numeric and named arguments.
+//!
 //! Ignored: `.ci/run` builds the binaries in release and runs these
-//! (`LAB5=…`, `PROBE=…` to point at others).
+//! (`LAB5=…`, `PROBE=…`, `EXPERIMENT=…` to point at others).
 
 // Built on the two-cart lab.
 #![cfg(feature = "lab")]
@@ -14,7 +17,7 @@
 #[path = "common/example.rs"]
 mod example;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use example::example_binary;
@@ -22,6 +25,15 @@ use proptest::prelude::*;
 
 fn lab5(args: &[&str]) -> Output {
     let bin = example_binary("lab5", "LAB5", "cargo build --release --example lab5");
+    Command::new(bin).args(args).output().unwrap()
+}
+
+fn experiment(args: &[&str]) -> Output {
+    let bin = example_binary(
+        "experiment",
+        "EXPERIMENT",
+        "cargo build --release --example experiment",
+    );
     Command::new(bin).args(args).output().unwrap()
 }
 
@@ -192,6 +204,88 @@ fn garbage() -> impl Strategy<Value = String> {
     .prop_filter("not a number", |s| s.trim().parse::<f64>().is_err())
 }
 
+/// A SCHED_FIFO priority outside 1–99, or not an integer.
+fn bad_priority() -> impl Strategy<Value = String> {
+    prop_oneof![
+        any::<i64>()
+            .prop_filter("in 1–99", |p| !(1..=99).contains(p))
+            .prop_map(|p| p.to_string()),
+        number()
+            .prop_flat_map(typed)
+            .prop_filter("an integer", |s| s.parse::<i64>().is_err()),
+        garbage(),
+    ]
+}
+
+/// One argument of experiment's that its parser refuses (the checks
+/// against the rig, such as the setpoint within the travel, come later and
+/// are tests/experiment.rs's): (flag, value).
+fn bad_experiment_argument() -> impl Strategy<Value = (&'static str, String)> {
+    let non_finite = prop::sample::select(vec![f64::NAN, f64::INFINITY, f64::NEG_INFINITY]);
+    prop_oneof![
+        bad_priority().prop_map(|v| ("--rt-priority", v)),
+        prop_oneof![
+            any::<i128>()
+                .prop_filter("a u64", |s| u64::try_from(*s).is_err())
+                .prop_map(|s| s.to_string()),
+            garbage(),
+        ]
+        .prop_map(|v| ("--seed", v)),
+        garbage()
+            .prop_filter("a cart", |c| !matches!(c.trim(), "1" | "2"))
+            .prop_map(|v| ("--cart", v)),
+        prop_oneof![
+            (number(), number(), number(), non_finite.clone())
+                .prop_map(|(a, b, c, d)| format!("{a},{b},{d},{c}")),
+            prop::collection::vec(-100.0..100.0f64, 0..8)
+                .prop_filter("four", |v| v.len() != 4)
+                .prop_map(|v| v.iter().map(f64::to_string).collect::<Vec<_>>().join(",")),
+            garbage(),
+        ]
+        .prop_map(|v| ("--kf", v)),
+        prop_oneof![
+            number()
+                .prop_filter("a valid duration", |&x| !(x.is_finite() && x > 0.0))
+                .prop_flat_map(typed),
+            garbage().prop_filter("3s", |s| s
+                .trim()
+                .trim_end_matches('s')
+                .trim()
+                .parse::<f64>()
+                .is_err()),
+        ]
+        .prop_map(|v| ("--duration", v)),
+        prop_oneof![
+            non_finite.prop_map(|x| format!("{x}mm")),
+            number().prop_flat_map(typed),
+        ]
+        .prop_map(|v| ("--setpoint", v)),
+    ]
+}
+
+/// Refused by clap (exit 2) before anything ran, naming `flag`, without a
+/// panic, and `out` not made.
+fn refused_at_once(
+    output: &Output,
+    args: &[String],
+    flag: &str,
+    out: &Path,
+) -> Result<(), TestCaseError> {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    prop_assert_eq!(output.status.code(), Some(2), "{:?}: {}", args, stderr);
+    prop_assert!(
+        stderr.contains(flag),
+        "{:?}: `{}` not named: {}",
+        args,
+        flag,
+        stderr
+    );
+    prop_assert!(!stderr.contains("panicked"), "{:?}: {}", args, stderr);
+    prop_assert!(output.stdout.is_empty(), "{:?} ran", args);
+    prop_assert!(!out.exists(), "{:?} made {}", args, out.display());
+    Ok(())
+}
+
 /// One argument of lab5's that its own check (the library's validation,
 /// not the binary's parser) refuses: (flag, value, extra arguments it needs).
 fn bad_lab5_argument() -> impl Strategy<Value = (&'static str, String, Vec<String>)> {
@@ -243,16 +337,7 @@ fn bad_lab5_argument() -> impl Strategy<Value = (&'static str, String, Vec<Strin
         prop::sample::select(vec!["-1", "1.5", "1,2", "1,0.1,0.1,0.1"]).prop_map(str::to_owned),
     ]
     .prop_map(|v| ("--jitter", v, vec![]));
-    let priority = prop_oneof![
-        any::<i64>()
-            .prop_filter("in 1–99", |p| !(1..=99).contains(p))
-            .prop_map(|p| p.to_string()),
-        number()
-            .prop_flat_map(typed)
-            .prop_filter("an integer", |s| s.parse::<i64>().is_err()),
-        garbage(),
-    ]
-    .prop_map(|v| ("--rt-priority", v, vec![]));
+    let priority = bad_priority().prop_map(|v| ("--rt-priority", v, vec![]));
     let metres = prop_oneof![
         number()
             .prop_filter("a valid length", |&m| !(m.is_finite() && m > 0.0))
@@ -308,13 +393,32 @@ proptest! {
             args.extend(bad);
         }
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
-        let output = lab5(&refs);
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        prop_assert_eq!(output.status.code(), Some(2), "{:?}: {}", args, stderr);
-        prop_assert!(stderr.contains(flag), "{:?}: `{}` not named: {}", args, flag, stderr);
-        prop_assert!(!stderr.contains("panicked"), "{:?}: {}", args, stderr);
-        prop_assert!(output.stdout.is_empty(), "{:?} ran", args);
-        prop_assert!(!out.exists(), "{:?} made {}", args, out.display());
+        refused_at_once(&lab5(&refs), &args, flag, &out)?;
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The same for the single experiment's arguments: the bad one in
+    /// place of a good one, the value after `=` or as the next word.
+    #[test]
+    #[ignore = "runs the experiment binary; .ci/run builds it first"]
+    fn experiment_refuses_every_bad_argument_before_running(
+        (flag, value) in bad_experiment_argument(),
+        joined in any::<bool>(),
+    ) {
+        let dir = scratch("experiment_prop");
+        let out = dir.join("out");
+        let good = [("--cart", "2"), ("--kf", "0,0,10,0.1"), ("--duration", "3"), ("--seed", "7")];
+        let mut args: Vec<String> = vec!["--out".to_owned(), out.to_str().unwrap().to_owned()];
+        for (name, v) in good.iter().filter(|(name, _)| *name != flag) {
+            args.extend([(*name).to_owned(), (*v).to_owned()]);
+        }
+        if joined {
+            args.push(format!("{flag}={value}"));
+        } else {
+            args.extend([flag.to_owned(), value.clone()]);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused_at_once(&experiment(&refs), &args, flag, &out)?;
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -71,13 +71,18 @@ pub struct Args {
     pub truth: Option<PathBuf>,
     /// The simulated card's noise seed [default: lab5's for the matching
     /// table row (100 + row), else 100]
-    #[arg(long, value_name = "N", conflicts_with = "port")]
+    #[arg(
+        long,
+        value_name = "N",
+        allow_hyphen_values = true,
+        conflicts_with = "port"
+    )]
     pub seed: Option<u64>,
     /// Run the simulated rig on the wall clock instead of virtual time
     #[arg(long, conflicts_with = "port")]
     pub real_time: bool,
     /// Run the loop with SCHED_FIFO priority N, memory locked (Linux)
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(i32).range(1..=99))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(i32).range(1..=99), allow_hyphen_values = true)]
     pub rt_priority: Option<i32>,
     /// Run on the real PC104 card on this parallel port (feature `ppdev`);
     /// needs --card
