@@ -1,7 +1,7 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test; Lyapunov
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
-//! [`lyapchol`]).
+//! [`lyapchol`], [`dlyapchol`]).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
@@ -39,8 +39,8 @@ mod state_space;
 
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
 pub use lyapunov::{
-    FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, lyap,
-    lyapchol, sylvester,
+    FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, dlyapchol,
+    lyap, lyapchol, sylvester,
 };
 pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
