@@ -1,7 +1,8 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test; Lyapunov
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
-//! [`lyapchol`], [`dlyapchol`]).
+//! [`lyapchol`], [`dlyapchol`]); Gramians and Hankel singular values
+//! (`gram`, `hsvd`, on both model types).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
@@ -31,6 +32,7 @@ mod balance;
 mod controllability;
 mod dyn_state_space;
 mod gain;
+mod gramian;
 mod lyapunov;
 mod minreal;
 mod poles;
@@ -38,6 +40,7 @@ mod stability;
 mod state_space;
 
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
+pub use gramian::GramianKind;
 pub use lyapunov::{
     FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, dlyapchol,
     lyap, lyapchol, sylvester,
