@@ -1,8 +1,8 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test; Lyapunov
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
-//! [`lyapchol`], [`dlyapchol`]); Gramians and Hankel singular values
-//! (`gram`, `hsvd`, on both model types).
+//! [`lyapchol`], [`dlyapchol`]); Gramians, Hankel singular values and
+//! balanced truncation (`gram`, `hsvd`, `balred`, on both model types).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
@@ -29,6 +29,7 @@
 //! ```
 
 mod balance;
+mod balred;
 mod controllability;
 mod dyn_state_space;
 mod gain;
@@ -39,6 +40,7 @@ mod poles;
 mod stability;
 mod state_space;
 
+pub use balred::{BalancedTruncation, ReducedOrder};
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
 pub use gramian::GramianKind;
 pub use lyapunov::{
