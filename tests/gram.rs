@@ -564,6 +564,51 @@ fn unstable_and_extreme_models_are_refused_by_name() {
     )
     .unwrap();
     assert_eq!(tiny.hsvd().unwrap()[0], 0.0);
+    // Stiff: poles at 1e-3 and 1e6 rad/s, unit channels: σ₁ ≈ 1/(2a) = 500.
+    let stiff = |fast: f64| {
+        DynStateSpace::continuous(
+            dmatrix![-1e-3, 0.0; 0.0, -fast],
+            dmatrix![1.0; 1.0],
+            dmatrix![1.0, 1.0],
+            dmatrix![0.0],
+        )
+        .unwrap()
+    };
+    let hsv = stiff(1e6).hsvd().unwrap();
+    assert!((hsv[0] - 500.0).abs() < 1e-9 * 500.0, "{hsv:?}");
+    let red = stiff(1e6).balred(ReducedOrder::States(1)).unwrap();
+    // NumPy's square-root truncation of the same model: −0.001000000004
+    // (the fast mode's coupling shifts the kept pole by 4e-9 relative).
+    assert!(
+        (red.model.a()[(0, 0)] + 0.001000000004).abs() < 1e-12 * 1e-3,
+        "{}",
+        red.model.a()
+    );
+    // At 1e-3 and 1e12 rad/s (stable by the crate's componentwise test)
+    // the Lyapunov solvers' normwise singularity test (|λ + μ| within
+    // 100 n ε ‖S‖ of zero, here 9e-2 against 2e-3) refuses the slow
+    // pole's equation: a named refusal, not a wrong Gramian.
+    assert!(stiff(1e12).is_stable().unwrap());
+    assert!(matches!(
+        stiff(1e12).hsvd(),
+        Err(Error::SingularEquation { .. })
+    ));
+    assert!(matches!(
+        stiff(1e12).gram(GramianKind::Controllability),
+        Err(Error::SingularEquation { .. })
+    ));
+    // Huge A and B with a representable Gramian: Wc = (1e300)² / 2e300.
+    let fast = StateSpace::continuous(matrix![-1e300], matrix![1e300], matrix![1.0], matrix![0.0])
+        .unwrap();
+    assert!(matches!(
+        fast.gram(GramianKind::Controllability),
+        Err(Error::Overflow { operation: "gram" })
+    ));
+    let r = fast
+        .gram_factor(GramianKind::Controllability)
+        .unwrap()
+        .factor[(0, 0)];
+    assert!((r / 0.5e150f64.sqrt() / 1e75 - 1.0).abs() < 1e-14, "{r:e}");
     // No states: empty answers.
     let empty = DynStateSpace::continuous(
         DMatrix::zeros(0, 0),

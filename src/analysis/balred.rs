@@ -109,8 +109,9 @@ fn kept(order: ReducedOrder, sigma: &[f64]) -> Result<usize, Error> {
             }
             let floor = t.max(tol);
             let mut r = sigma.iter().filter(|&&s| s > floor).count();
-            // A group of equal values straddling the tolerance is kept whole.
-            while splits(r) {
+            // A group of equal values straddling the tolerance is kept
+            // whole, short of its members that are zero to rounding.
+            while splits(r) && sigma[r] > tol {
                 r += 1;
             }
             Ok(r)

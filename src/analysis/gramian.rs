@@ -155,7 +155,11 @@ impl<D: Domain> DynStateSpace<D> {
     /// [`unstable_pole`](Self::unstable_pole)'s test (the Gramian of an
     /// unstable model is infinite); [`Error::Overflow`] (operation
     /// `"gram"`) if `B Bᵀ` (`Cᵀ C`) or the Gramian is beyond `f64`;
-    /// otherwise as [`lyap`].
+    /// otherwise as [`lyap`]: in particular [`Error::SingularEquation`]
+    /// for a stable but very stiff model, whose slowest pole is within
+    /// `100 n ε` of the Schur form's norm (poles at 1e-3 and 1e12 rad/s;
+    /// 1e-3 and 1e6 are solved), which the solvers' normwise test cannot
+    /// tell from the imaginary axis.
     ///
     /// # Examples
     ///
