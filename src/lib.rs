@@ -34,7 +34,10 @@
 //!   observability; Lyapunov and Sylvester equations
 //!   ([`lyap`](analysis::lyap), [`dlyap`](analysis::dlyap),
 //!   [`sylvester`](analysis::sylvester), and the Gramian's factor
-//!   [`lyapchol`](analysis::lyapchol)).
+//!   [`lyapchol`](analysis::lyapchol), [`dlyapchol`](analysis::dlyapchol));
+//!   Gramians ([`gram`](StateSpace::gram)), Hankel singular values
+//!   ([`hsvd`](StateSpace::hsvd)) and balanced truncation
+//!   ([`balred`](StateSpace::balred)).
 //! - [`design`]: the [`Controller`] trait (measurements and reference in,
 //!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
 //!   [`acker`], [`place`], [`lqr`], [`dlqr`], Riccati solvers that scale

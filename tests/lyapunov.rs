@@ -22,7 +22,6 @@ use ctrlab::analysis::{dlyap, lyap, lyapchol, sylvester};
 use ctrlab::signal::Rng;
 use nalgebra::{DMatrix, SMatrix, dmatrix, matrix};
 use proptest::prelude::*;
-use serde_json::Value;
 
 /// `max |X − X_SciPy| / max |X_SciPy|` allowed, per family; SciPy's `X`
 /// comes from LAPACK's Schur and `dtrsyl` (the discrete one for `n > 10`
@@ -30,15 +29,7 @@ use serde_json::Value;
 /// the conditioning of each case times ε.
 const X_AGREEMENT: f64 = 1e-9;
 
-fn dm(v: &Value) -> DMatrix<f64> {
-    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).unwrap();
-    let (n, m) = (rows.len(), rows.first().map_or(0, Vec::len));
-    DMatrix::from_fn(n, m, |i, j| rows[i][j])
-}
-
-fn rel_diff(x: &DMatrix<f64>, reference: &DMatrix<f64>) -> f64 {
-    (x - reference).amax() / reference.amax().max(f64::MIN_POSITIVE)
-}
+use common::{dmatrix as dm, rel_amax as rel_diff};
 
 /// The fixed-size solution of a fixture case of `N` states, on the heap.
 fn fixed_lyap<const N: usize>(a: &DMatrix<f64>, q: &DMatrix<f64>, discrete: bool) -> DMatrix<f64> {

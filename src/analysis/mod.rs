@@ -1,7 +1,8 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test; Lyapunov
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
-//! [`lyapchol`]).
+//! [`lyapchol`], [`dlyapchol`]); Gramians, Hankel singular values and
+//! balanced truncation (`gram`, `hsvd`, `balred`, on both model types).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
@@ -28,19 +29,23 @@
 //! ```
 
 mod balance;
+mod balred;
 mod controllability;
 mod dyn_state_space;
 mod gain;
+mod gramian;
 mod lyapunov;
 pub(crate) mod minreal;
 mod poles;
 mod stability;
 mod state_space;
 
+pub use balred::{BalancedTruncation, ReducedOrder};
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
+pub use gramian::GramianKind;
 pub use lyapunov::{
-    FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, lyap,
-    lyapchol, sylvester,
+    FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, dlyapchol,
+    lyap, lyapchol, sylvester,
 };
 pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};

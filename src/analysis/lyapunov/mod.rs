@@ -8,6 +8,8 @@ mod bartels_stewart;
 mod francis;
 mod hammarling;
 
+pub use hammarling::dlyapchol;
+
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::{Error, check_finite_dyn, check_shape};
@@ -338,18 +340,9 @@ where
     B: sealed::Matrix,
 {
     const OPERATION: &str = "Lyapunov factor (lyapchol)";
-    let (a, b) = (a.to_heap(), b.to_heap());
-    let n = a.nrows();
-    check_shape("A", &a, n, n)?;
-    check_shape("B", &b, n, b.ncols())?;
-    check_finite_dyn("A", &a)?;
-    check_finite_dyn("B", &b)?;
-    if n == 0 || b.ncols() == 0 {
-        return Ok(LyapunovFactor {
-            factor: A::from_heap(DMatrix::zeros(n, n)),
-            residual: 0.0,
-        });
-    }
+    let Some((a, b)) = hammarling::operands(a, b)? else {
+        return Ok(hammarling::trivial(a));
+    };
     // Scaled by 4^k and 2^j (exact): R scales by 2^j / 2^k.
     let mut alpha = pow2_floor(a.amax());
     if (alpha.log2() as i64) % 2 != 0 {
@@ -374,7 +367,7 @@ where
             alpha,
         ));
     }
-    let r = hammarling::factor(&s, &b);
+    let r = hammarling::factor(&s, &b, hammarling::Time::Continuous);
     let x = r.transpose() * &r;
     let bb = &b * b.transpose();
     let (ax, xat) = (&a * &x, &x * a.transpose());
