@@ -1,7 +1,7 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test; Lyapunov
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
-//! [`lyapchol`]).
+//! [`lyapchol`], the discrete Sylvester equation [`dsylvester`]).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
@@ -42,6 +42,7 @@ pub use lyapunov::{
     FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, lyap,
     lyapchol, sylvester,
 };
+pub use lyapunov::dsylvester;
 pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
 

@@ -2,17 +2,20 @@
 //! fixed-size (`SMatrix`) and run-time-sized (`DMatrix`) matrices alike:
 //! [`lyap`], [`dlyap`] and [`sylvester`], each with the relative residual
 //! of its solution, and [`lyapchol`], Hammarling's Cholesky factor of a
-//! stable continuous equation's solution.
+//! stable continuous equation's solution; the discrete Sylvester (Stein)
+//! equation [`dsylvester`] in `stein.rs`.
 
 mod bartels_stewart;
 mod francis;
 mod hammarling;
+mod stein;
 
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::error::{Error, check_finite_dyn, check_shape};
 use crate::kernels::reduce::pow2_floor;
 use bartels_stewart::{Condition, Schur, quasi_stein, quasi_sylvester, schur, singular_pair};
+pub use stein::dsylvester;
 
 /// The solution `X` of a Lyapunov, Stein (discrete Lyapunov) or Sylvester
 /// equation, and how well it satisfies the equation.
@@ -476,7 +479,7 @@ fn discrete(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<(DMatrix<f64>, f64), E
         return Err(refuse(EQUATION, "λ μ = 1", pair, 1.0));
     }
     let mut y = s.u.transpose() * &q * &s.u;
-    quasi_stein(&s.t, &s.blocks, &mut y);
+    quasi_stein(&s.t, &s.blocks, &s.t, &s.blocks, &mut y);
     let x = back(&s, &y, &s, is_symmetric(&q));
     let axa = a * &x * a.transpose();
     let r = (&axa - &x + &q).norm();
