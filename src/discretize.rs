@@ -1,6 +1,8 @@
 //! Continuous → discrete conversion: [`Discretization::Zoh`] (exact for a
 //! zero-order-held input), [`Discretization::Tustin`], [`Discretization::ForwardEuler`] and
-//! [`Discretization::BackwardEuler`], plus the matrix exponential [`expm`].
+//! [`Discretization::BackwardEuler`], plus the matrix exponential [`expm`];
+//! and back: [`StateSpace::d2c`] / [`DynStateSpace::d2c`] invert each
+//! method (ZOH through the principal matrix logarithm [`logm`]).
 //!
 //! The definitions match SciPy's `cont2discrete` (methods `zoh`, `bilinear`,
 //! `euler`, `backward_diff`); the reference fixtures in `tests/data/` check it.
@@ -15,6 +17,11 @@ use nalgebra::{Const, DMatrix, DefaultAllocator, Dim, OMatrix, SMatrix, U0, allo
 use crate::error::{Error, check_dt};
 use crate::kernels::linalg::Lu;
 use crate::model::{Continuous, Discrete, DynStateSpace, StateSpace};
+
+mod d2c;
+mod logm;
+
+pub use logm::{LOGM_MAX_ERROR, logm, logm_dyn};
 
 /// How to turn a continuous model into a discrete one with period `h`.
 ///
