@@ -134,6 +134,29 @@ impl DynStateSpace<Continuous> {
     }
 }
 
+/// The allocations the conversions of a model with `N` states, `M`
+/// inputs and `P` outputs need (`Allocator<N, P>` for `Cᵀ`): one bound,
+/// met by every triple of nalgebra's dimensions.
+pub(crate) trait ModelAlloc<N: Dim, M: Dim, P: Dim>:
+    Allocator<N, N>
+    + Allocator<N, M>
+    + Allocator<P, N>
+    + Allocator<N, P>
+    + Allocator<P, M>
+    + Allocator<N>
+{
+}
+
+impl<N: Dim, M: Dim, P: Dim, T> ModelAlloc<N, M, P> for T where
+    T: Allocator<N, N>
+        + Allocator<N, M>
+        + Allocator<P, N>
+        + Allocator<N, P>
+        + Allocator<P, M>
+        + Allocator<N>
+{
+}
+
 /// The four matrices of a model with `N` states, `M` inputs, `P` outputs.
 type Parts<N, M, P> = (
     OMatrix<f64, N, N>,
@@ -153,12 +176,7 @@ fn discretize_parts<N: Dim, M: Dim, P: Dim>(
     method: Discretization,
 ) -> Result<(Parts<N, M, P>, &'static str), Error>
 where
-    DefaultAllocator: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<P, N>
-        + Allocator<N, P>
-        + Allocator<P, M>
-        + Allocator<N>,
+    DefaultAllocator: ModelAlloc<N, M, P>,
 {
     match method {
         Discretization::Zoh => {
@@ -183,12 +201,7 @@ fn gbt<N: Dim, M: Dim, P: Dim>(
     operation: &'static str,
 ) -> Result<(Parts<N, M, P>, &'static str), Error>
 where
-    DefaultAllocator: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<P, N>
-        + Allocator<N, P>
-        + Allocator<P, M>
-        + Allocator<N>,
+    DefaultAllocator: ModelAlloc<N, M, P>,
 {
     let (n, _) = a.shape_generic();
     let id = OMatrix::<f64, N, N>::identity_generic(n, n);

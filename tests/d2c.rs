@@ -66,7 +66,10 @@ fn recovery_error(case: &Value) -> f64 {
         // SciPy's logm of the augmented matrix, read independently.
         let (la, lb) = (dm(&case["logm_a"]), dm(&case["logm_b"]));
         let against_logm = rel(back.a(), &la).max(rel(back.b(), &lb));
-        assert!(against_logm < 1e-9, "{name}: against scipy logm {against_logm:e}");
+        assert!(
+            against_logm < 1e-9,
+            "{name}: against scipy logm {against_logm:e}"
+        );
     }
     errors.into_iter().fold(0.0, f64::max)
 }
@@ -100,7 +103,12 @@ fn d2c_recovers_the_models_scipy_discretised() {
 /// `P` outputs: bit for bit the run-time-sized one.
 fn fixed_matches_dyn<const N: usize, const M: usize, const P: usize>(case: &Value) {
     let dt = case["dt"].as_f64().unwrap();
-    let (ad, bd, cd, dd) = (dm(&case["ad"]), dm(&case["bd"]), dm(&case["cd"]), dm(&case["dd"]));
+    let (ad, bd, cd, dd) = (
+        dm(&case["ad"]),
+        dm(&case["bd"]),
+        dm(&case["cd"]),
+        dm(&case["dd"]),
+    );
     let fixed = StateSpace::discrete(
         SMatrix::<f64, N, N>::from_column_slice(ad.as_slice()),
         SMatrix::<f64, N, M>::from_column_slice(bd.as_slice()),
@@ -158,11 +166,21 @@ fn stein_matches_a_kronecker_solve() {
     let data = common::fixture("d2c_fixtures.json");
     let mut worst: f64 = 0.0;
     for case in data["stein"].as_array().unwrap() {
-        let (a, b, c, x) = (dm(&case["a"]), dm(&case["b"]), dm(&case["c"]), dm(&case["x"]));
+        let (a, b, c, x) = (
+            dm(&case["a"]),
+            dm(&case["b"]),
+            dm(&case["c"]),
+            dm(&case["x"]),
+        );
         let sol = dsylvester(&a, &b, &c).unwrap();
         let e = rel(&sol.x, &x);
         assert!(e < 1e-11, "{}: {e:e}", case["name"]);
-        assert!(sol.residual < 1e-14, "{}: residual {:e}", case["name"], sol.residual);
+        assert!(
+            sol.residual < 1e-14,
+            "{}: residual {:e}",
+            case["name"],
+            sol.residual
+        );
         worst = worst.max(e);
         if (a.nrows(), b.nrows()) == (2, 3) {
             let f = dsylvester(
@@ -213,7 +231,10 @@ fn scalar_closed_forms() {
         .d2c(Discretization::Zoh)
         .unwrap();
     let exact = 1.5f64.ln() / 0.1;
-    println!("ad = 1.5: {:e} relative", (u.a()[(0, 0)] - exact).abs() / exact);
+    println!(
+        "ad = 1.5: {:e} relative",
+        (u.a()[(0, 0)] - exact).abs() / exact
+    );
     assert!(close(u.a()[(0, 0)], exact));
     // logm of a diagonal; Stein of scalars: x = c / (1 − a b).
     let l = logm(&matrix![2.0, 0.0; 0.0, 0.5]).unwrap();
@@ -227,9 +248,22 @@ fn integrator_chain_and_oscillator_round_trip() {
     // A double integrator (Ad a Jordan block at z = 1) and an undamped
     // oscillator at 0.9 of the Nyquist frequency.
     let w = 0.9 * std::f64::consts::PI / 0.1;
-    for a in [dmatrix![0.0, 1.0; 0.0, 0.0], dmatrix![0.0, 1.0; -w * w, 0.0]] {
-        let sys = DynStateSpace::continuous(a.clone(), dmatrix![0.0; 1.0], dmatrix![1.0, 0.0], dmatrix![0.0]).unwrap();
-        let back = sys.discretize(0.1, Discretization::Zoh).unwrap().d2c(Discretization::Zoh).unwrap();
+    for a in [
+        dmatrix![0.0, 1.0; 0.0, 0.0],
+        dmatrix![0.0, 1.0; -w * w, 0.0],
+    ] {
+        let sys = DynStateSpace::continuous(
+            a.clone(),
+            dmatrix![0.0; 1.0],
+            dmatrix![1.0, 0.0],
+            dmatrix![0.0],
+        )
+        .unwrap();
+        let back = sys
+            .discretize(0.1, Discretization::Zoh)
+            .unwrap()
+            .d2c(Discretization::Zoh)
+            .unwrap();
         assert!(rel(back.a(), &a) < 1e-12, "{}", back.a());
         assert!(rel(back.b(), sys.b()) < 1e-12, "{}", back.b());
     }
@@ -238,7 +272,9 @@ fn integrator_chain_and_oscillator_round_trip() {
 #[test]
 fn refusals_are_named() {
     let h = 0.1;
-    let d1 = |ad: f64| StateSpace::discrete(matrix![ad], matrix![1.0], matrix![1.0], matrix![0.0], h).unwrap();
+    let d1 = |ad: f64| {
+        StateSpace::discrete(matrix![ad], matrix![1.0], matrix![1.0], matrix![0.0], h).unwrap()
+    };
     // A pole on the negative real axis (and at 0): no real principal log.
     for ad in [-0.5, 0.0, -1.0] {
         assert!(matches!(
@@ -247,41 +283,96 @@ fn refusals_are_named() {
         ));
     }
     // A real pair on the negative axis, rotated: still refused by name.
-    let neg = StateSpace::discrete(matrix![-2.0, 1.0; 0.25, -2.0], matrix![1.0; 0.0], matrix![1.0, 0.0], matrix![0.0], h).unwrap();
-    assert!(matches!(neg.d2c(Discretization::Zoh), Err(Error::EigenvalueOutOfDomain { .. })));
+    let neg = StateSpace::discrete(
+        matrix![-2.0, 1.0; 0.25, -2.0],
+        matrix![1.0; 0.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+        h,
+    )
+    .unwrap();
+    assert!(matches!(
+        neg.d2c(Discretization::Zoh),
+        Err(Error::EigenvalueOutOfDomain { .. })
+    ));
     // Tustin at z = −1, backward Euler at z = 0.
-    assert!(matches!(d1(-1.0).d2c(Discretization::Tustin), Err(Error::EigenvalueOutOfDomain { re, .. }) if re == -1.0));
-    assert!(matches!(d1(0.0).d2c(Discretization::BackwardEuler), Err(Error::EigenvalueOutOfDomain { re, .. }) if re == 0.0));
+    assert!(
+        matches!(d1(-1.0).d2c(Discretization::Tustin), Err(Error::EigenvalueOutOfDomain { re, .. }) if re == -1.0)
+    );
+    assert!(
+        matches!(d1(0.0).d2c(Discretization::BackwardEuler), Err(Error::EigenvalueOutOfDomain { re, .. }) if re == 0.0)
+    );
     // ... but forward Euler takes both, and Tustin takes z = 0.
     assert!(d1(-1.0).d2c(Discretization::ForwardEuler).is_ok());
     assert!(d1(0.0).d2c(Discretization::Tustin).is_ok());
     // A complex pair 1e-9 rad from the negative axis: ill-conditioned.
     let th = std::f64::consts::PI - 1e-9;
     let near = StateSpace::discrete(
-        matrix![th.cos(), -th.sin(); th.sin(), th.cos()], matrix![1.0; 0.0], matrix![1.0, 0.0], matrix![0.0], h).unwrap();
+        matrix![th.cos(), -th.sin(); th.sin(), th.cos()],
+        matrix![1.0; 0.0],
+        matrix![1.0, 0.0],
+        matrix![0.0],
+        h,
+    )
+    .unwrap();
     let r = near.d2c(Discretization::Zoh);
     assert!(matches!(r, Err(Error::IllConditioned { .. })), "{r:?}");
     // A stiff model sampled slowly: its fast mode decayed past rounding.
-    let stiff = DynStateSpace::continuous(dmatrix![-1.0, 0.0; 1.0, -300.0], dmatrix![1.0; 0.0], dmatrix![0.0, 1.0], dmatrix![0.0]).unwrap();
+    let stiff = DynStateSpace::continuous(
+        dmatrix![-1.0, 0.0; 1.0, -300.0],
+        dmatrix![1.0; 0.0],
+        dmatrix![0.0, 1.0],
+        dmatrix![0.0],
+    )
+    .unwrap();
     let d = stiff.discretize(0.1, Discretization::Zoh).unwrap();
-    assert!(matches!(d.d2c(Discretization::Zoh), Err(Error::IllConditioned { .. } | Error::EigenvalueOutOfDomain { .. })));
+    assert!(matches!(
+        d.d2c(Discretization::Zoh),
+        Err(Error::IllConditioned { .. } | Error::EigenvalueOutOfDomain { .. })
+    ));
     // NaN and a bad period are refused when the discrete model is built.
     assert!(matches!(
-        StateSpace::discrete(matrix![f64::NAN], matrix![1.0], matrix![1.0], matrix![0.0], h),
+        StateSpace::discrete(
+            matrix![f64::NAN],
+            matrix![1.0],
+            matrix![1.0],
+            matrix![0.0],
+            h
+        ),
         Err(Error::NonFinite { matrix: "A", .. })
     ));
     for dt in [0.0, -0.1, f64::NAN, f64::INFINITY] {
         assert!(matches!(
-            DynStateSpace::discrete(dmatrix![0.5], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0], dt),
+            DynStateSpace::discrete(
+                dmatrix![0.5],
+                dmatrix![1.0],
+                dmatrix![1.0],
+                dmatrix![0.0],
+                dt
+            ),
             Err(Error::InvalidParameter { name: "dt", .. })
         ));
     }
     // logm: NaN, infinity, non-square, a negative eigenvalue, a singular matrix.
-    assert!(matches!(logm(&matrix![1.0, f64::NAN; 0.0, 1.0]), Err(Error::NonFinite { row: 0, col: 1, .. })));
-    assert!(matches!(logm_dyn(&dmatrix![f64::INFINITY]), Err(Error::NonFinite { .. })));
-    assert!(matches!(logm_dyn(&DMatrix::zeros(2, 3)), Err(Error::DimensionMismatch { .. })));
-    assert!(matches!(logm(&matrix![1.0, 0.0; 0.0, -3.0]), Err(Error::EigenvalueOutOfDomain { re, .. }) if re == -3.0));
-    assert!(matches!(logm(&matrix![1.0, 1.0; 1.0, 1.0]), Err(Error::EigenvalueOutOfDomain { .. })));
+    assert!(matches!(
+        logm(&matrix![1.0, f64::NAN; 0.0, 1.0]),
+        Err(Error::NonFinite { row: 0, col: 1, .. })
+    ));
+    assert!(matches!(
+        logm_dyn(&dmatrix![f64::INFINITY]),
+        Err(Error::NonFinite { .. })
+    ));
+    assert!(matches!(
+        logm_dyn(&DMatrix::zeros(2, 3)),
+        Err(Error::DimensionMismatch { .. })
+    ));
+    assert!(
+        matches!(logm(&matrix![1.0, 0.0; 0.0, -3.0]), Err(Error::EigenvalueOutOfDomain { re, .. }) if re == -3.0)
+    );
+    assert!(matches!(
+        logm(&matrix![1.0, 1.0; 1.0, 1.0]),
+        Err(Error::EigenvalueOutOfDomain { .. })
+    ));
     assert_eq!(logm_dyn(&DMatrix::zeros(0, 0)).unwrap().shape(), (0, 0));
     // Extreme magnitudes that have a logarithm are taken.
     assert!((logm(&matrix![1e300]).unwrap()[(0, 0)] - 1e300f64.ln()).abs() < 1e-12 * 700.0);
@@ -291,34 +382,87 @@ fn refusals_are_named() {
 #[test]
 fn stein_refusals_and_extremes() {
     // λ μ = 1: 2 · 0.5, and −1 · −1.
-    match dsylvester(&matrix![2.0, 0.0; 0.0, 0.3], &matrix![0.5], &matrix![1.0; 1.0]) {
-        Err(Error::SingularEquation { lambda_re, mu_re, condition, .. }) => {
+    match dsylvester(
+        &matrix![2.0, 0.0; 0.0, 0.3],
+        &matrix![0.5],
+        &matrix![1.0; 1.0],
+    ) {
+        Err(Error::SingularEquation {
+            lambda_re,
+            mu_re,
+            condition,
+            ..
+        }) => {
             assert_eq!((lambda_re, mu_re, condition), (2.0, 0.5, "λ μ = 1"));
         }
         other => panic!("{other:?}"),
     }
-    assert!(matches!(dsylvester(&dmatrix![-1.0], &dmatrix![-1.0], &dmatrix![1.0]), Err(Error::SingularEquation { .. })));
-    assert!(matches!(dsylvester(&dmatrix![f64::NAN], &dmatrix![0.5], &dmatrix![1.0]), Err(Error::NonFinite { matrix: "A", .. })));
-    assert!(matches!(dsylvester(&dmatrix![0.5], &dmatrix![0.5], &dmatrix![f64::INFINITY]), Err(Error::NonFinite { matrix: "C", .. })));
-    assert!(matches!(dsylvester(&dmatrix![0.5], &DMatrix::zeros(2, 2), &dmatrix![1.0]), Err(Error::DimensionMismatch { matrix: "C", .. })));
-    assert!(matches!(dsylvester(&DMatrix::zeros(2, 3), &dmatrix![0.5], &dmatrix![1.0; 1.0]), Err(Error::DimensionMismatch { matrix: "A", .. })));
-    assert_eq!(dsylvester(&DMatrix::zeros(0, 0), &dmatrix![0.5], &DMatrix::zeros(0, 1)).unwrap().x.shape(), (0, 1));
+    assert!(matches!(
+        dsylvester(&dmatrix![-1.0], &dmatrix![-1.0], &dmatrix![1.0]),
+        Err(Error::SingularEquation { .. })
+    ));
+    assert!(matches!(
+        dsylvester(&dmatrix![f64::NAN], &dmatrix![0.5], &dmatrix![1.0]),
+        Err(Error::NonFinite { matrix: "A", .. })
+    ));
+    assert!(matches!(
+        dsylvester(&dmatrix![0.5], &dmatrix![0.5], &dmatrix![f64::INFINITY]),
+        Err(Error::NonFinite { matrix: "C", .. })
+    ));
+    assert!(matches!(
+        dsylvester(&dmatrix![0.5], &DMatrix::zeros(2, 2), &dmatrix![1.0]),
+        Err(Error::DimensionMismatch { matrix: "C", .. })
+    ));
+    assert!(matches!(
+        dsylvester(&DMatrix::zeros(2, 3), &dmatrix![0.5], &dmatrix![1.0; 1.0]),
+        Err(Error::DimensionMismatch { matrix: "A", .. })
+    ));
+    assert_eq!(
+        dsylvester(&DMatrix::zeros(0, 0), &dmatrix![0.5], &DMatrix::zeros(0, 1))
+            .unwrap()
+            .x
+            .shape(),
+        (0, 1)
+    );
     // A 1e300 against B 1e-300: balanced, x = c / (1 − a b) = 2.
-    let s = dsylvester(&dmatrix![1e300, 0.0; 0.0, 2e300], &dmatrix![-1e-300], &dmatrix![2.0; 3.0]).unwrap();
-    assert!((s.x[(0, 0)] - 1.0).abs() < 1e-15 && (s.x[(1, 0)] - 1.0).abs() < 1e-15, "{}", s.x);
+    let s = dsylvester(
+        &dmatrix![1e300, 0.0; 0.0, 2e300],
+        &dmatrix![-1e-300],
+        &dmatrix![2.0; 3.0],
+    )
+    .unwrap();
+    assert!(
+        (s.x[(0, 0)] - 1.0).abs() < 1e-15 && (s.x[(1, 0)] - 1.0).abs() < 1e-15,
+        "{}",
+        s.x
+    );
 }
 
 /// A random continuous model with `n` states whose eigenvalues have
 /// modulus at most `rate` (1/s): a rotated quasi-triangular matrix.
-fn model(rng: &mut Rng, n: usize, m: usize, p: usize, rate: f64, stable: bool) -> DynStateSpace<ctrlab::Continuous> {
+fn model(
+    rng: &mut Rng,
+    n: usize,
+    m: usize,
+    p: usize,
+    rate: f64,
+    stable: bool,
+) -> DynStateSpace<ctrlab::Continuous> {
     let g = DMatrix::from_fn(n, n, |_, _| rng.gaussian());
     let q = g.qr().q();
     let mut t = DMatrix::zeros(n, n);
     let mut i = 0;
     while i < n {
-        let sign = if stable || rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        let sign = if stable || rng.uniform() < 0.5 {
+            -1.0
+        } else {
+            1.0
+        };
         if i + 1 < n && rng.uniform() < 0.5 {
-            let (re, im) = (sign * (0.05 + 0.5 * rng.uniform()) * rate, (0.1 + 0.6 * rng.uniform()) * rate);
+            let (re, im) = (
+                sign * (0.05 + 0.5 * rng.uniform()) * rate,
+                (0.1 + 0.6 * rng.uniform()) * rate,
+            );
             t[(i, i)] = re;
             t[(i + 1, i + 1)] = re;
             t[(i, i + 1)] = im;

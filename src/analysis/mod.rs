@@ -38,11 +38,11 @@ mod stability;
 mod state_space;
 
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
+pub use lyapunov::dsylvester;
 pub use lyapunov::{
     FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, lyap,
     lyapchol, sylvester,
 };
-pub use lyapunov::dsylvester;
 pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
 

@@ -6,7 +6,7 @@
 use nalgebra::{DMatrix, DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
 use super::logm::{frobenius, principal_log};
-use super::{Discretization, Parts};
+use super::{Discretization, Held, ModelAlloc, Parts};
 use crate::analysis::eigenvalues_dyn;
 use crate::error::Error;
 use crate::kernels::linalg::Lu;
@@ -82,7 +82,7 @@ impl<const N: usize, const M: usize, const P: usize> StateSpace<N, M, P, Discret
     #[doc(alias = "undiscretize")]
     pub fn d2c(&self, method: Discretization) -> Result<StateSpace<N, M, P, Continuous>, Error> {
         let ((a, b, c, d), operation) =
-            d2c_parts(self.a(), self.b(), self.c(), self.d(), self.dt(), method)?;
+            d2c_parts((self.a(), self.b(), self.c(), self.d()), self.dt(), method)?;
         let mut all = a.iter().chain(b.iter()).chain(c.iter()).chain(d.iter());
         if all.any(|v| !v.is_finite()) {
             return Err(Error::Overflow { operation });
@@ -124,7 +124,7 @@ impl DynStateSpace<Discrete> {
     #[doc(alias = "undiscretize")]
     pub fn d2c(&self, method: Discretization) -> Result<DynStateSpace<Continuous>, Error> {
         let ((a, b, c, d), operation) =
-            d2c_parts(self.a(), self.b(), self.c(), self.d(), self.dt(), method)?;
+            d2c_parts((self.a(), self.b(), self.c(), self.d()), self.dt(), method)?;
         DynStateSpace::from_computed(a, b, c, d, Continuous, operation)
     }
 }
@@ -132,32 +132,33 @@ impl DynStateSpace<Discrete> {
 /// `(A, B, C, D)` of the discrete `(Ad, Bd, Cd, Dd)` at period `h` by the
 /// inverse of `method`, with the operation's name for an overflow.
 fn d2c_parts<N: Dim, M: Dim, P: Dim>(
-    ad: &OMatrix<f64, N, N>,
-    bd: &OMatrix<f64, N, M>,
-    cd: &OMatrix<f64, P, N>,
-    dd: &OMatrix<f64, P, M>,
+    sys: PartsRef<'_, N, M, P>,
     h: f64,
     method: Discretization,
 ) -> Result<(Parts<N, M, P>, &'static str), Error>
 where
-    DefaultAllocator: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<P, N>
-        + Allocator<N, P>
-        + Allocator<P, M>
-        + Allocator<N>,
+    DefaultAllocator: ModelAlloc<N, M, P>,
 {
-    match method {
+    let (alpha, operation) = match method {
         Discretization::Zoh => {
             const OP: &str = "ZOH d2c (matrix logarithm of [[Ad, Bd], [0, I]])";
-            let (a, b) = zoh_inverse(ad, bd, h, OP)?;
-            Ok(((a, b, cd.clone(), dd.clone()), OP))
+            let (a, b) = zoh_inverse(sys.0, sys.1, h, OP)?;
+            return Ok(((a, b, sys.2.clone(), sys.3.clone()), OP));
         }
-        Discretization::Tustin => gbt_inverse(ad, bd, cd, dd, h, 0.5, "Tustin d2c"),
-        Discretization::ForwardEuler => gbt_inverse(ad, bd, cd, dd, h, 0.0, "forward Euler d2c"),
-        Discretization::BackwardEuler => gbt_inverse(ad, bd, cd, dd, h, 1.0, "backward Euler d2c"),
-    }
+        Discretization::Tustin => (0.5, "Tustin d2c"),
+        Discretization::ForwardEuler => (0.0, "forward Euler d2c"),
+        Discretization::BackwardEuler => (1.0, "backward Euler d2c"),
+    };
+    Ok((gbt_inverse(sys, h, alpha, operation)?, operation))
 }
+
+/// `(Ad, Bd, Cd, Dd)` borrowed.
+type PartsRef<'a, N, M, P> = (
+    &'a OMatrix<f64, N, N>,
+    &'a OMatrix<f64, N, M>,
+    &'a OMatrix<f64, P, N>,
+    &'a OMatrix<f64, P, M>,
+);
 
 /// `(A, B)` of a ZOH discretisation `(Ad, Bd)`: the upper blocks of the
 /// logarithm of `[[Ad, Bd/β], [0, I]]` over `h` (`B` times `β`). `β`, a
@@ -169,7 +170,7 @@ fn zoh_inverse<N: Dim, M: Dim>(
     bd: &OMatrix<f64, N, M>,
     h: f64,
     operation: &'static str,
-) -> Result<(OMatrix<f64, N, N>, OMatrix<f64, N, M>), Error>
+) -> Result<Held<N, M>, Error>
 where
     DefaultAllocator: Allocator<N, N> + Allocator<N, M>,
 {
@@ -191,27 +192,19 @@ where
 /// The inverse of the generalised bilinear transform with weight `alpha`
 /// (see [`StateSpace::d2c`]).
 fn gbt_inverse<N: Dim, M: Dim, P: Dim>(
-    ad: &OMatrix<f64, N, N>,
-    bd: &OMatrix<f64, N, M>,
-    cd: &OMatrix<f64, P, N>,
-    dd: &OMatrix<f64, P, M>,
+    (ad, bd, cd, dd): PartsRef<'_, N, M, P>,
     h: f64,
     alpha: f64,
     operation: &'static str,
-) -> Result<(Parts<N, M, P>, &'static str), Error>
+) -> Result<Parts<N, M, P>, Error>
 where
-    DefaultAllocator: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<P, N>
-        + Allocator<N, P>
-        + Allocator<P, M>
-        + Allocator<N>,
+    DefaultAllocator: ModelAlloc<N, M, P>,
 {
     let (n, _) = ad.shape_generic();
     let id = OMatrix::<f64, N, N>::identity_generic(n, n);
     let step = ad - &id;
     if alpha == 0.0 {
-        return Ok(((step / h, bd / h, cd.clone(), dd.clone()), operation));
+        return Ok((step / h, bd / h, cd.clone(), dd.clone()));
     }
     // V = α Ad + (1 − α) I is singular exactly at the eigenvalue z = −(1 − α)/α.
     let pole = -(1.0 - alpha) / alpha;
@@ -235,5 +228,5 @@ where
     let b = lu.solve(bd) / h;
     let c = Lu::solve_right(&v, cd, operation)?;
     let d = dd - &c * bd * alpha;
-    Ok(((a, b, c, d), operation))
+    Ok((a, b, c, d))
 }

@@ -104,7 +104,10 @@ const AXIS_FACTOR: f64 = 100.0;
 /// ```
 pub fn logm<const N: usize>(a: &SMatrix<f64, N, N>) -> Result<SMatrix<f64, N, N>, Error> {
     check_finite("A", a)?;
-    let l = principal_log(&DMatrix::from_column_slice(N, N, a.as_slice()), "matrix logarithm")?;
+    let l = principal_log(
+        &DMatrix::from_column_slice(N, N, a.as_slice()),
+        "matrix logarithm",
+    )?;
     Ok(SMatrix::from_column_slice(l.as_slice()))
 }
 
@@ -138,7 +141,10 @@ pub fn logm_dyn(a: &DMatrix<f64>) -> Result<DMatrix<f64>, Error> {
 
 /// The principal logarithm of a square, finite `m`, refused as [`logm`]
 /// documents; `operation` names the caller in the errors.
-pub(super) fn principal_log(m: &DMatrix<f64>, operation: &'static str) -> Result<DMatrix<f64>, Error> {
+pub(super) fn principal_log(
+    m: &DMatrix<f64>,
+    operation: &'static str,
+) -> Result<DMatrix<f64>, Error> {
     let n = m.nrows();
     if n == 0 {
         return Ok(DMatrix::zeros(0, 0));
@@ -172,7 +178,11 @@ pub(super) fn principal_log(m: &DMatrix<f64>, operation: &'static str) -> Result
             // axis that `M + I`-like iterates are singular): judged with
             // the eigenvalues' logarithms for `‖log M‖_F`, which bound it
             // below, the error estimate says why.
-            let size = eigenvalues.iter().map(|l| l.ln().norm_sqr()).sum::<f64>().sqrt();
+            let size = eigenvalues
+                .iter()
+                .map(|l| l.ln().norm_sqr())
+                .sum::<f64>()
+                .sqrt();
             let error = f64::EPSILON * slope * norm / size;
             return Err(if error.is_nan() || error > LOGM_MAX_ERROR {
                 ill(error)
@@ -236,7 +246,10 @@ fn norm1(x: &DMatrix<f64>) -> f64 {
 
 /// The logarithm of `m` (no eigenvalue on the closed negative real axis)
 /// by inverse scaling and squaring.
-fn inverse_scaling_squaring(m: &DMatrix<f64>, operation: &'static str) -> Result<DMatrix<f64>, Error> {
+fn inverse_scaling_squaring(
+    m: &DMatrix<f64>,
+    operation: &'static str,
+) -> Result<DMatrix<f64>, Error> {
     let n = m.nrows();
     let id = DMatrix::<f64>::identity(n, n);
     let mut x = m.clone();
@@ -321,7 +334,10 @@ mod tests {
     #[test]
     fn pade_is_exact_to_rounding_on_its_radius() {
         for x in [-PADE_RADIUS, PADE_RADIUS, 1e-3] {
-            let r: f64 = GAUSS_LEGENDRE.iter().map(|(t, w)| w * x / (1.0 + t * x)).sum();
+            let r: f64 = GAUSS_LEGENDRE
+                .iter()
+                .map(|(t, w)| w * x / (1.0 + t * x))
+                .sum();
             assert!((r - x.ln_1p()).abs() <= 2.0 * f64::EPSILON * x.ln_1p().abs());
         }
     }

@@ -263,6 +263,26 @@ where
     A: SylvesterOperands<B>,
     B: SquareMatrix,
 {
+    pair_equation(a, b, c, sylvester_dyn)
+}
+
+/// A solver of a two-coefficient equation on the heap: `(A, B, C)` to
+/// `(X, relative residual)`.
+type PairSolver =
+    fn(&DMatrix<f64>, &DMatrix<f64>, &DMatrix<f64>) -> Result<(DMatrix<f64>, f64), Error>;
+
+/// [`sylvester`] and [`dsylvester`]: `A`, `B`, `C` checked (shapes,
+/// finite), then `solve` on the heap, the solution back in `A::Rhs`.
+fn pair_equation<A, B>(
+    a: &A,
+    b: &B,
+    c: &A::Rhs,
+    solve: PairSolver,
+) -> Result<Lyapunov<A::Rhs>, Error>
+where
+    A: SylvesterOperands<B>,
+    B: SquareMatrix,
+{
     use sealed::Matrix;
     let (a, b, c) = (a.to_heap(), b.to_heap(), c.to_heap());
     let (m, n) = (a.nrows(), b.nrows());
@@ -272,7 +292,7 @@ where
     check_finite_dyn("A", &a)?;
     check_finite_dyn("B", &b)?;
     check_finite_dyn("C", &c)?;
-    let (x, residual) = sylvester_dyn(&a, &b, &c)?;
+    let (x, residual) = solve(&a, &b, &c)?;
     Ok(Lyapunov {
         x: A::Rhs::from_heap(x),
         residual,

@@ -3,8 +3,8 @@
 use nalgebra::DMatrix;
 
 use super::bartels_stewart::{Condition, quasi_stein, schur, singular_pair};
-use super::{Lyapunov, SquareMatrix, SylvesterOperands, back, relative, sealed, unscale};
-use crate::error::{Error, check_finite_dyn, check_shape};
+use super::{Lyapunov, SquareMatrix, SylvesterOperands, back, pair_equation, relative, unscale};
+use crate::error::Error;
 use crate::kernels::reduce::pow2_floor;
 
 /// Discrete Sylvester (Stein) equation `A X B − X + C = 0`: its solution
@@ -63,20 +63,7 @@ where
     A: SylvesterOperands<B>,
     B: SquareMatrix,
 {
-    use sealed::Matrix;
-    let (a, b, c) = (a.to_heap(), b.to_heap(), c.to_heap());
-    let (m, n) = (a.nrows(), b.nrows());
-    check_shape("A", &a, m, m)?;
-    check_shape("B", &b, n, n)?;
-    check_shape("C", &c, m, n)?;
-    check_finite_dyn("A", &a)?;
-    check_finite_dyn("B", &b)?;
-    check_finite_dyn("C", &c)?;
-    let (x, residual) = stein(&a, &b, &c)?;
-    Ok(Lyapunov {
-        x: A::Rhs::from_heap(x),
-        residual,
-    })
+    pair_equation(a, b, c, stein)
 }
 
 /// [`dsylvester`] on checked, finite data of matching shapes.
