@@ -5,12 +5,11 @@
 
 use nalgebra::{DMatrix, DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
-use super::logm::{frobenius, principal_log};
+use super::logm::{frobenius, held_log};
 use super::{Discretization, Held, ModelAlloc, Parts};
 use crate::analysis::eigenvalues_dyn;
 use crate::error::Error;
 use crate::kernels::linalg::Lu;
-use crate::kernels::reduce::pow2_floor;
 use crate::model::{Continuous, Discrete, DynStateSpace, StateSpace};
 
 /// Eigenvalues within this many `n ε (1 + ‖Ad‖_F)` of the pole an
@@ -161,10 +160,7 @@ type PartsRef<'a, N, M, P> = (
 );
 
 /// `(A, B)` of a ZOH discretisation `(Ad, Bd)`: the upper blocks of the
-/// logarithm of `[[Ad, Bd/β], [0, I]]` over `h` (`B` times `β`). `β`, a
-/// power of two, brings `Bd` to entries in `[1, 2)`: a similarity by
-/// `diag(I, β I)`, exact, so that the logarithm's scale and its error
-/// estimate follow `Ad`, not the units of the input.
+/// logarithm of `[[Ad, Bd], [0, I]]` over `h`, on the blocks alone.
 fn zoh_inverse<N: Dim, M: Dim>(
     ad: &OMatrix<f64, N, N>,
     bd: &OMatrix<f64, N, M>,
@@ -175,17 +171,14 @@ where
     DefaultAllocator: Allocator<N, N> + Allocator<N, M>,
 {
     let (n, m) = bd.shape_generic();
-    let (nv, mv) = (n.value(), m.value());
-    let beta = pow2_floor(bd.amax());
-    let augmented = DMatrix::from_fn(nv + mv, nv + mv, |i, j| match (i < nv, j < nv) {
-        (true, true) => ad[(i, j)],
-        (true, false) => bd[(i, j - nv)] / beta,
-        (false, false) => f64::from(u8::from(i == j)),
-        (false, true) => 0.0,
-    });
-    let l = principal_log(&augmented, operation)?;
+    let heap = |x: &[f64], cols: usize| DMatrix::from_column_slice(n.value(), cols, x);
+    let (l, f) = held_log(
+        &heap(ad.as_slice(), n.value()),
+        &heap(bd.as_slice(), m.value()),
+        operation,
+    )?;
     let a = OMatrix::<f64, N, N>::from_fn_generic(n, n, |i, j| l[(i, j)] / h);
-    let b = OMatrix::<f64, N, M>::from_fn_generic(n, m, |i, j| l[(i, nv + j)] / h * beta);
+    let b = OMatrix::<f64, N, M>::from_fn_generic(n, m, |i, j| f[(i, j)] / h);
     Ok((a, b))
 }
 

@@ -24,7 +24,9 @@ use crate::error::{Error, check_finite, check_finite_dyn, check_shape};
 /// tiny against `‖M‖` (a mode that decayed past rounding within the
 /// sampling period), when a complex pair nears the negative real axis
 /// (a pole near the Nyquist frequency), or when `log M` is tiny against
-/// `M` (a period so short that `M` stores `log M` in few digits).
+/// `M` (a period so short that `M` stores `log M` in few digits). For a
+/// ZOH [`d2c`](crate::StateSpace::d2c), `M` is `Ad`: the identity block
+/// of `[[Ad, Bd], [0, I]]` is exact and `B` follows `Bd` linearly.
 ///
 /// # Examples
 ///
@@ -145,12 +147,29 @@ pub(super) fn principal_log(
     m: &DMatrix<f64>,
     operation: &'static str,
 ) -> Result<DMatrix<f64>, Error> {
-    let n = m.nrows();
+    let none = DMatrix::zeros(m.nrows(), 0);
+    held_log(m, &none, operation).map(|(l, _)| l)
+}
+
+/// `(L, F)` with `[[L, F], [0, 0]] = log([[E, G], [0, I]])` (`E` square,
+/// finite, `G` with as many rows), the inverse of ZOH's exponential, on
+/// the blocks alone: each square root of `[[E, G], [0, I]]` is
+/// `[[R, (R + I)⁻¹ G], [0, I]]` with `R = E^½`, and the Padé form of
+/// `log(I + [[X, Y], [0, 0]])` is `[[Σ wⱼ X (I + tⱼ X)⁻¹, Σ wⱼ (I + tⱼ X)⁻¹ Y], [0, 0]]`.
+/// The identity block is exact and `F` linear in `G`, so `E` alone is
+/// judged: its eigenvalues against the negative real axis, and the error
+/// estimate of [`LOGM_MAX_ERROR`] with `‖E‖_F` and `‖L‖_F`.
+pub(super) fn held_log(
+    e: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    operation: &'static str,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), Error> {
+    let n = e.nrows();
     if n == 0 {
-        return Ok(DMatrix::zeros(0, 0));
+        return Ok((DMatrix::zeros(0, 0), DMatrix::zeros(0, g.ncols())));
     }
-    let norm = frobenius(m);
-    let eigenvalues = eigenvalues_dyn(m)?;
+    let norm = frobenius(e);
+    let eigenvalues = &eigenvalues_dyn(e)?;
     let on_axis = AXIS_FACTOR * n as f64 * f64::EPSILON * norm;
     if let Some(l) = eigenvalues
         .iter()
@@ -163,7 +182,7 @@ pub(super) fn principal_log(
             reason: "lies on the closed negative real axis: no real principal logarithm",
         });
     }
-    let slope = largest_divided_difference(&eigenvalues);
+    let slope = largest_divided_difference(eigenvalues);
     let ill = |error: f64| Error::IllConditioned {
         operation: "matrix logarithm (an eigenvalue tiny against the matrix, a complex \
                     pair near the negative real axis, or a logarithm tiny against the \
@@ -171,8 +190,8 @@ pub(super) fn principal_log(
         error,
         limit: LOGM_MAX_ERROR,
     };
-    let l = match inverse_scaling_squaring(m, operation) {
-        Ok(l) => l,
+    let (l, f) = match inverse_scaling_squaring(e, g, operation) {
+        Ok(lf) => lf,
         Err(failed) => {
             // The square roots broke down (a pair so near the negative
             // axis that `M + I`-like iterates are singular): judged with
@@ -200,10 +219,10 @@ pub(super) fn principal_log(
     if !error.is_finite() || error > LOGM_MAX_ERROR {
         return Err(ill(error));
     }
-    if l.iter().any(|v| !v.is_finite()) {
+    if l.iter().chain(f.iter()).any(|v| !v.is_finite()) {
         return Err(Error::Overflow { operation });
     }
-    Ok(l)
+    Ok((l, f))
 }
 
 /// `max |(log λᵢ − log λⱼ)/(λᵢ − λⱼ)|` over the eigenvalues, `1/|λᵢ|` for
@@ -244,15 +263,16 @@ fn norm1(x: &DMatrix<f64>) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The logarithm of `m` (no eigenvalue on the closed negative real axis)
-/// by inverse scaling and squaring.
+/// `(L, F)` of [`held_log`] (no eigenvalue of `e` on the closed negative
+/// real axis) by inverse scaling and squaring.
 fn inverse_scaling_squaring(
-    m: &DMatrix<f64>,
+    e: &DMatrix<f64>,
+    g: &DMatrix<f64>,
     operation: &'static str,
-) -> Result<DMatrix<f64>, Error> {
-    let n = m.nrows();
+) -> Result<(DMatrix<f64>, DMatrix<f64>), Error> {
+    let n = e.nrows();
     let id = DMatrix::<f64>::identity(n, n);
-    let mut x = m.clone();
+    let (mut x, mut y) = (e.clone(), g.clone());
     let mut roots = 0;
     while norm1(&(&x - &id)) > PADE_RADIUS {
         if roots == MAX_ROOTS {
@@ -262,19 +282,22 @@ fn inverse_scaling_squaring(
             });
         }
         x = square_root(&x, operation)?;
+        y = (&x + &id)
+            .lu()
+            .solve(&y)
+            .ok_or(Error::Singular { operation })?;
         roots += 1;
     }
     let x = x - &id;
-    let mut sum = DMatrix::<f64>::zeros(n, n);
+    let mut l = DMatrix::<f64>::zeros(n, n);
+    let mut f = DMatrix::<f64>::zeros(n, g.ncols());
     for (t, w) in GAUSS_LEGENDRE {
-        let shifted = &id + &x * t;
-        let solved = shifted
-            .lu()
-            .solve(&x)
-            .ok_or(Error::Singular { operation })?;
-        sum += solved * w;
+        let lu = (&id + &x * t).lu();
+        l += lu.solve(&x).ok_or(Error::Singular { operation })? * w;
+        f += lu.solve(&y).ok_or(Error::Singular { operation })? * w;
     }
-    Ok(sum * 2f64.powi(roots as i32))
+    let scale = 2f64.powi(roots as i32);
+    Ok((l * scale, f * scale))
 }
 
 /// The principal square root of `a` by the product form of the
