@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use ctrlab::StateSpace;
-use nalgebra::{SMatrix, matrix};
+use nalgebra::{DMatrix, SMatrix, matrix};
 use serde_json::Value;
 
 /// A JSON fixture from `tests/data/`.
@@ -49,6 +49,18 @@ pub fn matrix<const R: usize, const C: usize>(v: &Value) -> SMatrix<f64, R, C> {
         assert_eq!(row.len(), C, "column count");
         row[c].as_f64().expect("entry is a number")
     })
+}
+
+/// A run-time-sized matrix from a JSON array of rows (empty: 0 × 0).
+pub fn dmatrix(v: &Value) -> DMatrix<f64> {
+    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).expect("an array of rows");
+    let (n, m) = (rows.len(), rows.first().map_or(0, Vec::len));
+    DMatrix::from_fn(n, m, |i, j| rows[i][j])
+}
+
+/// `max |got − want| / max |want|`.
+pub fn rel_max(got: &DMatrix<f64>, want: &DMatrix<f64>) -> f64 {
+    (got - want).amax() / want.amax().max(f64::MIN_POSITIVE)
 }
 
 /// Relative Frobenius error ‖got − want‖ / ‖want‖.
