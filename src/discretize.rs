@@ -1,6 +1,8 @@
 //! Continuous → discrete conversion: [`Discretization::Zoh`] (exact for a
 //! zero-order-held input), [`Discretization::Tustin`], [`Discretization::ForwardEuler`] and
-//! [`Discretization::BackwardEuler`], plus the matrix exponential [`expm`].
+//! [`Discretization::BackwardEuler`], plus the matrix exponential [`expm`];
+//! and back: [`StateSpace::d2c`] / [`DynStateSpace::d2c`] invert each
+//! method (ZOH through the principal matrix logarithm [`logm`]).
 //!
 //! The definitions match SciPy's `cont2discrete` (methods `zoh`, `bilinear`,
 //! `euler`, `backward_diff`); the reference fixtures in `tests/data/` check it.
@@ -15,6 +17,11 @@ use nalgebra::{Const, DMatrix, DefaultAllocator, Dim, OMatrix, SMatrix, U0, allo
 use crate::error::{Error, check_dt};
 use crate::kernels::linalg::Lu;
 use crate::model::{Continuous, Discrete, DynStateSpace, StateSpace};
+
+mod d2c;
+mod logm;
+
+pub use logm::{LOGM_MAX_ERROR, logm, logm_dyn};
 
 /// How to turn a continuous model into a discrete one with period `h`.
 ///
@@ -127,6 +134,29 @@ impl DynStateSpace<Continuous> {
     }
 }
 
+/// The allocations the conversions of a model with `N` states, `M`
+/// inputs and `P` outputs need (`Allocator<N, P>` for `Cᵀ`): one bound,
+/// met by every triple of nalgebra's dimensions.
+pub(crate) trait ModelAlloc<N: Dim, M: Dim, P: Dim>:
+    Allocator<N, N>
+    + Allocator<N, M>
+    + Allocator<P, N>
+    + Allocator<N, P>
+    + Allocator<P, M>
+    + Allocator<N>
+{
+}
+
+impl<N: Dim, M: Dim, P: Dim, T> ModelAlloc<N, M, P> for T where
+    T: Allocator<N, N>
+        + Allocator<N, M>
+        + Allocator<P, N>
+        + Allocator<N, P>
+        + Allocator<P, M>
+        + Allocator<N>
+{
+}
+
 /// The four matrices of a model with `N` states, `M` inputs, `P` outputs.
 type Parts<N, M, P> = (
     OMatrix<f64, N, N>,
@@ -146,12 +176,7 @@ fn discretize_parts<N: Dim, M: Dim, P: Dim>(
     method: Discretization,
 ) -> Result<(Parts<N, M, P>, &'static str), Error>
 where
-    DefaultAllocator: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<P, N>
-        + Allocator<N, P>
-        + Allocator<P, M>
-        + Allocator<N>,
+    DefaultAllocator: ModelAlloc<N, M, P>,
 {
     match method {
         Discretization::Zoh => {
@@ -176,12 +201,7 @@ fn gbt<N: Dim, M: Dim, P: Dim>(
     operation: &'static str,
 ) -> Result<(Parts<N, M, P>, &'static str), Error>
 where
-    DefaultAllocator: Allocator<N, N>
-        + Allocator<N, M>
-        + Allocator<P, N>
-        + Allocator<N, P>
-        + Allocator<P, M>
-        + Allocator<N>,
+    DefaultAllocator: ModelAlloc<N, M, P>,
 {
     let (n, _) = a.shape_generic();
     let id = OMatrix::<f64, N, N>::identity_generic(n, n);

@@ -275,6 +275,21 @@ pub enum Error {
         /// The largest relative error the operation accepts.
         limit: f64,
     },
+    /// A matrix has an eigenvalue where the operation is undefined: a
+    /// discrete model's pole on the closed negative real axis has no
+    /// continuous counterpart under ZOH (no real principal logarithm), one
+    /// at `z = −1` none under Tustin.
+    #[error("{operation}: eigenvalue {} + {}i {reason}", Readable(*.re), Readable(*.im))]
+    EigenvalueOutOfDomain {
+        /// The operation (`"ZOH d2c …"`, `"matrix logarithm"`, …).
+        operation: &'static str,
+        /// Real part of the eigenvalue.
+        re: f64,
+        /// Imaginary part of the eigenvalue.
+        im: f64,
+        /// Where it lies and why that is refused.
+        reason: &'static str,
+    },
     /// A target pole handed to a pole-placement routine is unusable.
     #[error("target pole {index} ({re} + {im}i): {reason}")]
     InvalidPole {
@@ -349,6 +364,7 @@ impl Error {
             | Error::IllConditioned { .. } => ErrorKind::Numerical,
             Error::NotSettled { .. }
             | Error::Unstable { .. }
+            | Error::EigenvalueOutOfDomain { .. }
             | Error::Uncontrollable { .. }
             | Error::Unobservable { .. } => ErrorKind::System,
         }

@@ -18,7 +18,8 @@
 //!   [`append`](DynStateSpace::append)), and the [`Dynamics`] trait any
 //!   plant implements.
 //! - [`discretize`]: ZOH (exact), Tustin, forward and backward Euler, and
-//!   [`expm`](discretize::expm).
+//!   [`expm`](discretize::expm); back with [`d2c`](StateSpace::d2c) (each
+//!   method inverted) and [`logm`](discretize::logm).
 //! - [`integrate`]: the [`Rk4`] and [`Euler`] steppers.
 //! - [`sim`]: continuous and discrete simulation, step, impulse and
 //!   initial-condition responses in either time domain, and the
@@ -33,7 +34,8 @@
 //! - [`analysis`]: poles, stability, DC gain, damping, controllability and
 //!   observability; Lyapunov and Sylvester equations
 //!   ([`lyap`](analysis::lyap), [`dlyap`](analysis::dlyap),
-//!   [`sylvester`](analysis::sylvester), and the Gramian's factor
+//!   [`sylvester`](analysis::sylvester), the discrete Sylvester equation
+//!   [`dsylvester`](analysis::dsylvester), and the Gramian's factor
 //!   [`lyapchol`](analysis::lyapchol), [`dlyapchol`](analysis::dlyapchol));
 //!   Gramians ([`gram`](StateSpace::gram)), Hankel singular values
 //!   ([`hsvd`](StateSpace::hsvd)) and balanced truncation

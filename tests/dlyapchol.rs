@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{dmatrix as dm, rel_amax as rel_diff};
+use common::{dmatrix as dm, rel_max as rel_diff};
 use ctrlab::Error;
 use ctrlab::analysis::{dlyap, dlyapchol};
 use ctrlab::nalgebra::{DMatrix, dmatrix, matrix};

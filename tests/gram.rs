@@ -23,7 +23,7 @@ use serde_json::Value;
 
 type C64 = Complex<f64>;
 
-use common::{dmatrix as dm, rel_amax as rel_diff};
+use common::{dmatrix as dm, rel_max as rel_diff};
 
 /// `C (zI − A)⁻¹ B + D`, by complex LU (independent of the crate's
 /// frequency-response code).

@@ -29,7 +29,7 @@ use proptest::prelude::*;
 /// the conditioning of each case times ε.
 const X_AGREEMENT: f64 = 1e-9;
 
-use common::{dmatrix as dm, rel_amax as rel_diff};
+use common::{dmatrix as dm, rel_max as rel_diff};
 
 /// The fixed-size solution of a fixture case of `N` states, on the heap.
 fn fixed_lyap<const N: usize>(a: &DMatrix<f64>, q: &DMatrix<f64>, discrete: bool) -> DMatrix<f64> {

@@ -1,8 +1,9 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test; Lyapunov
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
-//! [`lyapchol`], [`dlyapchol`]); Gramians, Hankel singular values and
-//! balanced truncation (`gram`, `hsvd`, `balred`, on both model types).
+//! [`lyapchol`], [`dlyapchol`], the discrete Sylvester equation
+//! [`dsylvester`]); Gramians, Hankel singular values and balanced
+//! truncation (`gram`, `hsvd`, `balred`, on both model types).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
@@ -43,6 +44,7 @@ mod state_space;
 pub use balred::{BalancedTruncation, ReducedOrder};
 pub(crate) use controllability::{krylov, scaled_krylov_rank};
 pub use gramian::GramianKind;
+pub use lyapunov::dsylvester;
 pub use lyapunov::{
     FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, dlyapchol,
     lyap, lyapchol, sylvester,

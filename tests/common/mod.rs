@@ -51,16 +51,16 @@ pub fn matrix<const R: usize, const C: usize>(v: &Value) -> SMatrix<f64, R, C> {
     })
 }
 
-/// A run-time-sized matrix from a JSON array of rows (`[]` is 0 × 0).
+/// A run-time-sized matrix from a JSON array of rows (empty: 0 × 0).
 pub fn dmatrix(v: &Value) -> DMatrix<f64> {
     let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).expect("an array of rows");
     let (n, m) = (rows.len(), rows.first().map_or(0, Vec::len));
     DMatrix::from_fn(n, m, |i, j| rows[i][j])
 }
 
-/// `max |x − reference| / max |reference|` (entrywise).
-pub fn rel_amax(x: &DMatrix<f64>, reference: &DMatrix<f64>) -> f64 {
-    (x - reference).amax() / reference.amax().max(f64::MIN_POSITIVE)
+/// `max |got − want| / max |want|`.
+pub fn rel_max(got: &DMatrix<f64>, want: &DMatrix<f64>) -> f64 {
+    (got - want).amax() / want.amax().max(f64::MIN_POSITIVE)
 }
 
 /// Relative Frobenius error ‖got − want‖ / ‖want‖.

@@ -294,50 +294,57 @@ pub(super) fn quasi_sylvester(
     }
 }
 
-/// Solves `S Y Sᵀ − Y + F = 0` in place (`f` becomes `Y`), `S`
-/// quasi-upper-triangular with diagonal blocks `blocks`: the columns of
-/// `Y` block by block from the last, each by back-substitution over the
-/// row blocks (Barraud's 1977 analogue of Bartels–Stewart, `O(N³)` in
-/// all).
-pub(super) fn quasi_stein(s: &DMatrix<f64>, blocks: &[(usize, usize)], f: &mut DMatrix<f64>) {
-    let n = s.nrows();
-    let mut w = DMatrix::<f64>::zeros(n, 2);
-    let mut sw = DMatrix::<f64>::zeros(n, 2);
-    let mut h = DMatrix::<f64>::zeros(n, 2);
-    for &(j, q) in blocks.iter().rev() {
-        // W = Σ_{l after the block} Y_l S_jlᵀ, then rhs −F_j − S W.
+/// Solves `S Y Tᵀ − Y + F = 0` in place (`f`, `m × n`, becomes `Y`), `S`
+/// (`m × m`) and `T` (`n × n`) quasi-upper-triangular with diagonal blocks
+/// `s_blocks` and `t_blocks`: the columns of `Y` block by block from the
+/// last, each by back-substitution over the row blocks (Barraud's 1977
+/// analogue of Bartels–Stewart, `O(m n (m + n))` in all). `T = S` is the
+/// discrete Lyapunov equation.
+pub(super) fn quasi_stein(
+    s: &DMatrix<f64>,
+    s_blocks: &[(usize, usize)],
+    t: &DMatrix<f64>,
+    t_blocks: &[(usize, usize)],
+    f: &mut DMatrix<f64>,
+) {
+    let (m, n) = f.shape();
+    let mut w = DMatrix::<f64>::zeros(m, 2);
+    let mut sw = DMatrix::<f64>::zeros(m, 2);
+    let mut h = DMatrix::<f64>::zeros(m, 2);
+    for &(j, q) in t_blocks.iter().rev() {
+        // W = Σ_{l after the block} Y_l T_jlᵀ, then rhs −F_j − S W.
         w.fill(0.0);
         for c in 0..q {
             for l in j + q..n {
-                let sjl = s[(j + c, l)];
-                if sjl != 0.0 {
-                    for r in 0..n {
-                        w[(r, c)] += f[(r, l)] * sjl;
+                let tjl = t[(j + c, l)];
+                if tjl != 0.0 {
+                    for r in 0..m {
+                        w[(r, c)] += f[(r, l)] * tjl;
                     }
                 }
             }
         }
         sw.fill(0.0);
         for c in 0..q {
-            for k in 0..n {
+            for k in 0..m {
                 let wk = w[(k, c)];
                 if wk != 0.0 {
                     // S is quasi-upper: rows up to k + 1.
-                    for r in 0..(k + 2).min(n) {
+                    for r in 0..(k + 2).min(m) {
                         sw[(r, c)] += s[(r, k)] * wk;
                     }
                 }
             }
         }
-        // S Z M − Z = −F_j − S W with M = S_jjᵀ; H_i = Σ_{k>i} S_ik Z_k
+        // S Z M − Z = −F_j − S W with M = T_jjᵀ; H_i = Σ_{k>i} S_ik Z_k
         // is formed row block by row block as Z is found.
         h.fill(0.0);
-        for &(i, p) in blocks.iter().rev() {
+        for &(i, p) in s_blocks.iter().rev() {
             let mut g = [0.0; 4];
             for c in 0..q {
                 for r in 0..p {
                     let mut hz = 0.0;
-                    for k in i + p..n {
+                    for k in i + p..m {
                         hz += s[(i + r, k)] * f[(k, j + c)];
                     }
                     h[(i + r, c)] = hz;
@@ -345,15 +352,15 @@ pub(super) fn quasi_stein(s: &DMatrix<f64>, blocks: &[(usize, usize)], f: &mut D
             }
             for c in 0..q {
                 for r in 0..p {
-                    // (H M)_rc with M = S_jjᵀ: Σ_e H_re S_jj[c, e].
+                    // (H M)_rc with M = T_jjᵀ: Σ_e H_re T_jj[c, e].
                     let mut hm = 0.0;
                     for e in 0..q {
-                        hm += h[(i + r, e)] * s[(j + c, j + e)];
+                        hm += h[(i + r, e)] * t[(j + c, j + e)];
                     }
                     g[r + p * c] = -f[(i + r, j + c)] - sw[(i + r, c)] - hm;
                 }
             }
-            solve_block(s, (i, p), s, (j, q), true, true, &mut g);
+            solve_block(s, (i, p), t, (j, q), true, true, &mut g);
             for c in 0..q {
                 for r in 0..p {
                     f[(i + r, j + c)] = g[r + p * c];
@@ -393,7 +400,13 @@ mod tests {
         }
         let s = &s * 0.3;
         let mut y = f.clone();
-        quasi_stein(&s, &blocks, &mut y);
+        quasi_stein(&s, &blocks, &s, &blocks, &mut y);
         assert!((&s * &y * s.transpose() - &y + &f).amax() < 1e-13);
+        // Two different factors, 3 × 3 and 2 × 2 (a 2×2 block), F 3 × 2.
+        let t = dmatrix![0.2, 0.9; -0.4, 0.1];
+        let f = f.columns(0, 2).into_owned();
+        let mut y = f.clone();
+        quasi_stein(&s, &blocks, &t, &[(0, 2)], &mut y);
+        assert!((&s * &y * t.transpose() - &y + &f).amax() < 1e-13);
     }
 }

@@ -2,11 +2,13 @@
 //! fixed-size (`SMatrix`) and run-time-sized (`DMatrix`) matrices alike:
 //! [`lyap`], [`dlyap`] and [`sylvester`], each with the relative residual
 //! of its solution, and [`lyapchol`], Hammarling's Cholesky factor of a
-//! stable continuous equation's solution.
+//! stable continuous equation's solution; the discrete Sylvester (Stein)
+//! equation [`dsylvester`] in `stein.rs`.
 
 mod bartels_stewart;
 mod francis;
 mod hammarling;
+mod stein;
 
 pub use hammarling::dlyapchol;
 
@@ -15,6 +17,7 @@ use nalgebra::{Complex, DMatrix, SMatrix};
 use crate::error::{Error, check_finite_dyn, check_shape};
 use crate::kernels::reduce::pow2_floor;
 use bartels_stewart::{Condition, Schur, quasi_stein, quasi_sylvester, schur, singular_pair};
+pub use stein::dsylvester;
 
 /// The solution `X` of a Lyapunov, Stein (discrete Lyapunov) or Sylvester
 /// equation, and how well it satisfies the equation.
@@ -262,6 +265,26 @@ where
     A: SylvesterOperands<B>,
     B: SquareMatrix,
 {
+    pair_equation(a, b, c, sylvester_dyn)
+}
+
+/// A solver of a two-coefficient equation on the heap: `(A, B, C)` to
+/// `(X, relative residual)`.
+type PairSolver =
+    fn(&DMatrix<f64>, &DMatrix<f64>, &DMatrix<f64>) -> Result<(DMatrix<f64>, f64), Error>;
+
+/// [`sylvester`] and [`dsylvester`]: `A`, `B`, `C` checked (shapes,
+/// finite), then `solve` on the heap, the solution back in `A::Rhs`.
+fn pair_equation<A, B>(
+    a: &A,
+    b: &B,
+    c: &A::Rhs,
+    solve: PairSolver,
+) -> Result<Lyapunov<A::Rhs>, Error>
+where
+    A: SylvesterOperands<B>,
+    B: SquareMatrix,
+{
     use sealed::Matrix;
     let (a, b, c) = (a.to_heap(), b.to_heap(), c.to_heap());
     let (m, n) = (a.nrows(), b.nrows());
@@ -271,7 +294,7 @@ where
     check_finite_dyn("A", &a)?;
     check_finite_dyn("B", &b)?;
     check_finite_dyn("C", &c)?;
-    let (x, residual) = sylvester_dyn(&a, &b, &c)?;
+    let (x, residual) = solve(&a, &b, &c)?;
     Ok(Lyapunov {
         x: A::Rhs::from_heap(x),
         residual,
@@ -469,7 +492,7 @@ fn discrete(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<(DMatrix<f64>, f64), E
         return Err(refuse(EQUATION, "λ μ = 1", pair, 1.0));
     }
     let mut y = s.u.transpose() * &q * &s.u;
-    quasi_stein(&s.t, &s.blocks, &mut y);
+    quasi_stein(&s.t, &s.blocks, &s.t, &s.blocks, &mut y);
     let x = back(&s, &y, &s, is_symmetric(&q));
     let axa = a * &x * a.transpose();
     let r = (&axa - &x + &q).norm();
