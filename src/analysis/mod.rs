@@ -33,6 +33,7 @@ mod dyn_state_space;
 mod gain;
 mod lyapunov;
 mod minreal;
+mod norms;
 mod poles;
 mod stability;
 mod state_space;
@@ -42,6 +43,7 @@ pub use lyapunov::{
     FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, lyap,
     lyapchol, sylvester,
 };
+pub use norms::{HINF_RTOL, HinfNorm, h2_norm, hinf_norm};
 pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
 
