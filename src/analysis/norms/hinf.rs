@@ -27,6 +27,11 @@ pub(super) const MAX_ITERATIONS: usize = 50;
 const AXIS_RTOL: f64 = 1e-6;
 const AXIS_ATOL: f64 = 1e-7;
 
+/// The first lower bound's grid: points per decade over the poles' range
+/// (a decade beyond each end), and at most this many.
+const GRID_PER_DECADE: f64 = 8.0;
+const GRID_MAX: f64 = 200.0;
+
 /// The operation named in errors.
 pub(super) const OPERATION: &str = "H∞ norm (Bruinsma–Steinbuch iteration)";
 
@@ -108,13 +113,27 @@ fn scaled(
         largest_singular_value(&g, p, m)
     };
     // Lower bound: ω = 0, each pole's |λ| (a lightly damped pair peaks
-    // near it), then ω → ∞ (σ̄(D)), kept only if strictly larger.
+    // near it), a coarse logarithmic grid over the poles' range, then
+    // ω → ∞ (σ̄(D)), kept only if strictly larger. A good first bound
+    // keeps `γ² I − DᵀD` away from singular and the crossings found.
     let mut best = Peak {
         value: sigma(0.0)?,
         omega: Some(0.0),
     };
-    for pole in poles {
-        let w = pole.norm() / alpha;
+    let mut candidates: Vec<f64> = poles.iter().map(|l| l.norm() / alpha).collect();
+    let (lo, hi) = candidates
+        .iter()
+        .filter(|w| **w > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &w| {
+            (lo.min(w), hi.max(w))
+        });
+    if lo <= hi {
+        let (lo, hi) = ((lo / 10.0).log10(), (hi * 10.0).log10());
+        let count = ((hi - lo) * GRID_PER_DECADE).ceil().clamp(2.0, GRID_MAX) as usize;
+        candidates
+            .extend((0..count).map(|i| 10f64.powf(lo + (hi - lo) * i as f64 / (count - 1) as f64)));
+    }
+    for w in candidates {
         let s = sigma(w)?;
         if s > best.value {
             best = Peak {
@@ -146,11 +165,17 @@ fn scaled(
             .collect();
         omegas.sort_by(f64::total_cmp);
         // Between two consecutive crossings a singular value stays above
-        // or below γ; where σ̄ > γ, the midpoint shows it. No midpoint above
-        // γ: no crossing (or only spurious ones), the norm is below γ.
+        // or below γ; where σ̄ > γ, any point between shows it. No such
+        // point above γ: no crossing (or only spurious ones), the norm is
+        // below γ. The crossings themselves are evaluated too (near the
+        // peak they are next to it).
         let mut crossed = false;
-        for pair in omegas.windows(2) {
-            let w = 0.5 * (pair[0] + pair[1]);
+        let midpoints = omegas.windows(2).map(|pair| match pair[0] > 0.0 {
+            // Geometric: a crossing interval can span decades.
+            true => (pair[0] * pair[1]).sqrt(),
+            false => 0.5 * (pair[0] + pair[1]),
+        });
+        for w in midpoints.chain(omegas.iter().copied()) {
             let s = sigma(w)?;
             if s > best.value {
                 best = Peak {
