@@ -1,5 +1,6 @@
 //! System norms: `hinf_norm` and `h2_norm` on the lab's two-cart plant (4
-//! states, fixed size, force on cart 2 to its position) and on random
+//! states, fixed size, `MassSpring::nominal()`, force on cart 2 to its
+//! position) and on random
 //! stable SISO models of 20 and 100 states (run-time sized; issue 29's
 //! target: H∞ at N = 100 at most twice python-control's `norm(sys, 'inf')`,
 //! timed on the same models by `scripts/norms_vs_python.py`).
@@ -7,8 +8,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctrlab::analysis::{h2_norm, hinf_norm};
 use ctrlab::signal::Rng;
-use ctrlab::{DynStateSpace, StateSpace};
-use nalgebra::{DMatrix, matrix};
+use ctrlab::{Cart, DynStateSpace, MassSpring};
+use nalgebra::DMatrix;
 use std::hint::black_box;
 
 /// `A = G / √n − 1.5 I` with `G` N(0, 1) (seeded), so it is stable; `B`,
@@ -23,18 +24,8 @@ fn random(n: usize, seed: u64) -> DynStateSpace {
 }
 
 fn benches(c: &mut Criterion) {
-    // tests/calling_style.rs `two_carts()`: the lab plant, force on cart 2.
-    let (m1, m2, k1, k2, c1, c2) = (1.3, 0.7, 1000.0, 1000.0, 2.0, 1.0);
-    let plant = StateSpace::continuous(
-        matrix![0.0, 1.0, 0.0, 0.0;
-                -(k1 + k2) / m1, -c1 / m1, k2 / m1, 0.0;
-                0.0, 0.0, 0.0, 1.0;
-                k2 / m2, 0.0, -k2 / m2, -c2 / m2],
-        matrix![0.0; 0.0; 0.0; 1.0 / m2],
-        matrix![0.0, 0.0, 1.0, 0.0],
-        matrix![0.0],
-    )
-    .unwrap();
+    // The lab plant: force on cart 2 to its position.
+    let plant = MassSpring::nominal().state_space(Cart::Two).unwrap();
     c.bench_function("hinf_norm, lab plant (4 states, fixed size)", |bench| {
         bench.iter(|| hinf_norm(black_box(&plant)).unwrap())
     });

@@ -28,22 +28,10 @@ from timing import median_time, run_example  # noqa: E402  (sets the BLAS thread
 import control  # noqa: E402
 import numpy as np  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "data"))
+from gen_norms_fixtures import two_carts  # noqa: E402  (the fixtures' lab plant)
+
 warnings.simplefilter("ignore")
-
-
-def two_carts():
-    m1, m2, k1, k2, c1, c2 = 1.3, 0.7, 1000.0, 1000.0, 2.0, 1.0
-    a = np.array(
-        [
-            [0.0, 1.0, 0.0, 0.0],
-            [-(k1 + k2) / m1, -c1 / m1, k2 / m1, 0.0],
-            [0.0, 0.0, 0.0, 1.0],
-            [k2 / m2, 0.0, -k2 / m2, -c2 / m2],
-        ]
-    )
-    b = np.array([[0.0], [0.0], [0.0], [1.0 / m2]])
-    c = np.array([[0.0, 0.0, 1.0, 0.0]])
-    return a, b, c, np.zeros((1, 1))
 
 
 def random(n, seed):
@@ -77,9 +65,13 @@ def main():
             value = f()
             t = median_time(f, repeats)
             ctr = mine[f"{key}_median_s"]
-            diff = abs(mine[key] - value) / abs(value)
+            # python-control's H2 is inf when the rounded Gramian has an
+            # eigenvalue below zero (a single input's Gramian of a random
+            # model is that ill-conditioned at n = 20 and 100).
+            diff = (f"{abs(mine[key] - value) / abs(value):>9.1e}" if np.isfinite(value)
+                    else f"{'(py: inf)':>9}")
             print(f"{name:<15} {label:<4} {ctr * 1e3:>8.3f} ms {t * 1e3:>12.3f} ms "
-                  f"{ctr / t:>7.3f}  {diff:>9.1e}")
+                  f"{ctr / t:>7.3f}  {diff}")
 
 
 if __name__ == "__main__":

@@ -34,7 +34,9 @@
 //!   observability; Lyapunov and Sylvester equations
 //!   ([`lyap`](analysis::lyap), [`dlyap`](analysis::dlyap),
 //!   [`sylvester`](analysis::sylvester), and the Gramian's factor
-//!   [`lyapchol`](analysis::lyapchol)).
+//!   [`lyapchol`](analysis::lyapchol)); system norms
+//!   ([`h2_norm`](analysis::h2_norm), [`hinf_norm`](analysis::hinf_norm)
+//!   with its peak frequency).
 //! - [`design`]: the [`Controller`] trait (measurements and reference in,
 //!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
 //!   [`acker`], [`place`], [`lqr`], [`dlqr`], Riccati solvers that scale

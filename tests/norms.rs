@@ -319,10 +319,10 @@ proptest! {
         let h = hinf_norm(&sys).unwrap();
         let w = logspace(-3.0, 3.0, 200).unwrap();
         let r = sys.frequency_response(&w).unwrap();
-        for k in 0..w.len() {
+        for (k, wk) in w.iter().enumerate() {
             let g = DMatrix::from_fn(r.outputs(), r.inputs(), |i, j| r.response(i, j).unwrap()[k]);
             let s = g.singular_values().max();
-            prop_assert!(s <= h.value * (1.0 + 2.0 * HINF_RTOL + 1e-12), "σ̄ = {} at {} > {:?}", s, w[k], h);
+            prop_assert!(s <= h.value * (1.0 + 2.0 * HINF_RTOL + 1e-12), "σ̄ = {} at {} > {:?}", s, wk, h);
         }
         if let Some(wp) = h.peak_frequency {
             prop_assert!(rel(sigma(&sys, wp), h.value) < 1e-12);

@@ -1,11 +1,13 @@
 //! Properties of a linear model: poles, stability, DC gain, damping, and
 //! controllability / observability with a numerical rank test; Lyapunov
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
-//! [`lyapchol`]).
+//! [`lyapchol`]); system norms ([`h2_norm`], [`hinf_norm`]).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
-//! `dyn_state_space.rs`), except [`rank`]; [`Poles`] prints a list of
+//! `dyn_state_space.rs`), except [`rank`], the equations, and the norms
+//! (free functions over [`LinearSystem`](crate::LinearSystem), MATLAB's
+//! `norm(sys)` style); [`Poles`] prints a list of
 //! poles. These are design-time computations, not inner loops:
 //! each is written once, on run-time-sized matrices (eigenvalues by a
 //! balanced Hessenberg QR on the stack up to 8 states, then, balanced as

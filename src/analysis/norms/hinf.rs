@@ -43,6 +43,15 @@ pub(super) struct Peak {
     pub(super) omega: Option<f64>,
 }
 
+impl Peak {
+    /// Takes `(value, omega)` if `value` is strictly larger.
+    fn raise(&mut self, value: f64, omega: Option<f64>) {
+        if value > self.value {
+            *self = Peak { value, omega };
+        }
+    }
+}
+
 /// The peak gain of the stable continuous `(a, b, c, d)` (checked: finite,
 /// consistent shapes) whose poles are `poles`.
 pub(super) fn continuous(
@@ -134,20 +143,9 @@ fn scaled(
             .extend((0..count).map(|i| 10f64.powf(lo + (hi - lo) * i as f64 / (count - 1) as f64)));
     }
     for w in candidates {
-        let s = sigma(w)?;
-        if s > best.value {
-            best = Peak {
-                value: s,
-                omega: Some(w),
-            };
-        }
+        best.raise(sigma(w)?, Some(w));
     }
-    if sigma_d > best.value {
-        best = Peak {
-            value: sigma_d,
-            omega: None,
-        };
-    }
+    best.raise(sigma_d, None);
     for _ in 0..MAX_ITERATIONS {
         // γ = 0 would be no test: G ≡ 0 to rounding is tested at ε (the
         // data are scaled to entries near 1).
@@ -177,12 +175,7 @@ fn scaled(
         });
         for w in midpoints.chain(omegas.iter().copied()) {
             let s = sigma(w)?;
-            if s > best.value {
-                best = Peak {
-                    value: s,
-                    omega: Some(w),
-                };
-            }
+            best.raise(s, Some(w));
             crossed |= s > gamma;
         }
         if !crossed {
