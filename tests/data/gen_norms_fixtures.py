@@ -28,6 +28,8 @@ lab plant (force on cart 2 to its position, tests/calling_style.rs
 """
 
 import json
+import os
+import sys
 import warnings
 
 import control
@@ -35,6 +37,9 @@ import numpy as np
 from scipy.linalg import solve_continuous_lyapunov, solve_discrete_lyapunov
 from scipy.optimize import minimize_scalar
 from scipy.signal import cont2discrete
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gen_lyapunov_fixtures import two_carts as lyapunov_two_carts  # noqa: E402
 
 warnings.simplefilter("ignore")
 
@@ -84,18 +89,9 @@ def hinf_grid(a, b, c, d, dt):
 
 
 def two_carts():
-    m1, m2, k1, k2, c1, c2 = 1.3, 0.7, 1000.0, 1000.0, 2.0, 1.0
-    a = np.array(
-        [
-            [0.0, 1.0, 0.0, 0.0],
-            [-(k1 + k2) / m1, -c1 / m1, k2 / m1, 0.0],
-            [0.0, 0.0, 0.0, 1.0],
-            [k2 / m2, 0.0, -k2 / m2, -c2 / m2],
-        ]
-    )
-    b = np.array([[0.0], [0.0], [0.0], [1.0 / m2]])
-    c = np.array([[0.0, 0.0, 1.0, 0.0]])
-    return a, b, c, np.zeros((1, 1))
+    """The lab plant of gen_lyapunov_fixtures.py, output: cart 2's position."""
+    a, b = lyapunov_two_carts()
+    return a, b, np.array([[0.0, 0.0, 1.0, 0.0]]), np.zeros((1, 1))
 
 
 def case(name, a, b, c, d, dt):
