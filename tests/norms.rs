@@ -233,6 +233,18 @@ fn static_and_empty_models() {
     .unwrap();
     assert_eq!(hinf_norm(&zero).unwrap().value, 0.0);
     assert_eq!(h2_norm(&zero).unwrap(), 0.0);
+    // B and C non-zero, G ≡ 0: the input drives a state the output does
+    // not see (the Hamiltonian is tested at γ = ε).
+    let hidden = StateSpace::continuous(
+        matrix![-1.0, 0.0; 0.0, -2.0],
+        matrix![1.0; 0.0],
+        matrix![0.0, 1.0],
+        matrix![0.0],
+    )
+    .unwrap();
+    let h = hinf_norm(&hidden).unwrap();
+    assert_eq!((h.value, h.peak_frequency), (0.0, Some(0.0)));
+    assert_eq!(h2_norm(&hidden).unwrap(), 0.0);
 }
 
 #[test]
