@@ -39,7 +39,9 @@
 //!   [`lyapchol`](analysis::lyapchol), [`dlyapchol`](analysis::dlyapchol));
 //!   Gramians ([`gram`](StateSpace::gram)), Hankel singular values
 //!   ([`hsvd`](StateSpace::hsvd)) and balanced truncation
-//!   ([`balred`](StateSpace::balred)).
+//!   ([`balred`](StateSpace::balred)); system norms
+//!   ([`h2_norm`](analysis::h2_norm), [`hinf_norm`](analysis::hinf_norm)
+//!   with its peak frequency).
 //! - [`design`]: the [`Controller`] trait (measurements and reference in,
 //!   input out; told what was applied), [`StateFeedback`], [`OpenLoop`],
 //!   [`acker`], [`place`], [`lqr`], [`dlqr`], Riccati solvers that scale

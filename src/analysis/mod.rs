@@ -3,11 +3,14 @@
 //! and Sylvester equations ([`lyap`], [`dlyap`], [`sylvester`],
 //! [`lyapchol`], [`dlyapchol`], the discrete Sylvester equation
 //! [`dsylvester`]); Gramians, Hankel singular values and balanced
-//! truncation (`gram`, `hsvd`, `balred`, on both model types).
+//! truncation (`gram`, `hsvd`, `balred`, on both model types); system
+//! norms ([`h2_norm`], [`hinf_norm`]).
 //!
 //! Everything here is a method on [`StateSpace`] (`state_space.rs`) and on
 //! [`DynStateSpace`](crate::DynStateSpace) (a model sized at run time,
-//! `dyn_state_space.rs`), except [`rank`]; [`Poles`] prints a list of
+//! `dyn_state_space.rs`), except [`rank`], the equations, and the norms
+//! (free functions over [`LinearSystem`](crate::LinearSystem), MATLAB's
+//! `norm(sys)` style); [`Poles`] prints a list of
 //! poles. These are design-time computations, not inner loops:
 //! each is written once, on run-time-sized matrices (eigenvalues by a
 //! balanced Hessenberg QR on the stack up to 8 states, then, balanced as
@@ -37,6 +40,7 @@ mod gain;
 mod gramian;
 mod lyapunov;
 pub(crate) mod minreal;
+mod norms;
 mod poles;
 mod stability;
 mod state_space;
@@ -49,6 +53,7 @@ pub use lyapunov::{
     FactorOperands, Lyapunov, LyapunovFactor, SquareMatrix, SylvesterOperands, dlyap, dlyapchol,
     lyap, lyapchol, sylvester,
 };
+pub use norms::{HINF_RTOL, HinfNorm, h2_norm, hinf_norm};
 pub use poles::Poles;
 pub(crate) use stability::{first_unstable, first_unstable_dyn};
 

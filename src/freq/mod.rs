@@ -52,6 +52,7 @@ mod tf;
 mod zeros;
 mod zpk;
 
+pub(crate) use kernel::Evaluator;
 pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stability_margins};
 pub use matrix::TransferMatrix;
 pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};
