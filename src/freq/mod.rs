@@ -2,8 +2,8 @@
 //! [`TransferMatrix`], [`Zpk`]) and their conversions to and from state
 //! space (`ss2tf`, `tf2ss`), invariant zeros, frequency responses
 //! ([`FrequencyResponse`], [`Bode`], [`Nyquist`]), [`stability_margins`]
-//! and [`bandwidth`], Padé approximations of a delay ([`pade`]), and
-//! (feature `plot`) Bode and Nyquist figures.
+//! and [`bandwidth`], Padé approximations of a delay ([`pade`]), root loci
+//! ([`root_locus`]), and (feature `plot`) Bode and Nyquist figures.
 //!
 //! Units: angular frequencies `ω` in rad/s everywhere (`frequency_hz`
 //! converts to Hz), magnitudes absolute or in dB (`20 log₁₀`), phases in
@@ -46,6 +46,7 @@ mod pade;
 mod phase;
 mod poly;
 mod response;
+mod rlocus;
 #[cfg(feature = "plot")]
 mod svg;
 mod tf;
@@ -58,6 +59,9 @@ pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};
 pub use phase::{BodeOptions, WrapPhase, bode_with};
 pub use response::{
     Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
+};
+pub use rlocus::{
+    Asymptotes, BoundaryCrossing, Breakaway, MAX_GAINS, RootLocus, root_locus, root_locus_at,
 };
 #[cfg(feature = "plot")]
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]

@@ -1,0 +1,364 @@
+//! Root loci (`freq::root_locus`, `freq::root_locus_at`): the closed-loop
+//! poles against python-control 0.10.2's `root_locus_map(sys, gains)`
+//! (`tests/data/rlocus_fixtures.json`, from
+//! `tests/data/gen_rlocus_fixtures.py`), closed forms worked by hand, the
+//! refusals, and invariants of every reported pole.
+
+use ctrlab::freq::{RootLocus, TransferFunction, root_locus, root_locus_at};
+use ctrlab::{DynStateSpace, Error};
+use nalgebra::{Complex, DMatrix};
+use proptest::prelude::*;
+use serde_json::Value;
+
+fn fixtures() -> Value {
+    serde_json::from_str(include_str!("data/rlocus_fixtures.json")).unwrap()
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    serde_json::from_value(v.clone()).unwrap()
+}
+
+fn matrix(v: &Value) -> DMatrix<f64> {
+    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).unwrap();
+    let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
+    DMatrix::from_fn(r, c, |i, j| rows[i][j])
+}
+
+fn complexes(v: &Value) -> Vec<Complex<f64>> {
+    let pairs: Vec<[f64; 2]> = serde_json::from_value(v.clone()).unwrap();
+    pairs.iter().map(|p| Complex::new(p[0], p[1])).collect()
+}
+
+/// The largest distance from a wanted pole to its match (each got pole
+/// used once, nearest first), relative to `max(|w|, 1)`.
+fn worst_match(got: &[Complex<f64>], want: &[Complex<f64>]) -> f64 {
+    assert_eq!(got.len(), want.len(), "{got:?} vs {want:?}");
+    let mut left = got.to_vec();
+    let mut worst: f64 = 0.0;
+    for w in want {
+        let (i, d) = left
+            .iter()
+            .enumerate()
+            .map(|(i, g)| (i, (g - w).norm()))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .unwrap();
+        worst = worst.max(d / w.norm().max(1.0));
+        left.remove(i);
+    }
+    worst
+}
+
+/// Every case's locus at the fixture's gains, by `root_locus_at`.
+fn loci_of(case: &Value) -> RootLocus {
+    let gains = floats(&case["gains"]);
+    let dt = case["dt"].as_f64();
+    if case["kind"] == "tf" {
+        let (num, den) = (floats(&case["num"]), floats(&case["den"]));
+        match dt {
+            None => root_locus_at(&TransferFunction::continuous(&num, &den).unwrap(), &gains),
+            Some(dt) => root_locus_at(&TransferFunction::discrete(&num, &den, dt).unwrap(), &gains),
+        }
+    } else {
+        let (a, b, c, d) = (
+            matrix(&case["a"]),
+            matrix(&case["b"]),
+            matrix(&case["c"]),
+            matrix(&case["d"]),
+        );
+        match dt {
+            None => root_locus_at(&DynStateSpace::continuous(a, b, c, d).unwrap(), &gains),
+            Some(dt) => root_locus_at(&DynStateSpace::discrete(a, b, c, d, dt).unwrap(), &gains),
+        }
+    }
+    .unwrap()
+}
+
+#[test]
+fn closed_loop_poles_match_python_control_at_its_gains() {
+    let f = fixtures();
+    for case in f["cases"].as_array().unwrap() {
+        let name = case["name"].as_str().unwrap();
+        let locus = loci_of(case);
+        let want: Vec<Value> = case["loci"].as_array().unwrap().clone();
+        assert_eq!(locus.gains.len(), want.len(), "{name}");
+        let mut worst: f64 = 0.0;
+        for (j, w) in want.iter().enumerate() {
+            worst = worst.max(worst_match(&locus.poles_at(j), &complexes(w)));
+        }
+        // Measured: 3.6e-12 for the lab's ZOH loop (poles clustered near
+        // z = 1, ill-conditioned roots), at most 3.2e-15 for the others.
+        assert!(
+            worst <= 1e-10,
+            "{name}: worst pole off by {worst:e} (relative)"
+        );
+        // Open-loop poles and zeros: python-control's pole_zero_map.
+        assert!(
+            worst_match(&locus.poles, &complexes(&case["poles"])) <= 1e-9,
+            "{name}"
+        );
+        assert!(
+            worst_match(&locus.zeros, &complexes(&case["zeros"])) <= 1e-7,
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn the_closed_forms_in_the_fixtures_hold() {
+    let f = fixtures();
+    for case in f["cases"].as_array().unwrap() {
+        let locus = loci_of(case);
+        let name = case["name"].as_str().unwrap();
+        if case["dt"].is_number() {
+            // The discrete closed form: `discrete_crossing_on_the_unit_circle`.
+            if let Some(c) = case.get("crossing") {
+                let gain = c[0].as_f64().unwrap();
+                assert_eq!(locus.crossings.len(), 1, "{name}");
+                assert!(
+                    (locus.crossings[0].gain - gain).abs() < 1e-10 * gain,
+                    "{name}"
+                );
+            }
+            continue;
+        }
+        if let Some(b) = case.get("breakaway") {
+            let [point, gain] = [b[0].as_f64().unwrap(), b[1].as_f64().unwrap()];
+            let got = root_locus(&tf_of(case)).unwrap().breakaways;
+            assert_eq!(got.len(), 1, "{name}: {got:?}");
+            assert!(
+                (got[0].point - Complex::new(point, 0.0)).norm() < 1e-12,
+                "{name}"
+            );
+            assert!((got[0].gain - gain).abs() < 1e-12, "{name}");
+        }
+        if let Some(c) = case.get("crossing") {
+            let [gain, w] = [c[0].as_f64().unwrap(), c[1].as_f64().unwrap()];
+            let got = root_locus(&tf_of(case)).unwrap().crossings;
+            assert_eq!(got.len(), 1, "{name}: {got:?}");
+            assert!((got[0].gain - gain).abs() < 1e-9 * gain, "{name}: {got:?}");
+            assert!((got[0].frequency - w).abs() < 1e-9 * w, "{name}: {got:?}");
+            assert!(got[0].destabilising, "{name}");
+            // At root_locus_at's gains the crossing is inside their range.
+            assert_eq!(locus.crossings.len(), 1, "{name}");
+        }
+    }
+}
+
+fn tf_of(case: &Value) -> TransferFunction<ctrlab::Continuous> {
+    TransferFunction::continuous(&floats(&case["num"]), &floats(&case["den"])).unwrap()
+}
+
+#[test]
+fn breakaway_of_a_double_integrator_with_lag() {
+    // 1 / (s (s + 2)): breakaway at −1 with k = 1, asymptotes ±90° from −1.
+    let l = TransferFunction::continuous(&[1.0], &[1.0, 2.0, 0.0]).unwrap();
+    let locus = root_locus(&l).unwrap();
+    assert_eq!(locus.breakaways.len(), 1);
+    assert!((locus.breakaways[0].point.re + 1.0).abs() < 1e-12);
+    assert!((locus.breakaways[0].gain - 1.0).abs() < 1e-12);
+    let a = locus.asymptotes.as_ref().unwrap();
+    assert_eq!(a.centroid, -1.0);
+    assert!(locus.crossings.is_empty());
+    // The breakaway gain is on the grid, and both poles are at −1 there.
+    let j = locus
+        .gains
+        .iter()
+        .position(|&k| k == locus.breakaways[0].gain)
+        .unwrap();
+    for p in locus.poles_at(j) {
+        assert!((p - Complex::new(-1.0, 0.0)).norm() < 1e-7, "{p}");
+    }
+}
+
+#[test]
+fn third_order_lag_crosses_at_root_11_for_gain_60() {
+    let l = TransferFunction::continuous(&[1.0], &[1.0, 6.0, 11.0, 6.0]).unwrap();
+    let locus = root_locus(&l).unwrap();
+    assert_eq!(locus.crossings.len(), 1);
+    let c = locus.crossings[0];
+    assert!((c.gain - 60.0).abs() < 1e-10, "{c:?}");
+    assert!((c.frequency - 11f64.sqrt()).abs() < 1e-12, "{c:?}");
+    assert!(c.destabilising);
+    // One real breakaway between −1 and −2: 3 s² + 12 s + 11 = 0.
+    assert_eq!(locus.breakaways.len(), 1);
+    let want = -2.0 + 1.0 / 3f64.sqrt();
+    assert!((locus.breakaways[0].point.re - want).abs() < 1e-12);
+    // The range reaches past the crossing.
+    assert!(*locus.gains.last().unwrap() >= 90.0);
+}
+
+#[test]
+fn discrete_crossing_on_the_unit_circle() {
+    // (z − 1)(z − 0.5) + 0.25 k: |z|² = 0.5 + 0.25 k = 1 at k = 2.
+    let l = TransferFunction::discrete(&[0.25], &[1.0, -1.5, 0.5], 0.1).unwrap();
+    let locus = root_locus(&l).unwrap();
+    assert_eq!(locus.period, Some(0.1));
+    assert_eq!(locus.crossings.len(), 1, "{:?}", locus.crossings);
+    let c = locus.crossings[0];
+    assert!((c.gain - 2.0).abs() < 1e-10, "{c:?}");
+    assert!((c.point - Complex::new(0.75, 7f64.sqrt() / 4.0)).norm() < 1e-10);
+    assert!((c.frequency - 0.75f64.acos() / 0.1).abs() < 1e-9);
+    assert!(c.destabilising);
+    // Breakaway: 2 z − 1.5 = 0 at z = 0.75, k = −D(0.75)/0.25 = 0.25.
+    assert!((locus.breakaways[0].point.re - 0.75).abs() < 1e-12);
+    assert!((locus.breakaways[0].gain - 0.25).abs() < 1e-12);
+}
+
+#[test]
+fn the_lab_plant_and_its_transfer_function_give_one_locus() {
+    // Fixed-size state space, run-time sized, and its tf: the same locus.
+    let plant = ctrlab::MassSpring::nominal()
+        .state_space(ctrlab::Cart::Two)
+        .unwrap();
+    let gains = [0.0, 1e3, 1e4];
+    let a = root_locus_at(&plant, &gains).unwrap();
+    let b = root_locus_at(&DynStateSpace::from(&plant), &gains).unwrap();
+    let c = root_locus_at(&TransferFunction::try_from(&plant).unwrap(), &gains).unwrap();
+    for j in 0..3 {
+        assert_eq!(a.poles_at(j), b.poles_at(j));
+        assert!(worst_match(&a.poles_at(j), &c.poles_at(j)) < 1e-12);
+    }
+}
+
+#[test]
+fn extreme_input_is_refused_by_name() {
+    let zero = TransferFunction::continuous(&[0.0], &[1.0, 1.0]).unwrap();
+    assert!(matches!(
+        root_locus(&zero),
+        Err(Error::InvalidData { what: "num", .. })
+    ));
+    let improper = TransferFunction::continuous(&[1.0, 0.0, 0.0], &[1.0, 1.0]).unwrap();
+    assert!(matches!(
+        root_locus(&improper),
+        Err(Error::InvalidData { what: "num", .. })
+    ));
+    let stat = TransferFunction::continuous(&[2.0], &[1.0]).unwrap();
+    assert!(matches!(
+        root_locus(&stat),
+        Err(Error::InvalidData { what: "den", .. })
+    ));
+    let l = TransferFunction::continuous(&[1.0], &[1.0, 1.0]).unwrap();
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let r = root_locus_at(&l, &[0.0, bad]);
+        assert!(
+            matches!(
+                r,
+                Err(Error::InvalidData {
+                    what: "gains",
+                    index: 1,
+                    ..
+                })
+            ),
+            "{r:?}"
+        );
+    }
+    assert!(matches!(
+        root_locus_at(&l, &[]),
+        Err(Error::InvalidData { what: "gains", .. })
+    ));
+    // A biproper loop whose branch passes through infinity at k = 1.
+    let through = TransferFunction::continuous(&[1.0, 2.0], &[-1.0, 1.0]).unwrap();
+    assert!(matches!(
+        root_locus_at(&through, &[1.0]),
+        Err(Error::Singular { .. })
+    ));
+    // ...which the automatic grid steps over.
+    let locus = root_locus(&through).unwrap();
+    assert!(locus.branches[0].iter().all(|p| p.re.is_finite()));
+    // Not SISO.
+    let mimo = DynStateSpace::continuous(
+        DMatrix::from_element(1, 1, -1.0),
+        DMatrix::from_element(1, 2, 1.0),
+        DMatrix::from_element(1, 1, 1.0),
+        DMatrix::zeros(1, 2),
+    )
+    .unwrap();
+    assert!(matches!(
+        root_locus(&mimo),
+        Err(Error::DimensionMismatch { .. })
+    ));
+    // Huge and tiny coefficients and gains: finite answers.
+    let huge = TransferFunction::continuous(&[1e300], &[1.0, 1e-300, 1e-300]).unwrap();
+    let locus = root_locus(&huge).unwrap();
+    assert!(
+        locus
+            .branches
+            .iter()
+            .flatten()
+            .all(|p| p.re.is_finite() && p.im.is_finite())
+    );
+    let r = root_locus_at(&l, &[1e300, -1e300, 0.0]).unwrap();
+    assert!(r.branches.iter().flatten().all(|p| p.re.is_finite()));
+}
+
+/// `|D(p) + k N(p)|` relative to the size of its terms
+/// (`Σ|dᵢ||p|ⁱ + |k| Σ|nᵢ||p|ⁱ`): the backward error of the pole.
+fn residual(num: &[f64], den: &[f64], k: f64, p: Complex<f64>) -> f64 {
+    let eval = |c: &[f64]| c.iter().fold(Complex::new(0.0, 0.0), |acc, &x| acc * p + x);
+    let size = |c: &[f64]| c.iter().fold(0.0, |acc, &x| acc * p.norm() + x.abs());
+    let (d, n) = (eval(den), eval(num));
+    // Above |k| = 1 the polynomial is D / k + N: the same scaled.
+    let (value, scale) = if k.abs() <= 1.0 {
+        ((d + n * k).norm(), size(den) + k.abs() * size(num))
+    } else {
+        ((d / k + n).norm(), size(den) / k.abs() + size(num))
+    };
+    value / scale
+}
+
+fn poly_strategy(len: std::ops::RangeInclusive<usize>) -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(prop_oneof![(-10.0f64..10.0), (0.1f64..5.0)], len)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Every reported pole solves 1 + k L = 0 to rounding, there are as
+    /// many branches as the order, and consecutive points of a branch are
+    /// close compared with the region the locus spans.
+    #[test]
+    fn every_point_is_a_closed_loop_pole(
+        den in poly_strategy(3..=6),
+        num in poly_strategy(1..=3),
+        lead in 0.5f64..3.0,
+    ) {
+        let mut den = den;
+        den[0] = lead;
+        prop_assume!(num[0].abs() > 1e-3);
+        let l = TransferFunction::continuous(&num, &den).unwrap();
+        let locus = root_locus(&l).unwrap();
+        prop_assert_eq!(locus.branches.len(), den.len() - 1);
+        for b in &locus.branches {
+            prop_assert_eq!(b.len(), locus.gains.len());
+            for (k, p) in locus.gains.iter().zip(b) {
+                let r = residual(&num, &den, *k, *p);
+                // Measured: at most 7.8e-15 over these cases.
+                prop_assert!(r <= 1e-12, "k = {k}, p = {p}, residual {r:e}");
+            }
+        }
+        prop_assert!(locus.gains.windows(2).all(|w| w[0] < w[1]));
+        // Continuity: in the region the refinement works in (the poles,
+        // zeros and special points), no branch jumps by more than a
+        // quarter of the open-loop pattern's size between gains unless the
+        // grid reached its narrowest interval there.
+        let mut pts: Vec<Complex<f64>> = locus.poles.clone();
+        pts.extend(&locus.zeros);
+        let lo = pts.iter().map(|p| p.re).fold(f64::INFINITY, f64::min);
+        let hi = pts.iter().map(|p| p.re).fold(f64::NEG_INFINITY, f64::max);
+        let top = pts.iter().map(|p| p.im.abs()).fold(0.0, f64::max);
+        let size = (hi - lo).max(top).max(1e-3);
+        for b in &locus.branches {
+            for j in 1..b.len() {
+                let inside = |p: Complex<f64>| p.re >= lo && p.re <= hi && p.im.abs() <= top;
+                if inside(b[j - 1]) && inside(b[j]) {
+                    let (k0, k1) = (locus.gains[j - 1], locus.gains[j]);
+                    let jump = (b[j] - b[j - 1]).norm();
+                    prop_assert!(
+                        jump <= 0.25 * size || k1 - k0 <= 1e-9 * k1,
+                        "jump {jump} of {size} between k = {k0} and {k1}"
+                    );
+                }
+            }
+        }
+    }
+}
