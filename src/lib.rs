@@ -48,7 +48,8 @@
 //!   [`Zpk`]) and `ss2tf`/`tf2ss`, invariant zeros, frequency responses
 //!   ([`bode`], [`nyquist`], [`frequency_response`]) in rad/s, dB and
 //!   degrees, [`stability_margins`] (gain, phase, delay) and [`bandwidth`],
-//!   root loci ([`freq::root_locus`]).
+//!   root loci ([`freq::root_locus`]) and pole-zero maps
+//!   ([`freq::pole_zero_map`]).
 //! - [`metrics`]: [`step_info`] / [`step_info_of`] / [`step_info_mimo`]
 //!   (rise, settling and transient time, overshoot, steady state) of data
 //!   or of any model, with interpolated crossing times, under the crate's

@@ -3,7 +3,7 @@
 //! space (`ss2tf`, `tf2ss`), invariant zeros, frequency responses
 //! ([`FrequencyResponse`], [`Bode`], [`Nyquist`]), [`stability_margins`]
 //! and [`bandwidth`], Padé approximations of a delay ([`pade`]), root loci
-//! ([`root_locus`]), and (feature `plot`) Bode and Nyquist figures.
+//! ([`root_locus`]), pole-zero maps ([`pole_zero_map`]), and (feature `plot`) Bode and Nyquist figures.
 //!
 //! Units: angular frequencies `ω` in rad/s everywhere (`frequency_hz`
 //! converts to Hz), magnitudes absolute or in dB (`20 log₁₀`), phases in
@@ -45,6 +45,7 @@ mod models;
 mod pade;
 mod phase;
 mod poly;
+mod pzmap;
 mod response;
 mod rlocus;
 #[cfg(feature = "plot")]
@@ -57,6 +58,7 @@ pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stab
 pub use matrix::TransferMatrix;
 pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};
 pub use phase::{BodeOptions, WrapPhase, bode_with};
+pub use pzmap::{PoleZero, PoleZeroMap, pole_zero_map};
 pub use response::{
     Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
 };
