@@ -83,7 +83,7 @@
 //! | (core) | always | models, discretisation, analysis, frequency tools, design, simulation, metrics, recordings and CSV, identification, signals | nalgebra, faer, rustfft, csv-core, thiserror |
 //! | `hw` | via `lab` | [`hw`]: the `Rig` trait, the fixed-period loop, real-time scheduling, stop signals, the PC104 card driver and its simulation, the probe | serde, signal-hook, libc |
 //! | `lab` | yes | [`lab`]: the two-cart plant, its identification and refinement, the simulated rig, card and truth files (implies `hw`) | toml, serde_path_to_error |
-//! | `plot` | yes | `plot`, `bode_svg`, `bode_marked_svg`, `nyquist_svg`: SVG figures | plotters (SVG backend only) |
+//! | `plot` | yes | `plot`, `bode_svg`, `bode_marked_svg`, `nyquist_svg`, `root_locus_svg`, `pole_zero_svg`: SVG figures | plotters (SVG backend only) |
 //! | `ppdev` | no | `hw::Ppdev`: the real card on a Linux parallel port (implies `hw`) | |
 //!
 //! A crate that wants the mathematics only depends on

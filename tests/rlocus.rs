@@ -269,6 +269,7 @@ fn discrete_crossing_on_the_unit_circle() {
     assert!((locus.breakaways[0].gain - 0.25).abs() < 1e-12);
 }
 
+#[cfg(feature = "lab")]
 #[test]
 fn the_lab_plant_and_its_transfer_function_give_one_locus() {
     // Fixed-size state space, run-time sized, and its tf: the same locus.
@@ -426,4 +427,51 @@ proptest! {
             }
         }
     }
+}
+
+#[cfg(feature = "plot")]
+#[test]
+fn figures_name_what_a_student_reads_and_refuse_bad_input() {
+    use ctrlab::freq::{pole_zero_svg, root_locus_svg, root_locus_zoomed_svg};
+    use ctrlab::plot::PlotError;
+
+    let dir = std::env::temp_dir().join("ctrlab_rlocus_figures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let l = TransferFunction::continuous(&[1.0], &[1.0, 6.0, 11.0, 6.0]).unwrap();
+    let locus = root_locus(&l).unwrap();
+    let path = dir.join("third.svg");
+    root_locus_svg(&path, "third order", &locus, &[("k = 20", 20.0)]).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    for text in [
+        "k = 60.0, ω = 3.32 rad/s",
+        "k = 0.385",
+        "k = 20",
+        "Re s (rad/s)",
+        "asymptotes",
+    ] {
+        assert!(svg.contains(text), "{text} missing");
+    }
+    let bad = root_locus_svg(dir.join("nan.svg"), "t", &locus, &[("nan", f64::NAN)]);
+    assert!(matches!(
+        bad,
+        Err(PlotError::Data(Error::InvalidParameter { name: "k", .. }))
+    ));
+    for (x, y) in [((1.0, 0.0), (0.0, 1.0)), ((0.0, 1.0), (f64::NAN, 1.0))] {
+        let r = root_locus_zoomed_svg(dir.join("view.svg"), "t", &locus, &[], x, y);
+        assert!(
+            matches!(r, Err(PlotError::Data(Error::InvalidParameter { .. }))),
+            "{r:?}"
+        );
+    }
+    let d = TransferFunction::discrete(&[0.25], &[1.0, -1.5, 0.5], 0.1).unwrap();
+    let path = dir.join("discrete.svg");
+    root_locus_svg(&path, "discrete", &root_locus(&d).unwrap(), &[]).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    assert!(svg.contains("crosses the unit circle") && svg.contains("k = 2.00"));
+    let pz = pole_zero_map(&d).unwrap();
+    pole_zero_svg(dir.join("pz.svg"), "pz", &[("L", &pz)]).unwrap();
+    assert!(matches!(
+        pole_zero_svg(dir.join("none.svg"), "pz", &[]),
+        Err(PlotError::Data(Error::InvalidData { what: "maps", .. }))
+    ));
 }

@@ -3,7 +3,8 @@
 //! space (`ss2tf`, `tf2ss`), invariant zeros, frequency responses
 //! ([`FrequencyResponse`], [`Bode`], [`Nyquist`]), [`stability_margins`]
 //! and [`bandwidth`], Padé approximations of a delay ([`pade`]), root loci
-//! ([`root_locus`]), pole-zero maps ([`pole_zero_map`]), and (feature `plot`) Bode and Nyquist figures.
+//! ([`root_locus`]), pole-zero maps ([`pole_zero_map`]), and (feature `plot`) Bode,
+//! Nyquist, root-locus and pole-zero figures.
 //!
 //! Units: angular frequencies `ω` in rad/s everywhere (`frequency_hz`
 //! converts to Hz), magnitudes absolute or in dB (`20 log₁₀`), phases in
@@ -38,6 +39,8 @@
 //! ```
 
 mod kernel;
+#[cfg(feature = "plot")]
+mod locus_svg;
 mod margins;
 mod matrix;
 mod minreal;
@@ -54,6 +57,9 @@ mod tf;
 mod zeros;
 mod zpk;
 
+#[cfg(feature = "plot")]
+#[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
+pub use locus_svg::{pole_zero_svg, root_locus_svg, root_locus_zoomed_svg};
 pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stability_margins};
 pub use matrix::TransferMatrix;
 pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};

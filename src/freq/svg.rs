@@ -91,7 +91,7 @@ fn thin(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
 }
 
 /// The range of finite values, padded as [`crate::plot`] pads.
-fn range(values: impl Iterator<Item = f64>, pad: f64) -> Result<(f64, f64), Error> {
+pub(super) fn range(values: impl Iterator<Item = f64>, pad: f64) -> Result<(f64, f64), Error> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);
@@ -108,11 +108,11 @@ fn range(values: impl Iterator<Item = f64>, pad: f64) -> Result<(f64, f64), Erro
 }
 
 /// Label font size, px (plotters' size).
-const FONT: f64 = 14.0;
+pub(super) const FONT: f64 = 14.0;
 /// Label areas and margin, px.
-const X_AREA: u32 = 44;
-const Y_AREA: u32 = 72;
-const MARGIN: u32 = 12;
+pub(super) const X_AREA: u32 = 44;
+pub(super) const Y_AREA: u32 = 72;
+pub(super) const MARGIN: u32 = 12;
 
 /// A Bode panel's frame: x range, axis names, and whether the marks are
 /// labelled (in the top panel only).
@@ -211,13 +211,13 @@ fn panel(
 }
 
 /// A mark's frequency in the axis' unit, three significant figures.
-fn frequency_label(f: f64) -> String {
+pub(super) fn frequency_label(f: f64) -> String {
     let decimals = (2.0 - f.abs().log10().floor()).clamp(0.0, 6.0) as usize;
     format!("{f:.decimals$}")
 }
 
 /// The i-th curve's colour: Okabe–Ito, readable by colour-blind readers.
-fn curve_color(i: usize) -> RGBColor {
+pub(super) fn curve_color(i: usize) -> RGBColor {
     crate::plot::PALETTE[i % crate::plot::PALETTE.len()]
 }
 

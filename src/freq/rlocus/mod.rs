@@ -153,9 +153,57 @@ pub struct RootLocus {
     /// The sampling period (s) of a discrete loop; `None` for a
     /// continuous one.
     pub period: Option<f64>,
+    /// The open loop's numerator and denominator.
+    num: Vec<f64>,
+    den: Vec<f64>,
 }
 
 impl RootLocus {
+    /// The closed-loop poles at any finite gain `k` (the roots of
+    /// `D + k N`), sorted by real then imaginary part.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::InvalidParameter`] (`"k"`) for a non-finite gain;
+    /// [`Error::Singular`] where a branch is at infinity.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::freq::{TransferFunction, root_locus};
+    ///
+    /// let locus = root_locus(&TransferFunction::continuous(&[1.0], &[1.0, 2.0, 0.0])?)?;
+    /// let p = locus.poles_at_gain(1.0)?; // (s + 1)²
+    /// assert!(p.iter().all(|p| (p.re + 1.0).abs() < 1e-7));
+    /// assert!(locus.poles_at_gain(f64::NAN).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn poles_at_gain(&self, k: f64) -> Result<Vec<Complex<f64>>, Error> {
+        if !k.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "k",
+                value: k,
+                reason: "the gain must be finite",
+            });
+        }
+        roots_at(&self.num, &self.den, k)?.ok_or(AT_INFINITY)
+    }
+
+    /// The region the locus is worth showing in: centre and radius (four
+    /// times the spread of the poles, zeros and special points around
+    /// the centroid).
+    #[cfg(feature = "plot")]
+    pub(crate) fn region(&self) -> (Complex<f64>, f64) {
+        let s = scale(
+            &self.poles,
+            &self.zeros,
+            &self.breakaways,
+            &self.crossings,
+            self.asymptotes.as_ref(),
+        );
+        (s.centre, s.radius)
+    }
+
     /// The closed-loop poles at `gains[index]`, one per branch.
     ///
     /// # Examples
@@ -176,6 +224,10 @@ impl RootLocus {
             .collect()
     }
 }
+
+const AT_INFINITY: Error = Error::Singular {
+    operation: "root locus (a branch is at infinity at this gain: d₀ + k n₀ = 0)",
+};
 
 /// The open loop checked: `(N, D)` with `N ≢ 0`, `deg N ≤ deg D`,
 /// `deg D ≥ 1`.
@@ -285,7 +337,7 @@ pub fn root_locus(l: &impl FrequencyDomain) -> Result<RootLocus, Error> {
     start.sort_by(f64::total_cmp);
     start.dedup();
     let (gains, roots) = refined(&num, &den, &start, &scale)?;
-    Ok(assemble(gains, roots, parts))
+    Ok(assemble(gains, roots, parts, num, den))
 }
 
 /// The closed-loop poles at the given gains (MATLAB's `rlocus(sys, k)`,
@@ -345,16 +397,20 @@ pub fn root_locus_at(l: &impl FrequencyDomain, gains: &[f64]) -> Result<RootLocu
     parts.crossings.retain(|c| c.gain >= lo && c.gain <= hi);
     let mut roots = Vec::with_capacity(gains.len());
     for &k in gains {
-        roots.push(roots_at(&num, &den, k)?.ok_or(Error::Singular {
-            operation: "root locus (a branch is at infinity at this gain: d₀ + k n₀ = 0)",
-        })?);
+        roots.push(roots_at(&num, &den, k)?.ok_or(AT_INFINITY)?);
     }
     track(&mut roots);
-    Ok(assemble(gains.to_vec(), roots, parts))
+    Ok(assemble(gains.to_vec(), roots, parts, num, den))
 }
 
 /// Root sets per gain turned into branches.
-fn assemble(gains: Vec<f64>, roots: Vec<Vec<Complex<f64>>>, parts: Parts) -> RootLocus {
+fn assemble(
+    gains: Vec<f64>,
+    roots: Vec<Vec<Complex<f64>>>,
+    parts: Parts,
+    num: Vec<f64>,
+    den: Vec<f64>,
+) -> RootLocus {
     let n = parts.poles.len();
     let branches = (0..n)
         .map(|b| roots.iter().map(|r| r[b]).collect())
@@ -368,6 +424,8 @@ fn assemble(gains: Vec<f64>, roots: Vec<Vec<Complex<f64>>>, parts: Parts) -> Roo
         breakaways: parts.breakaways,
         crossings: parts.crossings,
         period: parts.period,
+        num,
+        den,
     }
 }
 
@@ -375,11 +433,27 @@ fn assemble(gains: Vec<f64>, roots: Vec<Vec<Complex<f64>>>, parts: Parts) -> Roo
 /// landmarks' mean), four times the landmarks' spread around it (twice
 /// without asymptotes), at least 1 wide where every landmark coincides.
 fn scale_of(parts: &Parts) -> Scale {
-    let mut landmarks: Vec<Complex<f64>> = parts.poles.clone();
-    landmarks.extend(&parts.zeros);
-    landmarks.extend(parts.breakaways.iter().map(|b| b.point));
-    landmarks.extend(parts.crossings.iter().map(|c| c.point));
-    let centre = match &parts.asymptotes {
+    scale(
+        &parts.poles,
+        &parts.zeros,
+        &parts.breakaways,
+        &parts.crossings,
+        parts.asymptotes.as_ref(),
+    )
+}
+
+fn scale(
+    poles: &[Complex<f64>],
+    zeros: &[Complex<f64>],
+    breakaways: &[Breakaway],
+    crossings: &[BoundaryCrossing],
+    asymptotes: Option<&Asymptotes>,
+) -> Scale {
+    let mut landmarks: Vec<Complex<f64>> = poles.to_vec();
+    landmarks.extend(zeros);
+    landmarks.extend(breakaways.iter().map(|b| b.point));
+    landmarks.extend(crossings.iter().map(|c| c.point));
+    let centre = match asymptotes {
         Some(a) => Complex::new(a.centroid, 0.0),
         None => Complex::new(
             landmarks.iter().map(|p| p.re).sum::<f64>() / landmarks.len() as f64,
@@ -395,8 +469,8 @@ fn scale_of(parts: &Parts) -> Scale {
     } else {
         centre.norm().max(1.0)
     };
-    let factor = if parts.asymptotes.is_some() { 4.0 } else { 2.0 };
-    if let Some(a) = &parts.asymptotes {
+    let factor = if asymptotes.is_some() { 4.0 } else { 2.0 };
+    if let Some(a) = asymptotes {
         landmarks.push(Complex::new(a.centroid, 0.0));
     }
     Scale {
