@@ -496,7 +496,7 @@ fn gain_range(num: &[f64], den: &[f64], parts: &Parts, scale: &Scale) -> Result<
     for k in parts.crossings.iter().map(|c| c.gain) {
         kmax = kmax.max(1.5 * k);
     }
-    if !(kmax > 0.0) {
+    if kmax.is_nan() || kmax <= 0.0 {
         kmax = 1.0;
     }
     // Raise until each finite zero has a closed-loop pole near it.

@@ -113,7 +113,7 @@ pub(super) fn boundary_crossings<D: Domain>(
     for w in crossings(l, Crossing::RealAxis)? {
         let s = point(period, w);
         let Ok(g) = l.evaluate(s) else { continue };
-        if !(g.re < 0.0) || g.im.abs() > 1e-6 * g.norm() {
+        if g.re.is_nan() || g.re >= 0.0 || g.im.abs() > 1e-6 * g.norm() {
             continue;
         }
         let gain = -1.0 / g.re;

@@ -119,6 +119,9 @@ pub(super) fn track(roots: &mut [Vec<Complex<f64>>]) {
     }
 }
 
+/// Gains and the matched roots at each.
+type Grid = (Vec<f64>, Vec<Vec<Complex<f64>>>);
+
 /// The gains (ascending, from the sorted, de-duplicated `start`) and the
 /// matched roots at each, refined where a step is coarse: the midpoint
 /// (geometric where the gains differ by more than ten times) is added,
@@ -130,7 +133,7 @@ pub(super) fn refined(
     den: &[f64],
     start: &[f64],
     scale: &Scale,
-) -> Result<(Vec<f64>, Vec<Vec<Complex<f64>>>), Error> {
+) -> Result<Grid, Error> {
     let mut gains = Vec::with_capacity(start.len());
     let mut roots = Vec::with_capacity(start.len());
     for &k in start {
