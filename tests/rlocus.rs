@@ -8,71 +8,57 @@ use ctrlab::freq::{
     PoleZeroMap, RootLocus, TransferFunction, Zpk, pole_zero_map, root_locus, root_locus_at,
 };
 use ctrlab::{DynStateSpace, Error};
-use nalgebra::{Complex, DMatrix};
+use nalgebra::Complex;
 use proptest::prelude::*;
 use serde_json::Value;
 
+mod common;
+
+use common::{complexes, dmatrix as matrix, floats, two_inputs, worst_match};
+
 fn fixtures() -> Value {
-    serde_json::from_str(include_str!("data/rlocus_fixtures.json")).unwrap()
+    common::fixture("rlocus_fixtures.json")
 }
 
-fn floats(v: &Value) -> Vec<f64> {
-    serde_json::from_value(v.clone()).unwrap()
-}
-
-fn matrix(v: &Value) -> DMatrix<f64> {
-    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).unwrap();
-    let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
-    DMatrix::from_fn(r, c, |i, j| rows[i][j])
-}
-
-fn complexes(v: &Value) -> Vec<Complex<f64>> {
-    let pairs: Vec<[f64; 2]> = serde_json::from_value(v.clone()).unwrap();
-    pairs.iter().map(|p| Complex::new(p[0], p[1])).collect()
-}
-
-/// The largest distance from a wanted pole to its match (each got pole
-/// used once, nearest first), relative to `max(|w|, 1)`.
-fn worst_match(got: &[Complex<f64>], want: &[Complex<f64>]) -> f64 {
-    assert_eq!(got.len(), want.len(), "{got:?} vs {want:?}");
-    let mut left = got.to_vec();
-    let mut worst: f64 = 0.0;
-    for w in want {
-        let (i, d) = left
-            .iter()
-            .enumerate()
-            .map(|(i, g)| (i, (g - w).norm()))
-            .min_by(|x, y| x.1.total_cmp(&y.1))
-            .unwrap();
-        worst = worst.max(d / w.norm().max(1.0));
-        left.remove(i);
-    }
-    worst
+/// Runs `$body` with `$m` bound to the case's open loop: its transfer
+/// function or state-space model, continuous or discrete.
+macro_rules! with_model {
+    ($case:expr, $m:ident => $body:expr) => {{
+        let case = $case;
+        let dt = case["dt"].as_f64();
+        if case["kind"] == "tf" {
+            let (num, den) = (floats(&case["num"]), floats(&case["den"]));
+            match dt {
+                None => {
+                    let $m = TransferFunction::continuous(&num, &den).unwrap();
+                    $body
+                }
+                Some(dt) => {
+                    let $m = TransferFunction::discrete(&num, &den, dt).unwrap();
+                    $body
+                }
+            }
+        } else {
+            let m = |key: &str| matrix(&case[key]);
+            let (a, b, c, d) = (m("a"), m("b"), m("c"), m("d"));
+            match dt {
+                None => {
+                    let $m = DynStateSpace::continuous(a, b, c, d).unwrap();
+                    $body
+                }
+                Some(dt) => {
+                    let $m = DynStateSpace::discrete(a, b, c, d, dt).unwrap();
+                    $body
+                }
+            }
+        }
+    }};
 }
 
 /// Every case's locus at the fixture's gains, by `root_locus_at`.
 fn loci_of(case: &Value) -> RootLocus {
     let gains = floats(&case["gains"]);
-    let dt = case["dt"].as_f64();
-    if case["kind"] == "tf" {
-        let (num, den) = (floats(&case["num"]), floats(&case["den"]));
-        match dt {
-            None => root_locus_at(&TransferFunction::continuous(&num, &den).unwrap(), &gains),
-            Some(dt) => root_locus_at(&TransferFunction::discrete(&num, &den, dt).unwrap(), &gains),
-        }
-    } else {
-        let (a, b, c, d) = (
-            matrix(&case["a"]),
-            matrix(&case["b"]),
-            matrix(&case["c"]),
-            matrix(&case["d"]),
-        );
-        match dt {
-            None => root_locus_at(&DynStateSpace::continuous(a, b, c, d).unwrap(), &gains),
-            Some(dt) => root_locus_at(&DynStateSpace::discrete(a, b, c, d, dt).unwrap(), &gains),
-        }
-    }
-    .unwrap()
+    with_model!(case, l => root_locus_at(&l, &gains).unwrap())
 }
 
 #[test]
@@ -107,26 +93,7 @@ fn closed_loop_poles_match_python_control_at_its_gains() {
 
 /// Every case's pole-zero map, from its own model (tf or state space).
 fn pzmap_of(case: &Value) -> PoleZeroMap {
-    let dt = case["dt"].as_f64();
-    if case["kind"] == "tf" {
-        let (num, den) = (floats(&case["num"]), floats(&case["den"]));
-        match dt {
-            None => pole_zero_map(&TransferFunction::continuous(&num, &den).unwrap()),
-            Some(dt) => pole_zero_map(&TransferFunction::discrete(&num, &den, dt).unwrap()),
-        }
-    } else {
-        let (a, b, c, d) = (
-            matrix(&case["a"]),
-            matrix(&case["b"]),
-            matrix(&case["c"]),
-            matrix(&case["d"]),
-        );
-        match dt {
-            None => pole_zero_map(&DynStateSpace::continuous(a, b, c, d).unwrap()),
-            Some(dt) => pole_zero_map(&DynStateSpace::discrete(a, b, c, d, dt).unwrap()),
-        }
-    }
-    .unwrap()
+    with_model!(case, m => pole_zero_map(&m).unwrap())
 }
 
 #[test]
@@ -155,13 +122,7 @@ fn pole_zero_maps_match_python_control() {
     // A zpk is its own map; a non-square state-space model is refused.
     let z = Zpk::continuous(&[Complex::new(-3.0, 0.0)], &[Complex::new(-1.0, 0.0)], 2.0).unwrap();
     assert_eq!(pole_zero_map(&z).unwrap().zeros, [Complex::new(-3.0, 0.0)]);
-    let wide = DynStateSpace::continuous(
-        DMatrix::from_element(1, 1, -1.0),
-        DMatrix::from_element(1, 2, 1.0),
-        DMatrix::from_element(1, 1, 1.0),
-        DMatrix::zeros(1, 2),
-    )
-    .unwrap();
+    let wide = two_inputs();
     assert!(matches!(
         pole_zero_map(&wide),
         Err(Error::InvalidMatrix { matrix: "D", .. })
@@ -332,13 +293,7 @@ fn extreme_input_is_refused_by_name() {
     let locus = root_locus(&through).unwrap();
     assert!(locus.branches[0].iter().all(|p| p.re.is_finite()));
     // Not SISO.
-    let mimo = DynStateSpace::continuous(
-        DMatrix::from_element(1, 1, -1.0),
-        DMatrix::from_element(1, 2, 1.0),
-        DMatrix::from_element(1, 1, 1.0),
-        DMatrix::zeros(1, 2),
-    )
-    .unwrap();
+    let mimo = two_inputs();
     assert!(matches!(
         root_locus(&mimo),
         Err(Error::DimensionMismatch { .. })

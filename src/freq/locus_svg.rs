@@ -7,16 +7,15 @@
 use std::path::Path;
 
 use nalgebra::Complex;
-use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::pzmap::PoleZeroMap;
 use super::rlocus::RootLocus;
-use super::svg::{FONT, MARGIN, X_AREA, Y_AREA, curve_color, frequency_label, range};
-use crate::error::Error;
-use crate::plot::{
-    Along, Mark, PlotError, Ticked, Ticks, text_width, titled_with_legend, write_error,
+use super::svg::{
+    FONT, LinearChart, MARGIN, X_AREA, Y_AREA, curve_color, frequency_label, linear_axes, range,
 };
+use crate::error::Error;
+use crate::plot::{Mark, PlotError, text_width, titled_with_legend, write_error};
 
 /// A view: `((x0, x1), (y0, y1))`.
 type View = ((f64, f64), (f64, f64));
@@ -163,8 +162,7 @@ fn axis_names(discrete: bool) -> (&'static str, &'static str) {
     }
 }
 
-type Plane<'a, 'b> =
-    ChartContext<'a, SVGBackend<'b>, Cartesian2d<Ticked<RangedCoordf64>, Ticked<RangedCoordf64>>>;
+type Plane<'a, 'b> = LinearChart<'a, 'b>;
 
 /// The axes, the real axis and the stability boundary (the imaginary axis
 /// or the unit circle) in `area` over `view`.
@@ -176,36 +174,7 @@ fn plane<'a, 'b>(
 ) -> Result<Plane<'a, 'b>, PlotError> {
     let err = |e| write_error(path, e);
     let ((x0, x1), (y0, y1)) = view;
-    let (w, h) = area.dim_in_pixel();
-    let along = |lo, hi, len, dir| Ticks::linear(lo, hi, len, FONT, dir);
-    let xt = along(
-        x0,
-        x1,
-        f64::from(w - Y_AREA - 2 * MARGIN),
-        Along::Horizontal,
-    );
-    let yt = along(y0, y1, f64::from(h - X_AREA - 2 * MARGIN), Along::Vertical);
-    let mut chart = ChartBuilder::on(area)
-        .margin(MARGIN)
-        .x_label_area_size(X_AREA)
-        .y_label_area_size(Y_AREA)
-        .build_cartesian_2d(
-            Ticked::new(RangedCoordf64::from(x0..x1), &xt),
-            Ticked::new(RangedCoordf64::from(y0..y1), &yt),
-        )
-        .map_err(err)?;
-    let (xn, yn) = axis_names(discrete);
-    chart
-        .configure_mesh()
-        .x_desc(xn)
-        .y_desc(yn)
-        .x_label_formatter(&|v| xt.label(*v))
-        .y_label_formatter(&|v| yt.label(*v))
-        .bold_line_style(BLACK.mix(0.10))
-        .label_style(("sans-serif", FONT))
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
+    let mut chart = linear_axes(area, path, view, axis_names(discrete))?;
     let real_axis = clipped(&[(x0, 0.0), (x1, 0.0)], view);
     let boundary = if discrete {
         clipped(&unit_circle(), view)
