@@ -363,9 +363,21 @@ fn draw_locus(
             }
         }
     }
+    // A step between two points both outside the locus' region is not
+    // drawn: it is where a branch goes through infinity (a biproper loop
+    // at d₀ + k n₀ = 0), and its chord would cross the plane.
+    let near = |p: &Complex<f64>| (p - region.0).norm() <= 1.5 * region.1;
     for (i, b) in locus.branches.iter().enumerate() {
-        let points: Vec<(f64, f64)> = b.iter().map(|p| xy(*p)).collect();
-        for piece in clipped(&points, view) {
+        let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for (j, p) in b.iter().enumerate() {
+            if j > 0 && !near(p) && !near(&b[j - 1]) {
+                runs.push(Vec::new());
+            }
+            if let Some(run) = runs.last_mut() {
+                run.push(xy(*p));
+            }
+        }
+        for piece in runs.iter().flat_map(|r| clipped(r, view)) {
             let style = curve_color(i).stroke_width(2);
             chart
                 .draw_series(LineSeries::new(piece, style))
