@@ -54,7 +54,9 @@
 //! - [`freq`]: transfer functions ([`TransferFunction`], [`TransferMatrix`],
 //!   [`Zpk`]) and `ss2tf`/`tf2ss`, invariant zeros, frequency responses
 //!   ([`bode`], [`nyquist`], [`frequency_response`]) in rad/s, dB and
-//!   degrees, [`stability_margins`] (gain, phase, delay) and [`bandwidth`].
+//!   degrees, [`stability_margins`] (gain, phase, delay) and [`bandwidth`],
+//!   root loci ([`freq::root_locus`]) and pole-zero maps
+//!   ([`freq::pole_zero_map`]).
 //! - [`metrics`]: [`step_info`] / [`step_info_of`] / [`step_info_mimo`]
 //!   (rise, settling and transient time, overshoot, steady state) of data
 //!   or of any model, with interpolated crossing times, under the crate's
@@ -88,7 +90,7 @@
 //! | (core) | always | models, discretisation, analysis, frequency tools, design, simulation, metrics, recordings and CSV, identification, signals | nalgebra, faer, rustfft, csv-core, thiserror |
 //! | `hw` | via `lab` | [`hw`]: the `Rig` trait, the fixed-period loop, real-time scheduling, stop signals, the PC104 card driver and its simulation, the probe | serde, signal-hook, libc |
 //! | `lab` | yes | [`lab`]: the two-cart plant, its identification and refinement, the simulated rig, card and truth files (implies `hw`) | toml, serde_path_to_error |
-//! | `plot` | yes | `plot`, `bode_svg`, `bode_marked_svg`, `nyquist_svg`: SVG figures | plotters (SVG backend only) |
+//! | `plot` | yes | `plot`, `bode_svg`, `bode_marked_svg`, `nyquist_svg`, `root_locus_svg`, `pole_zero_svg`: SVG figures | plotters (SVG backend only) |
 //! | `ppdev` | no | `hw::Ppdev`: the real card on a Linux parallel port (implies `hw`) | |
 //!
 //! A crate that wants the mathematics only depends on

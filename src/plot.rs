@@ -27,8 +27,8 @@ mod legend;
 mod ticks;
 
 pub(crate) use legend::{Mark, titled_with_legend};
-pub(crate) use ticks::Ticked;
 pub use ticks::{Along, Ticks};
+pub(crate) use ticks::{Ticked, text_width};
 
 use crate::error::Error;
 

@@ -13,6 +13,8 @@ use ctrlab::{Cart, Discrete, DynStateSpace, Error, MassSpring};
 use nalgebra::{Complex, DMatrix};
 use serde_json::Value;
 
+mod common;
+
 fn fixtures() -> Value {
     serde_json::from_str(include_str!("data/freq_fixtures.json")).unwrap()
 }
@@ -373,13 +375,7 @@ fn bad_input_gives_typed_errors() {
         r.bode(0, 1),
         Err(Error::OutOfRange { what: "input", .. })
     ));
-    let mimo = DynStateSpace::continuous(
-        DMatrix::from_element(1, 1, -1.0),
-        DMatrix::from_element(1, 2, 1.0),
-        DMatrix::from_element(1, 1, 1.0),
-        DMatrix::zeros(1, 2),
-    )
-    .unwrap();
+    let mimo = common::two_inputs();
     assert!(matches!(
         bode(&mimo, &[1.0]),
         Err(Error::DimensionMismatch { .. })

@@ -12,6 +12,8 @@ use nalgebra::{Complex, DMatrix};
 use proptest::prelude::*;
 use serde_json::Value;
 
+mod common;
+
 fn fixtures() -> Value {
     serde_json::from_str(include_str!("data/minreal_fixtures.json")).unwrap()
 }
@@ -33,21 +35,8 @@ fn complexes(v: &Value) -> Vec<Complex<f64>> {
 
 /// Poles matched one to one (each to the nearest unmatched one).
 fn assert_same_poles(got: &[Complex<f64>], want: &[Complex<f64>], tol: f64, what: &str) {
-    assert_eq!(got.len(), want.len(), "{what}: {got:?} vs {want:?}");
-    let mut left: Vec<Complex<f64>> = got.to_vec();
-    for w in want {
-        let (i, d) = left
-            .iter()
-            .enumerate()
-            .map(|(i, g)| (i, (g - w).norm()))
-            .min_by(|x, y| x.1.total_cmp(&y.1))
-            .unwrap();
-        assert!(
-            d <= tol * w.norm().max(1.0),
-            "{what}: pole {w} off by {d:e}"
-        );
-        left.remove(i);
-    }
+    let worst = common::worst_match(got, want);
+    assert!(worst <= tol, "{what}: a pole off by {worst:e} of {want:?}");
 }
 
 /// The response at the fixture's frequencies, every channel, within `rtol`

@@ -48,13 +48,16 @@ fn shift(mut p: Vec<f64>, k: usize) -> Vec<f64> {
 
 /// Which crossing: `Im G = 0` (phase ±180° or 0°), or `|G| = level`.
 #[derive(Clone, Copy)]
-enum Crossing {
+pub(crate) enum Crossing {
     RealAxis,
     Magnitude(f64),
 }
 
 /// The frequencies `ω ≥ 0` (rad/s) of a crossing, ascending.
-fn crossings<D: Domain>(g: &TransferFunction<D>, kind: Crossing) -> Result<Vec<f64>, Error> {
+pub(crate) fn crossings<D: Domain>(
+    g: &TransferFunction<D>,
+    kind: Crossing,
+) -> Result<Vec<f64>, Error> {
     let (num, den) = (g.num(), g.den());
     let w = match period_of(&g.domain()) {
         None => {

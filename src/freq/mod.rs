@@ -2,8 +2,9 @@
 //! [`TransferMatrix`], [`Zpk`]) and their conversions to and from state
 //! space (`ss2tf`, `tf2ss`), invariant zeros, frequency responses
 //! ([`FrequencyResponse`], [`Bode`], [`Nyquist`]), [`stability_margins`]
-//! and [`bandwidth`], Padé approximations of a delay ([`pade`]), and
-//! (feature `plot`) Bode and Nyquist figures.
+//! and [`bandwidth`], Padé approximations of a delay ([`pade`]), root loci
+//! ([`root_locus`]), pole-zero maps ([`pole_zero_map`]), and (feature `plot`) Bode,
+//! Nyquist, root-locus and pole-zero figures.
 //!
 //! Units: angular frequencies `ω` in rad/s everywhere (`frequency_hz`
 //! converts to Hz), magnitudes absolute or in dB (`20 log₁₀`), phases in
@@ -38,6 +39,8 @@
 //! ```
 
 mod kernel;
+#[cfg(feature = "plot")]
+mod locus_svg;
 mod margins;
 mod matrix;
 mod minreal;
@@ -45,7 +48,9 @@ mod models;
 mod pade;
 mod phase;
 mod poly;
+mod pzmap;
 mod response;
+mod rlocus;
 #[cfg(feature = "plot")]
 mod svg;
 mod tf;
@@ -53,12 +58,19 @@ mod zeros;
 mod zpk;
 
 pub(crate) use kernel::Evaluator;
+#[cfg(feature = "plot")]
+#[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
+pub use locus_svg::{pole_zero_svg, root_locus_svg, root_locus_zoomed_svg};
 pub use margins::{DelayMargin, GainMargin, Margins, PhaseMargin, bandwidth, stability_margins};
 pub use matrix::TransferMatrix;
 pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};
 pub use phase::{BodeOptions, WrapPhase, bode_with};
+pub use pzmap::{PoleZero, PoleZeroMap, pole_zero_map};
 pub use response::{
     Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
+};
+pub use rlocus::{
+    Asymptotes, BoundaryCrossing, Breakaway, MAX_GAINS, RootLocus, root_locus, root_locus_at,
 };
 #[cfg(feature = "plot")]
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]

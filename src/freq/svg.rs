@@ -91,7 +91,7 @@ fn thin(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
 }
 
 /// The range of finite values, padded as [`crate::plot`] pads.
-fn range(values: impl Iterator<Item = f64>, pad: f64) -> Result<(f64, f64), Error> {
+pub(super) fn range(values: impl Iterator<Item = f64>, pad: f64) -> Result<(f64, f64), Error> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);
@@ -108,11 +108,11 @@ fn range(values: impl Iterator<Item = f64>, pad: f64) -> Result<(f64, f64), Erro
 }
 
 /// Label font size, px (plotters' size).
-const FONT: f64 = 14.0;
+pub(super) const FONT: f64 = 14.0;
 /// Label areas and margin, px.
-const X_AREA: u32 = 44;
-const Y_AREA: u32 = 72;
-const MARGIN: u32 = 12;
+pub(super) const X_AREA: u32 = 44;
+pub(super) const Y_AREA: u32 = 72;
+pub(super) const MARGIN: u32 = 12;
 
 /// A Bode panel's frame: x range, axis names, and whether the marks are
 /// labelled (in the top panel only).
@@ -211,13 +211,13 @@ fn panel(
 }
 
 /// A mark's frequency in the axis' unit, three significant figures.
-fn frequency_label(f: f64) -> String {
+pub(super) fn frequency_label(f: f64) -> String {
     let decimals = (2.0 - f.abs().log10().floor()).clamp(0.0, 6.0) as usize;
     format!("{f:.decimals$}")
 }
 
 /// The i-th curve's colour: Okabe–Ito, readable by colour-blind readers.
-fn curve_color(i: usize) -> RGBColor {
+pub(super) fn curve_color(i: usize) -> RGBColor {
     crate::plot::PALETTE[i % crate::plot::PALETTE.len()]
 }
 
@@ -395,41 +395,7 @@ pub fn nyquist_svg(
     let size = crate::plot::SIZE;
     let root = SVGBackend::new(path, size).into_drawing_area();
     let plot = titled_with_legend(&root, title, &entries, FONT).map_err(err)?;
-    let (w, h) = plot.dim_in_pixel();
-    let xt = Ticks::linear(
-        x0,
-        x1,
-        f64::from(w - Y_AREA - 2 * MARGIN),
-        FONT,
-        Along::Horizontal,
-    );
-    let yt = Ticks::linear(
-        y0,
-        y1,
-        f64::from(h - X_AREA - 2 * MARGIN),
-        FONT,
-        Along::Vertical,
-    );
-    let mut chart = ChartBuilder::on(&plot)
-        .margin(MARGIN)
-        .x_label_area_size(X_AREA)
-        .y_label_area_size(Y_AREA)
-        .build_cartesian_2d(
-            Ticked::new(RangedCoordf64::from(x0..x1), &xt),
-            Ticked::new(RangedCoordf64::from(y0..y1), &yt),
-        )
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("Re G")
-        .y_desc("Im G")
-        .x_label_formatter(&|v| xt.label(*v))
-        .y_label_formatter(&|v| yt.label(*v))
-        .bold_line_style(BLACK.mix(0.15))
-        .label_style(("sans-serif", FONT))
-        .axis_desc_style(("sans-serif", 16))
-        .draw()
-        .map_err(err)?;
+    let mut chart = linear_axes(&plot, path, ((x0, x1), (y0, y1)), ("Re G", "Im G"))?;
     for (i, p) in points.iter().enumerate() {
         let color = curve_color(i);
         chart
@@ -451,4 +417,54 @@ pub fn nyquist_svg(
         .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// A chart on linear axes over `((x0, x1), (y0, y1))` in `area`, its grid
+/// and tick labels (spaced by their size) drawn, the axes named.
+pub(super) type LinearChart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<Ticked<RangedCoordf64>, Ticked<RangedCoordf64>>>;
+
+pub(super) fn linear_axes<'a, 'b>(
+    area: &'a DrawingArea<SVGBackend<'b>, Shift>,
+    path: &Path,
+    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+    (x_desc, y_desc): (&str, &str),
+) -> Result<LinearChart<'a, 'b>, PlotError> {
+    let err = |e| write_error(path, e);
+    let (w, h) = area.dim_in_pixel();
+    let xt = Ticks::linear(
+        x0,
+        x1,
+        f64::from(w - Y_AREA - 2 * MARGIN),
+        FONT,
+        Along::Horizontal,
+    );
+    let yt = Ticks::linear(
+        y0,
+        y1,
+        f64::from(h - X_AREA - 2 * MARGIN),
+        FONT,
+        Along::Vertical,
+    );
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .x_label_area_size(X_AREA)
+        .y_label_area_size(Y_AREA)
+        .build_cartesian_2d(
+            Ticked::new(RangedCoordf64::from(x0..x1), &xt),
+            Ticked::new(RangedCoordf64::from(y0..y1), &yt),
+        )
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| xt.label(*v))
+        .y_label_formatter(&|v| yt.label(*v))
+        .bold_line_style(BLACK.mix(0.15))
+        .label_style(("sans-serif", FONT))
+        .axis_desc_style(("sans-serif", 16))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }

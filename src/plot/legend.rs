@@ -16,6 +16,10 @@ pub(crate) enum Mark {
     Dashed(RGBAColor),
     /// A cross (a marked point).
     Cross(RGBAColor),
+    /// A hollow circle (a zero).
+    Circle(RGBAColor),
+    /// A filled dot (a point on a curve).
+    Dot(RGBAColor),
 }
 
 /// Swatch length and the gap before its label, px.
@@ -101,6 +105,10 @@ pub(crate) fn draw_strip<DB: DrawingBackend>(
                 Mark::Cross(c) => {
                     area.draw(&Cross::new((x + SWATCH / 2, y), 5, c.stroke_width(2)))?
                 }
+                Mark::Circle(c) => {
+                    area.draw(&Circle::new((x + SWATCH / 2, y), 5, c.stroke_width(2)))?
+                }
+                Mark::Dot(c) => area.draw(&Circle::new((x + SWATCH / 2, y), 4, c.filled()))?,
             }
             area.draw(&Text::new(label, (x + SWATCH + GAP, y), style.clone()))?;
         }

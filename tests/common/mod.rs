@@ -77,3 +77,56 @@ mod lab;
 #[cfg(feature = "lab")]
 #[allow(unused_imports)] // each test binary uses some of them
 pub use lab::*;
+
+/// A list of numbers from a JSON array.
+pub fn floats(v: &Value) -> Vec<f64> {
+    serde_json::from_value(v.clone()).expect("an array of numbers")
+}
+
+/// A run-time sized matrix from a JSON array of rows.
+pub fn dmatrix(v: &Value) -> nalgebra::DMatrix<f64> {
+    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).expect("an array of rows");
+    let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
+    nalgebra::DMatrix::from_fn(r, c, |i, j| rows[i][j])
+}
+
+/// Complex numbers from a JSON array of `[re, im]` pairs.
+pub fn complexes(v: &Value) -> Vec<nalgebra::Complex<f64>> {
+    let pairs: Vec<[f64; 2]> = serde_json::from_value(v.clone()).expect("[re, im] pairs");
+    pairs
+        .into_iter()
+        .map(|[re, im]| nalgebra::Complex::new(re, im))
+        .collect()
+}
+
+/// `ẋ = −x + u₁ + u₂`, `y = x`: one output, two inputs (not SISO, not
+/// square).
+pub fn two_inputs() -> ctrlab::DynStateSpace {
+    ctrlab::DynStateSpace::continuous(
+        nalgebra::DMatrix::from_element(1, 1, -1.0),
+        nalgebra::DMatrix::from_element(1, 2, 1.0),
+        nalgebra::DMatrix::from_element(1, 1, 1.0),
+        nalgebra::DMatrix::zeros(1, 2),
+    )
+    .expect("a finite model")
+}
+
+/// The largest distance from a wanted pole to its match (each got pole
+/// used once, nearest first), relative to `max(|w|, 1)`; the counts must
+/// agree.
+pub fn worst_match(got: &[nalgebra::Complex<f64>], want: &[nalgebra::Complex<f64>]) -> f64 {
+    assert_eq!(got.len(), want.len(), "{got:?} vs {want:?}");
+    let mut left = got.to_vec();
+    let mut worst: f64 = 0.0;
+    for w in want {
+        let (i, d) = left
+            .iter()
+            .enumerate()
+            .map(|(i, g)| (i, (g - w).norm()))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .expect("a pole left to match");
+        worst = worst.max(d / w.norm().max(1.0));
+        left.remove(i);
+    }
+    worst
+}

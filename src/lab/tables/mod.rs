@@ -5,7 +5,8 @@
 //! - Table 1, the nominal model's static deflection under a constant force:
 //!   [`table1`] → [`Table1`];
 //! - Table 2, state feedback on the nominal model: [`table2`] → [`Table2`];
-//! - Tables 5 and 6 on the rig: the rows ([`TABLE5`], [`TABLE6`]), what the
+//! - Tables 5 and 6 on the rig: the rows ([`TABLE5`], [`TABLE6`]), the root
+//!   locus behind a group of rows ([`GroupLocus`]), what the
 //!   identified model predicts for each ([`Prediction`]), how a run ended
 //!   ([`RigOutcome::classify`]), and what a group of rows says about its
 //!   gain over every row ([`GroupEffect`], [`Trend`]);
@@ -32,6 +33,7 @@
 //! ```
 
 mod experiment;
+mod locus;
 mod rig;
 mod simulated;
 mod trend;
@@ -46,6 +48,7 @@ use super::Cart;
 pub use experiment::{
     Experiment, ExperimentError, ExperimentRun, MAX_DURATION, ROW_SEEDS_FROM, drive,
 };
+pub use locus::{GroupLocus, gain_loop, sampled_gain_loop};
 pub use rig::{
     ERROR_NOISE, GroupEffect, Halt, OVERSHOOT_NOISE, Prediction, RigOutcome, RigRun,
     SATURATED_OSCILLATION, SETTLING_NOISE,
