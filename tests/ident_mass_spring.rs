@@ -420,12 +420,13 @@ fn numbers(e: &MassSpringEstimate) -> Vec<f64> {
 /// Each spring model through the one pipeline gives what the two former
 /// pipelines gave (`identify_with` for equal springs,
 /// `identify_separate_springs_with` for separate ones, before they became
-/// one), bit for bit: every number of [`numbers`], pinned in
+/// one), bit for bit (the Newey–West standard errors to 1e-12 relative,
+/// their sums since reordered): every number of [`numbers`], pinned in
 /// `tests/data/ident_former_pipelines.json`, on the fixture and on a 3 s
 /// square-wave run of the default simulated card (seed 11), with Lab,
 /// Central, Coulomb friction, cart 2's mass free, and both (Lab).
 #[test]
-fn each_spring_model_gives_the_former_pipelines_numbers_bit_for_bit() {
+fn each_spring_model_gives_the_former_pipelines_numbers() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/tests/data/ident_former_pipelines.json"
@@ -473,6 +474,7 @@ fn each_spring_model_gives_the_former_pipelines_numbers_bit_for_bit() {
     };
     let cases = former["cases"].as_array().unwrap();
     assert_eq!(cases.len(), 20);
+    let mut worst = 0.0f64;
     for case in cases {
         let text = |key: &str| case[key].as_str().unwrap();
         let (recording, name) = (text("recording"), text("options"));
@@ -495,18 +497,31 @@ fn each_spring_model_gives_the_former_pipelines_numbers_bit_for_bit() {
         let want: Vec<f64> = serde_json::from_value(case["numbers"].clone()).unwrap();
         let what = format!("{recording}, {springs:?}, {name}");
         assert_eq!(got.len(), want.len(), "{what}");
+        // The parameters' pairs (value, standard error) come first.
+        let pairs = got.len() - 4;
         for (i, (g, w)) in got.iter().zip(&want).enumerate() {
-            assert_eq!(
-                g.to_bits(),
-                w.to_bits(),
-                "{what}: number {i}, {g:?} vs {w:?}"
-            );
+            if i < pairs && i % 2 == 1 {
+                // A Newey–West standard error: its sums are formed in
+                // cache-sized blocks since these were pinned (issue 30),
+                // which moves the last bits (measured: at most 2.4e-15
+                // relative over the 20 cases); issue 30 allows 1e-12.
+                let rel = (g - w).abs() / w.abs();
+                worst = worst.max(rel);
+                assert!(rel <= 1e-12, "{what}: standard error {i}, {g:?} vs {w:?}");
+            } else {
+                assert_eq!(
+                    g.to_bits(),
+                    w.to_bits(),
+                    "{what}: number {i}, {g:?} vs {w:?}"
+                );
+            }
         }
         // `identify` keeps the lab's default: equal springs.
         if springs == SpringModel::Equal && matches!(name, "lab" | "central") {
             assert_eq!(identify(rec, 1.3, 0.7, options.scheme).unwrap(), est);
         }
     }
+    eprintln!("worst standard error change: {worst:.2e}");
 }
 
 #[test]

@@ -233,17 +233,23 @@ fn segment_bounds(starts: &[usize], n: usize) -> Vec<usize> {
     bounds
 }
 
+/// Rows of `v` (and of the autocovariances' series) handled at a time:
+/// the block's columns stay in the cache between the running sums and the
+/// products, so the work is one pass over the series however long it is.
+const BLOCK: usize = 2048;
+
 /// `Σ_t v_t v_tᵀ` over every segment, with `v_t` the sum of the rows
 /// `t − L … t` of the segment (zero outside it), `t` running to `L` rows
 /// past its end: `(L + 1) (Γ₀ + Σ_{l=1}^{L} w_l (Γ_l + Γ_lᵀ))` with the
 /// Bartlett weights, exactly. The lower triangle, row by row.
 ///
 /// Column `j` of `x` is taken times `inverses[j]`, a power of two that
-/// brings its largest entry into [1, 2). Each segment's `v` is formed from
-/// prefix sums `P` (`v_t = P_t −
-/// P_{t−L−1}`) in `buf`, and the sums are dot products of its columns. A
-/// segment of `len ≤ L` rows has `v_t = P_{len−1}` for every `t` from
-/// `len − 1` to `L`: that row is kept once, with its weight.
+/// brings its largest entry into [1, 2). `v` is formed [`BLOCK`] rows at
+/// a time in `buf` as the running sum of `x_t − x_{t−L−1}` (carried from
+/// block to block), and each block's products are summed before the next:
+/// no copy of the series. A segment of `len ≤ L` rows has `v_t =
+/// v_{len−1}` for every `t` from `len − 1` to `L`: that row is counted
+/// once, with its weight.
 fn bartlett(
     x: &[f64],
     n: usize,
@@ -254,40 +260,68 @@ fn bartlett(
 ) -> Vec<f64> {
     let p = inverses.len();
     let mut s = vec![0.0; p * (p + 1) / 2];
+    let mut carry = vec![0.0; p];
+    buf.clear();
+    buf.resize(2 * BLOCK * p, 0.0);
+    let (diffs, v) = buf.split_at_mut(BLOCK * p);
     for w in bounds.windows(2) {
         let (start, len) = (w[0], w[1] - w[0]);
-        // Rows of v kept: t = 0 … len − 1, then t = max(len, L + 1) …
-        // len + L − 1, stored from index len on.
-        let tail = len + lags - len.max(lags + 1);
-        let rows = len + tail;
-        buf.clear();
-        buf.resize(rows * p, 0.0);
-        for (j, v) in buf.chunks_exact_mut(rows).enumerate() {
-            let col = &x[j * n + start..j * n + start + len];
-            let sum = prefix_sums(col, inverses[j], &mut v[..len]);
-            // v_t for t ≥ len: the total less P_{t−L−1}.
-            let first = len.max(lags + 1);
-            for (i, t) in (first..len + lags).enumerate() {
-                v[len + i] = sum - v[t - lags - 1];
+        carry.fill(0.0);
+        // The rows t of v, in three runs where the same rows of x enter:
+        // x_t alone (t ≤ L), x_t − x_{t−L−1}, then −x_{t−L−1} past the end.
+        let runs = [
+            (0, len.min(lags + 1), true, false),
+            (lags + 1, len, true, true),
+            (len.max(lags + 1), len + lags, false, true),
+        ];
+        for (run, &(from, to, add, sub)) in runs.iter().enumerate() {
+            let mut a = from;
+            while a < to {
+                let rows = (to - a).min(BLOCK);
+                for j in 0..p {
+                    let col = &x[j * n + start..j * n + start + len];
+                    let d = &mut diffs[j * BLOCK..j * BLOCK + rows];
+                    match (add, sub) {
+                        (true, false) => d.copy_from_slice(&col[a..a + rows]),
+                        (true, true) => d
+                            .iter_mut()
+                            .zip(&col[a..a + rows])
+                            .zip(&col[a - lags - 1..])
+                            .for_each(|((d, &x), &old)| *d = x - old),
+                        _ => d
+                            .iter_mut()
+                            .zip(&col[a - lags - 1..])
+                            .for_each(|(d, &old)| *d = -old),
+                    }
+                    let out = &mut v[j * BLOCK..j * BLOCK + rows];
+                    let total = prefix_sums(d, inverses[j], out);
+                    let c = carry[j];
+                    if c != 0.0 {
+                        out.iter_mut().for_each(|v| *v += c);
+                    }
+                    carry[j] = c + total;
+                }
+                let mut k = 0;
+                for i in 0..p {
+                    let vi = &v[i * BLOCK..i * BLOCK + rows];
+                    for j in 0..=i {
+                        s[k] += dot(vi, &v[j * BLOCK..j * BLOCK + rows]);
+                        k += 1;
+                    }
+                }
+                a += rows;
             }
-            // v_t for t < len, downwards so P_{t−L−1} is still there.
-            for t in (lags + 1..len).rev() {
-                v[t] -= v[t - lags - 1];
-            }
-        }
-        // A segment no longer than L: v_{len−1} stands for L − len + 2 rows.
-        let extra = if len <= lags {
-            (lags + 1 - len) as f64
-        } else {
-            0.0
-        };
-        let mut k = 0;
-        for i in 0..p {
-            let vi = &buf[i * rows..(i + 1) * rows];
-            for j in 0..=i {
-                let vj = &buf[j * rows..(j + 1) * rows];
-                s[k] += dot(vi, vj) + extra * vi[len - 1] * vj[len - 1];
-                k += 1;
+            // A segment no longer than L: v_{len−1} (the carry after the
+            // first run) stands for L − len + 2 rows, counted once above.
+            if run == 0 && len > 0 && len <= lags {
+                let extra = (lags + 1 - len) as f64;
+                let mut k = 0;
+                for i in 0..p {
+                    for j in 0..=i {
+                        s[k] += extra * carry[i] * carry[j];
+                        k += 1;
+                    }
+                }
             }
         }
     }
@@ -358,11 +392,19 @@ fn automatic_lags(
                 .for_each(|(h, v)| *h += (v * inverse) * w);
         }
     }
+    // σ_j over blocks of t, every lag per block: the block and the `pre`
+    // rows before it stay in the cache (one pass over h, not pre + 1).
     let mut sigma = vec![0.0; pre + 1];
     for w in bounds.windows(2) {
         let seg = &h[w[0]..w[1]];
-        for (j, sj) in sigma.iter_mut().enumerate().take(seg.len()) {
-            *sj += dot(&seg[j..], &seg[..seg.len() - j]);
+        let mut a = 0;
+        while a < seg.len() {
+            let b = (a + BLOCK).min(seg.len());
+            for (j, sj) in sigma.iter_mut().enumerate().take(b) {
+                let lo = a.max(j);
+                *sj += dot(&seg[lo..b], &seg[lo - j..b - j]);
+            }
+            a = b;
         }
     }
     let s0 = sigma[0] + 2.0 * sigma[1..].iter().sum::<f64>();
