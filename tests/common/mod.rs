@@ -83,13 +83,6 @@ pub fn floats(v: &Value) -> Vec<f64> {
     serde_json::from_value(v.clone()).expect("an array of numbers")
 }
 
-/// A run-time sized matrix from a JSON array of rows.
-pub fn dmatrix(v: &Value) -> nalgebra::DMatrix<f64> {
-    let rows: Vec<Vec<f64>> = serde_json::from_value(v.clone()).expect("an array of rows");
-    let (r, c) = (rows.len(), rows.first().map_or(0, Vec::len));
-    nalgebra::DMatrix::from_fn(r, c, |i, j| rows[i][j])
-}
-
 /// Complex numbers from a JSON array of `[re, im]` pairs.
 pub fn complexes(v: &Value) -> Vec<nalgebra::Complex<f64>> {
     let pairs: Vec<[f64; 2]> = serde_json::from_value(v.clone()).expect("[re, im] pairs");
