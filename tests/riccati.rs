@@ -336,3 +336,32 @@ proptest! {
         }
     }
 }
+
+/// A 12-state draw of `random_stabilisable_problems` (found by `.ci/run`,
+/// 2026-11-26; `tests/data/riccati_ill_conditioned.json`): ‖X‖_F ≈ 2.0e12.
+/// The first shift's doubling and Newton stalled at a relative residual of
+/// 0.47, and that was returned as if it were the problem's floor; the other
+/// shifts now get their turn and one reaches 8.4e-4 (SciPy 1.17.1's
+/// `solve_continuous_are`: ‖X‖_F 2.03e12, and its closed loop is unstable,
+/// max Re λ = +0.46).
+#[test]
+fn an_ill_conditioned_draw_is_solved_by_another_shift() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/riccati_ill_conditioned.json"
+    );
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let (a, b, c) = (
+        common::dmatrix(&v["a"]),
+        common::dmatrix(&v["b"]),
+        common::dmatrix(&v["c"]),
+    );
+    let n = a.nrows();
+    let q = c.transpose() * &c + DMatrix::identity(n, n) * 0.1;
+    let r = DMatrix::identity(1, 1);
+    let sys = DynStateSpace::continuous(a, b, DMatrix::zeros(0, n), DMatrix::zeros(0, 1)).unwrap();
+    let sol = lqr(&sys, &q, &r).unwrap();
+    assert!(sol.residual < 1e-3, "residual {:e}", sol.residual);
+    assert!(sol.residual < 1e-15 * sol.riccati.norm());
+    assert!(sol.poles.iter().all(|p| p.re < 0.0));
+}

@@ -56,8 +56,9 @@ use crate::model::{Continuous, Discrete, Token, display};
 /// stability boundary. The shift starts at
 /// `γ = max(‖A‖_F, √(‖G‖_F ‖Q‖_F))`, the scale of the Hamiltonian's
 /// eigenvalues; if the residual stays above 1e-13 and the Newton steps
-/// below could still lower it, a few other shifts (γ/2, 2γ, γ/4, 4γ,
-/// γ/10, 10γ) are tried and the best solution kept.
+/// below could still lower it (or they stall above 1e-8, which is a poor
+/// start rather than the problem's rounding floor), a few other shifts
+/// (γ/2, 2γ, γ/4, 4γ, γ/10, 10γ) are tried and the best solution kept.
 ///
 /// On an ill-conditioned problem (a large `X` from nearly cancelling terms)
 /// the doubling alone can stop at a relative residual of about 1e-9. Up to

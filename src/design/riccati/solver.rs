@@ -17,6 +17,10 @@ use crate::kernels::reduce::pow2_floor;
 /// refinement is retried with another Cayley shift, unless Newton stalled
 /// (the residual is then the problem's rounding floor); the best is kept.
 const GOOD_RESIDUAL: f64 = 1e-13;
+/// A Newton stall above this relative residual is not the problem's
+/// rounding floor but a poor start (doubling on an ill-conditioned
+/// Hamiltonian): the other shifts are tried.
+const STALL_FLOOR: f64 = 1e-8;
 /// Newton refinement steps after the doubling, at most.
 const REFINE_STEPS: usize = 3;
 /// Newton steps after doubling on a regularised `R` (a discrete equation
@@ -110,7 +114,7 @@ where
                 // Another shift helps only where Newton could not finish
                 // the job; at a stall the residual is the problem's floor,
                 // and every shift lands on it (7 times the cost for nothing).
-                if res <= GOOD_RESIDUAL || stalled {
+                if res <= GOOD_RESIDUAL || stalled && res <= STALL_FLOOR {
                     break;
                 }
             }
