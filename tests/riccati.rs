@@ -365,3 +365,17 @@ fn an_ill_conditioned_draw_is_solved_by_another_shift() {
     assert!(sol.residual < 1e-15 * sol.riccati.norm());
     assert!(sol.poles.iter().all(|p| p.re < 0.0));
 }
+
+/// A proptest draw of `tests/proptest_api.rs` (`.ci/run`, 2026-11-27):
+/// `dare` with A = diag(−1e308, 1e308), B = 0, R = 0 failed, and the
+/// diagnosis of the failure formed `A − p I` = −inf and panicked in
+/// nalgebra's SVD ("Singular value was NaN"). It is now an error.
+#[test]
+fn a_failed_riccati_diagnosis_of_huge_entries_is_an_error_not_a_panic() {
+    let a = dmatrix![-1e308, 0.0; 0.0, 1e308];
+    let b = dmatrix![0.0; 0.0];
+    let q = dmatrix![0.0, 0.0; 0.0, 8.330344918606244];
+    let r = dmatrix![0.0];
+    assert!(dare(&a, &b, &q, &r).is_err());
+    assert!(care(&a, &b, &q, &r).is_err());
+}

@@ -230,10 +230,20 @@ where
                 Complex::new(b[(i, j - n)], 0.0)
             }
         });
-        unstable
-            && pbh
-                .try_svd(false, false, f64::EPSILON, 100 * (n + m))
-                .is_some_and(|svd| svd.singular_values.min() <= 1e-8 * scale)
+        // `A − p I` overflows for entries near f64::MAX (nalgebra's SVD
+        // panics on the NaN that follows): nothing can be concluded then.
+        // Otherwise the matrix is scaled by a power of two (exact) so that
+        // its largest entry is in [1, 2) before the SVD.
+        let big = pbh
+            .iter()
+            .fold(0.0f64, |m, z| m.max(z.re.abs()).max(z.im.abs()));
+        if !unstable || !big.is_finite() || !scale.is_finite() {
+            return false;
+        }
+        let unit = pow2_floor(big);
+        let pbh = pbh.unscale(unit);
+        pbh.try_svd(false, false, f64::EPSILON, 100 * (n + m))
+            .is_some_and(|svd| svd.singular_values.min() * unit <= 1e-8 * scale)
     })?;
     Some(Error::Unstable {
         operation: "LQR: no stabilising Riccati solution, (A, B) is not stabilisable \
