@@ -5,6 +5,7 @@
 use nalgebra::{DMatrix, SMatrix};
 
 use super::lyapunov::{Lyapunov, LyapunovFactor, dlyap, dlyapchol, lyap, lyapchol};
+use super::stability::stable_poles;
 use crate::error::Error;
 use crate::model::{Domain, DynStateSpace, StateSpace, period_of};
 
@@ -46,29 +47,12 @@ fn operands<D: Domain>(sys: &DynStateSpace<D>, kind: GramianKind) -> (DMatrix<f6
     }
 }
 
-/// `Error::Unstable` of `operation` naming the first pole on or outside
-/// the stability boundary by the crate's one test
-/// ([`StateSpace::unstable_pole`]).
-pub(super) fn require_stable<D: Domain>(
-    sys: &DynStateSpace<D>,
-    operation: &'static str,
-) -> Result<(), Error> {
-    match sys.unstable_pole()? {
-        Some(p) => Err(Error::Unstable {
-            operation,
-            re: p.re,
-            im: p.im,
-        }),
-        None => Ok(()),
-    }
-}
-
 /// The Gramian `kind` of a model checked stable.
 fn gramian<D: Domain>(
     sys: &DynStateSpace<D>,
     kind: GramianKind,
 ) -> Result<Lyapunov<DMatrix<f64>>, Error> {
-    require_stable(sys, "gram")?;
+    stable_poles(sys, "gram")?;
     let (a, b) = operands(sys, kind);
     let q = &b * b.transpose();
     if !q.iter().all(|v| v.is_finite()) {
@@ -88,7 +72,7 @@ pub(super) fn gramian_factor<D: Domain>(
     kind: GramianKind,
     operation: &'static str,
 ) -> Result<LyapunovFactor<DMatrix<f64>>, Error> {
-    require_stable(sys, operation)?;
+    stable_poles(sys, operation)?;
     let (a, b) = operands(sys, kind);
     if period_of(&sys.domain()).is_some() {
         dlyapchol(&a, &b)

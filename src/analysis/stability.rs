@@ -4,7 +4,9 @@
 use nalgebra::{Complex, DMatrix, SMatrix};
 
 use super::ITERATIONS_PER_DIM;
+use crate::error::Error;
 use crate::kernels::linalg::boundary_tolerance;
+use crate::model::{Domain, DynStateSpace, period_of};
 
 /// [`first_unstable_dyn`] for a fixed-size `a` (the LQR and observer
 /// checks).
@@ -81,4 +83,23 @@ fn componentwise_tolerance(a: &DMatrix<f64>, p: Complex<f64>) -> Option<f64> {
     let overlap = y.dotc(&x).norm();
     let tol = 100.0 * n as f64 * f64::EPSILON * weighted / overlap;
     tol.is_finite().then_some(tol)
+}
+
+/// The poles of `sys`, or [`Error::Unstable`] of `operation` naming the
+/// first on or outside the stability boundary by the crate's one test
+/// ([`StateSpace::unstable_pole`](crate::StateSpace::unstable_pole)):
+/// what the Gramians and the system norms require.
+pub(crate) fn stable_poles<D: Domain>(
+    sys: &DynStateSpace<D>,
+    operation: &'static str,
+) -> Result<Vec<Complex<f64>>, Error> {
+    let poles = sys.poles()?;
+    match first_unstable_dyn(&poles, sys.a(), period_of(&sys.domain())) {
+        Some(p) => Err(Error::Unstable {
+            operation,
+            re: p.re,
+            im: p.im,
+        }),
+        None => Ok(poles),
+    }
 }

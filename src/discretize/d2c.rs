@@ -5,11 +5,11 @@
 
 use nalgebra::{DMatrix, DefaultAllocator, Dim, OMatrix, allocator::Allocator};
 
-use super::logm::{frobenius, held_log};
+use super::logm::held_log;
 use super::{Discretization, Held, ModelAlloc, Parts};
 use crate::analysis::eigenvalues_dyn;
 use crate::error::Error;
-use crate::kernels::linalg::Lu;
+use crate::kernels::linalg::{Lu, frobenius};
 use crate::model::{Continuous, Discrete, DynStateSpace, StateSpace};
 
 /// Eigenvalues within this many `n ε (1 + ‖Ad‖_F)` of the pole an

@@ -11,6 +11,7 @@ use nalgebra::{Complex, DMatrix, SMatrix};
 
 use crate::analysis::eigenvalues_dyn;
 use crate::error::{Error, check_finite, check_finite_dyn, check_shape};
+use crate::kernels::linalg::{frobenius, norm1};
 
 /// Largest estimated relative error of a matrix logarithm (and so of a ZOH
 /// [`d2c`](crate::StateSpace::d2c)) that is returned; above it the result
@@ -247,20 +248,6 @@ fn largest_divided_difference(eigenvalues: &[Complex<f64>]) -> f64 {
         }
     }
     largest
-}
-
-/// `‖X‖_F` without overflow (nalgebra's squares the entries): through
-/// the largest entry.
-pub(super) fn frobenius(x: &DMatrix<f64>) -> f64 {
-    let s = x.amax();
-    if s == 0.0 { 0.0 } else { s * (x / s).norm() }
-}
-
-/// `‖X‖₁`, the largest column sum.
-fn norm1(x: &DMatrix<f64>) -> f64 {
-    x.column_iter()
-        .map(|c| c.iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
 }
 
 /// `(L, F)` of [`held_log`] (no eigenvalue of `e` on the closed negative

@@ -291,6 +291,14 @@ pub(crate) fn norm<R: Dim, S: Storage<Complex<f64>, R>>(v: &Vector<Complex<f64>,
     dotc(v, v).re.sqrt()
 }
 
+/// `‖m‖_F` without overflowing early (nalgebra's `norm` squares the
+/// entries): the matrix is divided by the power of two at its largest
+/// entry (exact) first.
+pub(crate) fn frobenius(m: &nalgebra::DMatrix<f64>) -> f64 {
+    let s = crate::kernels::reduce::pow2_floor(m.amax());
+    (m / s).norm() * s
+}
+
 /// The 1-norm (largest column sum of magnitudes).
 pub(crate) fn norm1<R: Dim, C: Dim, S: Storage<f64, R, C>>(m: &Matrix<f64, R, C, S>) -> f64 {
     m.column_iter()

@@ -3,8 +3,8 @@
 use nalgebra::DMatrix;
 
 use super::super::{dlyap, lyapchol};
-use super::frobenius;
 use crate::error::Error;
+use crate::kernels::linalg::frobenius;
 use crate::kernels::reduce::pow2_floor;
 
 const OPERATION: &str = "H2 norm";

@@ -4,11 +4,9 @@
 mod h2;
 mod hinf;
 
-use nalgebra::DMatrix;
-
-use super::{eigenvalues_dyn, first_unstable_dyn};
+use super::stability::stable_poles;
 use crate::error::Error;
-use crate::model::{DynStateSpace, LinearSystem, Token, period_of};
+use crate::model::{LinearSystem, Token, period_of};
 
 /// The relative accuracy of [`hinf_norm`]: the norm lies in
 /// `[value, value · (1 + 2 · HINF_RTOL)]`.
@@ -112,7 +110,7 @@ pub struct HinfNorm {
 pub fn h2_norm<S: LinearSystem>(sys: &S) -> Result<f64, Error> {
     let sys = sys.to_dyn(Token(()));
     let period = period_of(&sys.domain());
-    check_stable(&sys, "H2 norm", period)?;
+    stable_poles(&sys, "H2 norm")?;
     h2::h2(sys.a(), sys.b(), sys.c(), sys.d(), period)
 }
 
@@ -192,7 +190,7 @@ pub fn h2_norm<S: LinearSystem>(sys: &S) -> Result<f64, Error> {
 pub fn hinf_norm<S: LinearSystem>(sys: &S) -> Result<HinfNorm, Error> {
     let sys = sys.to_dyn(Token(()));
     let period = period_of(&sys.domain());
-    let poles = check_stable(&sys, "H∞ norm", period)?;
+    let poles = stable_poles(&sys, "H∞ norm")?;
     let (a, b, c, d) = (sys.a(), sys.b(), sys.c(), sys.d());
     let peak = match period {
         None => hinf::continuous(a, b, c, d, &poles)?,
@@ -202,28 +200,4 @@ pub fn hinf_norm<S: LinearSystem>(sys: &S) -> Result<HinfNorm, Error> {
         value: peak.value,
         peak_frequency: peak.omega,
     })
-}
-
-/// The model's poles, or [`Error::Unstable`] naming the first on or
-/// outside the boundary.
-fn check_stable<D: crate::model::Domain>(
-    sys: &DynStateSpace<D>,
-    operation: &'static str,
-    period: Option<f64>,
-) -> Result<Vec<nalgebra::Complex<f64>>, Error> {
-    let poles = eigenvalues_dyn(sys.a())?;
-    match first_unstable_dyn(&poles, sys.a(), period) {
-        Some(p) => Err(Error::Unstable {
-            operation,
-            re: p.re,
-            im: p.im,
-        }),
-        None => Ok(poles),
-    }
-}
-
-/// `‖m‖_F`, scaled by a power of two so that it cannot overflow early.
-fn frobenius(m: &DMatrix<f64>) -> f64 {
-    let s = crate::kernels::reduce::pow2_floor(m.amax());
-    (m / s).norm() * s
 }

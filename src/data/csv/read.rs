@@ -505,6 +505,15 @@ fn read<R: Read>(
     // Whether the columns are sized (or cannot be: the length is unknown).
     let mut sized = size.is_none();
     loop {
+        // After the rows read so far, by either path.
+        size_columns(
+            &mut sized,
+            &mut cols,
+            size,
+            records.lines.consumed() - rows_start,
+            rows_start,
+            width,
+        );
         if fast_path && let Some(pending) = records.lines.pending() {
             // Up to the row after which the columns are sized, then all.
             let limit = match ESTIMATE_AFTER.checked_sub(cols[0].len()) {
@@ -516,14 +525,6 @@ fn read<R: Read>(
                 records.lines.skip(bytes, lines);
                 last = records.lines.line();
             }
-            size_columns(
-                &mut sized,
-                &mut cols,
-                size,
-                records.lines.consumed() - rows_start,
-                rows_start,
-                width,
-            );
             match stop {
                 Stop::Limit => continue,
                 Stop::Partial => match records.lines.more() {
@@ -573,14 +574,6 @@ fn read<R: Read>(
                 overflow = Some((last, before, now));
             }
         }
-        size_columns(
-            &mut sized,
-            &mut cols,
-            size,
-            records.lines.consumed() - rows_start,
-            rows_start,
-            width,
-        );
     }
 
     let rows = cols[0].len();
