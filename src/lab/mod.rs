@@ -68,6 +68,7 @@ mod gains;
 pub mod ident;
 pub mod ident_input;
 pub mod lqi;
+pub mod mpc;
 mod plant;
 mod probe;
 pub mod protocol;
