@@ -1,4 +1,7 @@
-//! The two-cart lab (LAB.md): everything that is about this one rig.
+//! The two-cart lab: everything that is about this one rig. The lab
+//! itself — the rig, its equations and its tables — is restated in the
+//! repository's [lab guide](https://github.com/ctrlab-rs/ctrlab/blob/main/docs/lab.md)
+//! (`docs/lab.md`).
 //!
 //! The generic modules never name a cart; this one builds the lab on them:
 //!
