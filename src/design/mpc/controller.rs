@@ -120,9 +120,6 @@ pub struct Mpc<const N: usize, const M: usize, const Q: usize, const R: usize> {
     plan: DVector<f64>,
     /// Ticks since `plan` was solved (`horizon` or more: none left).
     plan_age: usize,
-    /// Whether the solver's own iterate is the next warm start (after a
-    /// failed solve) rather than the shifted plan.
-    keep_iterate: bool,
     stats: MpcStats,
     last: TickStatus,
     report: Option<QpReport>,
@@ -274,7 +271,6 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q
             u_prev: SVector::zeros(),
             plan: DVector::zeros(mh),
             plan_age: horizon,
-            keep_iterate: false,
             stats: MpcStats::default(),
             last: TickStatus::NotStarted,
             report: None,
@@ -464,10 +460,16 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q
     /// the warm start, with its multipliers shifted alike.
     fn warm_start(&mut self) {
         let (h, mh) = (self.problem.horizon, M * self.problem.horizon);
+        // Shifted, and clipped along the chain from the input last applied
+        // (which the drive rounded) to the input and rate limits: a start
+        // that holds the hard rows, as the active-set method needs.
+        let mut previous = self.u_prev;
         for k in 0..h {
             let from = (k + 1).min(h - 1);
             for i in 0..M {
-                self.shifted[k * M + i] = self.plan[from * M + i] - self.steady[N + i];
+                let u = self.clip_from(previous[i], i, self.plan[from * M + i]);
+                previous[i] = u;
+                self.shifted[k * M + i] = u - self.steady[N + i];
             }
         }
         // The multipliers' blocks (inputs, rates, outputs), each shifted.
@@ -504,16 +506,7 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q
             self.roll_u.gemv(-1.0, &self.lqr_gain, &self.roll_x, 0.0);
             for i in 0..M {
                 let us = self.steady[N + i];
-                let (lo, hi) = (
-                    (previous[i] - self.rate_max[i]).max(self.input_min[i]),
-                    (previous[i] + self.rate_max[i]).min(self.input_max[i]),
-                );
-                let u = us + self.roll_u[i];
-                let u = if lo <= hi {
-                    u.clamp(lo, hi)
-                } else {
-                    u.clamp(self.input_min[i], self.input_max[i])
-                };
+                let u = self.clip_from(previous[i], i, us + self.roll_u[i]);
                 previous[i] = u;
                 self.roll_u[i] = u - us;
                 self.shifted[k * M + i] = u - us;
@@ -530,19 +523,24 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q
     /// `u` clipped to the input limits and the rate limit from `u_prev`.
     fn clip(&self, mut u: SVector<f64, M>) -> SVector<f64, M> {
         for i in 0..M {
-            let (lo, hi) = (
-                (self.u_prev[i] - self.rate_max[i]).max(self.input_min[i]),
-                (self.u_prev[i] + self.rate_max[i]).min(self.input_max[i]),
-            );
-            // An empty window (u_prev outside the limits by more than the
-            // rate) honours the input limits first.
-            u[i] = if lo <= hi {
-                u[i].clamp(lo, hi)
-            } else {
-                u[i].clamp(self.input_min[i], self.input_max[i])
-            };
+            u[i] = self.clip_from(self.u_prev[i], i, u[i]);
         }
         u
+    }
+
+    /// Input `i`'s value `u` clipped to its limits and to the rate limit
+    /// from `previous`. An empty window (`previous` outside the limits by
+    /// more than the rate) honours the input limits first.
+    fn clip_from(&self, previous: f64, i: usize, u: f64) -> f64 {
+        let (lo, hi) = (
+            (previous - self.rate_max[i]).max(self.input_min[i]),
+            (previous + self.rate_max[i]).min(self.input_max[i]),
+        );
+        if lo <= hi {
+            u.clamp(lo, hi)
+        } else {
+            u.clamp(self.input_min[i], self.input_max[i])
+        }
     }
 
     /// The fallback input when the QP gave none: the plan shifted while
@@ -597,12 +595,10 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
             self.stats.unreachable_targets += 1;
         }
         self.problem_data();
-        if !self.keep_iterate {
-            if self.plan_age < self.problem.horizon {
-                self.warm_start();
-            } else {
-                self.rollout_warm_start();
-            }
+        if self.plan_age < self.problem.horizon {
+            self.warm_start();
+        } else {
+            self.rollout_warm_start();
         }
         let report = self.qp.solve(
             self.q.as_slice(),
@@ -610,6 +606,10 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
             self.upper.as_slice(),
         );
         self.report = report.as_ref().ok().copied();
+        if let Some(r) = self.report {
+            self.stats.active_set_steps_max =
+                self.stats.active_set_steps_max.max(r.active_set_steps);
+        }
         let u = match report {
             Ok(report) if report.status.is_solved() => {
                 self.stats.solved += 1;
@@ -622,7 +622,6 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
                     }
                 }
                 self.plan_age = 1;
-                self.keep_iterate = false;
                 self.last = TickStatus::Solved {
                     iterations: report.iterations,
                 };
@@ -635,7 +634,6 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
                     QpStatus::PrimalInfeasible => self.stats.infeasible += 1,
                     _ => self.stats.iteration_limit += 1,
                 }
-                self.keep_iterate = true;
                 self.fallback(report.status)
             }
             // Finite data of the right lengths by construction; were it
@@ -688,7 +686,6 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
         self.plan.fill(0.0);
         self.integral.fill(0.0);
         self.plan_age = self.problem.horizon;
-        self.keep_iterate = false;
         self.qp.cold_start();
         self.stats = MpcStats::default();
         self.last = TickStatus::NotStarted;

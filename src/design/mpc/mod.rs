@@ -334,6 +334,9 @@ pub struct MpcStats {
     pub iterations_max: usize,
     /// Iterations over all ticks.
     pub iterations_total: usize,
+    /// Most active-set solves in one tick (see
+    /// [`QpSettings::active_set_steps`]).
+    pub active_set_steps_max: usize,
     /// Longest tick from measurement to input (estimate, target, solve),
     /// s, wall clock.
     pub solve_time_max: f64,
@@ -360,7 +363,7 @@ impl std::fmt::Display for MpcStats {
         write!(
             f,
             "ticks {}, solved {}, fallbacks {} ({} shifted plan, {} LQR; {} at the iteration limit, {} infeasible), \
-             unreachable targets {}, invalid inputs {}, iterations max {} mean {:.1}, longest tick {:.1} µs",
+             unreachable targets {}, invalid inputs {}, iterations max {} mean {:.1}, active-set solves max {}, longest tick {:.1} µs",
             self.ticks,
             self.solved,
             self.fallbacks(),
@@ -372,6 +375,7 @@ impl std::fmt::Display for MpcStats {
             self.invalid_inputs,
             self.iterations_max,
             self.iterations_total as f64 / self.ticks.max(1) as f64,
+            self.active_set_steps_max,
             self.solve_time_max * 1e6
         )
     }

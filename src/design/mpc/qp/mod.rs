@@ -11,6 +11,7 @@
 //! proximal operator replaces the projection. Nothing is allocated after
 //! [`DenseQp::new`].
 
+mod active_set;
 mod admm;
 mod kernels;
 mod polish;
@@ -18,7 +19,10 @@ mod polish;
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::{Error, check_finite_dyn, check_shape};
-/// Iterations between polishing attempts and step-size adaptations.
+/// Iterations between convergence checks.
+const CHECK_INTERVAL: usize = 5;
+/// Iterations between polishing attempts and step-size adaptations (a
+/// multiple of [`CHECK_INTERVAL`]).
 const POLISH_INTERVAL: usize = 10;
 use kernels::{SparseRows, equilibrate};
 use polish::Polish;
@@ -86,6 +90,12 @@ pub struct QpSettings {
     /// they define exactly, and stop there if it passes every optimality
     /// check (a solve of at most `n + m` unknowns each time).
     pub polish: bool,
+    /// Linear solves the primal active-set method may take from a warm
+    /// start that holds the hard rows, before ADMM (0: none). Each changes
+    /// the working set by one row, so a warm start a few rows from the
+    /// optimum (a plan shifted by a period, even after a step of the
+    /// reference) is solved exactly in that many.
+    pub active_set_steps: usize,
 }
 
 impl Default for QpSettings {
@@ -100,6 +110,7 @@ impl Default for QpSettings {
             alpha: 1.6,
             adaptive_rho: true,
             polish: true,
+            active_set_steps: 50,
         }
     }
 }
@@ -166,6 +177,9 @@ pub struct QpReport {
     /// Whether the solution is a polished one (exact to rounding on its
     /// active set) rather than an ADMM iterate within the tolerances.
     pub polished: bool,
+    /// Linear solves the active-set method took (0 if the polish from the
+    /// warm start already held, or it did not run).
+    pub active_set_steps: usize,
 }
 
 /// A convex quadratic program with fixed `P` and `G` and data that change
@@ -242,6 +256,8 @@ pub struct DenseQp {
     x_out: DVector<f64>,
     y_out: DVector<f64>,
     polisher: Polish,
+    /// The active-set method's solves in the current solve.
+    active_set_steps: usize,
 }
 
 impl DenseQp {
@@ -319,11 +335,13 @@ impl DenseQp {
                 operation: "QP equilibration",
             });
         }
+        let g_sparse = SparseRows::of(&gs);
+        let polisher = Polish::new(&ps, &g_sparse);
         let mut qp = Self {
             settings,
             p: ps,
             gtg,
-            g: SparseRows::of(&gs),
+            g: g_sparse,
             d,
             e,
             c,
@@ -343,7 +361,8 @@ impl DenseQp {
             work_m: DVector::zeros(m),
             x_out: DVector::zeros(n),
             y_out: DVector::zeros(m),
-            polisher: Polish::new(n, m),
+            polisher,
+            active_set_steps: 0,
         };
         if !qp.factor() {
             return Err(Error::InvalidMatrix {
@@ -428,7 +447,13 @@ impl DenseQp {
         let mut iterations = 0;
         // A warm start whose binding rows are still the right ones is
         // optimal after one polish.
+        self.active_set_steps = 0;
         let mut polished = s.polish && self.polish();
+        // Else the active-set method from the warm start, when it holds
+        // the hard rows.
+        if !polished && s.active_set_steps > 0 {
+            polished = self.active_set(s.active_set_steps);
+        }
         if polished {
             status = QpStatus::Solved;
         }
@@ -436,6 +461,11 @@ impl DenseQp {
             iterations += 1;
             self.y_prev.copy_from(&self.y);
             self.iterate();
+            // The residuals cost as much as an iteration: checked every
+            // few, and at the last.
+            if iterations % CHECK_INTERVAL != 0 && iterations != s.max_iterations {
+                continue;
+            }
             let r = self.residuals();
             if r.prim <= s.eps_abs + s.eps_rel * r.prim_scale
                 && r.dual <= s.eps_abs + s.eps_rel * r.dual_scale
@@ -470,6 +500,7 @@ impl DenseQp {
             objective: self.objective(q, lower, upper),
             rho: self.rho,
             polished,
+            active_set_steps: self.active_set_steps,
         })
     }
 

@@ -5,8 +5,10 @@
 //! thereby turned into the exact optimum, usually long before ADMM alone
 //! would reach its tolerance; a wrong guess costs one linear solve.
 
+use nalgebra::DMatrix;
+
 use super::DenseQp;
-use super::kernels::{lu_in_place, lu_solve};
+use super::kernels::{SparseRows, lu_in_place, lu_solve};
 
 /// How a row binds in a polishing guess.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -29,7 +31,7 @@ pub(super) enum State {
 
 /// Corrections of a polishing guess before it is given up (each one
 /// linear solve).
-const ACTIVE_SET_STEPS: usize = 6;
+const ACTIVE_SET_STEPS: usize = 2;
 
 /// Marks a variable neither fixed nor yet placed.
 const NONE: usize = usize::MAX;
@@ -37,13 +39,18 @@ const NONE: usize = usize::MAX;
 /// The polishing workspace, allocated once with the solver.
 #[derive(Debug, Clone)]
 pub(super) struct Polish {
-    state: Vec<State>,
+    pub(super) state: Vec<State>,
+    /// Per row: the objective's curvature along it, `gᵀ P g / ‖g‖⁴`
+    /// (scaled problem), which turns a multiplier into a distance.
+    pub(super) curvature: Vec<f64>,
     /// Per variable: the row that fixes it, or [`NONE`].
     fixed_by: Vec<usize>,
     /// Per variable: its index among the reduced system's unknowns.
     position: Vec<usize>,
-    /// The general equality rows, in order.
+    /// The general equality rows.
     equalities: Vec<usize>,
+    /// The rows that fixed a variable, in the order they did.
+    fix_order: Vec<usize>,
     /// The reduced KKT matrix (column major, leading dimension `n + m`),
     /// its pivots, right-hand side and scratch.
     kkt: Vec<f64>,
@@ -51,26 +58,56 @@ pub(super) struct Polish {
     rhs: Vec<f64>,
     work: Vec<f64>,
     /// The candidate solution, its `G x`, multipliers, and the gradient.
-    x: Vec<f64>,
-    gx: Vec<f64>,
-    y: Vec<f64>,
+    pub(super) x: Vec<f64>,
+    pub(super) gx: Vec<f64>,
+    /// The active-set method's iterate, its `G x` and working set.
+    pub(super) current: Vec<f64>,
+    pub(super) current_gx: Vec<f64>,
+    pub(super) working: Vec<State>,
+    /// Rows the active-set method may not free at present.
+    pub(super) tabu: Vec<bool>,
+    pub(super) y: Vec<f64>,
     grad: Vec<f64>,
 }
 
 impl Polish {
-    pub(super) fn new(n: usize, m: usize) -> Self {
+    /// The workspace for `n` variables and the rows of `g` with the
+    /// (scaled) Hessian `p`.
+    pub(super) fn new(p: &DMatrix<f64>, g: &SparseRows) -> Self {
+        let (n, m) = (p.nrows(), g.start.len() - 1);
         let k = n + m;
+        let curvature = (0..m)
+            .map(|i| {
+                let (a, b) = (g.start[i], g.start[i + 1]);
+                let norm2: f64 = g.values[a..b].iter().map(|v| v * v).sum();
+                let mut along = 0.0;
+                for s in a..b {
+                    for t in a..b {
+                        along += g.values[s] * p[(g.cols[s], g.cols[t])] * g.values[t];
+                    }
+                }
+                let c = along / (norm2 * norm2);
+                // A row the objective is flat along (or an empty row).
+                if c > 0.0 && c.is_finite() { c } else { 1.0 }
+            })
+            .collect();
         Self {
             state: vec![State::Free; m],
+            curvature,
             fixed_by: vec![NONE; n],
             position: vec![NONE; n],
             equalities: Vec::with_capacity(m),
+            fix_order: Vec::with_capacity(n),
             kkt: vec![0.0; k * k],
             perm: vec![0; k],
             rhs: vec![0.0; k],
             work: vec![0.0; k],
             x: vec![0.0; n],
             gx: vec![0.0; m],
+            current: vec![0.0; n],
+            current_gx: vec![0.0; m],
+            working: vec![State::Free; m],
+            tabu: vec![false; m],
             y: vec![0.0; m],
             grad: vec![0.0; n],
         }
@@ -88,8 +125,7 @@ impl DenseQp {
             if !self.solve_reduced() {
                 return false;
             }
-            self.recover_multipliers();
-            if self.optimal() {
+            if self.recover_multipliers() && self.optimal() {
                 break;
             }
             // A wrong guess is corrected from the candidate itself (a
@@ -99,9 +135,14 @@ impl DenseQp {
                 return false;
             }
         }
-        // Accept: the iterate becomes the polished point, with z the rows'
-        // values (inside the hard bounds to the tolerance, clamped) so the
-        // next warm start continues from it.
+        self.accept_candidate();
+        true
+    }
+
+    /// The candidate (`polisher.x`, its multipliers) becomes the iterate,
+    /// with z the rows' values (inside the hard bounds to the tolerance,
+    /// clamped) so the next warm start continues from it.
+    pub(super) fn accept_candidate(&mut self) {
         let w = &self.polisher;
         self.x.as_mut_slice().copy_from_slice(&w.x);
         self.y.as_mut_slice().copy_from_slice(&w.y);
@@ -111,7 +152,6 @@ impl DenseQp {
                 Some(_) => w.gx[i],
             };
         }
-        true
     }
 
     /// OSQP's rule on hard rows (`u − z < y`: upper binds), and the soft
@@ -119,13 +159,18 @@ impl DenseQp {
     fn guess_active_set(&mut self) {
         let w = &mut self.polisher;
         for i in 0..self.z.len() {
-            let (z, y, l, u) = (self.z[i], self.y[i], self.l[i], self.u[i]);
+            // The multiplier as a distance in the row's units, and a row
+            // at its bound to rounding (a clipped warm start, whose
+            // multipliers are not known, binds where it was clipped).
+            let y = self.y[i] / w.curvature[i];
+            let (z, l, u) = (self.z[i], self.l[i], self.u[i]);
+            let tie = 1e-9 * (1.0 + z.abs());
             w.state[i] = match self.soft[i] {
-                None if u.is_finite() && u - z < y => State::Upper,
-                None if l.is_finite() && z - l < -y => State::Lower,
+                None if u.is_finite() && u - z <= y + tie => State::Upper,
+                None if l.is_finite() && z - l <= -y + tie => State::Lower,
                 None => State::Free,
-                Some(_) if z > u => State::PenaltyUpper,
-                Some(_) if z < l => State::PenaltyLower,
+                Some(_) if z > u + tie => State::PenaltyUpper,
+                Some(_) if z < l - tie => State::PenaltyLower,
                 Some(_) if y > 0.0 && u - z < y => State::Upper,
                 Some(_) if y < 0.0 && z - l < -y => State::Lower,
                 Some(_) => State::Free,
@@ -134,24 +179,25 @@ impl DenseQp {
     }
 
     /// The primal-dual active-set step (Hintermüller, Ito and Kunisch's,
-    /// for the proximal form): each row's state from where `g x + y / ρ`
+    /// for the proximal form): each row's state from where `g x + y / c`
     /// of the failed candidate falls against its bounds (and, for a soft
-    /// row, its bounds widened by `linear / ρ`). False if nothing changes,
-    /// a cycle that more steps would not break.
+    /// row, its bounds widened by `linear / c`), `c` the objective's
+    /// curvature along the row (so `y / c` is a distance in the row's
+    /// units). False if nothing changes, a cycle that more steps would not
+    /// break.
     fn reclassify(&mut self) -> bool {
-        let rho = self.rho;
         let w = &mut self.polisher;
         let mut changed = false;
         for i in 0..self.z.len() {
-            let (l, u) = (self.l[i], self.u[i]);
-            let v = w.gx[i] + w.y[i] / rho;
+            let (l, u, c) = (self.l[i], self.u[i], w.curvature[i]);
+            let v = w.gx[i] + w.y[i] / c;
             let state = match self.soft[i] {
                 None if v > u => State::Upper,
                 None if v < l => State::Lower,
                 None => State::Free,
-                Some((w1, _)) if v > u + w1 / rho => State::PenaltyUpper,
+                Some((w1, _)) if v > u + w1 / c => State::PenaltyUpper,
                 Some(_) if v > u => State::Upper,
-                Some((w1, _)) if v < l - w1 / rho => State::PenaltyLower,
+                Some((w1, _)) if v < l - w1 / c => State::PenaltyLower,
                 Some(_) if v < l => State::Lower,
                 Some(_) => State::Free,
             };
@@ -168,28 +214,65 @@ impl DenseQp {
     /// with one entry fix their variable; the other binding rows are
     /// equalities; the penalised soft rows add their quadratic and linear
     /// terms. False if its KKT matrix is singular.
-    fn solve_reduced(&mut self) -> bool {
+    pub(super) fn solve_reduced(&mut self) -> bool {
         let (n, m) = (self.variables(), self.rows());
         let w = &mut self.polisher;
         w.fixed_by.fill(NONE);
         w.equalities.clear();
+        w.fix_order.clear();
+        // Binding rows are equalities; those with one unknown left fix it,
+        // which may leave another row with one (a rate limit's chain from
+        // the input last applied up to the input limit): propagate until
+        // nothing changes. A binding row with no unknown left duplicates
+        // others (degenerate: its multiplier is theirs) and is dropped,
+        // checked feasible later; singular KKT systems are thereby avoided
+        // in the input-and-rate structure of an MPC.
         for i in 0..m {
-            let bound = match w.state[i] {
-                State::Upper => self.u[i],
-                State::Lower => self.l[i],
-                _ => continue,
-            };
-            let (a, b) = (self.g.start[i], self.g.start[i + 1]);
-            if b - a == 1 {
-                let j = self.g.cols[a];
-                if w.fixed_by[j] == NONE {
-                    w.fixed_by[j] = i;
-                    w.x[j] = bound / self.g.values[a];
-                } else {
-                    w.state[i] = State::Dropped;
-                }
-            } else {
+            if matches!(w.state[i], State::Upper | State::Lower) {
                 w.equalities.push(i);
+            }
+        }
+        loop {
+            let mut changed = false;
+            let mut e = 0;
+            while e < w.equalities.len() {
+                let i = w.equalities[e];
+                let (a, b) = (self.g.start[i], self.g.start[i + 1]);
+                let mut unknown = NONE;
+                let mut count = 0;
+                let mut rest = if w.state[i] == State::Upper {
+                    self.u[i]
+                } else {
+                    self.l[i]
+                };
+                for t in a..b {
+                    let j = self.g.cols[t];
+                    if w.fixed_by[j] == NONE {
+                        count += 1;
+                        unknown = t;
+                    } else {
+                        rest -= self.g.values[t] * w.x[j];
+                    }
+                }
+                match count {
+                    0 => {
+                        w.state[i] = State::Dropped;
+                        w.equalities.swap_remove(e);
+                        changed = true;
+                    }
+                    1 => {
+                        let j = self.g.cols[unknown];
+                        w.x[j] = rest / self.g.values[unknown];
+                        w.fixed_by[j] = i;
+                        w.fix_order.push(i);
+                        w.equalities.swap_remove(e);
+                        changed = true;
+                    }
+                    _ => e += 1,
+                }
+            }
+            if !changed {
+                break;
             }
         }
         let mut k = 0;
@@ -293,7 +376,7 @@ impl DenseQp {
     /// Every row's multiplier at the candidate: the equalities' from the
     /// solve, the fixing rows' from the stationarity of their variable,
     /// the penalised rows' from their penalty's slope, zero elsewhere.
-    fn recover_multipliers(&mut self) {
+    pub(super) fn recover_multipliers(&mut self) -> bool {
         let (n, m) = (self.variables(), self.rows());
         let w = &mut self.polisher;
         let free = (0..n).filter(|&j| w.position[j] != NONE).count();
@@ -326,21 +409,31 @@ impl DenseQp {
                 }
             }
         }
-        for j in 0..n {
-            let i = w.fixed_by[j];
-            if i != NONE {
-                let gij = self.g.values[self.g.start[i]];
-                w.y[i] = -w.grad[j] / gij;
-                w.grad[j] = 0.0;
+        // The fixing rows last to first: a row fixed later may involve a
+        // variable fixed earlier, never the other way round, so each
+        // row's variable has every other multiplier in its gradient.
+        for f in (0..w.fix_order.len()).rev() {
+            let i = w.fix_order[f];
+            let (a, b) = (self.g.start[i], self.g.start[i + 1]);
+            // A fixing row fixed one of its own variables.
+            let Some(t) = (a..b).find(|&t| w.fixed_by[self.g.cols[t]] == i) else {
+                return false;
+            };
+            let j = self.g.cols[t];
+            let yi = -w.grad[j] / self.g.values[t];
+            w.y[i] = yi;
+            for t in a..b {
+                w.grad[self.g.cols[t]] += self.g.values[t] * yi;
             }
         }
+        true
     }
 
     /// The candidate's optimality: stationarity (the free variables'
     /// gradient, to the dual tolerance), feasibility of every row, and
     /// each multiplier's sign and range for its row's state, in the
     /// problem's unscaled units.
-    fn optimal(&self) -> bool {
+    pub(super) fn optimal(&self) -> bool {
         let s = self.settings;
         let w = &self.polisher;
         let (n, m) = (self.variables(), self.rows());
