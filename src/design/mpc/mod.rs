@@ -68,6 +68,31 @@ pub use qp::{DenseQp, QpReport, QpSettings, QpStatus, Row};
 use crate::error::Error;
 use condensed::OutputRows;
 
+/// An [`MpcDesign`]'s solver settings unless changed: [`QpSettings`]'
+/// defaults with at most 200 ADMM iterations per tick (the active-set
+/// method's 50 solves and the polish before them settle almost every
+/// tick; the bound is what a tick that needs ADMM may spend).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::design::mpc::{MPC_SOLVER, QpSettings};
+/// assert_eq!(MPC_SOLVER.max_iterations, 200);
+/// assert_eq!(MPC_SOLVER.active_set_steps, QpSettings::default().active_set_steps);
+/// ```
+pub const MPC_SOLVER: QpSettings = QpSettings {
+    max_iterations: 200,
+    eps_abs: 1e-6,
+    eps_rel: 1e-6,
+    eps_infeasible: 1e-6,
+    rho: 0.1,
+    sigma: 1e-6,
+    alpha: 1.6,
+    adaptive_rho: true,
+    polish: true,
+    active_set_steps: 50,
+};
+
 /// Inputs over the horizon at most (`M · horizon`): bounds the QP's size,
 /// so the memory and the time of a tick.
 pub const MAX_VARIABLES: usize = 400;
@@ -147,8 +172,8 @@ pub struct MpcDesign<const N: usize, const M: usize> {
     /// the reference's units (> 0; `+∞` by default): integral separation,
     /// so a large step's transient winds nothing up.
     pub integral_zone: f64,
-    /// The QP solver's settings; `max_iterations` bounds each tick's work
-    /// (default 200).
+    /// The QP solver's settings; `max_iterations` and `active_set_steps`
+    /// bound each tick's work ([`MPC_SOLVER`] by default).
     pub solver: QpSettings,
 }
 
@@ -171,10 +196,7 @@ impl<const N: usize, const M: usize> MpcDesign<N, M> {
             output_limits: Vec::new(),
             integral_gain: 0.0,
             integral_zone: f64::INFINITY,
-            solver: QpSettings {
-                max_iterations: 200,
-                ..QpSettings::default()
-            },
+            solver: MPC_SOLVER,
         }
     }
 
