@@ -468,7 +468,7 @@ fn the_mpc_tick_allocates_nothing() {
     let model = lqi::position_model(&MassSpring::nominal(), 0.002).unwrap();
     let mut c = mpc::design(&model, Cart::Two, &cal).unwrap();
     let mut x = SVector::<f64, 4>::zeros();
-    let mut tick = |c: &mut mpc::PositionsMpc, x: &mut SVector<f64, 4>, r: f64| {
+    let tick = |c: &mut mpc::PositionsMpc, x: &mut SVector<f64, 4>, r: f64| {
         let u = c.update(x, &vector![r]);
         c.applied(&u);
         *x = model.a() * *x + model.b() * u;
@@ -482,5 +482,8 @@ fn the_mpc_tick_allocates_nothing() {
     });
     let stats = *c.inner().stats();
     assert_eq!(n, 0, "{stats}");
-    assert!(stats.active_set_steps_max > 0, "the active-set method ran: {stats}");
+    assert!(
+        stats.active_set_steps_max > 0,
+        "the active-set method ran: {stats}"
+    );
 }

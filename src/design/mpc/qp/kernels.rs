@@ -4,6 +4,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::QpSettings;
+use crate::error::Error;
+
 /// OSQP's bounds on a Ruiz scaling factor, and its number of passes.
 const MIN_SCALING: f64 = 1e-4;
 const MAX_SCALING: f64 = 1e4;
@@ -225,4 +228,53 @@ pub(super) fn lu_solve(
         }
     }
     b[..k].copy_from_slice(&work[..k]);
+}
+
+/// Each setting within its range, named if not.
+pub(super) fn validate_settings(s: &QpSettings) -> Result<(), Error> {
+    let checks: [(&'static str, f64, bool, &'static str); 6] = [
+        (
+            "max_iterations",
+            s.max_iterations as f64,
+            s.max_iterations >= 1,
+            "at least one iteration",
+        ),
+        (
+            "eps_abs",
+            s.eps_abs,
+            s.eps_abs > 0.0,
+            "must be finite and > 0",
+        ),
+        (
+            "eps_rel",
+            s.eps_rel,
+            s.eps_rel >= 0.0,
+            "must be finite and ≥ 0",
+        ),
+        (
+            "eps_infeasible",
+            s.eps_infeasible,
+            s.eps_infeasible > 0.0,
+            "must be finite and > 0",
+        ),
+        ("rho", s.rho, s.rho > 0.0, "must be finite and > 0"),
+        ("sigma", s.sigma, s.sigma > 0.0, "must be finite and > 0"),
+    ];
+    for (name, value, ok, reason) in checks {
+        if !(ok && value.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name,
+                value,
+                reason,
+            });
+        }
+    }
+    if !(s.alpha > 0.0 && s.alpha < 2.0) {
+        return Err(Error::InvalidParameter {
+            name: "alpha",
+            value: s.alpha,
+            reason: "over-relaxation must lie in (0, 2)",
+        });
+    }
+    Ok(())
 }

@@ -4,12 +4,17 @@ use std::time::Instant;
 
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+mod estimator;
+mod requests;
+mod warm;
+
 use super::condensed::{Condensed, OutputRows, span_scale};
 use super::qp::{DenseQp, QpReport, QpStatus};
 use super::{Estimation, MAX_VARIABLES, MpcDesign, MpcStats, TickStatus};
-use crate::design::{Controller, kalman, lqr};
+use crate::design::{Controller, lqr};
 use crate::error::{Error, check_finite};
 use crate::model::{Discrete, StateSpace};
+use estimator::{check_weight, estimator, target_map};
 
 /// A linear model-predictive controller: every period it estimates the
 /// state and an input disturbance from the measurements, finds the steady
@@ -326,55 +331,87 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q
         self.plan.as_slice()
     }
 
-    /// Changes output limit `index` (in the order of the design's
-    /// [`output_limits`](MpcDesign::output_limits)) from the next tick on,
-    /// keeping its kind: an operator's request ("keep cart 2 below 20 mm").
-    /// A hard limit the state already violates makes the next QPs
-    /// infeasible: the controller then falls back and counts it.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::OutOfRange`] for an index past the limits,
-    /// [`Error::InvalidParameter`] for `min > max` or a NaN.
-    ///
-    /// # Examples
-    ///
-    /// ```
-    /// use ctrlab::StateSpace;
-    /// use ctrlab::design::mpc::{Estimation, Mpc, MpcDesign, OutputLimit, Row};
-    /// use ctrlab::nalgebra::matrix;
-    /// let model = StateSpace::discrete(matrix![1.0, 0.1; 0.0, 1.0], matrix![0.005; 0.1],
-    ///                                  matrix![1.0, 0.0], matrix![0.0], 0.1)?;
-    /// let mut design = MpcDesign::new(10, matrix![1.0, 0.0; 0.0, 0.0], matrix![0.1]);
-    /// design.output_limits.push(OutputLimit { output: matrix![1.0, 0.0], min: -2.0, max: 2.0, kind: Row::Hard });
-    /// let estimation = Estimation { input_noise: matrix![1e-2], disturbance_noise: matrix![1e-4],
-    ///                               output_disturbance_noise: 0.0,
-    ///                               measurement_noise: matrix![1e-6] };
-    /// let mut mpc = Mpc::new(&model, &matrix![1.0], &design, &estimation)?;
-    /// mpc.set_output_limit(0, -1.0, 1.0)?;
-    /// assert!(mpc.set_output_limit(1, 0.0, 1.0).is_err());
-    /// assert!(mpc.set_output_limit(0, 1.0, 0.0).is_err());
-    /// # Ok::<(), ctrlab::Error>(())
-    /// ```
-    pub fn set_output_limit(&mut self, index: usize, min: f64, max: f64) -> Result<(), Error> {
-        let len = self.outputs.lower.len();
-        if index >= len {
-            return Err(Error::OutOfRange {
-                what: "output limit",
-                index,
-                len,
-            });
+    /// One tick from the current estimate: target, QP data, warm start,
+    /// solve or fallback, clip; the counts. Allocates nothing.
+    fn tick(&mut self, r: &SVector<f64, R>) -> SVector<f64, M> {
+        let started = Instant::now();
+        self.steady_state(r);
+        for i in 0..N {
+            self.dx0[i] = self.estimate[i] - self.steady[i];
         }
-        if min.is_nan() || max.is_nan() || min > max {
-            return Err(Error::InvalidParameter {
-                name: "min",
-                value: min,
-                reason: "an output limit must satisfy min ≤ max (not NaN)",
-            });
+        if !self.reachable() {
+            self.stats.unreachable_targets += 1;
         }
-        self.outputs.lower[index] = min;
-        self.outputs.upper[index] = max;
-        Ok(())
+        self.problem_data();
+        if self.plan_age < self.problem.horizon {
+            self.warm_start();
+        } else {
+            self.rollout_warm_start();
+        }
+        let report = self.qp.solve(
+            self.q.as_slice(),
+            self.lower.as_slice(),
+            self.upper.as_slice(),
+        );
+        self.report = report.as_ref().ok().copied();
+        if let Some(r) = self.report {
+            self.stats.active_set_steps_max =
+                self.stats.active_set_steps_max.max(r.active_set_steps);
+        }
+        let u = match report {
+            Ok(report) if report.status.is_solved() => {
+                self.stats.solved += 1;
+                self.stats.iterations_total += report.iterations;
+                self.stats.iterations_max = self.stats.iterations_max.max(report.iterations);
+                let x = self.qp.solution();
+                for k in 0..self.problem.horizon {
+                    for i in 0..M {
+                        self.plan[k * M + i] = self.steady[N + i] + x[k * M + i];
+                    }
+                }
+                self.plan_age = 1;
+                self.last = TickStatus::Solved {
+                    iterations: report.iterations,
+                };
+                SVector::<f64, M>::from_fn(|i, _| self.plan[i])
+            }
+            Ok(report) => {
+                self.stats.iterations_total += report.iterations;
+                self.stats.iterations_max = self.stats.iterations_max.max(report.iterations);
+                match report.status {
+                    QpStatus::PrimalInfeasible => self.stats.infeasible += 1,
+                    _ => self.stats.iteration_limit += 1,
+                }
+                self.fallback(report.status)
+            }
+            // Finite data of the right lengths by construction; were it
+            // refused, the fallback is still safe.
+            Err(_) => {
+                self.stats.iteration_limit += 1;
+                self.fallback(QpStatus::IterationLimit)
+            }
+        };
+        let u = self.clip(u);
+        let elapsed = started.elapsed().as_secs_f64();
+        self.stats.solve_time_max = self.stats.solve_time_max.max(elapsed);
+        if u.iter().all(|v| v.is_finite()) {
+            u
+        } else {
+            self.clip(self.u_prev)
+        }
+    }
+
+    /// Whether the target's inputs lie within the input limits.
+    fn reachable(&self) -> bool {
+        (0..M).all(|i| {
+            let us = self.steady[N + i];
+            us >= self.input_min[i] && us <= self.input_max[i]
+        })
+    }
+
+    /// Whether an input is at its limit.
+    fn limited(&self, u: &SVector<f64, M>) -> bool {
+        (0..M).any(|i| u[i] <= self.input_min[i] || u[i] >= self.input_max[i])
     }
 
     /// The horizon, in periods.
@@ -455,119 +492,6 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q
         self.lower.component_mul_assign(&self.problem.row_scale);
         self.upper.component_mul_assign(&self.problem.row_scale);
     }
-
-    /// The previous plan shifted one step, relative to the new `u_s`, as
-    /// the warm start, with its multipliers shifted alike.
-    fn warm_start(&mut self) {
-        let (h, mh) = (self.problem.horizon, M * self.problem.horizon);
-        // Shifted, and clipped along the chain from the input last applied
-        // (which the drive rounded) to the input and rate limits: a start
-        // that holds the hard rows, as the active-set method needs.
-        let mut previous = self.u_prev;
-        for k in 0..h {
-            let from = (k + 1).min(h - 1);
-            for i in 0..M {
-                let u = self.clip_from(previous[i], i, self.plan[from * M + i]);
-                previous[i] = u;
-                self.shifted[k * M + i] = u - self.steady[N + i];
-            }
-        }
-        // The multipliers' blocks (inputs, rates, outputs), each shifted.
-        let y = self.qp.multipliers();
-        let l = self.outputs.c.nrows();
-        let blocks = [
-            (0, M),
-            (mh, if self.problem.rate_rows > 0 { M } else { 0 }),
-            (mh + self.problem.rate_rows, l),
-        ];
-        for (start, width) in blocks {
-            for k in 0..h {
-                let from = (k + 1).min(h - 1);
-                for i in 0..width {
-                    self.shifted_y[start + k * width + i] = y[start + from * width + i];
-                }
-            }
-        }
-        // Finite by construction (a solved plan, finite targets).
-        let _ = self
-            .qp
-            .warm_start(self.shifted.as_slice(), Some(self.shifted_y.as_slice()));
-    }
-
-    /// With no plan to shift (the first tick, or a plan run out): the LQR
-    /// law clipped to the limits, rolled out over the horizon on the
-    /// model, as the warm start. A saturated transient's plan is mostly
-    /// this, so the first solve starts near its answer.
-    fn rollout_warm_start(&mut self) {
-        self.roll_x.copy_from(&self.dx0);
-        let mut previous = self.u_prev;
-        for k in 0..self.problem.horizon {
-            // u = u_s − K [δx; z], clipped.
-            self.roll_u.gemv(-1.0, &self.lqr_gain, &self.roll_x, 0.0);
-            for i in 0..M {
-                let us = self.steady[N + i];
-                let u = self.clip_from(previous[i], i, us + self.roll_u[i]);
-                previous[i] = u;
-                self.roll_u[i] = u - us;
-                self.shifted[k * M + i] = u - us;
-            }
-            self.roll_next.gemv(1.0, &self.pa, &self.roll_x, 0.0);
-            self.roll_next.gemv(1.0, &self.pb, &self.roll_u, 1.0);
-            self.roll_x.copy_from(&self.roll_next);
-        }
-        if self.shifted.iter().all(|v| v.is_finite()) {
-            let _ = self.qp.warm_start(self.shifted.as_slice(), None);
-        }
-    }
-
-    /// `u` clipped to the input limits and the rate limit from `u_prev`.
-    fn clip(&self, mut u: SVector<f64, M>) -> SVector<f64, M> {
-        for i in 0..M {
-            u[i] = self.clip_from(self.u_prev[i], i, u[i]);
-        }
-        u
-    }
-
-    /// Input `i`'s value `u` clipped to its limits and to the rate limit
-    /// from `previous`. An empty window (`previous` outside the limits by
-    /// more than the rate) honours the input limits first.
-    fn clip_from(&self, previous: f64, i: usize, u: f64) -> f64 {
-        let (lo, hi) = (
-            (previous - self.rate_max[i]).max(self.input_min[i]),
-            (previous + self.rate_max[i]).min(self.input_max[i]),
-        );
-        if lo <= hi {
-            u.clamp(lo, hi)
-        } else {
-            u.clamp(self.input_min[i], self.input_max[i])
-        }
-    }
-
-    /// The fallback input when the QP gave none: the plan shifted while
-    /// it lasts, else the LQR law about the target.
-    fn fallback(&mut self, reason: QpStatus) -> SVector<f64, M> {
-        let h = self.problem.horizon;
-        let us = SVector::<f64, M>::from_fn(|i, _| self.steady[N + i]);
-        let shifted = self.plan_age < h;
-        let u = if shifted {
-            let k = self.plan_age;
-            self.plan_age += 1;
-            SVector::<f64, M>::from_fn(|i, _| self.plan[k * M + i])
-        } else {
-            self.roll_u.gemv(-1.0, &self.lqr_gain, &self.dx0, 0.0);
-            us + SVector::<f64, M>::from_fn(|i, _| self.roll_u[i])
-        };
-        self.last = TickStatus::Fallback {
-            reason,
-            shifted_plan: shifted,
-        };
-        if shifted {
-            self.stats.fallback_shifted += 1;
-        } else {
-            self.stats.fallback_lqr += 1;
-        }
-        u
-    }
 }
 
 impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<Q, R, M>
@@ -581,74 +505,12 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
             self.last = TickStatus::InvalidInput;
             return self.clip(self.u_prev);
         }
-        let started = Instant::now();
         self.correct(y);
-        self.steady_state(r);
-        for i in 0..N {
-            self.dx0[i] = self.estimate[i] - self.steady[i];
-        }
-        let reachable = (0..M).all(|i| {
-            let us = self.steady[N + i];
-            us >= self.input_min[i] && us <= self.input_max[i]
-        });
-        if !reachable {
-            self.stats.unreachable_targets += 1;
-        }
-        self.problem_data();
-        if self.plan_age < self.problem.horizon {
-            self.warm_start();
-        } else {
-            self.rollout_warm_start();
-        }
-        let report = self.qp.solve(
-            self.q.as_slice(),
-            self.lower.as_slice(),
-            self.upper.as_slice(),
-        );
-        self.report = report.as_ref().ok().copied();
-        if let Some(r) = self.report {
-            self.stats.active_set_steps_max =
-                self.stats.active_set_steps_max.max(r.active_set_steps);
-        }
-        let u = match report {
-            Ok(report) if report.status.is_solved() => {
-                self.stats.solved += 1;
-                self.stats.iterations_total += report.iterations;
-                self.stats.iterations_max = self.stats.iterations_max.max(report.iterations);
-                let x = self.qp.solution();
-                for k in 0..self.problem.horizon {
-                    for i in 0..M {
-                        self.plan[k * M + i] = self.steady[N + i] + x[k * M + i];
-                    }
-                }
-                self.plan_age = 1;
-                self.last = TickStatus::Solved {
-                    iterations: report.iterations,
-                };
-                SVector::<f64, M>::from_fn(|i, _| self.plan[i])
-            }
-            Ok(report) => {
-                self.stats.iterations_total += report.iterations;
-                self.stats.iterations_max = self.stats.iterations_max.max(report.iterations);
-                match report.status {
-                    QpStatus::PrimalInfeasible => self.stats.infeasible += 1,
-                    _ => self.stats.iteration_limit += 1,
-                }
-                self.fallback(report.status)
-            }
-            // Finite data of the right lengths by construction; were it
-            // refused, the fallback is still safe.
-            Err(_) => {
-                self.stats.iteration_limit += 1;
-                self.fallback(QpStatus::IterationLimit)
-            }
-        };
-        let u = self.clip(u);
+        let u = self.tick(r);
         // The integrated error, z += T (r − H y), frozen while an input
         // is at its limit or the target cannot be held (conditional
         // integration: no windup to unwind afterwards).
-        let limited = (0..M).any(|i| u[i] <= self.input_min[i] || u[i] >= self.input_max[i]);
-        if self.integral_gain > 0.0 && !limited && reachable {
+        if self.integral_gain > 0.0 && !self.limited(&u) && self.reachable() {
             for i in 0..R {
                 let measured: f64 = (0..Q).map(|j| self.tracked[(i, j)] * y[j]).sum();
                 let error = r[i] - measured;
@@ -657,13 +519,7 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
                 }
             }
         }
-        let elapsed = started.elapsed().as_secs_f64();
-        self.stats.solve_time_max = self.stats.solve_time_max.max(elapsed);
-        if u.iter().all(|v| v.is_finite()) {
-            u
-        } else {
-            self.clip(self.u_prev)
-        }
+        u
     }
 
     fn applied(&mut self, u: &SVector<f64, M>) {
@@ -694,156 +550,5 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Controller<
 
     fn period(&self) -> Option<f64> {
         Some(self.dt)
-    }
-}
-
-/// `[x_s; u_s] = T · [B d; r]`: the least-squares (minimum-norm) steady
-/// state of `(I − A) x − B u = B d`, `T x = r`.
-fn target_map<const R: usize, const N: usize>(
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
-    tracked: &SMatrix<f64, R, N>,
-) -> Result<DMatrix<f64>, Error> {
-    let (n, m) = (a.nrows(), b.ncols());
-    let mut k = DMatrix::zeros(n + R, n + m);
-    k.view_mut((0, 0), (n, n))
-        .copy_from(&(DMatrix::identity(n, n) - a));
-    k.view_mut((0, n), (n, m)).copy_from(&(-b));
-    for i in 0..R {
-        for j in 0..n {
-            k[(n + i, j)] = tracked[(i, j)];
-        }
-    }
-    let svd = k.clone().svd(true, true);
-    let largest = svd.singular_values.max();
-    let rank_needed = (n + R).min(n + m);
-    let tol = largest * (n + m) as f64 * f64::EPSILON * 1e3;
-    let rank = svd.singular_values.iter().filter(|&&s| s > tol).count();
-    if rank < rank_needed || !largest.is_finite() {
-        return Err(Error::Singular {
-            operation: "MPC steady-state target (a plant zero at z = 1 blocks the tracked outputs)",
-        });
-    }
-    svd.pseudo_inverse(tol).map_err(|_| Error::Singular {
-        operation: "MPC steady-state target",
-    })
-}
-
-/// The augmented model `[x; d_u; d_y]` and its current-form Kalman gain.
-type Augmented = (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>, DMatrix<f64>);
-
-/// The estimator of the state and `Q` disturbances: one on each input
-/// (`x⁺ = A x + B (u + d_u)`) and one on each direction of the
-/// measurements the tracked outputs do not see (`y = C x + N d_y`, `H N =
-/// 0`), so there are as many disturbances as measurements when `R = M`:
-/// the condition (Pannocchia and Rawlings, 2003) under which the tracked
-/// outputs settle on the reference without offset whatever constant
-/// mismatch the model has.
-fn estimator<const N: usize, const M: usize, const Q: usize, const R: usize>(
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
-    model: &StateSpace<N, M, Q, Discrete>,
-    tracked: &SMatrix<f64, R, Q>,
-    estimation: &Estimation<M, Q>,
-) -> Result<Augmented, Error> {
-    // N: an orthonormal basis of the measurements' directions H ignores.
-    let h = DMatrix::from_column_slice(R, Q, tracked.as_slice());
-    let svd = h.clone().svd(false, true);
-    let v_t = svd.v_t.unwrap_or_else(|| DMatrix::zeros(0, Q));
-    let tol = svd.singular_values.max() * Q as f64 * f64::EPSILON * 1e3;
-    let rank = svd.singular_values.iter().filter(|&&s| s > tol).count();
-    let full = DMatrix::<f64>::identity(Q, Q);
-    // Q − rank directions orthogonal to the row space of H.
-    let mut basis = full.clone();
-    for r in 0..rank {
-        let row = v_t.row(r).transpose();
-        let projection = &row * (row.transpose() * &basis);
-        basis -= projection;
-    }
-    let walk = estimation.output_disturbance_noise;
-    if !(walk.is_finite() && walk >= 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "output_disturbance_noise",
-            value: walk,
-            reason: "a variance must be finite and ≥ 0",
-        });
-    }
-    // Disturbances are modelled only where they have noise: none at all
-    // leaves a plain Kalman filter (offset-free then only by integral
-    // action).
-    let nu = if estimation.disturbance_noise.iter().any(|&v| v != 0.0) {
-        M
-    } else {
-        0
-    };
-    let out = if walk > 0.0 {
-        basis.qr().q().columns(0, Q - rank).into_owned()
-    } else {
-        DMatrix::zeros(Q, 0)
-    };
-    let ny = out.ncols();
-    let nd = nu + ny;
-    let na = N + nd;
-    let mut a_aug = DMatrix::zeros(na, na);
-    a_aug.view_mut((0, 0), (N, N)).copy_from(a);
-    a_aug.view_mut((0, N), (N, nu)).copy_from(&b.columns(0, nu));
-    a_aug.view_mut((N, N), (nd, nd)).fill_with_identity();
-    let mut b_aug = DMatrix::zeros(na, M);
-    b_aug.view_mut((0, 0), (N, M)).copy_from(b);
-    let mut c_aug = DMatrix::zeros(Q, na);
-    c_aug
-        .view_mut((0, 0), (Q, N))
-        .copy_from(&DMatrix::from_column_slice(Q, N, model.c().as_slice()));
-    c_aug.view_mut((0, N + nu), (Q, ny)).copy_from(&out);
-    // Noise: on the input (through B), on the input disturbances' walk,
-    // and on the output disturbances' walk.
-    let mut g = DMatrix::zeros(na, M + nd);
-    g.view_mut((0, 0), (N, M)).copy_from(b);
-    g.view_mut((N, M), (nd, nd)).fill_with_identity();
-    let mut qn = DMatrix::zeros(M + nd, M + nd);
-    qn.view_mut((0, 0), (M, M))
-        .copy_from(&DMatrix::from_column_slice(
-            M,
-            M,
-            estimation.input_noise.as_slice(),
-        ));
-    if nu > 0 {
-        qn.view_mut((M, M), (M, M))
-            .copy_from(&DMatrix::from_column_slice(
-                M,
-                M,
-                estimation.disturbance_noise.as_slice(),
-            ));
-    }
-    for i in 0..ny {
-        qn[(M + nu + i, M + nu + i)] = walk;
-    }
-    let rn = DMatrix::from_column_slice(Q, Q, estimation.measurement_noise.as_slice());
-    let kf = kalman::estimator(&a_aug, &c_aug, &g, &qn, &rn, Some(model.dt()))?;
-    let gain = kf.current_gain.ok_or(Error::Singular {
-        operation: "MPC disturbance estimator (current form)",
-    })?;
-    Ok((a_aug, b_aug, c_aug, gain))
-}
-
-/// `S` symmetric positive semidefinite (the rate weight; `Q` and `R` are
-/// checked by the Riccati design).
-fn check_weight(name: &'static str, s: &DMatrix<f64>) -> Result<(), Error> {
-    crate::error::check_finite_dyn(name, s)?;
-    let n = s.nrows();
-    let tol = 1e-12 * s.amax().max(f64::MIN_POSITIVE);
-    let symmetric = (0..n).all(|i| (0..i).all(|j| (s[(i, j)] - s[(j, i)]).abs() <= tol));
-    let psd = symmetric
-        && s.clone()
-            .symmetric_eigenvalues()
-            .iter()
-            .all(|&l| l >= -tol * n as f64);
-    if psd {
-        Ok(())
-    } else {
-        Err(Error::InvalidMatrix {
-            matrix: name,
-            reason: "must be symmetric positive semidefinite",
-        })
     }
 }
