@@ -10,7 +10,13 @@
 //!   encoders' counts) that took the most active-set solves, replayed from
 //!   a copy of the controller taken just before it.
 //!
-//! The step and worst ticks run on a fresh copy each time (its memory
+//! - *budget spent*: the step's first tick with tolerances no iterate
+//!   meets, so it runs every bound out (a polish, 50 active-set solves,
+//!   200 ADMM iterations with a polish every 10) and falls back: the most
+//!   work any tick can do, whatever the state; and the same with the
+//!   real-time budget (`lab::mpc::TICK_TIME_LIMIT`), the most time.
+//!
+//! The step, worst and budget ticks run on a fresh copy each time (its memory
 //! just written, so they include the cache misses a copy brings).
 //!
 //! `scripts/mpc_vs_python.py` times python-control's MPC on the same
@@ -18,6 +24,7 @@
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use ctrlab::Controller;
+use ctrlab::design::mpc::{MPC_SOLVER, QpSettings};
 use ctrlab::lab::{Calibration, Cart, MassSpring, lqi, mpc};
 use ctrlab::nalgebra::{SVector, vector};
 use ctrlab::sim::run_sampled;
@@ -105,6 +112,47 @@ fn benches(c: &mut Criterion) {
         )
         .unwrap();
         let (steps, before, y) = watch.worst.expect("ticks ran");
+        // Tolerances no iterate meets: every bound runs out. Without a time
+        // limit that is the most work a tick can do; with the wall-clock
+        // one (`Tuning::REAL_TIME`) the most time.
+        for (what, time_limit) in [
+            ("", None),
+            (", real-time budget", Some(mpc::TICK_TIME_LIMIT)),
+        ] {
+            let unmet = QpSettings {
+                eps_abs: f64::MIN_POSITIVE,
+                eps_rel: 0.0,
+                time_limit,
+                ..MPC_SOLVER
+            };
+            let spent = mpc::design_with(
+                &model,
+                Cart::Two,
+                &cal,
+                &mpc::Tuning {
+                    solver: unmet,
+                    ..tuning
+                },
+            )
+            .unwrap();
+            let mut trial = spent.clone();
+            trial.update(&SVector::zeros(), &setpoint);
+            let report = trial.inner().last_report().expect("a solve ran");
+            let counts = format!(
+                "{} active-set solves, {} ADMM iterations, {:?}",
+                report.active_set_steps, report.iterations, report.status
+            );
+            c.bench_function(
+                &format!("MPC tick, budget spent{what} ({counts}), horizon {horizon}"),
+                |b| {
+                    b.iter_batched_ref(
+                        || spent.clone(),
+                        |ctrl| ctrl.update(black_box(&SVector::zeros()), black_box(&setpoint)),
+                        BatchSize::SmallInput,
+                    )
+                },
+            );
+        }
         c.bench_function(
             &format!("MPC tick, worst of a step ({steps} active-set solves), horizon {horizon}"),
             |b| {

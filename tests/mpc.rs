@@ -308,6 +308,36 @@ fn a_solver_out_of_iterations_falls_back_and_counts_it() {
 }
 
 #[test]
+fn a_solver_out_of_time_falls_back_within_the_limits_and_counts_it() {
+    // A nanosecond is spent before the first check: every tick whose warm
+    // start the first polish cannot finish stops at the time limit.
+    let model = double_integrator();
+    let mut design = limited_design();
+    design.solver.time_limit = Some(std::time::Duration::from_nanos(1));
+    design.solver.polish = false;
+    let mut mpc = Mpc::new(&model, &matrix![1.0], &design, &trusting()).unwrap();
+    let mut x = vector![0.0, 0.0];
+    for _ in 0..50 {
+        let u = mpc.update(&(model.c() * x), &vector![1.0]);
+        assert!(u[0].abs() <= 0.5);
+        mpc.applied(&u);
+        x = model.advance(&x, &u);
+    }
+    let stats = *mpc.stats();
+    assert_eq!(
+        (stats.time_limit, stats.iteration_limit),
+        (50, 0),
+        "{stats}"
+    );
+    assert_eq!(stats.fallbacks(), 50);
+    assert_eq!((stats.iterations_max, stats.active_set_steps_max), (0, 0));
+    // No limit at all is refused by name.
+    design.solver.time_limit = Some(std::time::Duration::ZERO);
+    let err = Mpc::new(&model, &matrix![1.0], &design, &trusting()).unwrap_err();
+    assert!(err.to_string().contains("time_limit"), "{err}");
+}
+
+#[test]
 fn a_non_finite_measurement_holds_the_input_and_reset_forgets_the_run() {
     let model = double_integrator();
     let mut mpc = Mpc::new(&model, &matrix![1.0], &limited_design(), &trusting()).unwrap();

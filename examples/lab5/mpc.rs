@@ -59,6 +59,10 @@ pub fn section(
         let spec = Spec::new(cart, setpoint, calibration.volts_full_scale);
         let mut controller = mpc::design(&model, cart, &calibration)?;
         let predicted = lqi::predict(&rig, &mut controller, setpoint, DURATION)?;
+        // On the wall clock each tick's solve also has a time budget.
+        if backend.real_time() {
+            controller = mpc::design_with(&model, cart, &calibration, &mpc::Tuning::REAL_TIME)?;
+        }
         backend.save(&format!("mpc_cart{n}_predicted"), &predicted)?;
         let predicted = run_of(predicted, controller.inner().stats(), &spec, &rig)?;
         let outcome = backend.experiment(

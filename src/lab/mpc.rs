@@ -36,9 +36,11 @@
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
+use std::time::Duration;
+
 use crate::data::Recording;
 use crate::design::SelectOutputs;
-use crate::design::mpc::{Estimation, Mpc, MpcDesign, OutputLimit, Row};
+use crate::design::mpc::{Estimation, MPC_SOLVER, Mpc, MpcDesign, OutputLimit, QpSettings, Row};
 use crate::error::Error;
 use crate::lab::{self, Calibration, Cart, lqi, position_channel};
 use crate::model::{Discrete, StateSpace};
@@ -97,6 +99,10 @@ pub struct Tuning {
     /// The other cart's reading's offset from the model, its change per
     /// period, m².
     pub output_disturbance_noise: f64,
+    /// The QP solver's settings, which bound each tick's work
+    /// ([`MPC_SOLVER`]: at most 200 ADMM iterations and 50 active-set
+    /// solves).
+    pub solver: QpSettings,
 }
 
 impl Tuning {
@@ -128,8 +134,37 @@ impl Tuning {
         input_noise: lqi::INPUT_NOISE,
         disturbance_noise: 0.0,
         output_disturbance_noise: 0.0,
+        solver: MPC_SOLVER,
+    };
+
+    /// [`Tuning::LAB`] for a loop on the wall clock (the real card,
+    /// `lab5 --real-time`): each solve also stops at [`TICK_TIME_LIMIT`], so
+    /// no tick takes much more than a tenth of the 2 ms period whatever
+    /// the state; a tick stopped there falls back as one out of
+    /// iterations does, counted in [`MpcStats::time_limit`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::mpc::{TICK_TIME_LIMIT, Tuning};
+    /// assert_eq!(Tuning::REAL_TIME.solver.time_limit, Some(TICK_TIME_LIMIT));
+    /// assert_eq!(Tuning::LAB.solver.time_limit, None);
+    /// ```
+    ///
+    /// [`MpcStats::time_limit`]: crate::design::mpc::MpcStats::time_limit
+    pub const REAL_TIME: Self = Self {
+        solver: QpSettings {
+            time_limit: Some(TICK_TIME_LIMIT),
+            ..MPC_SOLVER
+        },
+        ..Self::LAB
     };
 }
+
+/// The solver's wall-clock budget per tick on the real loop, 100 µs:
+/// with the estimate, the target and the fallback around it, a tick stays
+/// within a tenth of the 2 ms period (`benches/mpc.rs`, *budget spent*).
+pub const TICK_TIME_LIMIT: Duration = Duration::from_micros(100);
 
 /// The lab's cases for `calibration`: cart 2 to [`SETPOINT_MARGIN`] inside
 /// its travel limit, cart 1 to [`CART1_SETPOINT`] (m).
@@ -191,6 +226,7 @@ pub fn design_with(
     d.input_min = vector![-volts];
     d.input_max = vector![volts];
     d.rate_max = vector![t.rate_limit];
+    d.solver = t.solver;
     for (i, limit) in calibration.travel_limits.iter().enumerate() {
         let soft = limit - t.travel_margin;
         if soft.is_nan() || soft <= 0.0 {

@@ -3,7 +3,7 @@
 
 use ctrlab::design::mpc::Row;
 use ctrlab::lab::lqi::DURATION;
-use ctrlab::lab::mpc::{CART1_SETPOINT, SETPOINT_MARGIN, Tuning};
+use ctrlab::lab::mpc::{CART1_SETPOINT, SETPOINT_MARGIN, TICK_TIME_LIMIT, Tuning};
 use ctrlab::lab::position_channel;
 
 use super::{ComparePanel, Report, curve};
@@ -21,7 +21,7 @@ impl Report {
             Row::Hard => (f64::INFINITY, f64::INFINITY),
         };
         self.add(&format!(
-            "**Controller** (`lab::mpc::design`, `design::mpc::Mpc`), on the model identified above at {} ms: every period it estimates the state from both positions (a steady-state Kalman filter), finds the steady state that puts the tracked cart on its setpoint, and plans the drive over the next {} periods ({:.0} ms) by a quadratic program: weights {:.0e} /m² on the tracked position, {:.0e} /m² on the other cart, {} /V² on the drive and {} /V² on its change per period; **hard** limits on the drive (±{} V) and on its change ({} V per period); **soft** limits on both carts {} mm inside their travel limits (±{:.1} and ±{:.1} mm), at {:.0e} per metre and {:.0e} per square metre of violation at each predicted step; integral action {} /s within {} mm of the setpoint (a cart held by friction is walked off it). The QP is solved by `DenseQp`: the plan of the last period, shifted and clipped to the hard limits, is polished by an active-set method, with ADMM behind it; each tick is bounded (at most {} ADMM iterations and {} active-set solves), and if that runs out or the hard limits cannot hold, the tick falls back to the last plan shifted, else the LQR law clipped — counted below.\n",
+            "**Controller** (`lab::mpc::design`, `design::mpc::Mpc`), on the model identified above at {} ms: every period it estimates the state from both positions (a steady-state Kalman filter), finds the steady state that puts the tracked cart on its setpoint, and plans the drive over the next {} periods ({:.0} ms) by a quadratic program: weights {:.0e} /m² on the tracked position, {:.0e} /m² on the other cart, {} /V² on the drive and {} /V² on its change per period; **hard** limits on the drive (±{} V) and on its change ({} V per period); **soft** limits on both carts {} mm inside their travel limits (±{:.1} and ±{:.1} mm), at {:.0e} per metre and {:.0e} per square metre of violation at each predicted step; integral action {} /s within {} mm of the setpoint (a cart held by friction is walked off it). The QP is solved by `DenseQp`: the plan of the last period, shifted and clipped to the hard limits, is polished by an active-set method, with ADMM behind it; each tick is bounded (at most {} ADMM iterations and {} active-set solves; on the wall clock, the card or `--real-time`, also {} µs of solving), and if that runs out or the hard limits cannot hold, the tick falls back to the last plan shifted, else the LQR law clipped — counted below.\n",
             PERIOD_MS,
             t.horizon,
             t.horizon as f64 * PERIOD_MS,
@@ -40,6 +40,7 @@ impl Report {
             t.integral_zone * 1e3,
             ctrlab::design::mpc::MPC_SOLVER.max_iterations,
             ctrlab::design::mpc::MPC_SOLVER.active_set_steps,
+            TICK_TIME_LIMIT.as_micros(),
         ));
         self.add(&format!(
             "**Cases**: cart 2 to {:.0} mm, {} mm inside its travel limit — holding it there takes most of the drive, so a fixed gain either creeps up to it or overshoots into the stop; cart 1 to Table 6's {:.0} mm. **Prediction**: `run_sampled` on the identified plant with its Coulomb friction, the drive's steps and delay, the encoders' counts (as the Design section). **Rig**: the same controller through `hw::run`. Recordings: `runs/mpc_cart{{1,2}}_{{predicted,rig}}.csv`.\n",

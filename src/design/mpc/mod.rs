@@ -91,6 +91,7 @@ pub const MPC_SOLVER: QpSettings = QpSettings {
     adaptive_rho: true,
     polish: true,
     active_set_steps: 50,
+    time_limit: None,
 };
 
 /// Inputs over the horizon at most (`M · horizon`): bounds the QP's size,
@@ -341,6 +342,8 @@ pub struct MpcStats {
     pub solved: usize,
     /// Solves that ran out of iterations.
     pub iteration_limit: usize,
+    /// Solves that ran out of time ([`QpSettings::time_limit`]).
+    pub time_limit: usize,
     /// Solves whose hard limits could not hold.
     pub infeasible: usize,
     /// Fallbacks served by the previous plan.
@@ -384,7 +387,7 @@ impl std::fmt::Display for MpcStats {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "ticks {}, solved {}, fallbacks {} ({} shifted plan, {} LQR; {} at the iteration limit, {} infeasible), \
+            "ticks {}, solved {}, fallbacks {} ({} shifted plan, {} LQR; {} at the iteration limit, {} at the time limit, {} infeasible), \
              unreachable targets {}, invalid inputs {}, iterations max {} mean {:.1}, active-set solves max {}, longest tick {:.1} µs",
             self.ticks,
             self.solved,
@@ -392,6 +395,7 @@ impl std::fmt::Display for MpcStats {
             self.fallback_shifted,
             self.fallback_lqr,
             self.iteration_limit,
+            self.time_limit,
             self.infeasible,
             self.unreachable_targets,
             self.invalid_inputs,

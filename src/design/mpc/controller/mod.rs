@@ -380,6 +380,7 @@ impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q
                 self.stats.iterations_max = self.stats.iterations_max.max(report.iterations);
                 match report.status {
                     QpStatus::PrimalInfeasible => self.stats.infeasible += 1,
+                    QpStatus::TimeLimit => self.stats.time_limit += 1,
                     _ => self.stats.iteration_limit += 1,
                 }
                 self.fallback(report.status)

@@ -9,6 +9,8 @@
 //! few from a plan shifted by a period, where ADMM needs hundreds of
 //! iterations after a step of the reference.
 
+use std::time::Instant;
+
 use super::DenseQp;
 use super::polish::State;
 
@@ -21,9 +23,9 @@ fn binding(state: State) -> bool {
 impl DenseQp {
     /// Runs the active-set method from the current iterate `x` (scaled) for
     /// at most `steps` linear solves; true with the iterate replaced by the
-    /// optimum, false (iterate untouched) if `x` violates a hard row or the
-    /// steps run out.
-    pub(super) fn active_set(&mut self, steps: usize) -> bool {
+    /// optimum, false (iterate untouched) if `x` violates a hard row, or the
+    /// steps or the time to `deadline` run out.
+    pub(super) fn active_set(&mut self, steps: usize, deadline: Option<Instant>) -> bool {
         self.active_set_steps = 0;
         let m = self.rows();
         let tol = self.settings.eps_abs;
@@ -54,6 +56,9 @@ impl DenseQp {
         let mut freed = usize::MAX;
         self.polisher.tabu.fill(false);
         for _ in 0..steps {
+            if deadline.is_some_and(|d| Instant::now() >= d) {
+                return false;
+            }
             self.active_set_steps += 1;
             let w = &mut self.polisher;
             w.state.copy_from_slice(&w.working);

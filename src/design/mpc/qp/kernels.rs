@@ -276,5 +276,12 @@ pub(super) fn validate_settings(s: &QpSettings) -> Result<(), Error> {
             reason: "over-relaxation must lie in (0, 2)",
         });
     }
+    if s.time_limit.is_some_and(|t| t.is_zero()) {
+        return Err(Error::InvalidParameter {
+            name: "time_limit",
+            value: 0.0,
+            reason: "must be > 0 s, or None for no limit",
+        });
+    }
     Ok(())
 }

@@ -16,6 +16,8 @@ mod admm;
 mod kernels;
 mod polish;
 
+use std::time::{Duration, Instant};
+
 use nalgebra::{DMatrix, DVector};
 
 use crate::error::{Error, check_finite_dyn, check_shape};
@@ -96,6 +98,16 @@ pub struct QpSettings {
     /// optimum (a plan shifted by a period, even after a step of the
     /// reference) is solved exactly in that many.
     pub active_set_steps: usize,
+    /// A wall-clock budget for a solve (OSQP's `time_limit`, qpOASES's
+    /// `cputime`), `None` for none. Checked before each active-set solve and
+    /// each ADMM iteration and polish, so a solve ends within one of them
+    /// after it (at most a few tens of µs for the lab's MPC); it then
+    /// reports [`QpStatus::TimeLimit`]. The polish of the warm start comes
+    /// first whatever the limit: it is what solves a typical tick. With a limit
+    /// the outcome depends on the machine's speed and load: leave it `None`
+    /// where runs must reproduce (simulations on virtual time), and set it
+    /// on the wall clock of a real loop. Must be > 0.
+    pub time_limit: Option<Duration>,
 }
 
 impl Default for QpSettings {
@@ -111,6 +123,7 @@ impl Default for QpSettings {
             adaptive_rho: true,
             polish: true,
             active_set_steps: 50,
+            time_limit: None,
         }
     }
 }
@@ -131,6 +144,9 @@ pub enum QpStatus {
     /// [`QpSettings::max_iterations`] ran out first; the iterate is the
     /// last one (usually close, never certified).
     IterationLimit,
+    /// [`QpSettings::time_limit`] ran out first; the iterate is the last
+    /// one (never certified).
+    TimeLimit,
     /// The hard rows cannot all hold: a certificate (a direction of the
     /// multipliers, OSQP's test) proves it.
     PrimalInfeasible,
@@ -413,6 +429,7 @@ impl DenseQp {
     /// # Ok::<(), ctrlab::Error>(())
     /// ```
     pub fn solve(&mut self, q: &[f64], lower: &[f64], upper: &[f64]) -> Result<QpReport, Error> {
+        let started = Instant::now();
         let (n, m) = (self.variables(), self.rows());
         crate::error::check_len("q", n, q.len())?;
         crate::error::check_len("lower", m, lower.len())?;
@@ -445,6 +462,7 @@ impl DenseQp {
         }
 
         let s = self.settings;
+        let deadline = s.time_limit.map(|t| started + t);
         let mut status = QpStatus::IterationLimit;
         let mut iterations = 0;
         // A warm start whose binding rows are still the right ones is
@@ -454,12 +472,16 @@ impl DenseQp {
         // Else the active-set method from the warm start, when it holds
         // the hard rows.
         if !polished && s.active_set_steps > 0 {
-            polished = self.active_set(s.active_set_steps);
+            polished = self.active_set(s.active_set_steps, deadline);
         }
         if polished {
             status = QpStatus::Solved;
         }
         while !polished && iterations < s.max_iterations {
+            if deadline.is_some_and(|d| Instant::now() >= d) {
+                status = QpStatus::TimeLimit;
+                break;
+            }
             iterations += 1;
             self.y_prev.copy_from(&self.y);
             self.iterate();
@@ -482,6 +504,11 @@ impl DenseQp {
                 break;
             }
             if iterations % POLISH_INTERVAL == 0 {
+                // A polish costs several iterations: only with time left.
+                if deadline.is_some_and(|d| Instant::now() >= d) {
+                    status = QpStatus::TimeLimit;
+                    break;
+                }
                 if s.polish && self.polish() {
                     status = QpStatus::Solved;
                     polished = true;
