@@ -2,7 +2,7 @@
 //! [`Controller`](crate::Controller) that plans the inputs over a horizon
 //! every period under hard input and rate limits and soft or hard output
 //! limits, tracks without offset by estimating an input disturbance, and
-//! falls back safely when its solver runs out of iterations; and
+//! falls back safely when its solver runs out of iterations or time; and
 //! [`DenseQp`], the quadratic-program solver under it (ADMM as OSQP runs
 //! it, warm-started, allocation-free after construction).
 //!
