@@ -8,7 +8,9 @@
 #![cfg(feature = "lab")]
 
 use ctrlab::design::dlqr;
-use ctrlab::design::mpc::{Estimation, Mpc, MpcDesign, OutputLimit, QpStatus, Row, TickStatus};
+use ctrlab::design::mpc::{
+    Estimation, Mpc, MpcDesign, MpcStats, OutputLimit, QpStatus, Row, TickStatus,
+};
 use ctrlab::hw::{Clock, LoopConfig, VirtualClock, run};
 use ctrlab::lab::{Calibration, Cart, MassSpring, SimulatedRig, lqi, mpc};
 use ctrlab::{Controller, Error, Recording, StateSpace};
@@ -285,14 +287,11 @@ fn an_infeasible_request_falls_back_within_the_limits_and_is_counted() {
     assert_eq!((before.infeasible, before.fallbacks()), (0, 0), "{before}");
 }
 
-#[test]
-fn a_solver_out_of_iterations_falls_back_and_counts_it() {
+/// The double integrator under `design` for 50 ticks toward 1 from rest,
+/// every input within the ±0.5 limit; the run's counts.
+fn fifty_ticks_to_one(design: &MpcDesign<2, 1>) -> MpcStats {
     let model = double_integrator();
-    let mut design = limited_design();
-    design.solver.max_iterations = 1;
-    design.solver.polish = false;
-    design.solver.active_set_steps = 0;
-    let mut mpc = Mpc::new(&model, &matrix![1.0], &design, &trusting()).unwrap();
+    let mut mpc = Mpc::new(&model, &matrix![1.0], design, &trusting()).unwrap();
     let mut x = vector![0.0, 0.0];
     for _ in 0..50 {
         let u = mpc.update(&(model.c() * x), &vector![1.0]);
@@ -300,7 +299,16 @@ fn a_solver_out_of_iterations_falls_back_and_counts_it() {
         mpc.applied(&u);
         x = model.advance(&x, &u);
     }
-    let stats = *mpc.stats();
+    *mpc.stats()
+}
+
+#[test]
+fn a_solver_out_of_iterations_falls_back_and_counts_it() {
+    let mut design = limited_design();
+    design.solver.max_iterations = 1;
+    design.solver.polish = false;
+    design.solver.active_set_steps = 0;
+    let stats = fifty_ticks_to_one(&design);
     assert!(stats.iteration_limit > 0, "{stats}");
     assert_eq!(stats.iteration_limit + stats.solved, 50);
     assert_eq!(stats.fallbacks(), stats.iteration_limit + stats.infeasible);
@@ -311,19 +319,10 @@ fn a_solver_out_of_iterations_falls_back_and_counts_it() {
 fn a_solver_out_of_time_falls_back_within_the_limits_and_counts_it() {
     // A nanosecond is spent before the first check: every tick whose warm
     // start the first polish cannot finish stops at the time limit.
-    let model = double_integrator();
     let mut design = limited_design();
     design.solver.time_limit = Some(std::time::Duration::from_nanos(1));
     design.solver.polish = false;
-    let mut mpc = Mpc::new(&model, &matrix![1.0], &design, &trusting()).unwrap();
-    let mut x = vector![0.0, 0.0];
-    for _ in 0..50 {
-        let u = mpc.update(&(model.c() * x), &vector![1.0]);
-        assert!(u[0].abs() <= 0.5);
-        mpc.applied(&u);
-        x = model.advance(&x, &u);
-    }
-    let stats = *mpc.stats();
+    let stats = fifty_ticks_to_one(&design);
     assert_eq!(
         (stats.time_limit, stats.iteration_limit),
         (50, 0),
@@ -333,7 +332,7 @@ fn a_solver_out_of_time_falls_back_within_the_limits_and_counts_it() {
     assert_eq!((stats.iterations_max, stats.active_set_steps_max), (0, 0));
     // No limit at all is refused by name.
     design.solver.time_limit = Some(std::time::Duration::ZERO);
-    let err = Mpc::new(&model, &matrix![1.0], &design, &trusting()).unwrap_err();
+    let err = Mpc::new(&double_integrator(), &matrix![1.0], &design, &trusting()).unwrap_err();
     assert!(err.to_string().contains("time_limit"), "{err}");
 }
 

@@ -82,16 +82,7 @@ use condensed::OutputRows;
 /// ```
 pub const MPC_SOLVER: QpSettings = QpSettings {
     max_iterations: 200,
-    eps_abs: 1e-6,
-    eps_rel: 1e-6,
-    eps_infeasible: 1e-6,
-    rho: 0.1,
-    sigma: 1e-6,
-    alpha: 1.6,
-    adaptive_rho: true,
-    polish: true,
-    active_set_steps: 50,
-    time_limit: None,
+    ..QpSettings::DEFAULT
 };
 
 /// Inputs over the horizon at most (`M · horizon`): bounds the QP's size,

@@ -110,21 +110,35 @@ pub struct QpSettings {
     pub time_limit: Option<Duration>,
 }
 
+impl QpSettings {
+    /// The defaults ([`Default::default`]) as a constant, for other
+    /// constants to start from.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::QpSettings;
+    /// assert_eq!(QpSettings::DEFAULT, QpSettings::default());
+    /// assert_eq!(QpSettings::DEFAULT.max_iterations, 4000);
+    /// ```
+    pub const DEFAULT: Self = Self {
+        max_iterations: 4000,
+        eps_abs: 1e-6,
+        eps_rel: 1e-6,
+        eps_infeasible: 1e-6,
+        rho: 0.1,
+        sigma: 1e-6,
+        alpha: 1.6,
+        adaptive_rho: true,
+        polish: true,
+        active_set_steps: 50,
+        time_limit: None,
+    };
+}
+
 impl Default for QpSettings {
     fn default() -> Self {
-        Self {
-            max_iterations: 4000,
-            eps_abs: 1e-6,
-            eps_rel: 1e-6,
-            eps_infeasible: 1e-6,
-            rho: 0.1,
-            sigma: 1e-6,
-            alpha: 1.6,
-            adaptive_rho: true,
-            polish: true,
-            active_set_steps: 50,
-            time_limit: None,
-        }
+        Self::DEFAULT
     }
 }
 
