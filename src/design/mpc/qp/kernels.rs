@@ -78,11 +78,17 @@ pub(super) fn equilibrate(
     let (n, m) = (p.nrows(), g.nrows());
     let mut d = DVector::from_element(n, 1.0);
     let mut e = DVector::from_element(m, 1.0);
+    // A row or column of norm below MIN_SCALING is scaled by at most
+    // 1/√MIN_SCALING, not left alone as OSQP leaves it: OSQP sees a soft
+    // row through its slack (an entry of 1), here a soft row in metres (an
+    // MPC's position of 1e-5 m per N) is all there is, and unscaled it
+    // stalls ADMM (the lab MPC from beyond a limit: 100000 iterations
+    // without convergence, against 270).
     let limit = |norm: f64| {
-        if norm < MIN_SCALING {
-            1.0
+        if norm > 0.0 {
+            1.0 / norm.clamp(MIN_SCALING, MAX_SCALING).sqrt()
         } else {
-            1.0 / norm.min(MAX_SCALING).sqrt()
+            1.0
         }
     };
     let mut dd = DVector::zeros(n);
