@@ -6,8 +6,10 @@
 
 mod common;
 
-use common::qp::{QpFixture, assert_finite, assert_kkt, qp_fixtures, rel_diff};
-use ctrlab::design::mpc::{QpSettings, QpStatus, Row};
+use common::qp::{Qp, QpFixture, assert_finite, assert_kkt, qp_fixtures, rel_diff};
+use ctrlab::Error;
+use ctrlab::design::mpc::{DenseQp, QpSettings, QpStatus, Row};
+use nalgebra::{DMatrix, dmatrix};
 
 /// Iterations allowed on the fixtures: the default 4000 is a controller's
 /// time budget; a few generic fixtures are hard for ADMM (OSQP itself
@@ -108,4 +110,40 @@ fn the_fixtures_hold_random_mpcs_of_the_labs_size() {
         assert!(soft == 2 * n || soft == n, "{}: {soft} soft rows", f.name);
     }
     assert!(mpc.iter().any(|f| f.qp.n() > 40));
+}
+
+/// A problem of one or two variables with unit boxes.
+fn boxed(p: DMatrix<f64>) -> Qp {
+    let n = p.nrows();
+    Qp {
+        p,
+        q: vec![0.1; n],
+        g: DMatrix::identity(n, n),
+        lower: vec![-1.0; n],
+        upper: vec![1.0; n],
+        rows: vec![Row::Hard; n],
+    }
+}
+
+/// An indefinite `P` is a nonconvex problem, refused. (`P + σI + ρ GᵀG`,
+/// the ADMM matrix, factors for this one: ρ GᵀG hides P's negative
+/// eigenvalue, so the factorisation alone does not tell.)
+#[test]
+fn an_indefinite_p_is_refused() {
+    for p in [
+        dmatrix![1.0, 0.0; 0.0, -0.01],
+        dmatrix![1.0, 1.1; 1.1, 1.0],
+        dmatrix![-1e-3],
+    ] {
+        let qp = boxed(p);
+        let r = DenseQp::new(&qp.p, &qp.g, &qp.rows, QpSettings::default());
+        assert!(
+            matches!(r, Err(Error::InvalidMatrix { matrix: "P", .. })),
+            "{:?}: {r:?}",
+            qp.p
+        );
+    }
+    // Semidefinite (rank one) stays accepted.
+    let qp = boxed(dmatrix![1.0, 1.0; 1.0, 1.0]);
+    assert!(DenseQp::new(&qp.p, &qp.g, &qp.rows, QpSettings::default()).is_ok());
 }

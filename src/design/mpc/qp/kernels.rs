@@ -155,6 +155,21 @@ pub(super) fn cholesky_in_place(a: &mut DMatrix<f64>) -> bool {
     true
 }
 
+/// Whether the symmetric `p` (its lower triangle) is positive
+/// semidefinite: Cholesky of `p + τI` in `work`, `τ = 1e-9 ‖p‖`, which the
+/// rounding of a semidefinite `p` (≈ n ε ‖p‖) passes and a negative
+/// eigenvalue beyond `τ` does not.
+pub(super) fn semidefinite(p: &DMatrix<f64>, work: &mut DMatrix<f64>) -> bool {
+    let tau = 1e-9 * p.amax() + f64::MIN_POSITIVE;
+    for j in 0..p.ncols() {
+        for i in j..p.nrows() {
+            work[(i, j)] = p[(i, j)];
+        }
+        work[(j, j)] += tau;
+    }
+    cholesky_in_place(work)
+}
+
 /// LU with partial pivoting of the leading `k × k` block of `a` (column
 /// major, leading dimension `lda`), in place; `perm` receives the row
 /// order. False if a pivot is zero or not finite, or below `tiny` times

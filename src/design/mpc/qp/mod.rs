@@ -26,7 +26,7 @@ const CHECK_INTERVAL: usize = 5;
 /// Iterations between polishing attempts and step-size adaptations (a
 /// multiple of [`CHECK_INTERVAL`]).
 const POLISH_INTERVAL: usize = 10;
-use kernels::{SparseRows, equilibrate, validate_settings};
+use kernels::{SparseRows, equilibrate, semidefinite, validate_settings};
 use polish::Polish;
 
 /// How a row `lᵢ ≤ gᵢᵀ x ≤ uᵢ` of the constraints binds.
@@ -288,7 +288,7 @@ impl DenseQp {
     ///
     /// [`Error::DimensionMismatch`] (`"P"`, `"G"`), [`Error::LengthMismatch`]
     /// (`"rows"`), [`Error::NonFinite`], [`Error::InvalidMatrix`] (`"P"` not
-    /// symmetric or not positive semidefinite: the factorisation fails),
+    /// symmetric or not positive semidefinite),
     /// [`Error::InvalidParameter`] for a setting out of its range or a
     /// negative or non-finite soft weight (`"linear"`, `"quadratic"`).
     ///
@@ -383,7 +383,9 @@ impl DenseQp {
             polisher,
             active_set_steps: 0,
         };
-        if !qp.factor() {
+        // P itself must be semidefinite: ρ GᵀG in the ADMM matrix can hide
+        // an indefinite P (a nonconvex problem) from its factorisation.
+        if !semidefinite(&qp.p, &mut qp.chol) || !qp.factor() {
             return Err(Error::InvalidMatrix {
                 matrix: "P",
                 reason: "must be positive semidefinite",
