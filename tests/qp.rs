@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::qp::{Qp, QpFixture, assert_finite, assert_kkt, qp_fixtures, rel_diff};
+use common::qp::{Qp, QpFixture, assert_finite, assert_kkt, assert_names, qp_fixtures, rel_diff};
 use ctrlab::Error;
 use ctrlab::design::mpc::{DenseQp, QpSettings, QpStatus, Row};
 use nalgebra::{DMatrix, dmatrix};
@@ -146,4 +146,20 @@ fn an_indefinite_p_is_refused() {
     // Semidefinite (rank one) stays accepted.
     let qp = boxed(dmatrix![1.0, 1.0; 1.0, 1.0]);
     assert!(DenseQp::new(&qp.p, &qp.g, &qp.rows, QpSettings::default()).is_ok());
+}
+
+/// `lower = +∞` or `upper = −∞` is no interval (`lower ≤ upper` holds for
+/// two equal infinities): refused, naming the bounds.
+#[test]
+fn a_bound_infinite_on_the_wrong_side_is_refused() {
+    let qp = boxed(DMatrix::identity(2, 2));
+    let inf = f64::INFINITY;
+    for (l, u) in [(inf, inf), (-inf, -inf)] {
+        let mut solver = qp.solver(QpSettings::default());
+        let r = solver.solve(&qp.q, &[-1.0, l], &[1.0, u]);
+        assert_names(r, "bounds");
+        // The solver is still usable.
+        let ok = solver.solve(&qp.q, &qp.lower, &qp.upper).unwrap();
+        assert!(ok.status.is_solved(), "{ok:?}");
+    }
 }

@@ -411,8 +411,9 @@ impl DenseQp {
     /// # Errors
     ///
     /// [`Error::LengthMismatch`] (`"q"`, `"lower"`, `"upper"`),
-    /// [`Error::InvalidData`] for a NaN, an infinite `q`, or `lower > upper`
-    /// (named by index). An unsolved problem is not an error: the report's
+    /// [`Error::InvalidData`] for a NaN, an infinite `q`, `lower > upper`,
+    /// or a bound infinite on the wrong side (`lower = +∞`, `upper = −∞`;
+    /// named by index). An unsolved problem is not an error: the report's
     /// [`QpStatus`] says what happened.
     ///
     /// # Examples
@@ -446,6 +447,10 @@ impl DenseQp {
             }
             if lower[i] > upper[i] {
                 return Err(invalid("bounds", i, "lower bound above the upper"));
+            }
+            // Two equal infinities pass `lower ≤ upper` but bound nothing.
+            if lower[i] == f64::INFINITY || upper[i] == f64::NEG_INFINITY {
+                return Err(invalid("bounds", i, "an infinite bound on the wrong side"));
             }
         }
         for (j, qj) in q.iter().enumerate() {
