@@ -163,3 +163,23 @@ fn a_bound_infinite_on_the_wrong_side_is_refused() {
         assert!(ok.status.is_solved(), "{ok:?}");
     }
 }
+
+/// Finite data whose optimum lies beyond f64's range (`x = −q/p` with
+/// `q = 1e300`, `p = 1e-10`): an `Error::Overflow`, never an `Ok` with a
+/// non-finite solution or objective; the next sensible solve still works.
+#[test]
+fn an_overflowing_solve_is_an_error_not_a_non_finite_answer() {
+    let g = DMatrix::zeros(0, 1);
+    let mut solver = DenseQp::new(&dmatrix![1e-10], &g, &[], QpSettings::default()).unwrap();
+    for q in [1e300, -1e300, f64::MAX] {
+        match solver.solve(&[q], &[], &[]) {
+            Ok(report) => {
+                assert_finite(&solver, &report, QpSettings::default().max_iterations);
+            }
+            Err(e) => assert!(matches!(e, Error::Overflow { .. }), "{e:?}"),
+        }
+    }
+    let report = solver.solve(&[-1e-10], &[], &[]).unwrap();
+    assert!(report.status.is_solved(), "{report:?}");
+    assert!((solver.solution()[0] - 1.0).abs() < 1e-9);
+}

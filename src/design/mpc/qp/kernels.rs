@@ -306,3 +306,11 @@ pub(super) fn validate_settings(s: &QpSettings) -> Result<(), Error> {
     }
     Ok(())
 }
+
+pub(super) fn invalid(what: &'static str, index: usize, reason: &'static str) -> Error {
+    Error::InvalidData {
+        what,
+        index,
+        reason,
+    }
+}

@@ -26,7 +26,7 @@ const CHECK_INTERVAL: usize = 5;
 /// Iterations between polishing attempts and step-size adaptations (a
 /// multiple of [`CHECK_INTERVAL`]).
 const POLISH_INTERVAL: usize = 10;
-use kernels::{SparseRows, equilibrate, semidefinite, validate_settings};
+use kernels::{SparseRows, equilibrate, invalid, semidefinite, validate_settings};
 use polish::Polish;
 
 /// How a row `lᵢ ≤ gᵢᵀ x ≤ uᵢ` of the constraints binds.
@@ -413,8 +413,9 @@ impl DenseQp {
     /// [`Error::LengthMismatch`] (`"q"`, `"lower"`, `"upper"`),
     /// [`Error::InvalidData`] for a NaN, an infinite `q`, `lower > upper`,
     /// or a bound infinite on the wrong side (`lower = +∞`, `upper = −∞`;
-    /// named by index). An unsolved problem is not an error: the report's
-    /// [`QpStatus`] says what happened.
+    /// named by index); [`Error::Overflow`] if the answer would leave f64's
+    /// range (the next solve then starts cold). An unsolved problem is not
+    /// an error: the report's [`QpStatus`] says what happened.
     ///
     /// # Examples
     ///
@@ -529,12 +530,30 @@ impl DenseQp {
         }
         let r = self.residuals();
         self.unscale();
+        let objective = self.objective(q, lower, upper);
+        let finite = [r.prim, r.dual, objective].iter().all(|v| v.is_finite())
+            && self
+                .x_out
+                .iter()
+                .chain(self.y_out.iter())
+                .all(|v| v.is_finite());
+        if !finite {
+            // Finite data far beyond what the scaling brings to order one
+            // (an optimum beyond f64's range) is no answer; the next solve
+            // starts afresh.
+            self.cold_start();
+            self.x_out.fill(0.0);
+            self.y_out.fill(0.0);
+            return Err(Error::Overflow {
+                operation: "QP solve",
+            });
+        }
         Ok(QpReport {
             status,
             iterations,
             primal_residual: r.prim,
             dual_residual: r.dual,
-            objective: self.objective(q, lower, upper),
+            objective,
             rho: self.rho,
             polished,
             active_set_steps: self.active_set_steps,
@@ -596,13 +615,5 @@ impl DenseQp {
     pub fn cold_start(&mut self) {
         self.x.fill(0.0);
         self.y.fill(0.0);
-    }
-}
-
-fn invalid(what: &'static str, index: usize, reason: &'static str) -> Error {
-    Error::InvalidData {
-        what,
-        index,
-        reason,
     }
 }
