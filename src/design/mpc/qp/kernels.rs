@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::QpSettings;
+use super::{QpSettings, Row};
 use crate::error::Error;
 
 /// OSQP's bounds on a Ruiz scaling factor, and its number of passes.
@@ -302,6 +302,32 @@ pub(super) fn validate_settings(s: &QpSettings) -> Result<(), Error> {
             name: "time_limit",
             value: 0.0,
             reason: "must be > 0 s, or None for no limit",
+        });
+    }
+    Ok(())
+}
+
+/// Each soft row's weights finite and ≥ 0, and `p` symmetric.
+pub(super) fn validate_problem(p: &DMatrix<f64>, rows: &[Row]) -> Result<(), Error> {
+    for row in rows {
+        if let Row::Soft { linear, quadratic } = *row {
+            for (name, value) in [("linear", linear), ("quadratic", quadratic)] {
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name,
+                        value,
+                        reason: "a soft row's weight must be finite and ≥ 0",
+                    });
+                }
+            }
+        }
+    }
+    let tol = 1e-12 * p.amax().max(f64::MIN_POSITIVE);
+    let n = p.nrows();
+    if (0..n).any(|i| (0..i).any(|j| (p[(i, j)] - p[(j, i)]).abs() > tol)) {
+        return Err(Error::InvalidMatrix {
+            matrix: "P",
+            reason: "must be symmetric",
         });
     }
     Ok(())

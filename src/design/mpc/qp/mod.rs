@@ -26,7 +26,9 @@ const CHECK_INTERVAL: usize = 5;
 /// Iterations between polishing attempts and step-size adaptations (a
 /// multiple of [`CHECK_INTERVAL`]).
 const POLISH_INTERVAL: usize = 10;
-use kernels::{SparseRows, equilibrate, invalid, semidefinite, validate_settings};
+use kernels::{
+    SparseRows, equilibrate, invalid, semidefinite, validate_problem, validate_settings,
+};
 use polish::Polish;
 
 /// How a row `lᵢ ≤ gᵢᵀ x ≤ uᵢ` of the constraints binds.
@@ -315,26 +317,7 @@ impl DenseQp {
         check_finite_dyn("P", p)?;
         check_finite_dyn("G", g)?;
         validate_settings(&settings)?;
-        for row in rows {
-            if let Row::Soft { linear, quadratic } = *row {
-                for (name, value) in [("linear", linear), ("quadratic", quadratic)] {
-                    if !(value.is_finite() && value >= 0.0) {
-                        return Err(Error::InvalidParameter {
-                            name,
-                            value,
-                            reason: "a soft row's weight must be finite and ≥ 0",
-                        });
-                    }
-                }
-            }
-        }
-        let tol = 1e-12 * p.amax().max(f64::MIN_POSITIVE);
-        if (0..n).any(|i| (0..i).any(|j| (p[(i, j)] - p[(j, i)]).abs() > tol)) {
-            return Err(Error::InvalidMatrix {
-                matrix: "P",
-                reason: "must be symmetric",
-            });
-        }
+        validate_problem(p, rows)?;
 
         let (mut ps, mut gs) = (p.clone(), g.clone());
         let (d, e, c) = equilibrate(&mut ps, &mut gs);
