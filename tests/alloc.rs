@@ -487,3 +487,55 @@ fn the_mpc_tick_allocates_nothing() {
         "the active-set method ran: {stats}"
     );
 }
+
+/// `DenseQp::solve` allocates nothing after `DenseQp::new`, whatever path
+/// it takes: on the lab's condensed MPC fixture (30 inputs, 120 rows) from
+/// beyond a position limit, a cold solve (ADMM with step-size adaptations
+/// and their refactorisations, then the polish), a warm re-solve (one
+/// polish), new bounds with an equality row and a row without bounds, an
+/// infeasible request (the certificate), a refused one (a bound infinite
+/// on the wrong side), and warm starts.
+#[test]
+fn dense_qp_solve_allocates_nothing_after_construction() {
+    use ctrlab::design::mpc::QpSettings;
+    let f = common::qp::qp_fixtures()
+        .into_iter()
+        .find(|f| f.name == "mpc_lab_h30_beyond_limit")
+        .unwrap();
+    let qp = &f.qp;
+    let mut solver = qp.solver(QpSettings::default());
+    let (mut lower, mut upper) = (qp.lower.clone(), qp.upper.clone());
+    // The first input (row 0) and its rate from the last applied input
+    // (row 30) apart: infeasible.
+    let (mut tight_l, mut tight_u) = (qp.lower.clone(), qp.upper.clone());
+    (tight_l[0], tight_u[0]) = (1.0, 1.5);
+    (tight_l[30], tight_u[30]) = (-2.0, -1.9);
+    let mut wrong = qp.lower.clone();
+    wrong[3] = f64::INFINITY;
+    let x0 = vec![0.0; qp.n()];
+    let mut reports = Vec::with_capacity(8);
+    let mut refused = None;
+    let n = allocations(|| {
+        reports.push(solver.solve(&qp.q, &qp.lower, &qp.upper).unwrap());
+        reports.push(solver.solve(&qp.q, &qp.lower, &qp.upper).unwrap());
+        (lower[5], upper[5]) = (f.x[5], f.x[5]);
+        (lower[70], upper[70]) = (f64::NEG_INFINITY, f64::INFINITY);
+        reports.push(solver.solve(&qp.q, &lower, &upper).unwrap());
+        reports.push(solver.solve(&qp.q, &tight_l, &tight_u).unwrap());
+        refused = Some(solver.solve(&qp.q, &wrong, &qp.upper).is_err());
+        solver.cold_start();
+        solver.warm_start(&x0, None).unwrap();
+        reports.push(solver.solve(&qp.q, &qp.lower, &qp.upper).unwrap());
+    });
+    assert_eq!(n, 0, "{reports:?}");
+    assert!(
+        reports[0].polished && reports[0].iterations > 10,
+        "{:?}",
+        reports[0]
+    );
+    assert!(reports[1].polished, "{:?}", reports[1]);
+    assert!(reports[2].status.is_solved(), "{:?}", reports[2]);
+    assert!(!reports[3].status.is_solved(), "{:?}", reports[3]);
+    assert_eq!(refused, Some(true));
+    assert!(reports[4].status.is_solved(), "{:?}", reports[4]);
+}

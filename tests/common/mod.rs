@@ -123,3 +123,7 @@ pub fn worst_match(got: &[nalgebra::Complex<f64>], want: &[nalgebra::Complex<f64
     }
     worst
 }
+
+// Quadratic programs for `DenseQp`'s tests: the OSQP fixtures and the KKT
+// certificate.
+pub mod qp;

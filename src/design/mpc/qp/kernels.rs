@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::QpSettings;
+use super::{QpSettings, Row};
 use crate::error::Error;
 
 /// OSQP's bounds on a Ruiz scaling factor, and its number of passes.
@@ -78,11 +78,17 @@ pub(super) fn equilibrate(
     let (n, m) = (p.nrows(), g.nrows());
     let mut d = DVector::from_element(n, 1.0);
     let mut e = DVector::from_element(m, 1.0);
+    // A row or column of norm below MIN_SCALING is scaled by at most
+    // 1/√MIN_SCALING, not left alone as OSQP leaves it: OSQP sees a soft
+    // row through its slack (an entry of 1), here a soft row in metres (an
+    // MPC's position of 1e-5 m per N) is all there is, and unscaled it
+    // stalls ADMM (the lab MPC from beyond a limit: 100000 iterations
+    // without convergence, against 270).
     let limit = |norm: f64| {
-        if norm < MIN_SCALING {
-            1.0
+        if norm > 0.0 {
+            1.0 / norm.clamp(MIN_SCALING, MAX_SCALING).sqrt()
         } else {
-            1.0 / norm.min(MAX_SCALING).sqrt()
+            1.0
         }
     };
     let mut dd = DVector::zeros(n);
@@ -147,6 +153,21 @@ pub(super) fn cholesky_in_place(a: &mut DMatrix<f64>) -> bool {
         }
     }
     true
+}
+
+/// Whether the symmetric `p` (its lower triangle) is positive
+/// semidefinite: Cholesky of `p + τI` in `work`, `τ = 1e-9 ‖p‖`, which the
+/// rounding of a semidefinite `p` (≈ n ε ‖p‖) passes and a negative
+/// eigenvalue beyond `τ` does not.
+pub(super) fn semidefinite(p: &DMatrix<f64>, work: &mut DMatrix<f64>) -> bool {
+    let tau = 1e-9 * p.amax() + f64::MIN_POSITIVE;
+    for j in 0..p.ncols() {
+        for i in j..p.nrows() {
+            work[(i, j)] = p[(i, j)];
+        }
+        work[(j, j)] += tau;
+    }
+    cholesky_in_place(work)
 }
 
 /// LU with partial pivoting of the leading `k × k` block of `a` (column
@@ -284,4 +305,38 @@ pub(super) fn validate_settings(s: &QpSettings) -> Result<(), Error> {
         });
     }
     Ok(())
+}
+
+/// Each soft row's weights finite and ≥ 0, and `p` symmetric.
+pub(super) fn validate_problem(p: &DMatrix<f64>, rows: &[Row]) -> Result<(), Error> {
+    for row in rows {
+        if let Row::Soft { linear, quadratic } = *row {
+            for (name, value) in [("linear", linear), ("quadratic", quadratic)] {
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name,
+                        value,
+                        reason: "a soft row's weight must be finite and ≥ 0",
+                    });
+                }
+            }
+        }
+    }
+    let tol = 1e-12 * p.amax().max(f64::MIN_POSITIVE);
+    let n = p.nrows();
+    if (0..n).any(|i| (0..i).any(|j| (p[(i, j)] - p[(j, i)]).abs() > tol)) {
+        return Err(Error::InvalidMatrix {
+            matrix: "P",
+            reason: "must be symmetric",
+        });
+    }
+    Ok(())
+}
+
+pub(super) fn invalid(what: &'static str, index: usize, reason: &'static str) -> Error {
+    Error::InvalidData {
+        what,
+        index,
+        reason,
+    }
 }

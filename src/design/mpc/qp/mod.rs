@@ -26,7 +26,9 @@ const CHECK_INTERVAL: usize = 5;
 /// Iterations between polishing attempts and step-size adaptations (a
 /// multiple of [`CHECK_INTERVAL`]).
 const POLISH_INTERVAL: usize = 10;
-use kernels::{SparseRows, equilibrate, validate_settings};
+use kernels::{
+    SparseRows, equilibrate, invalid, semidefinite, validate_problem, validate_settings,
+};
 use polish::Polish;
 
 /// How a row `lᵢ ≤ gᵢᵀ x ≤ uᵢ` of the constraints binds.
@@ -228,9 +230,10 @@ pub struct QpReport {
 /// and multipliers (a warm start), or from what
 /// [`warm_start`](Self::warm_start) sets, and allocates nothing.
 ///
-/// The answer is what OSQP's would be, to its tolerance: the tests check it
-/// against an interior-point solution of the same problems with explicit
-/// slack variables.
+/// The answer is what OSQP's would be, to its tolerance: `tests/qp.rs`
+/// checks it against OSQP's (itself checked against Clarabel and quadprog)
+/// on random problems and random MPCs of the lab's size, solved with
+/// explicit slack variables.
 ///
 /// # Examples
 ///
@@ -301,7 +304,7 @@ impl DenseQp {
     ///
     /// [`Error::DimensionMismatch`] (`"P"`, `"G"`), [`Error::LengthMismatch`]
     /// (`"rows"`), [`Error::NonFinite`], [`Error::InvalidMatrix`] (`"P"` not
-    /// symmetric or not positive semidefinite: the factorisation fails),
+    /// symmetric or not positive semidefinite),
     /// [`Error::InvalidParameter`] for a setting out of its range or a
     /// negative or non-finite soft weight (`"linear"`, `"quadratic"`).
     ///
@@ -328,26 +331,7 @@ impl DenseQp {
         check_finite_dyn("P", p)?;
         check_finite_dyn("G", g)?;
         validate_settings(&settings)?;
-        for row in rows {
-            if let Row::Soft { linear, quadratic } = *row {
-                for (name, value) in [("linear", linear), ("quadratic", quadratic)] {
-                    if !(value.is_finite() && value >= 0.0) {
-                        return Err(Error::InvalidParameter {
-                            name,
-                            value,
-                            reason: "a soft row's weight must be finite and ≥ 0",
-                        });
-                    }
-                }
-            }
-        }
-        let tol = 1e-12 * p.amax().max(f64::MIN_POSITIVE);
-        if (0..n).any(|i| (0..i).any(|j| (p[(i, j)] - p[(j, i)]).abs() > tol)) {
-            return Err(Error::InvalidMatrix {
-                matrix: "P",
-                reason: "must be symmetric",
-            });
-        }
+        validate_problem(p, rows)?;
 
         let (mut ps, mut gs) = (p.clone(), g.clone());
         let (d, e, c) = equilibrate(&mut ps, &mut gs);
@@ -396,7 +380,9 @@ impl DenseQp {
             polisher,
             active_set_steps: 0,
         };
-        if !qp.factor() {
+        // P itself must be semidefinite: ρ GᵀG in the ADMM matrix can hide
+        // an indefinite P (a nonconvex problem) from its factorisation.
+        if !semidefinite(&qp.p, &mut qp.chol) || !qp.factor() {
             return Err(Error::InvalidMatrix {
                 matrix: "P",
                 reason: "must be positive semidefinite",
@@ -422,9 +408,11 @@ impl DenseQp {
     /// # Errors
     ///
     /// [`Error::LengthMismatch`] (`"q"`, `"lower"`, `"upper"`),
-    /// [`Error::InvalidData`] for a NaN, an infinite `q`, or `lower > upper`
-    /// (named by index). An unsolved problem is not an error: the report's
-    /// [`QpStatus`] says what happened.
+    /// [`Error::InvalidData`] for a NaN, an infinite `q`, `lower > upper`,
+    /// or a bound infinite on the wrong side (`lower = +∞`, `upper = −∞`;
+    /// named by index); [`Error::Overflow`] if the answer would leave f64's
+    /// range (the next solve then starts cold). An unsolved problem is not
+    /// an error: the report's [`QpStatus`] says what happened.
     ///
     /// # Examples
     ///
@@ -457,6 +445,10 @@ impl DenseQp {
             }
             if lower[i] > upper[i] {
                 return Err(invalid("bounds", i, "lower bound above the upper"));
+            }
+            // Two equal infinities pass `lower ≤ upper` but bound nothing.
+            if lower[i] == f64::INFINITY || upper[i] == f64::NEG_INFINITY {
+                return Err(invalid("bounds", i, "an infinite bound on the wrong side"));
             }
         }
         for (j, qj) in q.iter().enumerate() {
@@ -535,12 +527,30 @@ impl DenseQp {
         }
         let r = self.residuals();
         self.unscale();
+        let objective = self.objective(q, lower, upper);
+        let finite = [r.prim, r.dual, objective].iter().all(|v| v.is_finite())
+            && self
+                .x_out
+                .iter()
+                .chain(self.y_out.iter())
+                .all(|v| v.is_finite());
+        if !finite {
+            // Finite data far beyond what the scaling brings to order one
+            // (an optimum beyond f64's range) is no answer; the next solve
+            // starts afresh.
+            self.cold_start();
+            self.x_out.fill(0.0);
+            self.y_out.fill(0.0);
+            return Err(Error::Overflow {
+                operation: "QP solve",
+            });
+        }
         Ok(QpReport {
             status,
             iterations,
             primal_residual: r.prim,
             dual_residual: r.dual,
-            objective: self.objective(q, lower, upper),
+            objective,
             rho: self.rho,
             polished,
             active_set_steps: self.active_set_steps,
@@ -602,13 +612,5 @@ impl DenseQp {
     pub fn cold_start(&mut self) {
         self.x.fill(0.0);
         self.y.fill(0.0);
-    }
-}
-
-fn invalid(what: &'static str, index: usize, reason: &'static str) -> Error {
-    Error::InvalidData {
-        what,
-        index,
-        reason,
     }
 }
