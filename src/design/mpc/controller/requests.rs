@@ -8,7 +8,7 @@ use crate::error::Error;
 
 impl<const N: usize, const M: usize, const Q: usize, const R: usize> Mpc<N, M, Q, R> {
     /// Changes output limit `index` (in the order of the design's
-    /// [`output_limits`](MpcDesign::output_limits)) from the next tick on,
+    /// [`output_limits`](crate::design::mpc::MpcDesign::output_limits)) from the next tick on,
     /// keeping its kind: an operator's request ("keep cart 2 below 20 mm").
     /// A hard limit the state already violates makes the next QPs
     /// infeasible: the controller then falls back and counts it.
