@@ -30,6 +30,7 @@
 //! ```
 
 mod covariance;
+mod hac;
 mod least_squares;
 mod rls;
 mod solve;

@@ -6,7 +6,8 @@ use faer::linalg::qr::no_pivoting::factor::{qr_in_place, qr_in_place_scratch};
 use faer::{MatMut, Par};
 use nalgebra::{DMatrix, DVector};
 
-use super::covariance::{Scratch, newey_west};
+use super::covariance::newey_west;
+use super::hac::Scratch;
 use super::{Covariance, LeastSquaresFit};
 use crate::error::Error;
 use crate::kernels::reduce::{dot, first_non_finite, max_abs, pow2_floor, sum_by, zip_sum};
