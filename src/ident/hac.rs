@@ -17,6 +17,12 @@ pub(crate) trait Series {
     /// Writes rows `from .. from + len`: column `j` to
     /// `out[j * stride..][..len]`.
     fn fill(&mut self, from: usize, len: usize, out: &mut [f64], stride: usize);
+
+    /// The whole series, column-major, and its length, when it is stored:
+    /// then it is read in place, not copied block by block.
+    fn stored(&self) -> Option<(&[f64], usize)> {
+        None
+    }
 }
 
 /// A stored column-major series (`n` rows).
@@ -30,6 +36,58 @@ impl Series for Stored<'_> {
         for (j, col) in self.x.chunks_exact(self.n).enumerate() {
             out[j * stride..j * stride + len].copy_from_slice(&col[from..from + len]);
         }
+    }
+
+    fn stored(&self) -> Option<(&[f64], usize)> {
+        Some((self.x, self.n))
+    }
+}
+
+/// How the passes see one segment of a series at a time: rows `from ..
+/// to` of a column, made present first by [`ensure`](Self::ensure).
+trait View {
+    fn begin(&mut self, start: usize, len: usize);
+    /// Makes rows `from .. to` of the segment present (`from` never less
+    /// than an earlier call's, `to − from` at most the window's room).
+    fn ensure(&mut self, from: usize, to: usize);
+    fn col(&self, j: usize, from: usize, to: usize) -> &[f64];
+}
+
+/// A stored series, read in place.
+struct Direct<'a> {
+    x: &'a [f64],
+    n: usize,
+    start: usize,
+}
+
+impl View for Direct<'_> {
+    fn begin(&mut self, start: usize, _len: usize) {
+        self.start = start;
+    }
+    fn ensure(&mut self, _from: usize, _to: usize) {}
+    fn col(&self, j: usize, from: usize, to: usize) -> &[f64] {
+        let at = j * self.n + self.start;
+        &self.x[at + from..at + to]
+    }
+}
+
+/// A series handed out in blocks, through a [`Window`] of `cap` rows.
+struct Windowed<'a, S> {
+    source: &'a mut S,
+    window: &'a mut Window,
+    p: usize,
+    cap: usize,
+}
+
+impl<S: Series> View for Windowed<'_, S> {
+    fn begin(&mut self, start: usize, len: usize) {
+        self.window.begin(self.p, self.cap, start, len);
+    }
+    fn ensure(&mut self, from: usize, to: usize) {
+        self.window.ensure(self.source, from, to);
+    }
+    fn col(&self, j: usize, from: usize, to: usize) -> &[f64] {
+        self.window.col(j, from, to)
     }
 }
 
@@ -223,6 +281,28 @@ fn bandwidth_sums(
     scratch: &mut Scratch,
 ) -> (f64, f64) {
     let Scratch { window, work } = scratch;
+    if let Some((x, n)) = source.stored() {
+        let mut view = Direct { x, n, start: 0 };
+        return moving_sums(&mut view, p, bounds, pre, work);
+    }
+    let cap = pre + 1 + 2 * SUB;
+    let mut view = Windowed {
+        source,
+        window,
+        p,
+        cap,
+    };
+    moving_sums(&mut view, p, bounds, pre, work)
+}
+
+/// [`bandwidth_sums`] through `view`.
+fn moving_sums(
+    view: &mut impl View,
+    p: usize,
+    bounds: &[usize],
+    pre: usize,
+    work: &mut Vec<f64>,
+) -> (f64, f64) {
     let mut scales = Scales::new(p);
     let mut ss = vec![0.0; p];
     let mut x0 = vec![0.0; p * p];
@@ -235,18 +315,17 @@ fn bandwidth_sums(
     let stride = vat + SUB;
     work.clear();
     work.resize(p * stride, 0.0);
-    let cap = (pre + 1 + SUB).max(4 * SUB);
     for w in bounds.windows(2) {
         let (start, len) = (w[0], w[1] - w[0]);
-        window.begin(p, cap, start, len);
+        view.begin(start, len);
         let mut a = 0;
         while a < len {
             let b = (a + SUB).min(len);
             let from = a.saturating_sub(pre + 1);
             let pad = (pre + 1).saturating_sub(a);
-            window.ensure(source, from, b);
+            view.ensure(from, b);
             for (j, ss) in ss.iter_mut().enumerate() {
-                if let Some(f) = scales.raise(j, max_abs(window.col(j, a, b))) {
+                if let Some(f) = scales.raise(j, max_abs(view.col(j, a, b))) {
                     *ss *= f * f;
                     rescale_square(&mut x0, p, j, f);
                     rescale_square(&mut x1, p, j, f);
@@ -261,7 +340,7 @@ fn bandwidth_sums(
                 let (q, rest) = rest.split_at_mut(ny + 1);
                 let (zv, vv) = rest.split_at_mut(SUB);
                 y[..pad].fill(0.0);
-                y[pad..n].copy_from_slice(window.col(j, from, b));
+                y[pad..n].copy_from_slice(view.col(j, from, b));
                 // pp[i] = Σ_{r<i} y_r / scale, q[i] = Σ_{r<i} pp[r].
                 pp[0] = 0.0;
                 prefix_sums(&y[..n], scales.inverse[j], &mut pp[1..=n]);
@@ -328,16 +407,38 @@ pub(crate) fn bartlett(
     scratch: &mut Scratch,
 ) -> (Vec<f64>, Vec<f64>) {
     let Scratch { window, work } = scratch;
+    if let Some((x, n)) = source.stored() {
+        let mut view = Direct { x, n, start: 0 };
+        return bartlett_sums(&mut view, p, bounds, lags, work);
+    }
+    // Room for a block and the L + 1 rows before it, and a block ahead.
+    let cap = lags + 1 + 2 * BLOCK;
+    let mut view = Windowed {
+        source,
+        window,
+        p,
+        cap,
+    };
+    bartlett_sums(&mut view, p, bounds, lags, work)
+}
+
+/// [`bartlett`] through `view`.
+fn bartlett_sums(
+    view: &mut impl View,
+    p: usize,
+    bounds: &[usize],
+    lags: usize,
+    work: &mut Vec<f64>,
+) -> (Vec<f64>, Vec<f64>) {
     let mut scales = Scales::new(p);
     let mut s = vec![0.0; p * (p + 1) / 2];
     let mut carry = vec![0.0; p];
     work.clear();
     work.resize(2 * BLOCK * p, 0.0);
     let (diffs, v) = work.split_at_mut(BLOCK * p);
-    let cap = (lags + 1 + BLOCK).max(4 * BLOCK);
     for w in bounds.windows(2) {
         let (start, len) = (w[0], w[1] - w[0]);
-        window.begin(p, cap, start, len);
+        view.begin(start, len);
         carry.fill(0.0);
         // The rows t of v, in three runs where the same rows of x enter:
         // x_t alone (t ≤ L), x_t − x_{t−L−1}, then −x_{t−L−1} past the end.
@@ -352,10 +453,10 @@ pub(crate) fn bartlett(
                 let rows = (to - a).min(BLOCK);
                 let first = if sub { a - lags - 1 } else { a };
                 let last = if add { a + rows } else { a - lags - 1 + rows };
-                window.ensure(source, first, last);
+                view.ensure(first, last);
                 if add {
                     for (j, carry) in carry.iter_mut().enumerate() {
-                        if let Some(f) = scales.raise(j, max_abs(window.col(j, a, a + rows))) {
+                        if let Some(f) = scales.raise(j, max_abs(view.col(j, a, a + rows))) {
                             *carry *= f;
                             rescale_lower(&mut s, p, j, f);
                         }
@@ -364,15 +465,15 @@ pub(crate) fn bartlett(
                 for j in 0..p {
                     let d = &mut diffs[j * BLOCK..j * BLOCK + rows];
                     match (add, sub) {
-                        (true, false) => d.copy_from_slice(window.col(j, a, a + rows)),
+                        (true, false) => d.copy_from_slice(view.col(j, a, a + rows)),
                         (true, true) => d
                             .iter_mut()
-                            .zip(window.col(j, a, a + rows))
-                            .zip(window.col(j, a - lags - 1, a - lags - 1 + rows))
+                            .zip(view.col(j, a, a + rows))
+                            .zip(view.col(j, a - lags - 1, a - lags - 1 + rows))
                             .for_each(|((d, &x), &old)| *d = x - old),
                         _ => d
                             .iter_mut()
-                            .zip(window.col(j, a - lags - 1, a - lags - 1 + rows))
+                            .zip(view.col(j, a - lags - 1, a - lags - 1 + rows))
                             .for_each(|(d, &old)| *d = -old),
                     }
                     let out = &mut v[j * BLOCK..j * BLOCK + rows];

@@ -56,10 +56,18 @@ fn the_streamed_bartlett_sum_is_the_former_bit_for_bit() {
         let (scales, inverses) = reference::scales(&x, n);
         for lags in [0, 1, 7, 29, 700, 2047, 2048, 2500, 5000] {
             let want = reference::bartlett(&x, n, &inverses, &bounds, lags, &mut Vec::new());
+            let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            // Read in place, and handed out block by block.
             let (got, got_scales) =
                 bartlett(&mut Stored { x: &x, n }, p, &bounds, lags, &mut scratch);
             assert_eq!(got_scales, scales, "n {n}, p {p}, lags {lags}");
-            let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "n {n}, p {p}, lags {lags}");
+            let mut blocks = Counting {
+                inner: Stored { x: &x, n },
+                rows: 0,
+            };
+            let (got, got_scales) = bartlett(&mut blocks, p, &bounds, lags, &mut scratch);
+            assert_eq!(got_scales, scales, "n {n}, p {p}, lags {lags}");
             assert_eq!(bits(&got), bits(&want), "n {n}, p {p}, lags {lags}");
         }
     }
@@ -86,6 +94,12 @@ fn the_bandwidth_sums_are_the_former_ones() {
         let lags =
             reference::automatic_lags(&x, n, &inverses, &bounds, n, &mut Vec::new(), &mut want);
         let got = bandwidth_sums(&mut Stored { x: &x, n }, p, &bounds, pre, &mut scratch);
+        let mut blocks = Counting {
+            inner: Stored { x: &x, n },
+            rows: 0,
+        };
+        let windowed = bandwidth_sums(&mut blocks, p, &bounds, pre, &mut scratch);
+        assert_eq!(windowed, got, "n {n}, p {p}");
         // Relative to σ₀ (s⁽⁰⁾ cancels nearly to zero for over-differenced
         // noise): the size of the terms summed.
         let sigma0 = {
