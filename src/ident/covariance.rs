@@ -188,7 +188,15 @@ pub(crate) fn newey_west(
     scratch: &mut Scratch,
 ) -> (DMatrix<f64>, usize) {
     debug_assert!(x.len() == n * p);
-    newey_west_of(&mut Stored { x, n }, n, p, starts, rows, lags, scratch)
+    newey_west_of(
+        &mut Stored { x, n, stats: None },
+        n,
+        p,
+        starts,
+        rows,
+        lags,
+        scratch,
+    )
 }
 
 /// [`newey_west`] of a series handed out in blocks (`n` rows of `p`).

@@ -1,9 +1,9 @@
 //! The Newey–West sums as they were before they were streamed (issue
 //! 30): the whole series in memory, its scales found first, and the
-//! automatic bandwidth's autocovariances lag by lag. The tests check the
-//! streamed sums against them.
+//! automatic bandwidth's autocovariances lag by lag, the running sums
+//! offset after them. The tests check the present sums against them.
 
-use super::prefix_sums;
+use super::running::prefix_sums;
 use crate::ident::newey_west_lags;
 use crate::kernels::reduce::{dot, max_abs, pow2_floor, sum_by};
 

@@ -1,6 +1,7 @@
-//! The streamed sums against the former whole-series ones
+//! The sums against the former whole-series ones
 //! ([`reference`](super::reference)).
 
+use super::bandwidth::bandwidth_sums;
 use super::*;
 
 /// A seeded series of `n` rows and `p` columns: an over-differenced noise
@@ -39,12 +40,15 @@ fn bounds_of(starts: &[usize], n: usize) -> Vec<usize> {
     b
 }
 
-/// The Bartlett sum is the former one bit for bit, whatever the lags (none,
-/// a few, more than a segment, more than a block) and the segments (a
-/// short one among them).
+/// The Bartlett sum is the former one to rounding (its running sums now
+/// start from the carry: measured at most a few 1e-16 of the largest
+/// entry), whatever the lags (none, a few, more than a segment, more than
+/// a block) and the segments (a short one among them); read in place,
+/// with the columns' stats, and handed out in blocks, the same bits.
 #[test]
-fn the_streamed_bartlett_sum_is_the_former_bit_for_bit() {
+fn the_bartlett_sum_is_the_former_one() {
     let mut scratch = Scratch::default();
+    let mut worst = 0.0f64;
     for (n, p, starts) in [
         (7000usize, 2usize, vec![]),
         (9000, 3, vec![2000, 2030, 6500]),
@@ -54,27 +58,73 @@ fn the_streamed_bartlett_sum_is_the_former_bit_for_bit() {
         let x = series(n, p, n as u64 * 31 + p as u64);
         let bounds = bounds_of(&starts, n);
         let (scales, inverses) = reference::scales(&x, n);
+        let stats = Stats {
+            max: x
+                .chunks_exact(n)
+                .map(crate::kernels::reduce::max_abs)
+                .collect(),
+            ss: vec![1.0; p],
+        };
         for lags in [0, 1, 7, 29, 700, 2047, 2048, 2500, 5000] {
             let want = reference::bartlett(&x, n, &inverses, &bounds, lags, &mut Vec::new());
             let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-            // Read in place, and handed out block by block.
-            let (got, got_scales) =
-                bartlett(&mut Stored { x: &x, n }, p, &bounds, lags, &mut scratch);
-            assert_eq!(got_scales, scales, "n {n}, p {p}, lags {lags}");
-            assert_eq!(bits(&got), bits(&want), "n {n}, p {p}, lags {lags}");
+            let what = format!("n {n}, p {p}, lags {lags}");
+            let (got, got_scales) = bartlett(
+                &mut Stored {
+                    x: &x,
+                    n,
+                    stats: None,
+                },
+                p,
+                &bounds,
+                lags,
+                &mut scratch,
+            );
+            assert_eq!(got_scales, scales, "{what}");
+            let largest = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (g, w) in got.iter().zip(&want) {
+                let rel = (g - w).abs() / largest;
+                worst = worst.max(rel);
+                assert!(rel < 1e-14, "{what}: {g} vs {w}");
+            }
+            let known = bartlett(
+                &mut Stored {
+                    x: &x,
+                    n,
+                    stats: Some(&stats),
+                },
+                p,
+                &bounds,
+                lags,
+                &mut scratch,
+            );
+            assert_eq!(
+                (bits(&known.0), &known.1),
+                (bits(&got), &got_scales),
+                "{what}"
+            );
             let mut blocks = Counting {
-                inner: Stored { x: &x, n },
+                inner: Stored {
+                    x: &x,
+                    n,
+                    stats: None,
+                },
                 rows: 0,
             };
-            let (got, got_scales) = bartlett(&mut blocks, p, &bounds, lags, &mut scratch);
-            assert_eq!(got_scales, scales, "n {n}, p {p}, lags {lags}");
-            assert_eq!(bits(&got), bits(&want), "n {n}, p {p}, lags {lags}");
+            let streamed = bartlett(&mut blocks, p, &bounds, lags, &mut scratch);
+            assert_eq!(
+                (bits(&streamed.0), &streamed.1),
+                (bits(&got), &got_scales),
+                "{what}"
+            );
         }
     }
+    eprintln!("Bartlett sums: worst difference {worst:e} of the largest entry");
 }
 
-/// The automatic bandwidth's two sums, from moving sums, are the former
-/// ones (lag by lag) to rounding, and give the same bandwidth.
+/// The automatic bandwidth's two sums are the former ones (lag by lag) to
+/// rounding, from moving sums, stored (with and without the columns'
+/// stats) or handed out in blocks; the same bandwidth.
 #[test]
 fn the_bandwidth_sums_are_the_former_ones() {
     let mut scratch = Scratch::default();
@@ -93,34 +143,56 @@ fn the_bandwidth_sums_are_the_former_ones() {
         let mut want = (0.0, 0.0);
         let lags =
             reference::automatic_lags(&x, n, &inverses, &bounds, n, &mut Vec::new(), &mut want);
-        let got = bandwidth_sums(&mut Stored { x: &x, n }, p, &bounds, pre, &mut scratch);
-        let mut blocks = Counting {
-            inner: Stored { x: &x, n },
-            rows: 0,
-        };
-        let windowed = bandwidth_sums(&mut blocks, p, &bounds, pre, &mut scratch);
-        assert_eq!(windowed, got, "n {n}, p {p}");
         // Relative to σ₀ (s⁽⁰⁾ cancels nearly to zero for over-differenced
         // noise): the size of the terms summed.
-        let sigma0 = {
-            let mut h = vec![0.0; n];
-            let mut ss = vec![0.0; p];
-            for j in 0..p {
-                let c = &x[j * n..(j + 1) * n];
-                ss[j] = c.iter().map(|v| (v * inverses[j]).powi(2)).sum::<f64>();
-                for t in 0..n {
-                    h[t] += c[t] * inverses[j] / ss[j].sqrt();
+        let mut h = vec![0.0; n];
+        for j in 0..p {
+            let c = &x[j * n..(j + 1) * n];
+            let ss = c.iter().map(|v| (v * inverses[j]).powi(2)).sum::<f64>();
+            for t in 0..n {
+                h[t] += c[t] * inverses[j] / ss.sqrt();
+            }
+        }
+        let sigma0 = h.iter().map(|v| v * v).sum::<f64>();
+        let stats = Stats {
+            max: x
+                .chunks_exact(n)
+                .map(crate::kernels::reduce::max_abs)
+                .collect(),
+            ss: x
+                .chunks_exact(n)
+                .map(|c| c.iter().map(|v| v * v).sum())
+                .collect(),
+        };
+        for known in [None, Some(&stats)] {
+            let mut stored = Stored {
+                x: &x,
+                n,
+                stats: known,
+            };
+            let mut blocks = Counting {
+                inner: Stored {
+                    x: &x,
+                    n,
+                    stats: None,
+                },
+                rows: 0,
+            };
+            for got in [
+                bandwidth_sums(&mut stored, p, &bounds, pre, &mut scratch),
+                bandwidth_sums(&mut blocks, p, &bounds, pre, &mut scratch),
+            ] {
+                for (g, w) in [(got.0, want.0), (got.1, want.1)] {
+                    let rel = (g - w).abs() / sigma0;
+                    worst = worst.max(rel);
+                    assert!(rel < 1e-13, "n {n}, p {p}: {g} vs {w} (σ₀ {sigma0})");
                 }
             }
-            h.iter().map(|v| v * v).sum::<f64>()
-        };
-        for (g, w) in [(got.0, want.0), (got.1, want.1)] {
-            let rel = (g - w).abs() / sigma0;
-            worst = worst.max(rel);
-            assert!(rel < 1e-13, "n {n}, p {p}: {g} vs {w} (σ₀ {sigma0})");
+            let streamed = automatic_lags(&mut stored, p, &bounds, pre, n, &mut scratch);
+            assert_eq!(streamed, lags, "n {n}, p {p}");
+            let streamed = automatic_lags(&mut blocks, p, &bounds, pre, n, &mut scratch);
+            assert_eq!(streamed, lags, "n {n}, p {p}");
         }
-        let streamed = automatic_lags(&mut Stored { x: &x, n }, p, &bounds, pre, n, &mut scratch);
-        assert_eq!(streamed, lags, "n {n}, p {p}");
     }
     eprintln!("bandwidth sums: worst difference {worst:e} of σ₀");
 }
@@ -146,7 +218,11 @@ fn each_pass_reads_each_row_once() {
     let bounds = bounds_of(&[10_000], n);
     let mut scratch = Scratch::default();
     let mut source = Counting {
-        inner: Stored { x: &x, n },
+        inner: Stored {
+            x: &x,
+            n,
+            stats: None,
+        },
         rows: 0,
     };
     bartlett(&mut source, p, &bounds, 900, &mut scratch);
