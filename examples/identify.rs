@@ -1,4 +1,4 @@
-//! Identifies the two-cart plant from a logged run (LAB.md section 2.2 and
+//! Identifies the two-cart plant from a logged run (docs/lab.md, the lab's section 2.2 and
 //! the report's question 1).
 //!
 //! ```text

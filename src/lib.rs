@@ -199,7 +199,14 @@ pub use sim::{
     DynResponse, Response, Simulate, impulse_response, initial_response, run_sampled, step_response,
 };
 
-// The README's code blocks are compiled and run as doctests.
+// The README's code blocks are compiled and run as doctests, and so are the
+// guides' that hold Rust (the others' blocks are shell and text).
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
+#[cfg(doctest)]
+#[doc = include_str!("../docs/lab.md")]
+pub struct LabGuideDoctests;
+#[cfg(doctest)]
+#[doc = include_str!("../docs/identification.md")]
+pub struct IdentificationGuideDoctests;

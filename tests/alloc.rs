@@ -455,3 +455,35 @@ fn generic_simulations_of_a_fixed_size_model_allocate_per_run_not_per_sample() {
     assert_eq!(short, long, "allocations grow with the number of samples");
     assert!(long.iter().all(|&n| n > 0), "the counter sees the buffers");
 }
+
+#[test]
+fn the_mpc_tick_allocates_nothing() {
+    // The lab's MPC, cart 2 stepped to 5 mm inside its travel and back:
+    // every tick of both steps (the active-set solves, the polish, the
+    // target, the estimator, the shifted and clipped warm start) runs in
+    // the buffers made at construction.
+    use ctrlab::Controller;
+    use ctrlab::lab::{Calibration, lqi, mpc};
+    let cal = Calibration::default();
+    let model = lqi::position_model(&MassSpring::nominal(), 0.002).unwrap();
+    let mut c = mpc::design(&model, Cart::Two, &cal).unwrap();
+    let mut x = SVector::<f64, 4>::zeros();
+    let tick = |c: &mut mpc::PositionsMpc, x: &mut SVector<f64, 4>, r: f64| {
+        let u = c.update(x, &vector![r]);
+        c.applied(&u);
+        *x = model.a() * *x + model.b() * u;
+    };
+    // Counted from the very first tick: it builds nothing either.
+    let n = allocations(|| {
+        for k in 0..1200 {
+            let r = if k < 600 { 0.045 } else { -0.02 };
+            tick(&mut c, &mut x, r);
+        }
+    });
+    let stats = *c.inner().stats();
+    assert_eq!(n, 0, "{stats}");
+    assert!(
+        stats.active_set_steps_max > 0,
+        "the active-set method ran: {stats}"
+    );
+}

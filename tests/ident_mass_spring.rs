@@ -313,7 +313,7 @@ fn state_space_holds_the_identified_parameters() {
 
 #[test]
 fn simulated_fixture_plant_central_within_0_3_percent_lab_biased() {
-    // LAB.md says "within 0.1 %" on exact quantised data; on this run b2
+    // docs/lab.md says "within 0.1 %" on exact quantised data; on this run b2
     // comes out at 0.105 %, so the bar is the 0.3 % for the fixture.
     let plant = MassSpring {
         k1: 950.0,

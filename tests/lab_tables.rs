@@ -33,7 +33,7 @@ fn table_1_holds_every_force_at_its_static_deflection() {
         assert!((r.x1_mm - r.x1_static_mm).abs() < 1e-6, "{r:?}");
         assert!((r.x2_mm - r.x2_static_mm).abs() < 1e-6, "{r:?}");
     }
-    // LAB.md: F = 10 N gives 10 mm and 20 mm.
+    // docs/lab.md: F = 10 N gives 10 mm and 20 mm.
     assert!((t.rows[0].x1_mm - 10.0).abs() < 1e-9 && (t.rows[0].x2_mm - 20.0).abs() < 1e-9);
 }
 

@@ -31,7 +31,8 @@
 //!   (Tables 1 and 2, the identification input and runs with Tables 3 and
 //!   4, the identified state equations and their uncertainty, Tables 5
 //!   and 6, the answers); then "Further sections" (what the identification
-//!   does not recover, excitation, validation, frequency response, design).
+//!   does not recover, excitation, validation, frequency response, design,
+//!   constrained MPC).
 //!   The sections run in the order the computation needs (the
 //!   identification first: Tables 5 and 6 predict from it); the report is
 //!   collected in its two parts ([`report::Part`]) and written in this
@@ -46,7 +47,7 @@
 //!   `ident_probe1_square_2.00V.csv`, `excite_prbs_8.00V_seed1.csv`,
 //!   `table5_cart2_kf_0_0_10_0.1_to_30mm.csv` (the table and
 //!   `lab::tables::Experiment`'s name, as `examples/experiment` saves it),
-//!   `frequency_multisine.csv`, `design_cart1_rig.csv`.
+//!   `frequency_multisine.csv`, `design_cart1_rig.csv`, `mpc_cart2_rig.csv`.
 //!
 //! The terminal gets a line per section as it finishes and a short summary
 //! at the end: Tables 5 and 6 by outcome, the identified parameters, and
@@ -78,7 +79,8 @@
 //! The program is the library's lab sections in order: each section runs
 //! its experiments on the backend ([`backend`]), calls the library's
 //! computation for it (`ctrlab::lab::tables`, `lab::ident::summarize`,
-//! `lab::excitation`, `lab::validation`, `lab::frequency`, `lab::lqi`) and
+//! `lab::excitation`, `lab::validation`, `lab::frequency`, `lab::lqi`,
+//! `lab::mpc`) and
 //! returns a typed result, which the one renderer ([`report`]) turns into
 //! Markdown, figures and CSV tables as soon as it is there. The command line is
 //! [`cli::Args`]: every argument is checked before anything runs.
@@ -102,6 +104,7 @@ mod design;
 mod excitation;
 mod frequency;
 mod identification;
+mod mpc;
 mod paths;
 mod report;
 mod rig_tables;
@@ -277,6 +280,13 @@ fn rig_sections(
             "Design ({} cases): designed on the identified model, run and compared",
             design.cases.len()
         ));
+        let mpc = mpc::section(backend, &ident)?;
+        report.mpc(&mpc)?;
+        report.progress(&format!(
+            "Constrained MPC ({} cases): designed on the identified model, run and compared; {} fallbacks on the rig",
+            mpc.cases.len(),
+            mpc.cases.iter().map(|c| c.rig.stats.fallbacks()).sum::<usize>()
+        ));
         report.part(Part::Student);
     }
     report.answer_model(Some(backend), &ident);
@@ -286,7 +296,7 @@ fn rig_sections(
 }
 
 /// What the report says `--tables-only` left out.
-const SKIPPED: &str = "Skipped with `--tables-only`: the Excitation, Validation, Frequency response and Design sections and their runs (four inputs five times each, the multisine, the two designs). Run lab5 without `--tables-only` for them.";
+const SKIPPED: &str = "Skipped with `--tables-only`: the Excitation, Validation, Frequency response, Design and Constrained MPC sections and their runs (four inputs five times each, the multisine, the two designs, the two MPC cases). Run lab5 without `--tables-only` for them.";
 
 /// Tables 1 and 2 in simulation, each with its CSV; Table 2 is kept for
 /// the answers.

@@ -11,7 +11,7 @@ use crate::model::{Domain, StateSpace};
 ///
 /// The textbook's law with `N` chosen for zero steady-state error is
 /// [`with_prefilter`](Self::with_prefilter). The lab's `u = Kf (G r − x)`
-/// (LAB.md, Figure 8) is the same law with `K = Kf`, `N = Kf G`; the lab
+/// (the lab's Figure 8, `docs/lab.md`) is the same law with `K = Kf`, `N = Kf G`; the lab
 /// module's [`LabGains`](crate::lab) builds it from the lab's
 /// per-millimetre gains.
 ///

@@ -24,7 +24,10 @@
 //! - output feedback: [`ObserverController`] (observer, state feedback and
 //!   integrators on measured outputs), and [`SelectOutputs`] to run it on
 //!   some of a loop's measurements (the rig's positions, not its
-//!   differenced speeds).
+//!   differenced speeds);
+//! - constrained model-predictive control: [`Mpc`] (input, rate and
+//!   output limits, offset-free, a bounded solve per tick with a safe
+//!   fallback) on the QP solver [`mpc::DenseQp`].
 //!
 //! The lab's per-millimetre gains are a named conversion in the lab module,
 //! [`LabGains`](crate::lab).
@@ -52,6 +55,7 @@ mod feedback;
 mod integral;
 mod kalman;
 mod lqr;
+pub mod mpc;
 mod observer;
 mod observer_controller;
 mod place;
@@ -64,6 +68,7 @@ pub use feedback::StateFeedback;
 pub use integral::{AntiWindup, IntegralFeedback, augment_integral, dlqi, lqi};
 pub use kalman::{DynLqe, Lqe, dlqe, lqe};
 pub use lqr::{DynLqr, Lqr, dlqr, lqr};
+pub use mpc::Mpc;
 pub use observer::{EstimatorForm, Observer};
 pub use observer_controller::{ObserverController, SelectOutputs};
 pub use place::acker;

@@ -265,6 +265,20 @@ impl<C, const P: usize, const Q: usize> SelectOutputs<C, P, Q> {
     pub fn inner(&self) -> &C {
         &self.inner
     }
+
+    /// The inner controller, to change (an MPC's limits mid-run).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{OpenLoop, design::SelectOutputs};
+    /// let mut c = SelectOutputs::new(OpenLoop, ctrlab::lab::position_output_matrix())?;
+    /// *c.inner_mut() = OpenLoop;
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
+    pub fn inner_mut(&mut self) -> &mut C {
+        &mut self.inner
+    }
 }
 
 impl<C, const P: usize, const Q: usize, const R: usize, const M: usize> Controller<P, R, M>

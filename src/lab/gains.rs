@@ -11,8 +11,8 @@ use crate::error::{Error, check_finite};
 /// Millimetres per metre: the lab's gains are per millimetre of state.
 const MM_PER_M: f64 = 1000.0;
 
-/// A state-feedback law in the lab's units, `u = Kf (G r − x_mm)` (LAB.md,
-/// Figure 8): what is typed into the lab's Simulink model, and the SI
+/// A state-feedback law in the lab's units, `u = Kf (G r − x_mm)` (the
+/// lab's Figure 8, `docs/lab.md`): what is typed into the lab's Simulink model, and the SI
 /// [`StateFeedback`] it is ([`state_feedback`](Self::state_feedback)) or
 /// comes from ([`from_state_feedback`](Self::from_state_feedback)).
 ///

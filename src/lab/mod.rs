@@ -1,4 +1,7 @@
-//! The two-cart lab (LAB.md): everything that is about this one rig.
+//! The two-cart lab: everything that is about this one rig. The lab
+//! itself — the rig, its equations and its tables — is restated in the
+//! repository's [lab guide](https://github.com/ctrlab-rs/ctrlab/blob/main/docs/lab.md)
+//! (`docs/lab.md`).
 //!
 //! The generic modules never name a cart; this one builds the lab on them:
 //!
@@ -68,6 +71,7 @@ mod gains;
 pub mod ident;
 pub mod ident_input;
 pub mod lqi;
+pub mod mpc;
 mod plant;
 mod probe;
 pub mod protocol;

@@ -1,5 +1,5 @@
 //! The lab's plant: two carts joined by springs, the second pushed by a DC motor
-//! (LAB.md equations (1)–(3) and (14)).
+//! (equations (1)–(3) and (14) of the lab, `docs/lab.md`).
 
 use crate::nalgebra::{SMatrix, SVector, matrix};
 

@@ -27,7 +27,7 @@ import scipy
 import scipy.signal
 import control as ct
 
-# The lab's nominal plant (LAB.md), force input.
+# The lab's nominal plant (docs/lab.md), force input.
 M1, M2, K1, K2, B1, B2 = 1.3, 0.7, 1000.0, 1000.0, 10.0, 5.0
 A_LAB = np.array([
     [0.0, 1.0, 0.0, 0.0],

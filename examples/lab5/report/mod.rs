@@ -29,6 +29,7 @@ mod design;
 mod figures;
 mod ident;
 mod models;
+mod mpc;
 mod tables;
 pub mod terminal;
 mod unmodelled;

@@ -1,5 +1,6 @@
 //! The lab's regressors: the two-cart plant's parameters from a recording
-//! (LAB.md section 2.2, equations (4)–(11)).
+//! (the lab handout's section 2.2, equations (4)–(11), restated in
+//! `docs/lab.md`).
 //!
 //! Both carts' equations of motion are linear in the unknowns once the
 //! masses are known. The identification runs in two stages, as in the lab:
@@ -59,8 +60,9 @@
 //! (equations (6), (9)): within a segment that scaling does not change the
 //! estimate, and across segments it keeps every row in the unit of `λ` (a
 //! position difference), in which the encoder's noise is the same for all
-//! rows whatever their period. The standard errors of stage 2 treat `k2`
-//! as exact.
+//! rows whatever their period. Under the default Newey–West covariance the
+//! standard errors of stage 2 carry stage 1's error in `k2`; the classical
+//! ones treat `k2` as exact (see [`Options::covariance`]).
 //!
 //! [`hw::run`]: crate::hw::run
 

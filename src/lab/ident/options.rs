@@ -18,7 +18,7 @@ pub const DEFAULT_MIN_SPEED: f64 = 0.005;
 
 /// Which springs the identification fits ([`Options::springs`]).
 ///
-/// The lab's model (LAB.md equations (4)–(11)) takes the two springs as
+/// The lab's model (`docs/lab.md`, equations (4)–(11)) takes the two springs as
 /// equal, `k1 = k2 = k12`: stage 1 fits `[k12, b1]`. Real springs are never
 /// exactly equal; [`Separate`](Self::Separate) fits `[k1, k2, b1]` from the
 /// same equation of cart 1, which needs a run that moves the carts in both

@@ -1,4 +1,4 @@
-//! The lab's tables (LAB.md): the gains of Tables 2, 5 and 6 as data, with
+//! The lab's tables (`docs/lab.md`): the gains of Tables 2, 5 and 6 as data, with
 //! the rows that belong together named ([`GainGroup`]), and the computation
 //! of each table as a function returning a typed result.
 //!
@@ -169,7 +169,7 @@ impl GainGroup {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GainTable {
-    /// The table's number in LAB.md.
+    /// The table's number in the lab handout (and `docs/lab.md`).
     pub number: u8,
     /// The cart whose position is controlled (`G` selects it).
     pub cart: Cart,
