@@ -3,7 +3,7 @@
 
 use nalgebra::DMatrix;
 
-use super::hac::{Scratch, Series, Stored, automatic_lags, bartlett};
+use super::hac::{Scratch, Series, automatic_lags, bartlett};
 
 /// Largest number of lags the Newey–West sum uses, whatever is asked or
 /// chosen.
@@ -188,34 +188,26 @@ pub(crate) fn newey_west(
     scratch: &mut Scratch,
 ) -> (DMatrix<f64>, usize) {
     debug_assert!(x.len() == n * p);
-    newey_west_of(
-        &mut Stored { x, n, stats: None },
-        n,
-        p,
-        starts,
-        rows,
-        lags,
-        scratch,
-    )
+    let series = Series { x, n, stats: None };
+    newey_west_of(series, p, starts, rows, lags, scratch)
 }
 
-/// [`newey_west`] of a series handed out in blocks (`n` rows of `p`).
+/// [`newey_west`] of a series that may come with its columns' stats.
 pub(crate) fn newey_west_of(
-    source: &mut impl Series,
-    n: usize,
+    x: Series<'_>,
     p: usize,
     starts: &[usize],
     rows: usize,
     lags: Option<usize>,
     scratch: &mut Scratch,
 ) -> (DMatrix<f64>, usize) {
-    debug_assert!(rows > p);
-    let bounds = segment_bounds(starts, n);
+    debug_assert!(rows > p && x.x.len() == x.n * p);
+    let bounds = segment_bounds(starts, x.n);
     let lags = lags
-        .unwrap_or_else(|| automatic_lags(source, p, &bounds, newey_west_lags(rows), rows, scratch))
+        .unwrap_or_else(|| automatic_lags(x, &bounds, newey_west_lags(rows), rows, scratch))
         .min(MAX_LAGS)
         .min(rows / 4);
-    let (lower, scales) = bartlett(source, p, &bounds, lags, scratch);
+    let (lower, scales) = bartlett(x, p, &bounds, lags, scratch);
     let factor = rows as f64 / ((rows - p) as f64 * (lags + 1) as f64);
     let mut s = DMatrix::<f64>::zeros(p, p);
     let mut k = 0;

@@ -1,8 +1,7 @@
-//! The Newey–West sums over a series handed out in blocks ([`Series`]):
-//! stored (a fit's influence series) or computed again block by block from
-//! the samples (the lab's long stages), so that no copy of a long series
-//! is needed. Two passes at most: the automatic bandwidth's sums
-//! ([`automatic_lags`]), then the Bartlett sum ([`bartlett`]).
+//! The Newey–West sums of a stored series ([`Series`]), a block of rows
+//! at a time, so that no other series of its length is formed: the
+//! automatic bandwidth's sums ([`automatic_lags`]), then the Bartlett sum
+//! ([`bartlett`]).
 //!
 //! Each column is divided by a power of two near its largest entry, so
 //! that no sum can overflow or underflow. It is known in advance when the
@@ -14,30 +13,14 @@
 mod bandwidth;
 mod bartlett;
 mod running;
-mod view;
 
 pub(crate) use self::bandwidth::automatic_lags;
 pub(crate) use self::bartlett::bartlett;
-pub(crate) use self::view::Window;
 
 use crate::kernels::reduce::pow2_floor;
 
-/// A series of `p`-vectors, rows `0 … n`, handed out in blocks.
-pub(crate) trait Series {
-    /// Writes rows `from .. from + len`: column `j` to
-    /// `out[j * stride..][..len]`.
-    fn fill(&mut self, from: usize, len: usize, out: &mut [f64], stride: usize);
-
-    /// The whole series, column-major, its length and what is known of its
-    /// columns, when it is stored: then it is read in place, not copied
-    /// block by block.
-    fn stored(&self) -> Option<(&[f64], usize, Option<&Stats>)> {
-        None
-    }
-}
-
 /// Each column's largest magnitude and sum of squares, when whoever
-/// stored the series found them on the way (the lab's influence kernel):
+/// stored the series found them on the way (the lab's identification):
 /// the sums then need no pass to find them.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub(crate) struct Stats {
@@ -45,23 +28,19 @@ pub(crate) struct Stats {
     pub ss: Vec<f64>,
 }
 
-/// A stored column-major series (`n` rows), with its columns' [`Stats`]
-/// when known.
-pub(crate) struct Stored<'a> {
+/// A column-major series of `n` rows, with its columns' [`Stats`] when
+/// known.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Series<'a> {
     pub x: &'a [f64],
     pub n: usize,
     pub stats: Option<&'a Stats>,
 }
 
-impl Series for Stored<'_> {
-    fn fill(&mut self, from: usize, len: usize, out: &mut [f64], stride: usize) {
-        for (j, col) in self.x.chunks_exact(self.n).enumerate() {
-            out[j * stride..j * stride + len].copy_from_slice(&col[from..from + len]);
-        }
-    }
-
-    fn stored(&self) -> Option<(&[f64], usize, Option<&Stats>)> {
-        Some((self.x, self.n, self.stats))
+impl Series<'_> {
+    /// Rows `from .. to` of column `j`.
+    fn col(&self, j: usize, from: usize, to: usize) -> &[f64] {
+        &self.x[j * self.n + from..j * self.n + to]
     }
 }
 
@@ -69,7 +48,6 @@ impl Series for Stored<'_> {
 /// none of the series'.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Scratch {
-    window: Window,
     /// Running sums and their products' operands.
     work: Vec<f64>,
 }
@@ -127,14 +105,6 @@ fn powers(max: &[f64]) -> Scales {
         scales.raise(j, m);
     }
     scales
-}
-
-/// `x` (`p × p`, row-major) with row and column `j` times `factor`.
-pub(super) fn rescale_square(x: &mut [f64], p: usize, j: usize, factor: f64) {
-    for i in 0..p {
-        x[i * p + j] *= factor;
-        x[j * p + i] *= factor;
-    }
 }
 
 /// `s` (the lower triangle, row by row) with row and column `j` times

@@ -44,7 +44,7 @@ mod tsqr;
 pub(crate) use covariance::newey_west_of;
 pub use covariance::{Covariance, MAX_LAGS, newey_west_lags};
 #[cfg(feature = "lab")]
-pub(crate) use hac::{Scratch, Series, Stats, Stored};
+pub(crate) use hac::{Scratch, Series, Stats};
 #[cfg(feature = "lab")]
 pub(crate) use influence::{influence_rows, sensitivity_of};
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};

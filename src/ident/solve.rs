@@ -47,13 +47,6 @@ pub(crate) const NARROW: usize = 8;
 /// vectorises). The columns are equilibrated (entries below 2), so the
 /// plain sums of squares cannot overflow.
 pub(crate) fn householder_narrow(a: &mut [f64], m: usize, n: usize) {
-    householder_narrow_with(a, m, n, &mut []);
-}
-
-/// [`householder_narrow`], each reflector also applied to the columns of
-/// `extra` (column-major, `m` rows each): they become `Qᵀ` times
-/// themselves, and leave `a`'s factor as it is without them, bit for bit.
-pub(crate) fn householder_narrow_with(a: &mut [f64], m: usize, n: usize, extra: &mut [f64]) {
     for j in 0..n.min(m) {
         let (left, right) = a.split_at_mut((j + 1) * m);
         let v = &mut left[j * m + j..];
@@ -67,9 +60,8 @@ pub(crate) fn householder_narrow_with(a: &mut [f64], m: usize, n: usize, extra: 
         let alpha = if x0 >= 0.0 { -norm } else { norm };
         v[0] = x0 - alpha;
         let scale = 1.0 / (norm * v[0].abs());
-        let later = right[..(n - j - 1) * m].chunks_exact_mut(m);
-        for col in later.chain(extra.chunks_exact_mut(m)) {
-            let c = &mut col[j..];
+        for k in 0..n - j - 1 {
+            let c = &mut right[k * m + j..(k + 1) * m];
             let d = dot(v, c) * scale;
             for (ci, vi) in c.iter_mut().zip(v.iter()) {
                 *ci -= d * vi;

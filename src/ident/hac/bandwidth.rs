@@ -1,16 +1,15 @@
 //! Newey and West's (1994) automatic bandwidth for the Bartlett kernel.
 
 use super::running::prefix_sums;
-use super::view::{View, Windowed};
-use super::{Scales, Scratch, Series, Stats, rescale_square};
-use crate::kernels::reduce::{dot, max_abs, pow2_floor, sum_by};
+use super::{Scratch, Series};
+use crate::kernels::reduce::{max_abs, pow2_floor, sum_by};
 
 /// Rows per block: the running sums start afresh every block, which bounds
 /// their rounding.
 const SUB: usize = 512;
 
 /// Newey and West's (1994) automatic bandwidth for the Bartlett kernel
-/// over the `p` columns of `source` (`bounds`: `[0, segment starts…, n]`),
+/// over the columns of `x` (`bounds`: `[0, segment starts…, n]`),
 /// with `pre` the pre-bandwidth ([`newey_west_lags`](crate::ident::newey_west_lags)
 /// of the rows fitted) and `rows` the rows fitted: `⌊1.1447 (s⁽¹⁾ /
 /// s⁽⁰⁾)^(2/3) rows^(1/3)⌋`, `usize::MAX` when `s⁽⁰⁾ ≤ 0`; see
@@ -26,15 +25,10 @@ const SUB: usize = 512;
 /// of it a row, `O(rows)` whatever `pre`, where the lags one by one cost
 /// `O(rows · pre)` (measured: the two sums within 1e-14 of `σ₀` of the
 /// lag-by-lag ones).
-///
-/// A stored series knows `c` first (from its [`Stats`], or a pass over
-/// its columns) and sums `h` alone. A series handed out in blocks, where
-/// every pass costs its rows again, leaves `c` to the end: the matrices
-/// `Σ_t W_t(L) W_t(L)ᵀ` of the columns' own moving sums, then `cᵀ … c`:
-/// one pass, `O(rows · p²)`.
+/// `c` comes from the series' [`Stats`](super::Stats) when known, else
+/// from a pass over its columns; `h` is formed a block at a time.
 pub(crate) fn automatic_lags(
-    source: &mut impl Series,
-    p: usize,
+    x: Series<'_>,
     bounds: &[usize],
     pre: usize,
     rows: usize,
@@ -43,7 +37,7 @@ pub(crate) fn automatic_lags(
     if pre == 0 {
         return 0;
     }
-    let (s0, s1) = bandwidth_sums(source, p, bounds, pre, scratch);
+    let (s0, s1) = bandwidth_sums(x, bounds, pre, scratch);
     if s0 <= 0.0 {
         return usize::MAX;
     }
@@ -54,28 +48,6 @@ pub(crate) fn automatic_lags(
     } else {
         usize::MAX
     }
-}
-
-/// `(s⁽⁰⁾, s⁽¹⁾)` of [`automatic_lags`] (`pre ≥ 1`).
-pub(super) fn bandwidth_sums(
-    source: &mut impl Series,
-    p: usize,
-    bounds: &[usize],
-    pre: usize,
-    scratch: &mut Scratch,
-) -> (f64, f64) {
-    let Scratch { window, work } = scratch;
-    if let Some((x, n, stats)) = source.stored() {
-        return stored_sums(x, n, bounds, pre, stats, work);
-    }
-    let cap = pre + 1 + 2 * SUB;
-    let mut view = Windowed {
-        source,
-        window,
-        p,
-        cap,
-    };
-    column_sums(&mut view, p, bounds, pre, work)
 }
 
 /// The moving sums of one column's block: its rows with the `pre + 1`
@@ -133,17 +105,17 @@ fn from_windows(b1: f64, b2: f64, pre: usize) -> (f64, f64) {
     (s0, (pre + 1) as f64 * s0 - b1)
 }
 
-/// [`bandwidth_sums`] of a stored series: `c` from `stats` (or the
-/// columns), `h` a block at a time with the `pre + 1` rows before it.
-fn stored_sums(
-    x: &[f64],
-    n: usize,
+/// `(s⁽⁰⁾, s⁽¹⁾)` of [`automatic_lags`] (`pre ≥ 1`): `h` a block at a time
+/// with the `pre + 1` rows before it.
+pub(super) fn bandwidth_sums(
+    series: Series<'_>,
     bounds: &[usize],
     pre: usize,
-    stats: Option<&Stats>,
-    work: &mut Vec<f64>,
+    scratch: &mut Scratch,
 ) -> (f64, f64) {
-    let c = weights(x, n, stats);
+    let Series { x, n, .. } = series;
+    let work = &mut scratch.work;
+    let c = weights(series);
     let stride = room(pre);
     work.resize(stride, 0.0);
     let mut m = Windows::split(&mut work[..stride], pre);
@@ -181,7 +153,7 @@ fn stored_sums(
 /// from `stats` when they are known and their sums neither overflowed nor
 /// fell below the normal range, else from the columns, each divided first
 /// by its power of two.
-fn weights(x: &[f64], n: usize, stats: Option<&Stats>) -> Vec<f64> {
+fn weights(Series { x, n, stats }: Series<'_>) -> Vec<f64> {
     let known = stats.filter(|s| {
         s.ss.iter()
             .all(|&v| v == 0.0 || (v.is_finite() && v >= f64::MIN_POSITIVE))
@@ -201,89 +173,4 @@ fn weights(x: &[f64], n: usize, stats: Option<&Stats>) -> Vec<f64> {
             })
             .collect(),
     }
-}
-
-/// [`bandwidth_sums`] through `view`, `c` left to the end.
-fn column_sums(
-    view: &mut impl View,
-    p: usize,
-    bounds: &[usize],
-    pre: usize,
-    work: &mut Vec<f64>,
-) -> (f64, f64) {
-    let mut scales = Scales::new(p);
-    let mut ss = vec![0.0; p];
-    // Σ W(pre) W(pre)ᵀ and Σ W(pre − 1) W(pre − 1)ᵀ, p × p.
-    let mut b1 = vec![0.0; p * p];
-    let mut b2 = vec![0.0; p * p];
-    let stride = room(pre);
-    work.resize(p * stride, 0.0);
-    for w in bounds.windows(2) {
-        let (start, len) = (w[0], w[1] - w[0]);
-        view.begin(start, len);
-        let mut a = 0;
-        while a < len + pre {
-            let b = (a + SUB).min(len + pre);
-            let rows = b - a;
-            let (lo, hi) = (a.saturating_sub(pre + 1), b.min(len));
-            view.ensure(lo, hi);
-            let (new_lo, new_hi) = (a.min(len), hi);
-            for (j, ss) in ss.iter_mut().enumerate() {
-                let largest = if new_lo < new_hi {
-                    max_abs(view.col(j, new_lo, new_hi))
-                } else {
-                    0.0
-                };
-                if let Some(f) = scales.raise(j, largest) {
-                    *ss *= f * f;
-                    rescale_square(&mut b1, p, j, f);
-                    rescale_square(&mut b2, p, j, f);
-                }
-            }
-            for j in 0..p {
-                let mut m = Windows::split(&mut work[j * stride..(j + 1) * stride], pre);
-                let y = &mut m.y[..rows + pre + 1];
-                y.fill(0.0);
-                if lo < hi {
-                    y[lo + pre + 1 - a..hi + pre + 1 - a].copy_from_slice(view.col(j, lo, hi));
-                }
-                let own =
-                    &y[(new_lo + pre + 1).saturating_sub(a)..(new_hi + pre + 1).saturating_sub(a)];
-                ss[j] += sum_by(own, |v| (v * scales.inverse[j]) * (v * scales.inverse[j]));
-                m.sums(rows, pre, scales.inverse[j]);
-            }
-            for i in 0..p {
-                for j in 0..=i {
-                    let (wi, wj) = (&work[i * stride..], &work[j * stride..]);
-                    let at = 2 * (pre + 2 + SUB);
-                    let v1 = dot(&wi[at..at + rows], &wj[at..at + rows]);
-                    let v2 = dot(
-                        &wi[at + SUB..at + SUB + rows],
-                        &wj[at + SUB..at + SUB + rows],
-                    );
-                    b1[i * p + j] += v1;
-                    b2[i * p + j] += v2;
-                    if i != j {
-                        b1[j * p + i] += v1;
-                        b2[j * p + i] += v2;
-                    }
-                }
-            }
-            a = b;
-        }
-    }
-    let c: Vec<f64> = ss
-        .iter()
-        .map(|&s| if s > 0.0 { 1.0 / s.sqrt() } else { 0.0 })
-        .collect();
-    let form = |x: &[f64]| -> f64 {
-        let mut s = 0.0;
-        for i in 0..p {
-            for j in 0..p {
-                s += c[i] * c[j] * x[i * p + j];
-            }
-        }
-        s
-    };
-    from_windows(form(&b1), form(&b2), pre)
 }

@@ -1,7 +1,6 @@
 //! The Bartlett sum `Σ_t v_t v_tᵀ` of moving sums.
 
 use super::running::{Step, running};
-use super::view::{Direct, View, Windowed};
 use super::{Scales, Scratch, Series, powers, rescale_lower};
 use crate::kernels::reduce::{dot, max_abs};
 
@@ -9,7 +8,7 @@ use crate::kernels::reduce::{dot, max_abs};
 /// the running sums and the products.
 const BLOCK: usize = 2048;
 
-/// `Σ_t v_t v_tᵀ` over every segment of the `p` columns of `source`
+/// `Σ_t v_t v_tᵀ` over every segment of the `p` columns of `x`
 /// (`bounds`: `[0, segment starts…, n]`), with `v_t` the sum of the rows
 /// `t − L … t` of the segment (zero outside it), `t` running to `L` rows
 /// past its end: `(L + 1) (Γ₀ + Σ_{l=1}^{L} w_l (Γ_l + Γ_lᵀ))` with the
@@ -18,43 +17,19 @@ const BLOCK: usize = 2048;
 ///
 /// `v` is formed [`BLOCK`] rows at a time as the running sum of `x_t −
 /// x_{t−L−1}` (carried from block to block), and each block's products are
-/// summed before the next. A segment of `len ≤ L` rows has `v_t =
+/// summed before the next. The columns' powers of two come from the
+/// series' stats when known, else are found on the way. A segment of `len ≤ L` rows has `v_t =
 /// v_{len−1}` for every `t` from `len − 1` to `L`: that row is counted
 /// once, with its weight.
 pub(crate) fn bartlett(
-    source: &mut impl Series,
+    x: Series<'_>,
     p: usize,
     bounds: &[usize],
     lags: usize,
     scratch: &mut Scratch,
 ) -> (Vec<f64>, Vec<f64>) {
-    let Scratch { window, work } = scratch;
-    if let Some((x, n, stats)) = source.stored() {
-        let mut view = Direct { x, n, start: 0 };
-        let known = stats.map(|s| powers(&s.max));
-        return sums(&mut view, p, bounds, lags, work, known);
-    }
-    // Room for a block and the L + 1 rows before it, and a block ahead.
-    let cap = lags + 1 + 2 * BLOCK;
-    let mut view = Windowed {
-        source,
-        window,
-        p,
-        cap,
-    };
-    sums(&mut view, p, bounds, lags, work, None)
-}
-
-/// [`bartlett`] through `view`, with the columns' powers of two `known`
-/// or found on the way.
-fn sums(
-    view: &mut impl View,
-    p: usize,
-    bounds: &[usize],
-    lags: usize,
-    work: &mut Vec<f64>,
-    known: Option<Scales>,
-) -> (Vec<f64>, Vec<f64>) {
+    let work = &mut scratch.work;
+    let known = x.stats.map(|s| powers(&s.max));
     let fixed = known.is_some();
     let mut scales = known.unwrap_or_else(|| Scales::new(p));
     let mut s = vec![0.0; p * (p + 1) / 2];
@@ -63,7 +38,8 @@ fn sums(
     let v = &mut work[..BLOCK * p];
     for w in bounds.windows(2) {
         let (start, len) = (w[0], w[1] - w[0]);
-        view.begin(start, len);
+        // Rows `from .. to` of the segment's column `j`.
+        let col = |j: usize, from: usize, to: usize| x.col(j, start + from, start + to);
         carry.fill(0.0);
         // The rows t of v, in three runs where the same rows of x enter:
         // x_t alone (t ≤ L), x_t − x_{t−L−1}, then −x_{t−L−1} past the end.
@@ -76,12 +52,9 @@ fn sums(
             let mut a = from;
             while a < to {
                 let rows = (to - a).min(BLOCK);
-                let first = if sub { a - lags - 1 } else { a };
-                let last = if add { a + rows } else { a - lags - 1 + rows };
-                view.ensure(first, last);
                 if add && !fixed {
                     for (j, carry) in carry.iter_mut().enumerate() {
-                        if let Some(f) = scales.raise(j, max_abs(view.col(j, a, a + rows))) {
+                        if let Some(f) = scales.raise(j, max_abs(col(j, a, a + rows))) {
                             *carry *= f;
                             rescale_lower(&mut s, p, j, f);
                         }
@@ -89,12 +62,12 @@ fn sums(
                 }
                 for (j, carry) in carry.iter_mut().enumerate() {
                     let step = match (add, sub) {
-                        (true, false) => Step::Add(view.col(j, a, a + rows)),
+                        (true, false) => Step::Add(col(j, a, a + rows)),
                         (true, true) => Step::Replace(
-                            view.col(j, a, a + rows),
-                            view.col(j, a - lags - 1, a - lags - 1 + rows),
+                            col(j, a, a + rows),
+                            col(j, a - lags - 1, a - lags - 1 + rows),
                         ),
-                        _ => Step::Drop(view.col(j, a - lags - 1, a - lags - 1 + rows)),
+                        _ => Step::Drop(col(j, a - lags - 1, a - lags - 1 + rows)),
                     };
                     let out = &mut v[j * BLOCK..j * BLOCK + rows];
                     *carry = running(step, scales.inverse[j], *carry, out);

@@ -43,8 +43,8 @@ fn bounds_of(starts: &[usize], n: usize) -> Vec<usize> {
 /// The Bartlett sum is the former one to rounding (its running sums now
 /// start from the carry: measured at most a few 1e-16 of the largest
 /// entry), whatever the lags (none, a few, more than a segment, more than
-/// a block) and the segments (a short one among them); read in place,
-/// with the columns' stats, and handed out in blocks, the same bits.
+/// a block) and the segments (a short one among them); the same bits
+/// whether the columns' stats are known or found on the way.
 #[test]
 fn the_bartlett_sum_is_the_former_one() {
     let mut scratch = Scratch::default();
@@ -69,17 +69,12 @@ fn the_bartlett_sum_is_the_former_one() {
             let want = reference::bartlett(&x, n, &inverses, &bounds, lags, &mut Vec::new());
             let bits = |v: &[f64]| v.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
             let what = format!("n {n}, p {p}, lags {lags}");
-            let (got, got_scales) = bartlett(
-                &mut Stored {
-                    x: &x,
-                    n,
-                    stats: None,
-                },
-                p,
-                &bounds,
-                lags,
-                &mut scratch,
-            );
+            let plain = Series {
+                x: &x,
+                n,
+                stats: None,
+            };
+            let (got, got_scales) = bartlett(plain, p, &bounds, lags, &mut scratch);
             assert_eq!(got_scales, scales, "{what}");
             let largest = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for (g, w) in got.iter().zip(&want) {
@@ -87,33 +82,13 @@ fn the_bartlett_sum_is_the_former_one() {
                 worst = worst.max(rel);
                 assert!(rel < 1e-14, "{what}: {g} vs {w}");
             }
-            let known = bartlett(
-                &mut Stored {
-                    x: &x,
-                    n,
-                    stats: Some(&stats),
-                },
-                p,
-                &bounds,
-                lags,
-                &mut scratch,
-            );
+            let known = Series {
+                stats: Some(&stats),
+                ..plain
+            };
+            let known = bartlett(known, p, &bounds, lags, &mut scratch);
             assert_eq!(
                 (bits(&known.0), &known.1),
-                (bits(&got), &got_scales),
-                "{what}"
-            );
-            let mut blocks = Counting {
-                inner: Stored {
-                    x: &x,
-                    n,
-                    stats: None,
-                },
-                rows: 0,
-            };
-            let streamed = bartlett(&mut blocks, p, &bounds, lags, &mut scratch);
-            assert_eq!(
-                (bits(&streamed.0), &streamed.1),
                 (bits(&got), &got_scales),
                 "{what}"
             );
@@ -123,8 +98,8 @@ fn the_bartlett_sum_is_the_former_one() {
 }
 
 /// The automatic bandwidth's two sums are the former ones (lag by lag) to
-/// rounding, from moving sums, stored (with and without the columns'
-/// stats) or handed out in blocks; the same bandwidth.
+/// rounding, from two Bartlett sums, with and without the columns' stats;
+/// the same bandwidth.
 #[test]
 fn the_bandwidth_sums_are_the_former_ones() {
     let mut scratch = Scratch::default();
@@ -165,69 +140,20 @@ fn the_bandwidth_sums_are_the_former_ones() {
                 .collect(),
         };
         for known in [None, Some(&stats)] {
-            let mut stored = Stored {
+            let series = Series {
                 x: &x,
                 n,
                 stats: known,
             };
-            let mut blocks = Counting {
-                inner: Stored {
-                    x: &x,
-                    n,
-                    stats: None,
-                },
-                rows: 0,
-            };
-            for got in [
-                bandwidth_sums(&mut stored, p, &bounds, pre, &mut scratch),
-                bandwidth_sums(&mut blocks, p, &bounds, pre, &mut scratch),
-            ] {
-                for (g, w) in [(got.0, want.0), (got.1, want.1)] {
-                    let rel = (g - w).abs() / sigma0;
-                    worst = worst.max(rel);
-                    assert!(rel < 1e-13, "n {n}, p {p}: {g} vs {w} (σ₀ {sigma0})");
-                }
+            let got = bandwidth_sums(series, &bounds, pre, &mut scratch);
+            for (g, w) in [(got.0, want.0), (got.1, want.1)] {
+                let rel = (g - w).abs() / sigma0;
+                worst = worst.max(rel);
+                assert!(rel < 1e-13, "n {n}, p {p}: {g} vs {w} (σ₀ {sigma0})");
             }
-            let streamed = automatic_lags(&mut stored, p, &bounds, pre, n, &mut scratch);
-            assert_eq!(streamed, lags, "n {n}, p {p}");
-            let streamed = automatic_lags(&mut blocks, p, &bounds, pre, n, &mut scratch);
-            assert_eq!(streamed, lags, "n {n}, p {p}");
+            let got = automatic_lags(series, &bounds, pre, n, &mut scratch);
+            assert_eq!(got, lags, "n {n}, p {p}");
         }
     }
     eprintln!("bandwidth sums: worst difference {worst:e} of σ₀");
-}
-
-/// A source handing out rows of a stored series, counting what it hands
-/// out: the sums read each row a bounded number of times.
-struct Counting<'a> {
-    inner: Stored<'a>,
-    rows: usize,
-}
-
-impl Series for Counting<'_> {
-    fn fill(&mut self, from: usize, len: usize, out: &mut [f64], stride: usize) {
-        self.rows += len;
-        self.inner.fill(from, len, out, stride);
-    }
-}
-
-#[test]
-fn each_pass_reads_each_row_once() {
-    let (n, p) = (30_000, 2);
-    let x = series(n, p, 5);
-    let bounds = bounds_of(&[10_000], n);
-    let mut scratch = Scratch::default();
-    let mut source = Counting {
-        inner: Stored {
-            x: &x,
-            n,
-            stats: None,
-        },
-        rows: 0,
-    };
-    bartlett(&mut source, p, &bounds, 900, &mut scratch);
-    assert_eq!(source.rows, n);
-    source.rows = 0;
-    bandwidth_sums(&mut source, p, &bounds, 20, &mut scratch);
-    assert_eq!(source.rows, n);
 }

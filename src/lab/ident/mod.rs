@@ -419,8 +419,7 @@ fn identify_by<D: Differences>(
         keep: cart2,
         p: 2 + usize::from(fixed_m2.is_none()) + usize::from(cart2.is_some()),
     };
-    let carry = stage1.as_ref().map(|s| (&first_spec, s));
-    let (second, _) = solver.solve::<D>(&second_spec, 0, carry)?;
+    let (second, _) = solver.solve::<D>(&second_spec, 0, stage1.as_ref())?;
     let [gain, b2] = estimates::<2>(&second);
     let m2_estimate = fitted_m2(options.free_m2, &second);
     Ok(MassSpringEstimate {

@@ -1,48 +1,55 @@
-//! The two least-squares stages. A stage of fewer than
-//! [`BLOCKED_FROM_ROWS`] rows is built whole and solved as stored; a
-//! longer one is streamed: its rows built [`BLOCK_ROWS`] at a time and
-//! factored under the `R` of the rows before ([`Tsqr`]), the same factor
-//! bit for bit. With Newey–West, each row's influence is computed again
-//! block by block from the samples ([`influence`]) and handed to the sums,
-//! so that no column of the recording's length is held.
+//! The two least-squares stages. A stage is built by ranges of rows
+//! ([`Spec::fill`]). Under [`BLOCKED_FROM_ROWS`] rows it is built whole and
+//! solved as stored; a longer one is streamed, its rows built
+//! [`BLOCK_ROWS`] at a time and factored under the `R` of the rows before
+//! ([`Tsqr`]): the stored problem's factor, bit for bit, with no column
+//! of the recording's length held. With Newey–West the stage is built
+//! whole (streamed through the factor all the same when long): the sums
+//! need every row's influence twice, and its equilibrated copy becomes
+//! that influence in place, cheaper than building the rows again.
 
 use nalgebra::{DMatrix, DVector};
 
-use super::influence::{Influence, K2, Own, carry_and_map, overflows};
+use super::influence::{Carry, carry, overflows};
 use super::regressors::{Differences, Kind, Out, Spec};
 use crate::error::Error;
 use crate::ident::{
-    BLOCK_ROWS, BLOCKED_FROM_ROWS, Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, Scratch,
-    Stats, Stored, Triangular, Tsqr, classical, equilibrate, fit_from, householder_narrow,
-    influence_rows, newey_west_of, scale_pow2, sensitivity_of, spread, triangular,
+    BLOCK_ROWS, BLOCKED_FROM_ROWS, Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, NARROW,
+    Scratch, Series, Stats, Triangular, Tsqr, classical, equilibrate, fit_from, householder_narrow,
+    influence_rows, newey_west_of, scale_column, scale_pow2, sensitivity_of, spread, triangular,
 };
 use crate::kernels::reduce::max_ss;
 
 /// Most parameters of stage 2: `K`, `b2`, `m2`, `F2`.
 pub(super) const MAX_STAGE2: usize = 4;
 
-/// What stage 2's Newey–West errors need of stage 1: its solve, and its
-/// influence on `k2` at every row when it was solved whole.
-pub(super) struct FirstStage {
-    pub tri: Triangular,
-    pub exponents: Vec<i32>,
-    pub k2_index: usize,
-    pub whole: bool,
+/// What stage 2's Newey–West errors need of stage 1 besides its influence
+/// on `k2` (kept in the [`Solver`]).
+pub(super) struct FirstStage;
+
+/// A stage's factorisation: its triangular solve, the columns' exponents,
+/// `λ`'s spread, and with Newey–West where its equilibrated copy (and
+/// stage 2's `z`) lie in the solver's buffer.
+struct Factored {
+    tri: Triangular,
+    exponents: Vec<i32>,
+    sst: f64,
+    copy_at: usize,
+    z_at: usize,
 }
 
 /// The buffers of the stages, kept between them.
 pub(super) struct Solver {
     covariance: Covariance,
-    /// A stage's `[Φ | λ (| z)]`, whole or a block of it.
+    /// A stage's `[Φ | λ (| z)]` and its copy.
     buf: Vec<f64>,
     /// Stage 1's influence on `k2` at every row of the segments (zero
-    /// where it used none), when it was solved whole.
+    /// where it used none).
     k2: Vec<f64>,
-    /// A whole stage's series scattered to every row, when it keeps some.
+    /// A stage's series scattered to every row, when it keeps some.
     series: Vec<f64>,
-    /// A block of stage 1's rows, and its influence on `k2`.
+    /// The cold path's rows.
     block: Vec<f64>,
-    k2_rows: Vec<f64>,
     scratch: Scratch,
     stats: Stats,
     starts: Vec<usize>,
@@ -56,7 +63,6 @@ impl Solver {
             k2: Vec::new(),
             series: Vec::new(),
             block: Vec::new(),
-            k2_rows: Vec::new(),
             scratch: Scratch::default(),
             stats: Stats::default(),
             starts: Vec::new(),
@@ -64,8 +70,7 @@ impl Solver {
     }
 
     /// Solves the stage `spec`. Stage 1 (`k2_index`: its parameter `k2`)
-    /// returns what stage 2's errors need; stage 2 takes it as `first`
-    /// (with stage 1's `Spec`).
+    /// returns what stage 2's errors need; stage 2 takes it as `first`.
     ///
     /// With Newey–West, each row's influence `(ΦᵀΦ)⁻¹ φ_t e_t` is placed
     /// at its sample in the segments (zero at the rows left out, so that
@@ -80,7 +85,7 @@ impl Solver {
         &mut self,
         spec: &Spec<'_, '_>,
         k2_index: usize,
-        first: Option<(&Spec<'_, '_>, &FirstStage)>,
+        first: Option<&FirstStage>,
     ) -> Result<(LeastSquaresFit, Option<FirstStage>), Error> {
         let data = spec.data;
         let (m, p) = (spec.keep.map_or(data.rows, |k| k.moving), spec.p);
@@ -96,12 +101,18 @@ impl Solver {
             Covariance::NeweyWest { lags } => Some(lags),
         };
         let want_z = lags.is_some() && matches!(spec.kind, Kind::Second { .. });
-        let whole = m < BLOCKED_FROM_ROWS;
-        let (tri, exponents, sst, mut g) = if whole {
-            self.factor_whole::<D>(spec, m, lags.is_some(), want_z)?
+        let f = if lags.is_some() || m < BLOCKED_FROM_ROWS {
+            self.factor_stored::<D>(spec, m, lags.is_some(), want_z)?
         } else {
-            self.factor_streamed::<D>(spec, m, want_z)?
+            self.factor_streamed::<D>(spec, m)?
         };
+        let Factored {
+            tri,
+            exponents,
+            sst,
+            copy_at,
+            z_at,
+        } = f;
         let mut fit = fit_from(
             &tri,
             classical(&tri, m, p),
@@ -123,199 +134,193 @@ impl Solver {
             return finite(fit).map(|fit| (fit, None));
         };
         let n = data.rows;
-        // Where a whole stage's copy, then its series, lies in `buf`.
-        let copy_at = m * (spec.width() + usize::from(want_z));
-        if whole {
-            // The equilibrated problem, copied before the QR, then each
-            // row's influence in its place (and stage 2's g from z), as the
-            // stored solve.
-            let (head, work) = self.buf.split_at_mut(m * (p + 1 + usize::from(want_z)));
-            let work = &mut work[..m * (p + 1)];
-            if want_z {
-                let z = &head[m * (p + 1)..];
-                let (gz, e_z) = sensitivity_of(work, m, m, &tri.rinv, z, &mut self.block);
-                g = Some(
-                    (0..p)
-                        .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
-                        .collect(),
-                );
-            }
-            let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
-            influence_rows(work, m, m, &tri.theta, &tri.rinv, &d);
-        }
+        // Each row's influence in place of the equilibrated copy (stage
+        // 2's g from U = Φ R⁻¹ and z first), as the stored solve.
+        let (work, z): (&mut [f64], &[f64]) = if !want_z {
+            (&mut self.buf[copy_at..], &[])
+        } else if z_at < copy_at {
+            let (head, work) = self.buf.split_at_mut(copy_at);
+            (work, &head[z_at..z_at + m])
+        } else {
+            let (work, tail) = self.buf.split_at_mut(z_at);
+            (&mut work[copy_at..], &tail[..m])
+        };
+        let work = &mut work[..m * (p + 1)];
+        let g: Option<Vec<f64>> = want_z.then(|| {
+            let (gz, e_z) = sensitivity_of(work, m, m, &tri.rinv, z, &mut self.block);
+            (0..p)
+                .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
+                .collect()
+        });
+        let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
+        influence_rows(work, m, m, &tri.theta, &tri.rinv, &d);
         if let Some(g) = &g
             && !g.iter().all(|v| v.is_finite())
         {
-            return Err(sensitivity());
+            return Err(Error::Overflow {
+                operation: "least squares (a sensitivity exceeds f64::MAX)",
+            });
         }
         let map = match k2_value {
             Some(k2) => Some(free_mass(&mut fit.theta, k2)?),
             None => None,
         };
+        // The series at every row of the segments, scattered when the
+        // stage keeps some, then carried or mapped.
+        let series: &mut [f64] = match spec.keep {
+            None => &mut self.buf[copy_at..copy_at + n * p],
+            Some(keep) => {
+                self.series.clear();
+                self.series.resize(n * p, 0.0);
+                for j in 0..p {
+                    let h = &self.buf[copy_at + j * m..copy_at + (j + 1) * m];
+                    let to = &mut self.series[j * n..(j + 1) * n];
+                    let rows = keep
+                        .direction
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, d)| **d != 0.0);
+                    for (&v, (r, _)) in h.iter().zip(rows) {
+                        to[r] = v;
+                    }
+                }
+                &mut self.series
+            }
+        };
+        if first.is_some() {
+            let how = match (&g, &map) {
+                (Some(g), _) => Some(Carry::Sensitivity(g)),
+                (None, Some(map)) => Some(Carry::FreeMass(map)),
+                (None, None) => None,
+            };
+            if let Some(how) = how {
+                carry(series, n, p, &self.k2, &how);
+            }
+        }
+        // Each column's largest entry and sum of squares, for the sums.
+        self.stats.max.clear();
+        self.stats.ss.clear();
+        let mut known = true;
+        for col in series.chunks_exact(n) {
+            let (max, ss) = max_ss(col);
+            known &= max.is_finite() && ss.is_finite();
+            self.stats.max.push(max);
+            self.stats.ss.push(ss);
+        }
+        // Not finite: the stored solve's error if a row's own influence
+        // was not (else the sums overflow, which `finite` reports).
+        if !known && overflows::<D>(spec, &tri, &exponents, &mut self.block) {
+            return Err(Error::Overflow {
+                operation: "least squares (the influence of a row exceeds f64::MAX)",
+            });
+        }
         self.starts.clear();
         self.starts.extend(data.segments.iter().map(|s| s.row0));
-        let k2 = first.map(|(spec1, stage1)| {
-            if stage1.whole {
-                K2::Whole(&self.k2)
-            } else {
-                K2::Regen {
-                    spec: spec1,
-                    tri: &stage1.tri,
-                    exponents: &stage1.exponents,
-                    k2_index: stage1.k2_index,
-                }
-            }
-        });
-        let (covariance, used) = if whole {
-            // The series in place (scattered to every row when the stage
-            // keeps some), carried or mapped, then summed as stored.
-            let series: &mut [f64] = match spec.keep {
-                None => &mut self.buf[copy_at..copy_at + n * p],
-                Some(keep) => {
-                    self.series.clear();
-                    self.series.resize(n * p, 0.0);
-                    for j in 0..p {
-                        let h = &self.buf[copy_at + j * m..copy_at + (j + 1) * m];
-                        let to = &mut self.series[j * n..(j + 1) * n];
-                        let rows = keep
-                            .direction
-                            .iter()
-                            .enumerate()
-                            .filter(|(_, d)| **d != 0.0);
-                        for (&v, (r, _)) in h.iter().zip(rows) {
-                            to[r] = v;
-                        }
-                    }
-                    &mut self.series
-                }
-            };
-            if let Some(k2) = &k2 {
-                let mut from = 0;
-                while from < n {
-                    let len = BLOCK_ROWS.min(n - from);
-                    k2.rows::<D>((from, len), &mut self.block, &mut self.k2_rows);
-                    carry_and_map(
-                        &mut series[from..],
-                        n,
-                        p,
-                        &self.k2_rows,
-                        g.as_deref(),
-                        map.as_ref(),
-                    );
-                    from += len;
-                }
-            }
-            // Each column's largest entry and sum of squares, for the sums.
-            self.stats.max.clear();
-            self.stats.ss.clear();
-            let mut known = true;
-            for col in series.chunks_exact(n) {
-                let (max, ss) = max_ss(col);
-                known &= max.is_finite() && ss.is_finite();
-                self.stats.max.push(max);
-                self.stats.ss.push(ss);
-            }
-            // Not finite: the stored solve's error if a row's own influence
-            // was not (else the sums overflow, which `finite` reports).
-            if !known && overflows::<D>(spec, &tri, &exponents, &mut self.block) {
-                return Err(influence_overflow());
-            }
-            let mut stored = Stored {
-                x: series,
-                n,
-                stats: known.then_some(&self.stats),
-            };
-            newey_west_of(&mut stored, n, p, &self.starts, m, lags, &mut self.scratch)
-        } else {
-            let own = Own {
-                spec,
-                tri: &tri,
-                exponents: &exponents,
-            };
-            let mut source = Influence::<D>::new(own, p, k2, g, map);
-            let result = newey_west_of(&mut source, n, p, &self.starts, m, lags, &mut self.scratch);
-            drop(source);
-            if result.0.iter().any(|v| !v.is_finite())
-                && overflows::<D>(spec, &tri, &exponents, &mut self.block)
-            {
-                return Err(influence_overflow());
-            }
-            result
+        let x = Series {
+            x: series,
+            n,
+            stats: known.then_some(&self.stats),
         };
+        let (covariance, used) = newey_west_of(x, p, &self.starts, m, lags, &mut self.scratch);
         fit.std_errors = covariance.diagonal().map(|v| v.max(0.0).sqrt());
         fit.covariance = covariance;
         fit.covariance_kind = Covariance::NeweyWest { lags: Some(used) };
         let fit = finite(fit)?;
         // Stage 1 keeps its influence on k2 for stage 2.
         let state = matches!(spec.kind, Kind::First { .. }).then(|| {
-            if whole {
-                let series = match spec.keep {
-                    None => &self.buf[copy_at..copy_at + n * p],
-                    Some(_) => &self.series[..n * p],
-                };
-                self.k2.clear();
-                self.k2
-                    .extend_from_slice(&series[k2_index * n..(k2_index + 1) * n]);
-            }
-            FirstStage {
-                tri,
-                exponents,
-                k2_index,
-                whole,
-            }
+            let series = match spec.keep {
+                None => &self.buf[copy_at..copy_at + n * p],
+                Some(_) => &self.series[..n * p],
+            };
+            self.k2.clear();
+            self.k2
+                .extend_from_slice(&series[k2_index * n..(k2_index + 1) * n]);
+            FirstStage
         });
         Ok((fit, state))
     }
 
-    /// Builds the stage whole (`m` rows) and factors it as the stored
-    /// solve does; returns the triangular solve, the exponents, `λ`'s
-    /// spread and no `g` (the whole path finds it with the influence).
-    /// With `copy` (Newey–West), the equilibrated `[Φ | λ]` is also left
-    /// after the factor (and after stage 2's `z`, with `want_z`), for the
-    /// rows' influence.
-    #[allow(clippy::type_complexity)]
-    fn factor_whole<D: Differences>(
+    /// Builds the stage whole (`m` rows, then stage 2's `z` with
+    /// `want_z`) and factors it: under [`BLOCKED_FROM_ROWS`] rows as the
+    /// stored solve does, equilibrated then factored in place (with
+    /// `copy`, after a copy of the equilibrated `[Φ | λ]`); longer, its
+    /// blocks streamed through [`Tsqr`] and then equilibrated in place,
+    /// the copy.
+    fn factor_stored<D: Differences>(
         &mut self,
         spec: &Spec<'_, '_>,
         m: usize,
         copy: bool,
         want_z: bool,
-    ) -> Result<(Triangular, Vec<i32>, f64, Option<Vec<f64>>), Error> {
+    ) -> Result<Factored, Error> {
         let (p, n) = (spec.p, spec.data.rows);
         let width = spec.width();
         let filled = width + usize::from(want_z);
         self.buf.clear();
         let rows = spec.fill::<D>((0, n), true, want_z, Out::Push(&mut self.buf));
         debug_assert_eq!((rows, self.buf.len()), (m, m * filled));
+        if m >= BLOCKED_FROM_ROWS {
+            // Long: the blocks through the streamed factor, then the
+            // columns equilibrated with its powers of two (the same).
+            let mut tsqr = Tsqr::new(width);
+            let mut at = 0;
+            while at < m {
+                let rows = BLOCK_ROWS.min(m - at);
+                let (staging, stride) = tsqr.staging();
+                for (j, col) in self.buf.chunks_exact(m).take(width).enumerate() {
+                    staging[j * stride..j * stride + rows].copy_from_slice(&col[at..at + rows]);
+                }
+                if tsqr.push_staged(rows).is_err() {
+                    // The stored problem's error, naming the first entry.
+                    let mut exponents = vec![0; width];
+                    equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
+                    unreachable!("a block held a non-finite entry the columns do not");
+                }
+                at += rows;
+            }
+            let f = tsqr.finish();
+            for (col, &e) in self.buf.chunks_exact_mut(m).zip(&f.exponents) {
+                scale_column(col, e);
+            }
+            let sst = spread(&self.buf[p * m..width * m]);
+            let tri = triangular(|i, j| f.r(i, j), p, DEFAULT_MAX_CONDITION)?;
+            return Ok(Factored {
+                tri,
+                exponents: f.exponents,
+                sst,
+                copy_at: 0,
+                z_at: m * width,
+            });
+        }
         let mut exponents = vec![0; width];
         equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
         let sst = spread(&self.buf[p * m..width * m]);
         if copy {
             self.buf.extend_from_within(..m * width);
         }
-        if width <= crate::ident::NARROW {
-            householder_narrow(&mut self.buf[..m * width], m, width);
-        } else {
-            unreachable!("the lab's stages have at most six columns");
-        }
+        assert!(width <= NARROW, "the lab's stages have at most six columns");
+        householder_narrow(&mut self.buf[..m * width], m, width);
         let buf = &self.buf;
         let tri = triangular(|i, j| buf[j * m + i], p, DEFAULT_MAX_CONDITION)?;
-        Ok((tri, exponents, sst, None))
+        Ok(Factored {
+            tri,
+            exponents,
+            sst,
+            copy_at: m * filled,
+            z_at: m * width,
+        })
     }
 
     /// Streams the stage (`m` rows) through [`Tsqr`] in blocks of
-    /// [`BLOCK_ROWS`] kept rows; with `want_z` stage 2's `z` rides along
-    /// as a last column, and `g` is its least-squares fit on `Φ`.
-    #[allow(clippy::type_complexity)]
+    /// [`BLOCK_ROWS`] kept rows, built in place.
     fn factor_streamed<D: Differences>(
         &mut self,
         spec: &Spec<'_, '_>,
         m: usize,
-        want_z: bool,
-    ) -> Result<(Triangular, Vec<i32>, f64, Option<Vec<f64>>), Error> {
+    ) -> Result<Factored, Error> {
         let (p, n) = (spec.p, spec.data.rows);
-        let width = spec.width() + usize::from(want_z);
-        let mut tsqr = Tsqr::new(width, p + 1);
+        let width = spec.width();
+        let mut tsqr = Tsqr::new(width);
         let (mut from, mut have) = (0, 0);
         while from < n {
             let to = (from + BLOCK_ROWS - have).min(n);
@@ -323,7 +328,7 @@ impl Solver {
             have += spec.fill::<D>(
                 (from, to),
                 true,
-                want_z,
+                false,
                 Out::Slices(&mut staging[have..], stride),
             );
             from = to;
@@ -337,74 +342,28 @@ impl Solver {
         let f = tsqr.finish();
         debug_assert_eq!(f.rows, m);
         let tri = triangular(|i, j| f.r(i, j), p, DEFAULT_MAX_CONDITION)?;
-        let mut exponents = f.exponents.clone();
-        let g = want_z.then(|| {
-            // R g' = (Qᵀ z)'s first p entries, then unscaled.
-            let mut g = DVector::zeros(p);
-            for i in (0..p).rev() {
-                let mut s = f.r(i, p + 1);
-                for j in i + 1..p {
-                    s -= f.r(i, j) * g[j];
-                }
-                g[i] = s / f.r(i, i);
-            }
-            let e_z = f.exponents[p + 1];
-            if !f.extra_finite {
-                g.fill(f64::NAN);
-            }
-            (0..p)
-                .map(|j| scale_pow2(g[j], e_z - f.exponents[j]))
-                .collect()
-        });
-        exponents.truncate(p + 1);
-        Ok((tri, exponents, f.sst, g))
+        Ok(Factored {
+            tri,
+            exponents: f.exponents,
+            sst: f.sst,
+            copy_at: 0,
+            z_at: 0,
+        })
     }
 
     /// The error of the first non-finite entry of the stage's `[Φ | λ]`,
     /// column by column (as the stored solve names it).
     #[cold]
     fn first_non_finite<D: Differences>(&mut self, spec: &Spec<'_, '_>, m: usize) -> Error {
-        let (p, n) = (spec.p, spec.data.rows);
-        let width = spec.width();
-        self.buf.resize(width * BLOCK_ROWS, 0.0);
-        for col in 0..=p {
-            let (mut from, mut row) = (0, 0);
-            while from < n {
-                let to = (from + BLOCK_ROWS).min(n);
-                let rows = spec.fill::<D>(
-                    (from, to),
-                    true,
-                    false,
-                    Out::Slices(&mut self.buf, BLOCK_ROWS),
-                );
-                let values = &self.buf[col * BLOCK_ROWS..col * BLOCK_ROWS + rows];
-                if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-                    return Error::NonFinite {
-                        matrix: "regressor",
-                        row: row + i,
-                        col,
-                        value: values[i],
-                    };
-                }
-                (from, row) = (to, row + rows);
-            }
+        self.buf.clear();
+        spec.fill::<D>((0, spec.data.rows), true, false, Out::Push(&mut self.buf));
+        let mut exponents = vec![0; spec.width()];
+        match equilibrate(&mut self.buf, m, &mut exponents) {
+            Err(e) => e,
+            Ok(()) => Error::Overflow {
+                operation: "least squares (a regressor is not finite)",
+            },
         }
-        debug_assert!(false, "a block held a non-finite entry: {m} rows");
-        Error::Overflow {
-            operation: "least squares (a regressor is not finite)",
-        }
-    }
-}
-
-fn influence_overflow() -> Error {
-    Error::Overflow {
-        operation: "least squares (the influence of a row exceeds f64::MAX)",
-    }
-}
-
-fn sensitivity() -> Error {
-    Error::Overflow {
-        operation: "least squares (a sensitivity exceeds f64::MAX)",
     }
 }
 
