@@ -461,9 +461,7 @@ impl LeastSquares {
             max_condition: self.max_condition,
             covariance: self.covariance,
             segment_starts: &self.segment_starts,
-            influence: false,
-            also: None,
         };
-        Ok(solve_augmented(&mut self.work, m, p, &options, &mut self.hac)?.fit)
+        solve_augmented(&mut self.work, m, p, &options, &mut self.hac)
     }
 }

@@ -30,18 +30,32 @@
 //! ```
 
 mod covariance;
+mod hac;
+mod influence;
 mod least_squares;
 mod rls;
 mod solve;
 mod spectral;
+// The streamed least squares of the lab's long stages.
+#[cfg(any(feature = "lab", test))]
+mod tsqr;
 
 #[cfg(feature = "lab")]
-pub(crate) use covariance::newey_west;
+pub(crate) use covariance::newey_west_of;
 pub use covariance::{Covariance, MAX_LAGS, newey_west_lags};
+#[cfg(feature = "lab")]
+pub(crate) use hac::{Scratch, Series, Stats};
+#[cfg(feature = "lab")]
+pub(crate) use influence::{influence_rows, sensitivity_of};
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};
 pub use rls::Rls;
 #[cfg(feature = "lab")]
-pub(crate) use solve::{SolveOptions, Workspace, solve_augmented};
+pub(crate) use solve::{
+    BLOCK_ROWS, BLOCKED_FROM_ROWS, NARROW, Triangular, classical, equilibrate, fit_from,
+    householder_narrow, scale_column, scale_pow2, spread, triangular,
+};
 pub use spectral::{
     ETFE_MIN_INPUT, FrequencyEstimate, MAX_SPECTRAL_SAMPLES, SPA_DEFAULT_LAG, etfe, spa,
 };
+#[cfg(feature = "lab")]
+pub(crate) use tsqr::Tsqr;

@@ -6,10 +6,12 @@ use faer::linalg::qr::no_pivoting::factor::{qr_in_place, qr_in_place_scratch};
 use faer::{MatMut, Par};
 use nalgebra::{DMatrix, DVector};
 
-use super::covariance::{Scratch, newey_west};
+use super::covariance::newey_west;
+use super::hac::Scratch;
+use super::influence::influence_rows;
 use super::{Covariance, LeastSquaresFit};
 use crate::error::Error;
-use crate::kernels::reduce::{dot, first_non_finite, max_abs, pow2_floor, sum_by, zip_sum};
+use crate::kernels::reduce::{dot, first_non_finite, max_abs, pow2_floor, sum_by};
 
 /// How [`solve_augmented`] solves and what it reports.
 #[derive(Debug, Clone, Copy)]
@@ -21,11 +23,6 @@ pub(crate) struct SolveOptions<'a> {
     /// Rows where a new segment starts (increasing): the Newey–West sums
     /// do not pair rows across them. 0 and rows ≥ `m` are ignored.
     pub segment_starts: &'a [usize],
-    /// Leave the influence series in `hac` (see [`solve_augmented`]).
-    pub influence: bool,
-    /// Also solve `Φ g ≈ z` for this column `z` (`m` values, finite), by
-    /// the same factorisation; only with `influence`.
-    pub also: Option<&'a [f64]>,
 }
 
 /// The buffers of the covariance, kept between solves.
@@ -37,20 +34,10 @@ pub(crate) struct Workspace {
     pub scratch: Scratch,
 }
 
-/// What [`solve_augmented`] found.
-#[derive(Debug, Clone)]
-pub(crate) struct Solved {
-    pub fit: LeastSquaresFit,
-    /// `g` of [`SolveOptions::also`] (read by the lab's two-stage
-    /// identification only).
-    #[cfg_attr(not(feature = "lab"), allow(dead_code))]
-    pub also: Option<DVector<f64>>,
-}
-
 /// Up to this many columns (the lab's regressors have 2 to 5, with `λ`)
 /// [`householder_narrow`] factors, not faer's QR: at 5000 × 3 faer's
 /// general kernel took two thirds of the whole identification.
-const NARROW: usize = 8;
+pub(crate) const NARROW: usize = 8;
 
 /// Householder QR of the column-major `m × n` `a` in place, for tall and
 /// narrow problems: leaves `R` in the upper triangle (what lies below it
@@ -59,7 +46,7 @@ const NARROW: usize = 8;
 /// column, over contiguous memory (eight-lane sums; the update
 /// vectorises). The columns are equilibrated (entries below 2), so the
 /// plain sums of squares cannot overflow.
-fn householder_narrow(a: &mut [f64], m: usize, n: usize) {
+pub(crate) fn householder_narrow(a: &mut [f64], m: usize, n: usize) {
     for j in 0..n.min(m) {
         let (left, right) = a.split_at_mut((j + 1) * m);
         let v = &mut left[j * m + j..];
@@ -90,11 +77,11 @@ fn householder_narrow(a: &mut [f64], m: usize, n: usize) {
 /// passes no longer fit in the cache (at 500 000 rows they were a third of
 /// the identification's time). Below it the factorisation, and so every
 /// figure, is the unblocked one's, bit for bit.
-const BLOCKED_FROM_ROWS: usize = 1 << 16;
+pub(crate) const BLOCKED_FROM_ROWS: usize = 1 << 16;
 
 /// Rows per block of [`householder_blocked`]: with the `R` above them, a
 /// few dozen kB, in the L1/L2 cache.
-const BLOCK_ROWS: usize = 512;
+pub(crate) const BLOCK_ROWS: usize = 512;
 
 /// The triangular factor of the column-major `m × n` `a` (`n ≤ NARROW`),
 /// left in its upper triangle like [`householder_narrow`], by a blocked
@@ -103,7 +90,7 @@ const BLOCK_ROWS: usize = 512;
 /// data are read once. The same `R` up to rounding and the signs of its
 /// rows, which nothing downstream depends on (θ, `R⁻¹R⁻ᵀ`, `ρ²` and the
 /// singular values are invariant under them).
-fn householder_blocked(a: &mut [f64], m: usize, n: usize) {
+pub(crate) fn householder_blocked(a: &mut [f64], m: usize, n: usize) {
     let mut r = [0.0; NARROW * NARROW];
     // One buffer per solve, not per block.
     let mut w = vec![0.0; (BLOCK_ROWS + n) * n];
@@ -129,35 +116,12 @@ fn householder_blocked(a: &mut [f64], m: usize, n: usize) {
     }
 }
 
-/// Solves `Φ θ ≈ λ` by QR, given column-major `a = [Φ | λ]` (`m` rows, `p + 1`
-/// columns), destroying `a`. With a Newey–West covariance or `influence`,
-/// `workspace.copy` receives a copy of the equilibrated `a` (its allocation
-/// is reused); with `influence` it is left holding the influence series,
-/// column-major `m × p`: row `t` is `(ΦᵀΦ)⁻¹ φ_t e_t`, in the parameters'
-/// units (their sum over the rows is `θ̂ − θ` to first order).
-pub(crate) fn solve_augmented(
-    a: &mut [f64],
-    m: usize,
-    p: usize,
-    options: &SolveOptions<'_>,
-    workspace: &mut Workspace,
-) -> Result<Solved, Error> {
-    let hac = &mut workspace.copy;
-    let max_condition = options.max_condition;
-    debug_assert_eq!(a.len(), m * (p + 1));
-    if p == 0 || m <= p {
-        return Err(Error::TooFewSamples {
-            what: "least squares (more rows than parameters)",
-            needed: p.max(1) + 1,
-            got: m,
-        });
-    }
-    // Equilibrate every column (λ too) by a power of two, so that its
-    // largest entry is in [1, 2): exact, and then no norm, product or
-    // square in the QR or the statistics below can overflow or underflow,
-    // whatever the units (a column of 1e308, another of 1e-200). The
-    // results are unscaled at the end.
-    let mut exponents = vec![0i32; p + 1];
+/// Divides every column of the column-major `a` (`m` rows) by a power of
+/// two, so that its largest entry is in [1, 2), and returns the powers'
+/// exponents: exact, and then no norm, product or square in the QR or the
+/// statistics can overflow or underflow, whatever the units (a column of
+/// 1e308, another of 1e-200). The results are unscaled at the end.
+pub(crate) fn equilibrate(a: &mut [f64], m: usize, exponents: &mut [i32]) -> Result<(), Error> {
     for (j, (col, e)) in a.chunks_exact_mut(m).zip(exponents.iter_mut()).enumerate() {
         if let Some(i) = first_non_finite(col) {
             return Err(Error::NonFinite {
@@ -168,27 +132,28 @@ pub(crate) fn solve_augmented(
             });
         }
         *e = binary_exponent(max_abs(col));
-        if *e != 0 {
-            let f = pow2(-*e);
-            col.iter_mut().for_each(|v| *v *= f);
-        }
+        scale_column(col, *e);
     }
-    let e_lambda = exponents[p];
-    let newey_west_lags = match options.covariance {
-        Covariance::Classical => None,
-        Covariance::NeweyWest { lags } => Some(lags),
-    };
-    if newey_west_lags.is_some() || options.influence {
-        // The equilibrated problem, which QR is about to overwrite.
-        hac.clear();
-        hac.extend_from_slice(a);
-    }
-    // Spread of λ about its mean, before QR overwrites it.
-    let lam = &a[p * m..];
-    let mean = sum_by(lam, |v| v) / m as f64;
-    let sst = sum_by(lam, |v| (v - mean) * (v - mean));
+    Ok(())
+}
 
-    let n = p + 1;
+/// `col` divided by `2^e` (unchanged for `e = 0`).
+pub(crate) fn scale_column(col: &mut [f64], e: i32) {
+    if e != 0 {
+        let f = pow2(-e);
+        col.iter_mut().for_each(|v| *v *= f);
+    }
+}
+
+/// The sum of squares of `λ` about its mean.
+pub(crate) fn spread(lam: &[f64]) -> f64 {
+    let mean = sum_by(lam, |v| v) / lam.len() as f64;
+    sum_by(lam, |v| (v - mean) * (v - mean))
+}
+
+/// Factors the column-major `m × n` `a` in place: leaves `R` in its upper
+/// triangle.
+fn factor(a: &mut [f64], m: usize, n: usize) {
     if n <= NARROW && m >= BLOCKED_FROM_ROWS {
         householder_blocked(a, m, n);
     } else if n <= NARROW {
@@ -212,9 +177,31 @@ pub(crate) fn solve_augmented(
             Default::default(),
         );
     }
-    // The upper triangle of `a` now holds R_aug = [R z; 0 ρ], |ρ| = ‖r‖.
-    let r = |i: usize, j: usize| a[j * m + i];
+}
 
+/// What the triangular factor `[R z; 0 ρ]` of an equilibrated `[Φ | λ]`
+/// gives: the equilibrated estimate, `R⁻¹`, `ρ² = ‖r‖²` and the
+/// condition number.
+#[derive(Debug, Clone)]
+pub(crate) struct Triangular {
+    pub theta: DVector<f64>,
+    pub rinv: DMatrix<f64>,
+    pub ssr: f64,
+    pub condition: f64,
+}
+
+/// Solves the triangular factor `r(i, j)` of a problem with `p`
+/// parameters (`r(p, p)` is `ρ`).
+///
+/// # Errors
+///
+/// [`Error::RankDeficient`] above `max_condition`; [`Error::NoConvergence`]
+/// when the singular values do not converge.
+pub(crate) fn triangular(
+    r: impl Fn(usize, usize) -> f64,
+    p: usize,
+    max_condition: f64,
+) -> Result<Triangular, Error> {
     // Householder QR commutes with column scaling, so the equilibrated
     // regressor Φ D⁻¹ (unit columns) has the triangular factor R D⁻¹, with
     // ‖Φ_j‖ = ‖R_j‖: its singular values give a unit-free condition number.
@@ -265,30 +252,39 @@ pub(crate) fn solve_augmented(
             rinv[(i, c)] = s / r(i, i);
         }
     }
-    let ssr = r(p, p) * r(p, p);
-    let mut also = None;
-    if newey_west_lags.is_some() || options.influence {
-        let z = options.also.filter(|_| options.influence);
-        let g = influence(hac, m, p, &theta, &rinv, z);
-        also = g.map(|(g, e_z)| DVector::from_fn(p, |j, _| scale_pow2(g[j], e_z - exponents[j])));
-    }
-    let mut covariance_kind = options.covariance;
-    let mut covariance = match newey_west_lags {
-        None => &rinv * rinv.transpose() * (ssr / (m - p) as f64),
-        Some(lags) => {
-            let (cov, used) = newey_west(
-                &hac[..m * p],
-                m,
-                p,
-                options.segment_starts,
-                m,
-                lags,
-                &mut workspace.scratch,
-            );
-            covariance_kind = Covariance::NeweyWest { lags: Some(used) };
-            cov
-        }
-    };
+    Ok(Triangular {
+        theta,
+        rinv,
+        ssr: r(p, p) * r(p, p),
+        condition,
+    })
+}
+
+/// The classical covariance `σ̂² (ΦᵀΦ)⁻¹` of the equilibrated problem.
+pub(crate) fn classical(t: &Triangular, m: usize, p: usize) -> DMatrix<f64> {
+    &t.rinv * t.rinv.transpose() * (t.ssr / (m - p) as f64)
+}
+
+/// The fit of an equilibrated problem (`m` rows, `p` parameters, columns
+/// divided by `2^exponents[j]`, `λ`'s last; `sst` its spread) from its
+/// triangular solve and `covariance` (equilibrated, of kind `kind`), in
+/// the parameters' units.
+///
+/// # Errors
+///
+/// [`Error::Overflow`] when the estimate or its covariance exceeds
+/// `f64::MAX` once unscaled.
+pub(crate) fn fit_from(
+    t: &Triangular,
+    mut covariance: DMatrix<f64>,
+    covariance_kind: Covariance,
+    m: usize,
+    exponents: &[i32],
+    sst: f64,
+) -> Result<LeastSquaresFit, Error> {
+    let p = t.theta.len();
+    let (ssr, e_lambda) = (t.ssr, exponents[p]);
+    let mut theta = t.theta.clone();
     // A positive semi-definite covariance's diagonal is ≥ 0; rounding
     // could leave a vanishing variance a hair below.
     let mut std_errors = covariance.diagonal().map(|v| v.max(0.0).sqrt());
@@ -321,114 +317,91 @@ pub(crate) fn solve_augmented(
             operation: "least squares (the estimate or its covariance exceeds f64::MAX)",
         });
     }
-    let fit = LeastSquaresFit {
+    Ok(LeastSquaresFit {
         theta,
         covariance,
         std_errors,
         residual_rms,
         r_squared,
         fit_percent,
-        condition,
+        condition: t.condition,
         rows: m,
         covariance_kind,
-    };
-    if options.influence {
-        // In the parameters' units, as θ̂.
-        for (j, col) in hac[..m * p].chunks_exact_mut(m).enumerate() {
-            let d = e_lambda - exponents[j];
-            col.iter_mut().for_each(|v| *v = scale_pow2(*v, d));
-            if first_non_finite(col).is_some() {
-                return Err(Error::Overflow {
-                    operation: "least squares (the influence of a row exceeds f64::MAX)",
-                });
-            }
-        }
-    }
-    if let Some(g) = &also
-        && !g.iter().all(|v| v.is_finite())
-    {
-        return Err(Error::Overflow {
-            operation: "least squares (a sensitivity exceeds f64::MAX)",
+    })
+}
+
+/// Solves `Φ θ ≈ λ` by QR, given column-major `a = [Φ | λ]` (`m` rows, `p + 1`
+/// columns), destroying `a`. With a Newey–West covariance,
+/// `workspace.copy` receives a copy of the equilibrated `a` (its allocation
+/// is reused), then the influence series: row `t` is `(ΦᵀΦ)⁻¹ φ_t e_t`.
+pub(crate) fn solve_augmented(
+    a: &mut [f64],
+    m: usize,
+    p: usize,
+    options: &SolveOptions<'_>,
+    workspace: &mut Workspace,
+) -> Result<LeastSquaresFit, Error> {
+    let hac = &mut workspace.copy;
+    debug_assert_eq!(a.len(), m * (p + 1));
+    if p == 0 || m <= p {
+        return Err(Error::TooFewSamples {
+            what: "least squares (more rows than parameters)",
+            needed: p.max(1) + 1,
+            got: m,
         });
     }
-    Ok(Solved { fit, also })
+    let mut exponents = vec![0i32; p + 1];
+    equilibrate(a, m, &mut exponents)?;
+    let newey_west_lags = match options.covariance {
+        Covariance::Classical => None,
+        Covariance::NeweyWest { lags } => Some(lags),
+    };
+    if newey_west_lags.is_some() {
+        // The equilibrated problem, which QR is about to overwrite.
+        hac.clear();
+        hac.extend_from_slice(a);
+    }
+    // Spread of λ about its mean, before QR overwrites it.
+    let sst = spread(&a[p * m..]);
+    factor(a, m, p + 1);
+    // The upper triangle of `a` now holds R_aug = [R z; 0 ρ], |ρ| = ‖r‖.
+    let t = triangular(|i, j| a[j * m + i], p, options.max_condition)?;
+    let (covariance, kind) = match newey_west_lags {
+        None => (classical(&t, m, p), options.covariance),
+        Some(lags) => {
+            // Each row's influence, in the equilibrated units (unscaled
+            // with the covariance).
+            influence_rows(hac, m, m, &t.theta, &t.rinv, &vec![0; p]);
+            let (cov, used) = newey_west(
+                &hac[..m * p],
+                m,
+                p,
+                options.segment_starts,
+                m,
+                lags,
+                &mut workspace.scratch,
+            );
+            (cov, Covariance::NeweyWest { lags: Some(used) })
+        }
+    };
+    fit_from(&t, covariance, kind, m, &exponents, sst)
 }
 
 /// `e` with `2^e ≤ x < 2^(e+1)` for a finite `x > 0` (0 for `x = 0`).
-fn binary_exponent(x: f64) -> i32 {
+pub(crate) fn binary_exponent(x: f64) -> i32 {
     pow2_floor(x).log2() as i32
 }
 
 /// `2^e` for `|e| ≤ 1022`, exactly.
-fn pow2(e: i32) -> f64 {
+pub(crate) fn pow2(e: i32) -> f64 {
     2f64.powi(e)
 }
 
 /// `v · 2^d` for `|d| ≤ 2046`, in two exact halves: no intermediate
 /// overflows unless the result does.
-fn scale_pow2(v: f64, d: i32) -> f64 {
+pub(crate) fn scale_pow2(v: f64, d: i32) -> f64 {
     let half = d / 2;
     v * pow2(half) * pow2(d - half)
-}
-
-/// The influence series of the equilibrated problem in `work` (column-major
-/// `[Φ | λ]`, `m × (p + 1)`, equilibrated `θ`, `R⁻¹`): on return
-/// `work[..m p]` holds row by row `R⁻¹ R⁻ᵀ φ_t e_t` with `e = λ − Φ θ`, and
-/// `work[m p..]` holds `e`. With `z`, also `g = R⁻¹ R⁻ᵀ Φᵀ z` of `z`
-/// divided by `2^e_z` (returned with `e_z`).
-fn influence(
-    work: &mut [f64],
-    m: usize,
-    p: usize,
-    theta: &DVector<f64>,
-    rinv: &DMatrix<f64>,
-    z: Option<&[f64]>,
-) -> Option<(DVector<f64>, i32)> {
-    let (phi, lambda) = work.split_at_mut(m * p);
-    // e = λ − Φ θ, in place of λ.
-    for (j, col) in phi.chunks_exact(m).enumerate() {
-        let t = theta[j];
-        lambda.iter_mut().zip(col).for_each(|(e, &x)| *e -= t * x);
-    }
-    let e = &*lambda;
-    // U = Φ R⁻¹ (the thin Q), in place: column j needs columns 0 … j of Φ
-    // (R⁻¹ is upper triangular), so go down.
-    for j in (0..p).rev() {
-        let (before, rest) = phi.split_at_mut(j * m);
-        let col = &mut rest[..m];
-        let d = rinv[(j, j)];
-        col.iter_mut().for_each(|v| *v *= d);
-        for (k, other) in before.chunks_exact(m).enumerate() {
-            let c = rinv[(k, j)];
-            if c != 0.0 {
-                col.iter_mut().zip(other).for_each(|(v, &x)| *v += c * x);
-            }
-        }
-    }
-    // g = R⁻¹ Uᵀ z, z equilibrated like the other columns.
-    let g = z.map(|z| {
-        let e_z = binary_exponent(max_abs(z));
-        let f = pow2(-e_z);
-        let qz = DVector::from_fn(p, |j, _| {
-            zip_sum(&phi[j * m..(j + 1) * m], z, |q, z| q * (z * f))
-        });
-        (rinv * qz, e_z)
-    });
-    // diag(e) U R⁻ᵀ: column j of U R⁻ᵀ is Σ_{k ≥ j} U_k R⁻¹[j, k], so go up.
-    for j in 0..p {
-        let (head, tail) = phi.split_at_mut((j + 1) * m);
-        let col = &mut head[j * m..];
-        let d = rinv[(j, j)];
-        col.iter_mut().for_each(|v| *v *= d);
-        for (k, other) in tail.chunks_exact(m).enumerate() {
-            let c = rinv[(j, j + 1 + k)];
-            if c != 0.0 {
-                col.iter_mut().zip(other).for_each(|(v, &x)| *v += c * x);
-            }
-        }
-        col.iter_mut().zip(e).for_each(|(v, &e)| *v *= e);
-    }
-    g
 }
 
 #[cfg(test)]

@@ -115,6 +115,51 @@ pub(crate) fn max_abs(x: &[f64]) -> f64 {
     rest.iter().fold(worst, |m, v| m.max(v.abs()))
 }
 
+/// [`max_abs`] of a slice whose entries are all finite, `None` otherwise,
+/// in one pass: `x · 0` is 0 only for a finite `x`, and the test is an
+/// integer "and" across lanes.
+#[cfg(any(feature = "lab", test))]
+#[inline]
+pub(crate) fn finite_max_abs(x: &[f64]) -> Option<f64> {
+    let mut acc = [0.0f64; LANES];
+    let mut finite = [true; LANES];
+    let chunks = x.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for i in 0..LANES {
+            let v = c[i].abs();
+            acc[i] = if v > acc[i] { v } else { acc[i] };
+            finite[i] &= c[i] * 0.0 == 0.0;
+        }
+    }
+    let worst = acc.iter().fold(0.0f64, |m, &v| m.max(v));
+    let worst = rest.iter().fold(worst, |m, v| m.max(v.abs()));
+    let finite = finite.iter().all(|&f| f) && rest.iter().all(|v| v.is_finite());
+    finite.then_some(worst)
+}
+
+/// `(max |x|, Σ x²)` in one pass (eight lanes each): both finite only if
+/// every entry is (a NaN is left out of the maximum, not of the sum).
+#[cfg(any(feature = "lab", test))]
+#[inline]
+pub(crate) fn max_ss(x: &[f64]) -> (f64, f64) {
+    let mut acc = [0.0f64; LANES];
+    let mut squares = [0.0f64; LANES];
+    let chunks = x.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for i in 0..LANES {
+            let v = c[i].abs();
+            acc[i] = if v > acc[i] { v } else { acc[i] };
+            squares[i] += c[i] * c[i];
+        }
+    }
+    let worst = acc.iter().fold(0.0f64, |m, &v| m.max(v));
+    let worst = rest.iter().fold(worst, |m, v| m.max(v.abs()));
+    let ss = squares.iter().sum::<f64>() + rest.iter().map(|v| v * v).sum::<f64>();
+    (worst, ss)
+}
+
 /// The power of two `s` with `s ≤ x < 2 s`, from the exponent bits of a
 /// finite `x > 0` (no `log2`: cheap enough for inner loops); the smallest
 /// normal number for a subnormal `x`, and 1 for `x = 0`. Dividing by it is
@@ -163,8 +208,18 @@ mod tests {
         assert_eq!(sum_by(&x, |v| v), 231.0);
         assert_eq!(sum_by(&x, |v| v * v), 3311.0);
         assert_eq!(first_non_finite(&x), None);
+        assert_eq!(finite_max_abs(&x), Some(21.0));
+        assert_eq!(max_ss(&x), (21.0, 3311.0));
         for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
             let mut y = x.clone();
+            y[13] = bad;
+            assert_eq!(finite_max_abs(&y), None);
+            let (max, ss) = max_ss(&y);
+            assert!(!(max.is_finite() && ss.is_finite()));
+            y[13] = 1.0;
+            y[20] = bad;
+            assert_eq!(finite_max_abs(&y), None);
+            y[20] = 21.0;
             y[13] = bad;
             assert_eq!(first_non_finite(&y), Some(13));
         }

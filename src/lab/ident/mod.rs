@@ -69,10 +69,12 @@
 mod average;
 mod bootstrap;
 mod estimates;
+mod influence;
 mod options;
 mod refine;
 mod regressors;
 mod simulation;
+mod stages;
 mod summary;
 mod timing;
 
@@ -90,8 +92,9 @@ pub use summary::{
 pub use timing::{DEFAULT_MAX_JITTER, GAP_RATIO, Timing};
 
 use self::regressors::{
-    CentralDifferences, Data, Differences, LabDifferences, Motion, Solver, motion, stage1, stage2,
+    CentralDifferences, Data, Differences, Kind, LabDifferences, Motion, Spec, motion,
 };
+use self::stages::Solver;
 use crate::data::Recording;
 use crate::error::Error;
 use crate::ident::LeastSquaresFit;
@@ -384,9 +387,16 @@ fn identify_by<D: Differences>(
         Some([a, b]) => [Some(a), Some(b)],
         None => [None, None],
     };
-    // Column-major [Φ | λ], the rows of every segment.
+    // Stage 1: the springs, b1 (and F1).
     let mut solver = Solver::new(options.covariance);
-    let first = stage1::<D>(&data, m1, model, cart1, &mut solver)?;
+    let first_spec = Spec {
+        kind: Kind::First { springs: model, m1 },
+        data: &data,
+        keep: cart1,
+        p: model.parameters() + 1 + usize::from(cart1.is_some()),
+    };
+    let k2_index = model.parameters() - 1;
+    let (first, stage1) = solver.solve::<D>(&first_spec, k2_index, None)?;
     let (springs, b1) = match model {
         SpringModel::Equal => {
             let [k12, b1] = estimates::<2>(&first);
@@ -398,8 +408,18 @@ fn identify_by<D: Differences>(
         }
     };
     // Stage 2 takes the spring between the carts, stage 1's last spring.
-    let k2 = (springs.k2().value, model.parameters() - 1);
-    let second = stage2::<D>(&data, fixed_m2, k2, cart2, &mut solver)?;
+    let k2 = springs.k2().value;
+    let kind = match fixed_m2 {
+        Some(m2) => Kind::Second { m2, k2 },
+        None => Kind::FreeMass { k2 },
+    };
+    let second_spec = Spec {
+        kind,
+        data: &data,
+        keep: cart2,
+        p: 2 + usize::from(fixed_m2.is_none()) + usize::from(cart2.is_some()),
+    };
+    let (second, _) = solver.solve::<D>(&second_spec, 0, stage1.as_ref())?;
     let [gain, b2] = estimates::<2>(&second);
     let m2_estimate = fitted_m2(options.free_m2, &second);
     Ok(MassSpringEstimate {

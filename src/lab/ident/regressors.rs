@@ -1,13 +1,9 @@
-//! The regressor columns of equations (6) and (9), per [`Scheme`](super::Scheme),
-//! built segment by segment, and the two least-squares stages.
+//! The regressor columns of equations (6) and (9), per [`Scheme`](super::Scheme):
+//! any range of a stage's rows, segment by segment ([`Spec::fill`]), so
+//! that a stage is built whole or streamed in blocks.
 
 use super::SpringModel;
 use super::timing::Segment;
-use crate::error::Error;
-use crate::ident::{
-    Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, SolveOptions, Workspace, newey_west,
-    solve_augmented,
-};
 
 /// The finite differences of a [`Scheme`](super::Scheme), as monomorphised
 /// kernels: a runtime `match` on the scheme inside the per-sample column
@@ -145,378 +141,254 @@ pub(super) fn motion(x: &[f64], data: &Data<'_>, min_speed: f64) -> Motion {
     Motion { direction, moving }
 }
 
-/// Appends one column: `rows(segment)` for every segment, in order; with
-/// `keep`, only the rows whose direction is not 0.
-fn column<I: Iterator<Item = f64>>(
-    buf: &mut Vec<f64>,
+/// Which stage's columns, `[Φ | λ]`.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Kind {
+    /// Stage 1 (equation (6)): the springs (`[k12]` equal, `[k1, k2]`
+    /// separate), `b1`, then `F1` with the Coulomb column; `λ` from `m1`.
+    First { springs: SpringModel, m1: f64 },
+    /// Stage 2 (equations (9)–(11)): `[K, b2]`, then `F2`; `λ` holds `k2
+    /// z` with `k2` from stage 1, `z` the spring column [`Spec::fill`]
+    /// also writes on request.
+    Second { m2: f64, k2: f64 },
+    /// Stage 2 with cart 2's mass free, divided by it: `[K, b2, k2, (F2)]
+    /// / m2` on `[input, −velocity, −z, (Coulomb)]`, `λ` the bare second
+    /// difference; `k2` (stage 1's) maps the estimate to `[K, b2, m2,
+    /// (F2)]`.
+    FreeMass { k2: f64 },
+}
+
+/// One stage: its columns, the data, and the rows it keeps (with the
+/// Coulomb column, those where its cart moves).
+pub(super) struct Spec<'s, 'a> {
+    pub kind: Kind,
+    pub data: &'s Data<'a>,
+    pub keep: Option<&'s Motion>,
+    /// Parameters (columns of `Φ`).
+    pub p: usize,
+}
+
+/// Where a column's values go: into a slice, or appended to a vector
+/// (then nothing is written twice, not even zeros first).
+pub(super) enum Target<'o> {
+    Slice(&'o mut [f64]),
+    Push(&'o mut Vec<f64>),
+}
+
+/// Where [`Spec::fill`] writes: columns of a slice `stride` apart, or
+/// appended one after the other to a vector.
+pub(super) enum Out<'o> {
+    Slices(&'o mut [f64], usize),
+    Push(&'o mut Vec<f64>),
+}
+
+/// The columns of an [`Out`], one after the other.
+struct Cols<'o> {
+    slices: Option<std::slice::ChunksMut<'o, f64>>,
+    push: Option<&'o mut Vec<f64>>,
+}
+
+impl<'o> Cols<'o> {
+    fn new(out: Out<'o>) -> Self {
+        match out {
+            Out::Slices(buf, stride) => Self {
+                slices: Some(buf.chunks_mut(stride)),
+                push: None,
+            },
+            Out::Push(buf) => Self {
+                slices: None,
+                push: Some(buf),
+            },
+        }
+    }
+
+    fn next(&mut self) -> Target<'_> {
+        match (&mut self.slices, &mut self.push) {
+            (Some(slices), _) => Target::Slice(slices.next().unwrap_or_default()),
+            (None, Some(buf)) => Target::Push(buf),
+            (None, None) => Target::Slice(&mut []),
+        }
+    }
+}
+
+/// Writes `rows(segment, a, b)` (the segment's rows `a .. b`) for the
+/// rows `from .. to` of the segments (global row numbers), in order, to
+/// `out`; with `keep`, only the rows whose direction is not 0. Returns the
+/// rows written.
+fn put<I: Iterator<Item = f64>>(
+    mut out: Target<'_>,
     data: &Data<'_>,
+    (from, to): (usize, usize),
     keep: Option<&Motion>,
-    mut rows: impl FnMut(&Segment) -> I,
-) {
-    for seg in &data.segments {
-        let values = rows(seg);
-        match keep {
-            None => buf.extend(values),
-            Some(motion) => {
-                let direction = &motion.direction[seg.row0..seg.row0 + seg.rows()];
-                buf.extend(
+    mut rows: impl FnMut(&Segment, usize, usize) -> I,
+) -> usize {
+    let first = data.segments.partition_point(|s| s.row0 + s.rows() <= from);
+    let mut at = 0;
+    for seg in &data.segments[first..] {
+        if seg.row0 >= to {
+            break;
+        }
+        let (a, b) = (
+            from.max(seg.row0) - seg.row0,
+            to.min(seg.row0 + seg.rows()) - seg.row0,
+        );
+        let values = rows(seg, a, b);
+        let direction = keep.map(|m| &m.direction[seg.row0 + a..seg.row0 + b]);
+        match (&mut out, direction) {
+            (Target::Slice(out), None) => {
+                for (o, v) in out[at..at + (b - a)].iter_mut().zip(values) {
+                    *o = v;
+                }
+                at += b - a;
+            }
+            (Target::Slice(out), Some(direction)) => {
+                for (v, &d) in values.zip(direction) {
+                    if d != 0.0 {
+                        out[at] = v;
+                        at += 1;
+                    }
+                }
+            }
+            (Target::Push(out), None) => {
+                out.extend(values);
+                at += b - a;
+            }
+            (Target::Push(out), Some(direction)) => {
+                let before = out.len();
+                out.extend(
                     values
                         .zip(direction)
                         .filter(|&(_, &d)| d != 0.0)
                         .map(|(v, _)| v),
                 );
+                at += out.len() - before;
             }
         }
     }
+    at
 }
 
-/// Which stage [`Solver::solve`] solves.
-#[derive(Debug, Clone, Copy)]
-enum Stage {
-    /// Stage 1: its influence series is kept for stage 2.
-    First,
-    /// Stage 2, whose `λ` holds `k2 z` with `k2` from stage 1's parameter
-    /// `k2_index`.
-    Second { k2_index: usize },
-    /// Stage 2 with cart 2's mass free, solved divided by it for
-    /// `θ' = [K, b2, k2, (F2)] / m2` and mapped to `θ = [K, b2, m2, (F2)]`
-    /// with `k2` (value `k2`, stage 1's parameter `k2_index`).
-    FreeMass { k2_index: usize, k2: f64 },
+/// `x`'s samples for rows `a .. b` of `seg` (each row's `k − 1, k, k + 1`).
+fn samples<'x>(x: &'x [f64], seg: &Segment, a: usize, b: usize) -> &'x [f64] {
+    &x[seg.start + a..seg.start + b + 2]
 }
 
-/// The columns of a stage, `[Φ | λ]` column-major, and how they are solved.
-pub(super) struct Solver {
-    /// How the covariance is estimated.
-    covariance: Covariance,
-    /// The stage's columns.
-    buf: Vec<f64>,
-    /// Stage 2's `z`, the column multiplying `k2` in its `λ`.
-    z: Vec<f64>,
-    /// The solve's copy of `buf`, then its influence series; the sums'
-    /// buffer.
-    hac: Workspace,
-    /// Stage 1's influence series on all rows of the segments (zero where
-    /// it used none), column-major.
-    first: Vec<f64>,
-    /// The same for stage 2, with stage 1's carried through `k2`.
-    second: Vec<f64>,
-    /// Rows where a segment starts.
-    starts: Vec<usize>,
-}
-
-impl Solver {
-    pub fn new(covariance: Covariance) -> Self {
-        Self {
-            covariance,
-            buf: Vec::new(),
-            z: Vec::new(),
-            hac: Workspace::default(),
-            first: Vec::new(),
-            second: Vec::new(),
-            starts: Vec::new(),
-        }
+impl Spec<'_, '_> {
+    /// Columns of `[Φ | λ]`.
+    pub fn width(&self) -> usize {
+        self.p + 1
     }
 
-    /// Solves the `m × p` stage in `buf`, whose rows are those of `data`'s
-    /// segments, or with `keep` those where a cart moves.
-    ///
-    /// With Newey–West, each row's influence `(ΦᵀΦ)⁻¹ φ_t e_t` is placed
-    /// at its sample in the segments (zero at the rows left out, so that
-    /// lags count samples), and stage 2's carries stage 1's error in `k2`:
-    /// `θ̂₂` is affine in `k2`, `∂θ̂₂/∂k2 = g` solves `Φ₂ g ≈ z`, so a row's
-    /// influence on `θ̂₂` is its own plus `g` times its influence on `k̂2`.
-    /// The covariance is the Newey–West sum of those series, within the
-    /// segments.
-    fn solve(
-        &mut self,
-        data: &Data<'_>,
-        keep: Option<&Motion>,
-        m: usize,
-        p: usize,
-        stage: Stage,
-    ) -> Result<LeastSquaresFit, Error> {
-        let Covariance::NeweyWest { lags } = self.covariance else {
-            let options = SolveOptions {
-                max_condition: DEFAULT_MAX_CONDITION,
-                covariance: Covariance::Classical,
-                segment_starts: &[],
-                influence: false,
-                also: None,
-            };
-            let mut fit = solve_augmented(&mut self.buf, m, p, &options, &mut self.hac)?.fit;
-            if let Stage::FreeMass { k2, .. } = stage {
-                let (jacobian, _) = free_mass(&mut fit.theta, k2)?;
-                fit.covariance = &jacobian * &fit.covariance * jacobian.transpose();
-                fit.std_errors = fit.covariance.diagonal().map(|v| v.max(0.0).sqrt());
-            }
-            return finite(fit);
+    /// Writes the rows `from .. to` (global row numbers; with `compact`
+    /// only those the stage keeps, else all, the Coulomb column 0 where a
+    /// cart rests) of `[Φ | λ]`, then stage 2's `z` with `with_z`, to `out`.
+    /// Returns the rows written. Each value is the same expression,
+    /// evaluated in the same order, whatever the range.
+    pub fn fill<D: Differences>(
+        &self,
+        (from, to): (usize, usize),
+        compact: bool,
+        with_z: bool,
+        out: Out<'_>,
+    ) -> usize {
+        let data = self.data;
+        let (u, x1, x2) = (data.u, data.x1, data.x2);
+        let keep = self.keep.filter(|_| compact);
+        let range = (from, to);
+        let mut cols = Cols::new(out);
+        let rows;
+        // `T² (x2 − x1)` at the spring terms' positions.
+        let spring = |seg: &Segment, a, b| {
+            let t2 = seg.dt * seg.dt;
+            triples(samples(x2, seg, a, b))
+                .zip(triples(samples(x1, seg, a, b)))
+                .map(move |(x2, x1)| t2 * (D::pos(x2) - D::pos(x1)))
         };
-        let second = matches!(stage, Stage::Second { .. });
-        let options = SolveOptions {
-            max_condition: DEFAULT_MAX_CONDITION,
-            covariance: Covariance::Classical,
-            segment_starts: &[],
-            influence: true,
-            also: second.then_some(self.z.as_slice()),
-        };
-        let solved = solve_augmented(&mut self.buf, m, p, &options, &mut self.hac)?;
-        let mut fit = solved.fit;
-        let n = data.rows;
-        let series = match stage {
-            Stage::First => &mut self.first,
-            Stage::Second { .. } | Stage::FreeMass { .. } => &mut self.second,
-        };
-        series.clear();
-        series.resize(n * p, 0.0);
-        for (from, to) in self.hac.copy[..m * p]
-            .chunks_exact(m)
-            .zip(series.chunks_exact_mut(n))
-        {
-            match keep {
-                None => to.copy_from_slice(from),
-                Some(motion) => {
-                    let rows = motion
-                        .direction
+        let coulomb = |col: Target<'_>, scale: f64| {
+            if let Some(motion) = self.keep {
+                put(col, data, range, keep, |seg, a, b| {
+                    let t2 = seg.dt * seg.dt;
+                    motion.direction[seg.row0 + a..seg.row0 + b]
                         .iter()
-                        .enumerate()
-                        .filter(|(_, d)| **d != 0.0);
-                    for (&v, (r, _)) in from.iter().zip(rows) {
-                        to[r] = v;
+                        .map(move |&d| scale * t2 * d)
+                });
+            }
+        };
+        match self.kind {
+            Kind::First { springs, m1 } => {
+                match springs {
+                    // `k12 T² [2x1(k) − x2(k)]`.
+                    SpringModel::Equal => {
+                        rows = put(cols.next(), data, range, keep, |seg, a, b| {
+                            let t2 = seg.dt * seg.dt;
+                            triples(samples(x1, seg, a, b))
+                                .zip(triples(samples(x2, seg, a, b)))
+                                .map(move |(x1, x2)| t2 * (2.0 * D::pos(x1) - D::pos(x2)))
+                        });
+                    }
+                    // `k1 T² x1(k) + k2 T² [x1(k) − x2(k)]`.
+                    SpringModel::Separate => {
+                        rows = put(cols.next(), data, range, keep, |seg, a, b| {
+                            let t2 = seg.dt * seg.dt;
+                            triples(samples(x1, seg, a, b)).map(move |x| t2 * D::pos(x))
+                        });
+                        put(cols.next(), data, range, keep, |seg, a, b| {
+                            let t2 = seg.dt * seg.dt;
+                            triples(samples(x1, seg, a, b))
+                                .zip(triples(samples(x2, seg, a, b)))
+                                .map(move |(x1, x2)| t2 * (D::pos(x1) - D::pos(x2)))
+                        });
                     }
                 }
-            }
-        }
-        if let (Stage::Second { k2_index }, Some(g)) = (stage, &solved.also) {
-            let k2 = &self.first[k2_index * n..(k2_index + 1) * n];
-            for (j, col) in self.second.chunks_exact_mut(n).enumerate() {
-                col.iter_mut().zip(k2).for_each(|(v, &k)| *v += g[j] * k);
-            }
-        }
-        if let Stage::FreeMass { k2_index, k2 } = stage {
-            // θ = k2 h(θ'): a row's influence on θ is J times its
-            // influence on θ' plus ∂θ/∂k2 = θ/k2 times its influence on k2.
-            let (jacobian, per_k2) = free_mass(&mut fit.theta, k2)?;
-            let k2_series = &self.first[k2_index * n..(k2_index + 1) * n];
-            let mut own = [0.0; MAX_STAGE2];
-            for (r, &k) in k2_series.iter().enumerate() {
-                for (i, v) in own[..p].iter_mut().enumerate() {
-                    *v = self.second[i * n + r];
+                put(cols.next(), data, range, keep, |seg, a, b| {
+                    let t = seg.dt;
+                    triples(samples(x1, seg, a, b)).map(move |x| t * D::vel(x))
+                });
+                if self.keep.is_some() {
+                    coulomb(cols.next(), 1.0);
                 }
-                for j in 0..p {
-                    let mapped: f64 = (0..p).map(|i| jacobian[(j, i)] * own[i]).sum();
-                    self.second[j * n + r] = mapped + per_k2[j] * k;
+                // The lab's own order of operations, as its MATLAB `lamda`.
+                put(cols.next(), data, range, keep, |seg, a, b| {
+                    triples(samples(x1, seg, a, b)).map(move |x| m1 * (2.0 * x[1] - x[0] - x[2]))
+                });
+            }
+            Kind::Second { .. } | Kind::FreeMass { .. } => {
+                rows = put(cols.next(), data, range, keep, |seg, a, b| {
+                    let t2 = seg.dt * seg.dt;
+                    input_pairs(samples(u, seg, a, b)).map(move |(a, b)| t2 * D::input(a, b))
+                });
+                put(cols.next(), data, range, keep, |seg, a, b| {
+                    let t = seg.dt;
+                    triples(samples(x2, seg, a, b)).map(move |x| -t * D::vel(x))
+                });
+                if let Kind::Second { m2, k2 } = self.kind {
+                    if self.keep.is_some() {
+                        coulomb(cols.next(), -1.0);
+                    }
+                    put(cols.next(), data, range, keep, |seg, a, b| {
+                        let t2 = seg.dt * seg.dt;
+                        triples(samples(x2, seg, a, b))
+                            .zip(triples(samples(x1, seg, a, b)))
+                            .map(move |(x2, x1)| {
+                                m2 * second_difference(x2) + k2 * t2 * (D::pos(x2) - D::pos(x1))
+                            })
+                    });
+                    if with_z {
+                        put(cols.next(), data, range, keep, spring);
+                    }
+                } else {
+                    put(cols.next(), data, range, keep, |seg, a, b| {
+                        spring(seg, a, b).map(|v| -v)
+                    });
+                    if self.keep.is_some() {
+                        coulomb(cols.next(), -1.0);
+                    }
+                    put(cols.next(), data, range, keep, |seg, a, b| {
+                        triples(samples(x2, seg, a, b)).map(second_difference)
+                    });
                 }
             }
         }
-        let series = match stage {
-            Stage::First => &self.first,
-            Stage::Second { .. } | Stage::FreeMass { .. } => &self.second,
-        };
-        self.starts.clear();
-        self.starts.extend(data.segments.iter().map(|s| s.row0));
-        let (covariance, used) =
-            newey_west(series, n, p, &self.starts, m, lags, &mut self.hac.scratch);
-        fit.std_errors = covariance.diagonal().map(|v| v.max(0.0).sqrt());
-        fit.covariance = covariance;
-        fit.covariance_kind = Covariance::NeweyWest { lags: Some(used) };
-        finite(fit)
+        rows
     }
-}
-
-/// `fit`, unless a covariance or standard error overflowed.
-fn finite(fit: LeastSquaresFit) -> Result<LeastSquaresFit, Error> {
-    if fit.covariance.iter().all(|v| v.is_finite()) && fit.std_errors.iter().all(|v| v.is_finite())
-    {
-        Ok(fit)
-    } else {
-        Err(Error::Overflow {
-            operation: "identification (a standard error exceeds f64::MAX)",
-        })
-    }
-}
-
-/// Most parameters of stage 2: `K`, `b2`, `m2`, `F2`.
-const MAX_STAGE2: usize = 4;
-
-/// Maps stage 2's normalised estimate `θ' = [K, b2, k2, (F2)] / m2` in
-/// place to `θ = [K, b2, m2, (F2)]` with the coupling spring `k2`: `m2 =
-/// k2 / θ'₂`, the others `k2 θ'ᵢ / θ'₂`. Returns `J = ∂θ/∂θ'` and
-/// `∂θ/∂k2 = θ / k2`.
-fn free_mass(
-    theta: &mut nalgebra::DVector<f64>,
-    k2: f64,
-) -> Result<(nalgebra::DMatrix<f64>, [f64; MAX_STAGE2]), Error> {
-    let p = theta.len();
-    let c = theta[2];
-    let m2 = k2 / c;
-    if !(m2.is_finite() && m2 > 0.0) {
-        return Err(Error::InvalidParameter {
-            name: "m2 (fitted)",
-            value: m2,
-            reason: "cart 2's fitted mass is not finite and > 0 kg: the run does not \
-                     identify it (see Options::free_m2)",
-        });
-    }
-    let mut jacobian = nalgebra::DMatrix::zeros(p, p);
-    let mut per_k2 = [0.0; MAX_STAGE2];
-    for i in 0..p {
-        let ratio = if i == 2 { 1.0 } else { theta[i] };
-        // θᵢ = k2 ratio / c.
-        jacobian[(i, 2)] = -k2 * ratio / (c * c);
-        if i != 2 {
-            jacobian[(i, i)] = k2 / c;
-        }
-        per_k2[i] = ratio / c;
-        theta[i] = k2 * ratio / c;
-    }
-    Ok((jacobian, per_k2))
-}
-
-/// The rows a stage uses: all, or those where its cart moves.
-fn row_count(data: &Data<'_>, coulomb: Option<&Motion>) -> usize {
-    coulomb.map_or(data.rows, |m| m.moving)
-}
-
-/// The Coulomb column `sign · T²` (times `scale`) over the kept rows.
-fn push_coulomb(buf: &mut Vec<f64>, data: &Data<'_>, motion: &Motion, scale: f64) {
-    column(buf, data, Some(motion), |seg| {
-        let t2 = seg.dt * seg.dt;
-        motion.direction[seg.row0..seg.row0 + seg.rows()]
-            .iter()
-            .map(move |&d| scale * t2 * d)
-    });
-}
-
-/// The columns of equation (6) that do not depend on the spring model:
-/// cart 1's velocity regressor (for `b1`), the optional Coulomb column,
-/// and `λ`, appended to `buf`.
-fn push_cart1_friction_and_lambda<D: Differences>(
-    data: &Data<'_>,
-    m1: f64,
-    coulomb: Option<&Motion>,
-    buf: &mut Vec<f64>,
-) {
-    let x1 = data.x1;
-    column(buf, data, coulomb, |seg| {
-        let t = seg.dt;
-        triples(&x1[seg.start..seg.end]).map(move |x| t * D::vel(x))
-    });
-    if let Some(motion) = coulomb {
-        push_coulomb(buf, data, motion, 1.0);
-    }
-    // The lab's own order of operations, as its MATLAB `lamda`.
-    column(buf, data, coulomb, |seg| {
-        triples(&x1[seg.start..seg.end]).map(|x| m1 * (2.0 * x[1] - x[0] - x[2]))
-    });
-}
-
-/// Stage 1 (equation (6)): the springs (`[k12]` equal, `[k1, k2]`
-/// separate), `b1`, then `F1` with the Coulomb column.
-pub(super) fn stage1<D: Differences>(
-    data: &Data<'_>,
-    m1: f64,
-    springs: SpringModel,
-    coulomb: Option<&Motion>,
-    solver: &mut Solver,
-) -> Result<LeastSquaresFit, Error> {
-    let buf = &mut solver.buf;
-    let (x1, x2) = (data.x1, data.x2);
-    let m = row_count(data, coulomb);
-    let p = springs.parameters() + 1 + usize::from(coulomb.is_some());
-    buf.clear();
-    buf.reserve(m * (p + 1));
-    match springs {
-        // `k12 T² [2x1(k) − x2(k)]`.
-        SpringModel::Equal => column(buf, data, coulomb, |seg| {
-            let t2 = seg.dt * seg.dt;
-            let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
-            triples(x1)
-                .zip(triples(x2))
-                .map(move |(x1, x2)| t2 * (2.0 * D::pos(x1) - D::pos(x2)))
-        }),
-        // `k1 T² x1(k) + k2 T² [x1(k) − x2(k)]`.
-        SpringModel::Separate => {
-            column(buf, data, coulomb, |seg| {
-                let t2 = seg.dt * seg.dt;
-                triples(&x1[seg.start..seg.end]).map(move |x| t2 * D::pos(x))
-            });
-            column(buf, data, coulomb, |seg| {
-                let t2 = seg.dt * seg.dt;
-                let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
-                triples(x1)
-                    .zip(triples(x2))
-                    .map(move |(x1, x2)| t2 * (D::pos(x1) - D::pos(x2)))
-            });
-        }
-    }
-    push_cart1_friction_and_lambda::<D>(data, m1, coulomb, buf);
-    solver.solve(data, coulomb, m, p, Stage::First)
-}
-
-/// Stage 2 (equations (9)–(11)): `[K, b2]` given the coupling spring `k2`
-/// (stage 1's parameter `k2_index`), then `F2` with the Coulomb column.
-///
-/// With cart 2's mass free (`m2` is `None`) the equation is divided by
-/// `m2`: `λ` is the bare second difference and the columns fit `[K, b2,
-/// k2, (F2)] / m2`, mapped to `[K, b2, m2, (F2)]` with `k2`. Fitting `m2`
-/// on a column `−Δ²x2` instead would put the encoder's noise, amplified
-/// by the second difference, into a regressor, and least squares shrinks
-/// the coefficient of a noisy regressor (on the simulated rig, `m2` 3 to
-/// 7 % low).
-pub(super) fn stage2<D: Differences>(
-    data: &Data<'_>,
-    m2: Option<f64>,
-    (k2, k2_index): (f64, usize),
-    coulomb: Option<&Motion>,
-    solver: &mut Solver,
-) -> Result<LeastSquaresFit, Error> {
-    let (x1, x2) = (data.x1, data.x2);
-    // `T² (x2 − x1)` at the spring terms' positions: ∂λ/∂k2 with `m2`
-    // given, the `k2 / m2` column with it free.
-    let spring = |seg: &Segment| {
-        let t2 = seg.dt * seg.dt;
-        let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
-        triples(x2)
-            .zip(triples(x1))
-            .map(move |(x2, x1)| t2 * (D::pos(x2) - D::pos(x1)))
-    };
-    if m2.is_some() && matches!(solver.covariance, Covariance::NeweyWest { .. }) {
-        solver.z.clear();
-        column(&mut solver.z, data, coulomb, spring);
-    }
-    let buf = &mut solver.buf;
-    let u = data.u;
-    let m = row_count(data, coulomb);
-    let p = 2 + usize::from(m2.is_none()) + usize::from(coulomb.is_some());
-    buf.clear();
-    buf.reserve(m * (p + 1));
-    column(buf, data, coulomb, |seg| {
-        let t2 = seg.dt * seg.dt;
-        input_pairs(&u[seg.start..seg.end]).map(move |(a, b)| t2 * D::input(a, b))
-    });
-    column(buf, data, coulomb, |seg| {
-        let t = seg.dt;
-        triples(&x2[seg.start..seg.end]).map(move |x| -t * D::vel(x))
-    });
-    let Some(m2) = m2 else {
-        column(buf, data, coulomb, |seg| spring(seg).map(|v| -v));
-        if let Some(motion) = coulomb {
-            push_coulomb(buf, data, motion, -1.0);
-        }
-        column(buf, data, coulomb, |seg| {
-            triples(&x2[seg.start..seg.end]).map(second_difference)
-        });
-        return solver.solve(data, coulomb, m, p, Stage::FreeMass { k2_index, k2 });
-    };
-    if let Some(motion) = coulomb {
-        push_coulomb(buf, data, motion, -1.0);
-    }
-    column(buf, data, coulomb, |seg| {
-        let t2 = seg.dt * seg.dt;
-        let (x1, x2) = (&x1[seg.start..seg.end], &x2[seg.start..seg.end]);
-        triples(x2)
-            .zip(triples(x1))
-            .map(move |(x2, x1)| m2 * second_difference(x2) + k2 * t2 * (D::pos(x2) - D::pos(x1)))
-    });
-    solver.solve(data, coulomb, m, p, Stage::Second { k2_index })
 }

@@ -1,0 +1,414 @@
+//! The two least-squares stages. A stage is built by ranges of rows
+//! ([`Spec::fill`]). Under [`BLOCKED_FROM_ROWS`] rows it is built whole and
+//! solved as stored; a longer one is streamed, its rows built
+//! [`BLOCK_ROWS`] at a time and factored under the `R` of the rows before
+//! ([`Tsqr`]): the stored problem's factor, bit for bit, with no column
+//! of the recording's length held. With Newey–West the stage is built
+//! whole (streamed through the factor all the same when long): the sums
+//! need every row's influence twice, and its equilibrated copy becomes
+//! that influence in place, cheaper than building the rows again.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::influence::{Carry, carry, overflows};
+use super::regressors::{Differences, Kind, Out, Spec};
+use crate::error::Error;
+use crate::ident::{
+    BLOCK_ROWS, BLOCKED_FROM_ROWS, Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, NARROW,
+    Scratch, Series, Stats, Triangular, Tsqr, classical, equilibrate, fit_from, householder_narrow,
+    influence_rows, newey_west_of, scale_column, scale_pow2, sensitivity_of, spread, triangular,
+};
+use crate::kernels::reduce::max_ss;
+
+/// Most parameters of stage 2: `K`, `b2`, `m2`, `F2`.
+pub(super) const MAX_STAGE2: usize = 4;
+
+/// What stage 2's Newey–West errors need of stage 1 besides its influence
+/// on `k2` (kept in the [`Solver`]).
+pub(super) struct FirstStage;
+
+/// A stage's factorisation: its triangular solve, the columns' exponents,
+/// `λ`'s spread, and with Newey–West where its equilibrated copy (and
+/// stage 2's `z`) lie in the solver's buffer.
+struct Factored {
+    tri: Triangular,
+    exponents: Vec<i32>,
+    sst: f64,
+    copy_at: usize,
+    z_at: usize,
+}
+
+/// The buffers of the stages, kept between them.
+pub(super) struct Solver {
+    covariance: Covariance,
+    /// A stage's `[Φ | λ (| z)]` and its copy.
+    buf: Vec<f64>,
+    /// Stage 1's influence on `k2` at every row of the segments (zero
+    /// where it used none).
+    k2: Vec<f64>,
+    /// A stage's series scattered to every row, when it keeps some.
+    series: Vec<f64>,
+    /// The cold path's rows.
+    block: Vec<f64>,
+    scratch: Scratch,
+    stats: Stats,
+    starts: Vec<usize>,
+}
+
+impl Solver {
+    pub fn new(covariance: Covariance) -> Self {
+        Self {
+            covariance,
+            buf: Vec::new(),
+            k2: Vec::new(),
+            series: Vec::new(),
+            block: Vec::new(),
+            scratch: Scratch::default(),
+            stats: Stats::default(),
+            starts: Vec::new(),
+        }
+    }
+
+    /// Solves the stage `spec`. Stage 1 (`k2_index`: its parameter `k2`)
+    /// returns what stage 2's errors need; stage 2 takes it as `first`.
+    ///
+    /// With Newey–West, each row's influence `(ΦᵀΦ)⁻¹ φ_t e_t` is placed
+    /// at its sample in the segments (zero at the rows left out, so that
+    /// lags count samples), and stage 2's carries stage 1's error in `k2`:
+    /// `θ̂₂` is affine in `k2`, `∂θ̂₂/∂k2 = g` solves `Φ₂ g ≈ z`, so a row's
+    /// influence on `θ̂₂` is its own plus `g` times its influence on `k̂2`.
+    /// The covariance is the Newey–West sum of those series, within the
+    /// segments. With cart 2's mass free, stage 2 is solved divided by it
+    /// for `θ' = [K, b2, k2, (F2)] / m2` and mapped to `θ = [K, b2, m2,
+    /// (F2)]` with `k2`.
+    pub fn solve<D: Differences>(
+        &mut self,
+        spec: &Spec<'_, '_>,
+        k2_index: usize,
+        first: Option<&FirstStage>,
+    ) -> Result<(LeastSquaresFit, Option<FirstStage>), Error> {
+        let data = spec.data;
+        let (m, p) = (spec.keep.map_or(data.rows, |k| k.moving), spec.p);
+        if m <= p {
+            return Err(Error::TooFewSamples {
+                what: "least squares (more rows than parameters)",
+                needed: p + 1,
+                got: m,
+            });
+        }
+        let lags = match self.covariance {
+            Covariance::Classical => None,
+            Covariance::NeweyWest { lags } => Some(lags),
+        };
+        let want_z = lags.is_some() && matches!(spec.kind, Kind::Second { .. });
+        let f = if lags.is_some() || m < BLOCKED_FROM_ROWS {
+            self.factor_stored::<D>(spec, m, lags.is_some(), want_z)?
+        } else {
+            self.factor_streamed::<D>(spec, m)?
+        };
+        let Factored {
+            tri,
+            exponents,
+            sst,
+            copy_at,
+            z_at,
+        } = f;
+        let mut fit = fit_from(
+            &tri,
+            classical(&tri, m, p),
+            Covariance::Classical,
+            m,
+            &exponents,
+            sst,
+        )?;
+        let k2_value = match spec.kind {
+            Kind::FreeMass { k2 } => Some(k2),
+            _ => None,
+        };
+        let Some(lags) = lags else {
+            if let Some(k2) = k2_value {
+                let (jacobian, _) = free_mass(&mut fit.theta, k2)?;
+                fit.covariance = &jacobian * &fit.covariance * jacobian.transpose();
+                fit.std_errors = fit.covariance.diagonal().map(|v| v.max(0.0).sqrt());
+            }
+            return finite(fit).map(|fit| (fit, None));
+        };
+        let n = data.rows;
+        // Each row's influence in place of the equilibrated copy (stage
+        // 2's g from U = Φ R⁻¹ and z first), as the stored solve.
+        let (work, z): (&mut [f64], &[f64]) = if !want_z {
+            (&mut self.buf[copy_at..], &[])
+        } else if z_at < copy_at {
+            let (head, work) = self.buf.split_at_mut(copy_at);
+            (work, &head[z_at..z_at + m])
+        } else {
+            let (work, tail) = self.buf.split_at_mut(z_at);
+            (&mut work[copy_at..], &tail[..m])
+        };
+        let work = &mut work[..m * (p + 1)];
+        let g: Option<Vec<f64>> = want_z.then(|| {
+            let (gz, e_z) = sensitivity_of(work, m, m, &tri.rinv, z, &mut self.block);
+            (0..p)
+                .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
+                .collect()
+        });
+        let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
+        influence_rows(work, m, m, &tri.theta, &tri.rinv, &d);
+        if let Some(g) = &g
+            && !g.iter().all(|v| v.is_finite())
+        {
+            return Err(Error::Overflow {
+                operation: "least squares (a sensitivity exceeds f64::MAX)",
+            });
+        }
+        let map = match k2_value {
+            Some(k2) => Some(free_mass(&mut fit.theta, k2)?),
+            None => None,
+        };
+        // The series at every row of the segments, scattered when the
+        // stage keeps some, then carried or mapped.
+        let series: &mut [f64] = match spec.keep {
+            None => &mut self.buf[copy_at..copy_at + n * p],
+            Some(keep) => {
+                self.series.clear();
+                self.series.resize(n * p, 0.0);
+                for j in 0..p {
+                    let h = &self.buf[copy_at + j * m..copy_at + (j + 1) * m];
+                    let to = &mut self.series[j * n..(j + 1) * n];
+                    let rows = keep
+                        .direction
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, d)| **d != 0.0);
+                    for (&v, (r, _)) in h.iter().zip(rows) {
+                        to[r] = v;
+                    }
+                }
+                &mut self.series
+            }
+        };
+        if first.is_some() {
+            let how = match (&g, &map) {
+                (Some(g), _) => Some(Carry::Sensitivity(g)),
+                (None, Some(map)) => Some(Carry::FreeMass(map)),
+                (None, None) => None,
+            };
+            if let Some(how) = how {
+                carry(series, n, p, &self.k2, &how);
+            }
+        }
+        // Each column's largest entry and sum of squares, for the sums.
+        self.stats.max.clear();
+        self.stats.ss.clear();
+        let mut known = true;
+        for col in series.chunks_exact(n) {
+            let (max, ss) = max_ss(col);
+            known &= max.is_finite() && ss.is_finite();
+            self.stats.max.push(max);
+            self.stats.ss.push(ss);
+        }
+        // Not finite: the stored solve's error if a row's own influence
+        // was not (else the sums overflow, which `finite` reports).
+        if !known && overflows::<D>(spec, &tri, &exponents, &mut self.block) {
+            return Err(Error::Overflow {
+                operation: "least squares (the influence of a row exceeds f64::MAX)",
+            });
+        }
+        self.starts.clear();
+        self.starts.extend(data.segments.iter().map(|s| s.row0));
+        let x = Series {
+            x: series,
+            n,
+            stats: known.then_some(&self.stats),
+        };
+        let (covariance, used) = newey_west_of(x, p, &self.starts, m, lags, &mut self.scratch);
+        fit.std_errors = covariance.diagonal().map(|v| v.max(0.0).sqrt());
+        fit.covariance = covariance;
+        fit.covariance_kind = Covariance::NeweyWest { lags: Some(used) };
+        let fit = finite(fit)?;
+        // Stage 1 keeps its influence on k2 for stage 2.
+        let state = matches!(spec.kind, Kind::First { .. }).then(|| {
+            let series = match spec.keep {
+                None => &self.buf[copy_at..copy_at + n * p],
+                Some(_) => &self.series[..n * p],
+            };
+            self.k2.clear();
+            self.k2
+                .extend_from_slice(&series[k2_index * n..(k2_index + 1) * n]);
+            FirstStage
+        });
+        Ok((fit, state))
+    }
+
+    /// Builds the stage whole (`m` rows, then stage 2's `z` with
+    /// `want_z`) and factors it: under [`BLOCKED_FROM_ROWS`] rows as the
+    /// stored solve does, equilibrated then factored in place (with
+    /// `copy`, after a copy of the equilibrated `[Φ | λ]`); longer, its
+    /// blocks streamed through [`Tsqr`] and then equilibrated in place,
+    /// the copy.
+    fn factor_stored<D: Differences>(
+        &mut self,
+        spec: &Spec<'_, '_>,
+        m: usize,
+        copy: bool,
+        want_z: bool,
+    ) -> Result<Factored, Error> {
+        let (p, n) = (spec.p, spec.data.rows);
+        let width = spec.width();
+        let filled = width + usize::from(want_z);
+        self.buf.clear();
+        let rows = spec.fill::<D>((0, n), true, want_z, Out::Push(&mut self.buf));
+        debug_assert_eq!((rows, self.buf.len()), (m, m * filled));
+        if m >= BLOCKED_FROM_ROWS {
+            // Long: the blocks through the streamed factor, then the
+            // columns equilibrated with its powers of two (the same).
+            let mut tsqr = Tsqr::new(width);
+            let mut at = 0;
+            while at < m {
+                let rows = BLOCK_ROWS.min(m - at);
+                let (staging, stride) = tsqr.staging();
+                for (j, col) in self.buf.chunks_exact(m).take(width).enumerate() {
+                    staging[j * stride..j * stride + rows].copy_from_slice(&col[at..at + rows]);
+                }
+                if tsqr.push_staged(rows).is_err() {
+                    // The stored problem's error, naming the first entry.
+                    let mut exponents = vec![0; width];
+                    equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
+                    unreachable!("a block held a non-finite entry the columns do not");
+                }
+                at += rows;
+            }
+            let f = tsqr.finish();
+            for (col, &e) in self.buf.chunks_exact_mut(m).zip(&f.exponents) {
+                scale_column(col, e);
+            }
+            let sst = spread(&self.buf[p * m..width * m]);
+            let tri = triangular(|i, j| f.r(i, j), p, DEFAULT_MAX_CONDITION)?;
+            return Ok(Factored {
+                tri,
+                exponents: f.exponents,
+                sst,
+                copy_at: 0,
+                z_at: m * width,
+            });
+        }
+        let mut exponents = vec![0; width];
+        equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
+        let sst = spread(&self.buf[p * m..width * m]);
+        if copy {
+            self.buf.extend_from_within(..m * width);
+        }
+        assert!(width <= NARROW, "the lab's stages have at most six columns");
+        householder_narrow(&mut self.buf[..m * width], m, width);
+        let buf = &self.buf;
+        let tri = triangular(|i, j| buf[j * m + i], p, DEFAULT_MAX_CONDITION)?;
+        Ok(Factored {
+            tri,
+            exponents,
+            sst,
+            copy_at: m * filled,
+            z_at: m * width,
+        })
+    }
+
+    /// Streams the stage (`m` rows) through [`Tsqr`] in blocks of
+    /// [`BLOCK_ROWS`] kept rows, built in place.
+    fn factor_streamed<D: Differences>(
+        &mut self,
+        spec: &Spec<'_, '_>,
+        m: usize,
+    ) -> Result<Factored, Error> {
+        let (p, n) = (spec.p, spec.data.rows);
+        let width = spec.width();
+        let mut tsqr = Tsqr::new(width);
+        let (mut from, mut have) = (0, 0);
+        while from < n {
+            let to = (from + BLOCK_ROWS - have).min(n);
+            let (staging, stride) = tsqr.staging();
+            have += spec.fill::<D>(
+                (from, to),
+                true,
+                false,
+                Out::Slices(&mut staging[have..], stride),
+            );
+            from = to;
+            if have == BLOCK_ROWS || (from == n && have > 0) {
+                if tsqr.push_staged(have).is_err() {
+                    return Err(self.first_non_finite::<D>(spec, m));
+                }
+                have = 0;
+            }
+        }
+        let f = tsqr.finish();
+        debug_assert_eq!(f.rows, m);
+        let tri = triangular(|i, j| f.r(i, j), p, DEFAULT_MAX_CONDITION)?;
+        Ok(Factored {
+            tri,
+            exponents: f.exponents,
+            sst: f.sst,
+            copy_at: 0,
+            z_at: 0,
+        })
+    }
+
+    /// The error of the first non-finite entry of the stage's `[Φ | λ]`,
+    /// column by column (as the stored solve names it).
+    #[cold]
+    fn first_non_finite<D: Differences>(&mut self, spec: &Spec<'_, '_>, m: usize) -> Error {
+        self.buf.clear();
+        spec.fill::<D>((0, spec.data.rows), true, false, Out::Push(&mut self.buf));
+        let mut exponents = vec![0; spec.width()];
+        match equilibrate(&mut self.buf, m, &mut exponents) {
+            Err(e) => e,
+            Ok(()) => Error::Overflow {
+                operation: "least squares (a regressor is not finite)",
+            },
+        }
+    }
+}
+
+/// `fit`, unless a covariance or standard error overflowed.
+fn finite(fit: LeastSquaresFit) -> Result<LeastSquaresFit, Error> {
+    if fit.covariance.iter().all(|v| v.is_finite()) && fit.std_errors.iter().all(|v| v.is_finite())
+    {
+        Ok(fit)
+    } else {
+        Err(Error::Overflow {
+            operation: "identification (a standard error exceeds f64::MAX)",
+        })
+    }
+}
+
+/// Maps stage 2's normalised estimate `θ' = [K, b2, k2, (F2)] / m2` in
+/// place to `θ = [K, b2, m2, (F2)]` with the coupling spring `k2`: `m2 =
+/// k2 / θ'₂`, the others `k2 θ'ᵢ / θ'₂`. Returns `J = ∂θ/∂θ'` and
+/// `∂θ/∂k2 = θ / k2`.
+pub(super) fn free_mass(
+    theta: &mut DVector<f64>,
+    k2: f64,
+) -> Result<(DMatrix<f64>, [f64; MAX_STAGE2]), Error> {
+    let p = theta.len();
+    let c = theta[2];
+    let m2 = k2 / c;
+    if !(m2.is_finite() && m2 > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "m2 (fitted)",
+            value: m2,
+            reason: "cart 2's fitted mass is not finite and > 0 kg: the run does not \
+                     identify it (see Options::free_m2)",
+        });
+    }
+    let mut jacobian = DMatrix::zeros(p, p);
+    let mut per_k2 = [0.0; MAX_STAGE2];
+    for i in 0..p {
+        let ratio = if i == 2 { 1.0 } else { theta[i] };
+        // θᵢ = k2 ratio / c.
+        jacobian[(i, 2)] = -k2 * ratio / (c * c);
+        if i != 2 {
+            jacobian[(i, i)] = k2 / c;
+        }
+        per_k2[i] = ratio / c;
+        theta[i] = k2 * ratio / c;
+    }
+    Ok((jacobian, per_k2))
+}
