@@ -162,8 +162,10 @@ impl Tuning {
 }
 
 /// The solver's wall-clock budget per tick on the real loop, 100 µs:
-/// with the estimate, the target and the fallback around it, a tick stays
-/// within a tenth of the 2 ms period (`benches/mpc.rs`, *budget spent*).
+/// with the estimate, the target and the fallback around it, a tick at
+/// the lab's horizon of 30 stays within a tenth of the 2 ms period on a
+/// small loaded machine (`benches/mpc.rs`, *budget spent*; the figures are
+/// in the performance guide).
 pub const TICK_TIME_LIMIT: Duration = Duration::from_micros(100);
 
 /// The lab's cases for `calibration`: cart 2 to [`SETPOINT_MARGIN`] inside
