@@ -59,12 +59,13 @@ pub fn section(
         let spec = Spec::new(cart, setpoint, calibration.volts_full_scale);
         let mut controller = mpc::design(&model, cart, &calibration)?;
         let predicted = lqi::predict(&rig, &mut controller, setpoint, DURATION)?;
-        // On the wall clock each tick's solve also has a time budget.
+        backend.save(&format!("mpc_cart{n}_predicted"), &predicted)?;
+        let predicted = run_of(predicted, controller.inner().stats(), &spec, &rig)?;
+        // On the wall clock each tick's solve also has a time budget (the
+        // prediction's counts are taken above, from the controller it ran).
         if backend.real_time() {
             controller = mpc::design_with(&model, cart, &calibration, &mpc::Tuning::REAL_TIME)?;
         }
-        backend.save(&format!("mpc_cart{n}_predicted"), &predicted)?;
-        let predicted = run_of(predicted, controller.inner().stats(), &spec, &rig)?;
         let outcome = backend.experiment(
             &RunId::new(format!("mpc_cart{n}_rig")),
             300 + n as u64,

@@ -139,9 +139,10 @@ impl Tuning {
 
     /// [`Tuning::LAB`] for a loop on the wall clock (the real card,
     /// `lab5 --real-time`): each solve also stops at [`TICK_TIME_LIMIT`], so
-    /// no tick takes much more than a tenth of the 2 ms period whatever
-    /// the state; a tick stopped there falls back as one out of
-    /// iterations does, counted in [`MpcStats::time_limit`].
+    /// no tick overruns the 2 ms period whatever the state (the iteration
+    /// bounds alone allow 2 ms at horizon 40); a tick stopped there falls
+    /// back as one out of iterations does, counted in
+    /// [`MpcStats::time_limit`].
     ///
     /// # Examples
     ///
@@ -161,12 +162,14 @@ impl Tuning {
     };
 }
 
-/// The solver's wall-clock budget per tick on the real loop, 100 µs:
-/// with the estimate, the target and the fallback around it, a tick at
-/// the lab's horizon of 30 stays within a tenth of the 2 ms period on a
-/// small loaded machine (`benches/mpc.rs`, *budget spent*; the figures are
-/// in the performance guide).
-pub const TICK_TIME_LIMIT: Duration = Duration::from_micros(100);
+/// The solver's wall-clock budget per tick on the real loop, 1 ms: half
+/// the 2 ms period, so a tick never overruns it, and far above what the
+/// lab's ticks need (at most about 0.1 ms at horizon 30 on a small
+/// machine: the performance guide). A budget near what ticks need is
+/// spent by preemption instead: under normal scheduling beside a build,
+/// 100 µs made 230 of 317 ticks fall back. The clock is the wall clock,
+/// so under SCHED_FIFO (`--rt-priority`) the budget is the tick's work.
+pub const TICK_TIME_LIMIT: Duration = Duration::from_millis(1);
 
 /// The lab's cases for `calibration`: cart 2 to [`SETPOINT_MARGIN`] inside
 /// its travel limit, cart 1 to [`CART1_SETPOINT`] (m).

@@ -204,10 +204,14 @@ impl Report {
             } else {
                 "they rest differently (steady-state errors more than half a count apart, or the rig's readings spread wider)"
             };
-            let limits = if c.rig.figures.clearance.iter().all(|&x| x > 0.0) {
-                "neither cart reached its travel limit on the rig"
+            // The reading that halts a run is not in its recording: a halt
+            // says more than the recorded clearance.
+            let limits = if let Some(why) = &c.halted {
+                format!("**the rig halted the run**: {why}")
+            } else if c.rig.figures.clearance.iter().all(|&x| x > 0.0) {
+                "neither cart reached its travel limit on the rig".into()
             } else {
-                "**a cart reached its travel limit on the rig**"
+                "**a cart reached its travel limit on the rig**".into()
             };
             lines.push(format!(
                 "- **Cart {n} to {:.0} mm** (for {DURATION} s): {transient}; {rest}; {limits}; the rig's run had {} fallbacks in {} ticks.",
