@@ -37,18 +37,22 @@
 
 use nalgebra::{Const, DefaultAllocator, Dim, Dyn, OMatrix, OVector, allocator::Allocator};
 
+mod continuous;
+mod discrete;
 mod responses;
 mod sampled;
 
+use continuous::lsim;
+pub(crate) use continuous::lsim_zoh;
+pub use continuous::simulate;
+use discrete::{discrete_feedback, dsim};
+pub use discrete::{simulate_discrete, simulate_discrete_feedback};
 pub use responses::{impulse_response, initial_response, step_response};
 pub use sampled::{SampledConfig, Sensor, run_sampled};
 
-use crate::discretize::{Held, zoh};
 use crate::error::{Error, check_dt, check_finite_dyn, check_len};
 use crate::kernels::reduce::max_step_deviation;
-use crate::model::{
-    Continuous, Discrete, Domain, DynStateSpace, LinearSystem, StateSpace, Token, period_of,
-};
+use crate::model::{Domain, DynStateSpace, LinearSystem, StateSpace, Token, period_of};
 use responses::Test;
 
 /// Largest number of samples a simulation will allocate for (10⁷, about
@@ -365,154 +369,9 @@ pub fn time_grid(t_end: f64, dt: f64) -> Result<Vec<f64>, Error> {
     Ok((0..=n as usize).map(|k| k as f64 * dt).collect())
 }
 
-/// Simulates a continuous model over the time grid `t` (s, strictly
-/// increasing) from state `x0`.
-///
-/// The input is sampled at each grid time and held until the next, as a
-/// digital controller applies it; use a finer grid for a smooth input.
-/// [`Solver::Zoh`] is exact for that input, [`Solver::Rk4`] integrates it.
-/// A grid whose intervals agree to within the rounding of its times (any
-/// `k·dt` or accumulated grid) is simulated with one discretisation.
-///
-/// # Errors
-///
-/// [`Error::InvalidParameter`] named `"t"` for an empty, non-finite or
-/// non-increasing grid (or more than [`MAX_SAMPLES`] points), named
-/// `"substeps"` for zero RK4 sub-steps or more than [`MAX_RK4_STEPS`] in all,
-/// named `"input"` for a non-finite input sample; [`Error::NonFinite`] named
-/// `"x0"` for a non-finite initial state; [`Error::LengthMismatch`] named
-/// `"x0"` or `"input"` for a vector of the wrong length (a run-time-sized
-/// model); [`Error::Overflow`] when the response diverges past `f64::MAX`;
-/// errors of [`discretize`](StateSpace::discretize).
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::{DynStateSpace, MassSpring, Cart, sim::{simulate, time_grid, Solver}};
-/// use ctrlab::nalgebra::{DVector, dvector, vector};
-///
-/// let sys = MassSpring::nominal().state_space(Cart::Two)?;
-/// let t = time_grid(10.0, 0.002)?;
-/// let r = simulate(&sys, &t, vector![0.0, 0.0, 0.0, 0.0], |_t| vector![10.0], Solver::Zoh)?;
-/// // 10 N on cart 2 settles at 20 mm.
-/// assert!((r.y.last().unwrap()[0] - 0.020).abs() < 1e-9);
-///
-/// // The same model sized at run time.
-/// let dynamic = DynStateSpace::from(&sys);
-/// let d = simulate(&dynamic, &t, DVector::zeros(4), |_t| dvector![10.0], Solver::Zoh)?;
-/// assert_eq!(d.output(0)?, r.output(0)?);
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-#[doc(alias = "lsim")]
-pub fn simulate<S: Simulate<Domain = Continuous>>(
-    sys: &S,
-    t: &[f64],
-    x0: S::State,
-    input: impl FnMut(f64) -> S::Input,
-    solver: Solver,
-) -> Result<S::Response, Error> {
-    sys.lsim(Token(()), t, x0, input, solver)
-}
-
-/// [`simulate`] on the matrices of a continuous model (`period` is `None`).
-fn lsim<N: Dim, M: Dim, P: Dim>(
-    (a, b, c, d): Abcd<'_, N, M, P>,
-    period: Option<f64>,
-    t: &[f64],
-    x0: OVector<f64, N>,
-    mut input: impl FnMut(f64) -> OVector<f64, M>,
-    solver: Solver,
-) -> Result<Response<N, P>, Error>
-where
-    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
-    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
-{
-    if period.is_some() {
-        return Err(wrong_domain(
-            "a discrete model is simulated by simulate_discrete",
-        ));
-    }
-    check_grid(t)?;
-    check_state(&x0, a.nrows())?;
-    if let Solver::Rk4 { substeps } = solver {
-        let bad = |reason| Error::InvalidParameter {
-            name: "substeps",
-            value: substeps as f64,
-            reason,
-        };
-        if substeps == 0 {
-            return Err(bad("RK4 needs at least one sub-step per interval"));
-        }
-        match substeps.checked_mul(t.len() - 1) {
-            Some(total) if total <= MAX_RK4_STEPS => {}
-            _ => return Err(bad("more than sim::MAX_RK4_STEPS RK4 steps in all")),
-        }
-    }
-    let Solver::Rk4 { substeps } = solver else {
-        let (x, y) = lsim_zoh(a, b, c, d, t, x0, input)?;
-        return Ok(Response {
-            t: t.to_vec(),
-            x,
-            y,
-        });
-    };
-    let mut xs = Vec::with_capacity(t.len());
-    let mut ys = Vec::with_capacity(t.len());
-    let mut x = x0;
-    let uniform = uniform_step(t, grid_rounding(t));
-    for (k, &tk) in t.iter().enumerate() {
-        let u = input(tk);
-        check_input(&u, b.ncols())?;
-        ys.push(c * &x + d * &u);
-        xs.push(x.clone());
-        let Some(&next) = t.get(k + 1) else { break };
-        let h = uniform.unwrap_or(next - tk);
-        let hs = h / substeps as f64;
-        for _ in 0..substeps {
-            rk4_step(a, b, hs, &mut x, &u);
-        }
-    }
-    let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
-    if !xs
-        .iter()
-        .zip(&ys)
-        .all(|(x, y)| finite(x.as_slice()) & finite(y.as_slice()))
-    {
-        return Err(Error::Overflow {
-            operation: DIVERGED_CONTINUOUS,
-        });
-    }
-    Ok(Response {
-        t: t.to_vec(),
-        x: xs,
-        y: ys,
-    })
-}
-
-/// One classical RK4 step of `x' = A x + B u` with `u` held: the
-/// arithmetic of [`Rk4`](crate::integrate::Rk4) on a linear model, for
-/// matrices of either size (nothing allocated for fixed sizes).
-fn rk4_step<N: Dim, M: Dim>(
-    a: &OMatrix<f64, N, N>,
-    b: &OMatrix<f64, N, M>,
-    h: f64,
-    x: &mut OVector<f64, N>,
-    u: &OVector<f64, M>,
-) where
-    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<N> + Allocator<M>,
-{
-    let half = 0.5 * h;
-    let f = |x: &OVector<f64, N>| a * x + b * u;
-    let k1 = f(x);
-    let k2 = f(&(&*x + &k1 * half));
-    let k3 = f(&(&*x + &k2 * half));
-    let k4 = f(&(&*x + &k3 * h));
-    *x += (k1 + (k2 + k3) * 2.0 + k4) * (h / 6.0);
-}
-
 /// The error of a simulation asked of a model in the other time domain
 /// (the public functions' bounds make it unreachable).
-fn wrong_domain(reason: &'static str) -> Error {
+pub(super) fn wrong_domain(reason: &'static str) -> Error {
     Error::InvalidParameter {
         name: "dt",
         value: f64::NAN,
@@ -522,106 +381,12 @@ fn wrong_domain(reason: &'static str) -> Error {
 
 /// [`Error::LengthMismatch`] unless `x0` has `states` entries,
 /// [`Error::NonFinite`] named `"x0"` for its first non-finite entry.
-fn check_state<N: Dim>(x0: &OVector<f64, N>, states: usize) -> Result<(), Error>
+pub(super) fn check_state<N: Dim>(x0: &OVector<f64, N>, states: usize) -> Result<(), Error>
 where
     DefaultAllocator: Allocator<N>,
 {
     check_len("x0", states, x0.len())?;
     check_finite_dyn("x0", x0)
-}
-
-/// What a continuous simulation that overflows reports.
-const DIVERGED_CONTINUOUS: &str = "simulation (the response diverged past f64::MAX)";
-
-/// The states and outputs of `(A, B, C, D)` over the grid `t` (checked)
-/// from `x0` (checked) under the input `input(t)` held between grid times,
-/// by exact ZOH steps: the one implementation behind [`simulate`] (both
-/// model sizes) and the continuous standard responses. For fixed-size
-/// matrices nothing in the loop allocates.
-pub(crate) fn lsim_zoh<N: Dim, M: Dim, P: Dim>(
-    a: &OMatrix<f64, N, N>,
-    b: &OMatrix<f64, N, M>,
-    c: &OMatrix<f64, P, N>,
-    d: &OMatrix<f64, P, M>,
-    t: &[f64],
-    x0: OVector<f64, N>,
-    mut input: impl FnMut(f64) -> OVector<f64, M>,
-) -> Result<States<N, P>, Error>
-where
-    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
-    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
-{
-    let mut xs = Vec::with_capacity(t.len());
-    let mut ys = Vec::with_capacity(t.len());
-    let mut x = x0;
-    // Intervals that differ by no more than the rounding of the grid's
-    // times are one interval: a uniform grid is one discretisation with its
-    // mean step (no drift), however its times were rounded.
-    let tol = grid_rounding(t);
-    let uniform = uniform_step(t, tol);
-    if let Some(h) = uniform {
-        // One discretisation for the whole grid, and a loop that holds
-        // only the recursion and the stores.
-        let (ad, bd) = zoh(a, b, h)?;
-        // The finite check folded into the loop: once a state component is
-        // not finite, every component of every later state is not (`A x`
-        // sums every column, and 0·∞ and 0·NaN are NaN), so the last state
-        // stands for all; each output is probed with `0·v` (0, or NaN for ±∞ and NaN).
-        let mut probe = 0.0;
-        for &tk in t {
-            let u = input(tk);
-            check_input(&u, b.ncols())?;
-            let y = c * &x + d * &u;
-            probe += y.iter().map(|v| v * 0.0).sum::<f64>();
-            let next = &ad * &x + &bd * &u;
-            xs.push(x);
-            ys.push(y);
-            x = next;
-        }
-        let last = xs.last().is_none_or(|x| x.iter().all(|v| v.is_finite()));
-        if !(last && probe == 0.0) {
-            return Err(Error::Overflow {
-                operation: DIVERGED_CONTINUOUS,
-            });
-        }
-        return Ok((xs, ys));
-    }
-    // ZOH matrices, recomputed only when the interval length changes.
-    let mut cached: Option<(f64, Held<N, M>)> = None;
-    for (k, &tk) in t.iter().enumerate() {
-        let u = input(tk);
-        check_input(&u, b.ncols())?;
-        let y = c * &x + d * &u;
-        let next = match t.get(k + 1) {
-            None => None,
-            Some(&next) => {
-                let h = next - tk;
-                let same = matches!(&cached, Some((hc, ..)) if (hc - h).abs() <= tol);
-                if !same {
-                    cached = Some((h, zoh(a, b, h)?));
-                }
-                cached.as_ref().map(|(_, (ad, bd))| ad * &x + bd * &u)
-            }
-        };
-        xs.push(x);
-        ys.push(y);
-        match next {
-            Some(next) => x = next,
-            None => break,
-        }
-    }
-    let finite = |v: &[f64]| v.iter().fold(true, |ok, v| ok & v.is_finite());
-    if xs
-        .iter()
-        .zip(&ys)
-        .all(|(x, y)| finite(x.as_slice()) & finite(y.as_slice()))
-    {
-        Ok((xs, ys))
-    } else {
-        Err(Error::Overflow {
-            operation: DIVERGED_CONTINUOUS,
-        })
-    }
 }
 
 /// The states and outputs of a simulation, one per sample.
@@ -679,12 +444,9 @@ pub(super) fn check_grid(t: &[f64]) -> Result<(), Error> {
     Ok(())
 }
 
-/// What a discrete simulation that overflows reports.
-const DIVERGED: &str = "discrete simulation (the response diverged past f64::MAX)";
-
 /// Refuses an input sample that is not finite or does not have `inputs`
 /// entries (a closure's vector, sized at run time).
-fn check_input<M: Dim>(u: &OVector<f64, M>, inputs: usize) -> Result<(), Error>
+pub(super) fn check_input<M: Dim>(u: &OVector<f64, M>, inputs: usize) -> Result<(), Error>
 where
     DefaultAllocator: Allocator<M>,
 {
@@ -697,169 +459,4 @@ where
         }),
         None => Ok(()),
     }
-}
-
-/// Simulates a discrete model open loop: one sample per input, `t[k] = k dt`,
-/// `y[k] = C x[k] + D u[k]`, then `x[k+1] = A x[k] + B u[k]`.
-///
-/// # Errors
-///
-/// As [`simulate_discrete_feedback`].
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::{DynStateSpace, StateSpace, sim::simulate_discrete};
-/// use ctrlab::nalgebra::{dvector, matrix, vector};
-///
-/// let sys = StateSpace::discrete(matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
-/// let r = simulate_discrete(&sys, vector![0.0], &[vector![1.0]; 3])?;
-/// assert_eq!(r.output(0)?, vec![0.0, 1.0, 1.5]);
-/// let d = simulate_discrete(&DynStateSpace::from(&sys), dvector![0.0], &vec![dvector![1.0]; 3])?;
-/// assert_eq!(d.output(0)?, vec![0.0, 1.0, 1.5]);
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-pub fn simulate_discrete<S: Simulate<Domain = Discrete>>(
-    sys: &S,
-    x0: S::State,
-    inputs: &[S::Input],
-) -> Result<S::Response, Error> {
-    sys.dsim(Token(()), x0, inputs.len(), |k, _x| inputs[k].clone())
-}
-
-/// Simulates a discrete model for `steps` samples with the input computed
-/// from the current sample index and state, `u[k] = control(k, &x[k])`: a
-/// closed loop around any controller.
-///
-/// # Errors
-///
-/// [`Error::InvalidParameter`] named `"steps"` for more than
-/// [`MAX_SAMPLES`] samples, `"x0"` for a non-finite initial state, `"input"`
-/// for a non-finite input sample; [`Error::LengthMismatch`] named `"x0"` or
-/// `"input"` for a vector of the wrong length (a run-time-sized model);
-/// [`Error::Overflow`] when the response diverges past `f64::MAX`.
-///
-/// # Examples
-///
-/// ```
-/// use ctrlab::{DynStateSpace, Error, StateSpace, sim::simulate_discrete_feedback};
-/// use ctrlab::nalgebra::{dvector, matrix, vector};
-///
-/// // x[k+1] = x + u with u = -0.5 x halves the state every sample.
-/// let sys = StateSpace::discrete(matrix![1.0], matrix![1.0], matrix![1.0], matrix![0.0], 0.1)?;
-/// let r = simulate_discrete_feedback(&sys, vector![8.0], 4, |_k, x| -0.5 * x)?;
-/// assert_eq!(r.output(0)?, vec![8.0, 4.0, 2.0, 1.0]);
-/// // u = x doubles the state every sample: past f64::MAX within 30 samples
-/// // from 1e300, an error, not infinities.
-/// let diverging = simulate_discrete_feedback(&sys, vector![1e300], 40, |_k, x| *x);
-/// assert!(matches!(diverging, Err(Error::Overflow { .. })));
-///
-/// // The same loop on the model sized at run time.
-/// let d = simulate_discrete_feedback(&DynStateSpace::from(&sys), dvector![8.0], 4, |_k, x| -0.5 * x)?;
-/// assert_eq!(d.output(0)?, r.output(0)?);
-/// assert!((d.t[3] - 0.3).abs() < 1e-15);
-/// # Ok::<(), ctrlab::Error>(())
-/// ```
-pub fn simulate_discrete_feedback<S: Simulate<Domain = Discrete>>(
-    sys: &S,
-    x0: S::State,
-    steps: usize,
-    control: impl FnMut(usize, &S::State) -> S::Input,
-) -> Result<S::Response, Error> {
-    sys.dsim(Token(()), x0, steps, control)
-}
-
-/// [`simulate_discrete_feedback`] on the matrices of a discrete model
-/// (`period` is its period).
-fn dsim<N: Dim, M: Dim, P: Dim>(
-    abcd: Abcd<'_, N, M, P>,
-    period: Option<f64>,
-    x0: OVector<f64, N>,
-    steps: usize,
-    control: impl FnMut(usize, &OVector<f64, N>) -> OVector<f64, M>,
-) -> Result<Response<N, P>, Error>
-where
-    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
-    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
-{
-    let Some(dt) = period else {
-        return Err(wrong_domain("a continuous model is simulated by simulate"));
-    };
-    if steps > MAX_SAMPLES {
-        return Err(Error::InvalidParameter {
-            name: "steps",
-            value: steps as f64,
-            reason: "more samples than MAX_SAMPLES",
-        });
-    }
-    check_len("x0", abcd.0.nrows(), x0.len())?;
-    if let Some(&value) = x0.iter().find(|v| !v.is_finite()) {
-        return Err(Error::InvalidParameter {
-            name: "x0",
-            value,
-            reason: "the initial state must be finite",
-        });
-    }
-    let (t, x, y) = discrete_feedback(abcd, dt, x0, steps, control)?;
-    Ok(Response { t, x, y })
-}
-
-/// The times (`k dt`), states and outputs of the discrete `(A, B, C, D)`
-/// with period `dt` for `steps` samples from `x0` under
-/// `u[k] = control(k, &x[k])`: the one implementation behind
-/// [`simulate_discrete`], [`simulate_discrete_feedback`] and the discrete
-/// standard responses, for both model sizes. `steps` and `x0` are the
-/// caller's to check. For fixed-size matrices nothing in the
-/// loop allocates.
-pub(crate) fn discrete_feedback<N: Dim, M: Dim, P: Dim>(
-    (a, b, c, d): Abcd<'_, N, M, P>,
-    dt: f64,
-    x0: OVector<f64, N>,
-    steps: usize,
-    mut control: impl FnMut(usize, &OVector<f64, N>) -> OVector<f64, M>,
-) -> Result<Sampled<N, P>, Error>
-where
-    DefaultAllocator: Allocator<N, N> + Allocator<N, M> + Allocator<P, N> + Allocator<P, M>,
-    DefaultAllocator: Allocator<N> + Allocator<M> + Allocator<P>,
-{
-    // The times grow with k: the last one finite makes every one finite.
-    if steps > 0 && !((steps - 1) as f64 * dt).is_finite() {
-        return Err(Error::InvalidParameter {
-            name: "dt",
-            value: dt,
-            reason: "the last sample time (steps − 1) · dt exceeds f64::MAX s",
-        });
-    }
-    let mut ts = Vec::with_capacity(steps);
-    let mut xs = Vec::with_capacity(steps);
-    let mut ys = Vec::with_capacity(steps);
-    let mut x = x0;
-    for k in 0..steps {
-        let u = control(k, &x);
-        if u.len() != b.ncols() {
-            check_input(&u, b.ncols())?;
-        }
-        let y = c * &x + d * &u;
-        let next = a * &x + b * &u;
-        // Stop at the first overflow: a controller would otherwise see
-        // infinities and the error would blame its input. A non-finite
-        // input makes every entry of the next state non-finite, so this
-        // one check also catches it (but for a model without states); then
-        // the input is blamed.
-        if next.iter().chain(y.iter()).any(|v| !v.is_finite())
-            || (x.is_empty() && u.iter().any(|v| !v.is_finite()))
-        {
-            check_input(&u, b.ncols())?;
-            return Err(Error::Overflow {
-                operation: DIVERGED,
-            });
-        }
-        // Everything inside the loop, whose speed is the latency of
-        // `control` and `A x + B u`: a pass after it would cost more.
-        ts.push(k as f64 * dt);
-        xs.push(x);
-        ys.push(y);
-        x = next;
-    }
-    Ok((ts, xs, ys))
 }
