@@ -38,6 +38,7 @@
 //! # Ok::<(), ctrlab::Error>(())
 //! ```
 
+mod bode;
 mod kernel;
 #[cfg(feature = "plot")]
 mod locus_svg;
@@ -57,6 +58,7 @@ mod tf;
 mod zeros;
 mod zpk;
 
+pub use bode::{Bode, Nyquist};
 pub(crate) use kernel::Evaluator;
 #[cfg(feature = "plot")]
 #[cfg_attr(docsrs, doc(cfg(feature = "plot")))]
@@ -66,9 +68,7 @@ pub use matrix::TransferMatrix;
 pub use pade::{MAX_PADE_ORDER, pade, pade_with_degrees};
 pub use phase::{BodeOptions, WrapPhase, bode_with};
 pub use pzmap::{PoleZero, PoleZeroMap, pole_zero_map};
-pub use response::{
-    Bode, FrequencyDomain, FrequencyResponse, Nyquist, bode, frequency_response, nyquist,
-};
+pub use response::{FrequencyDomain, FrequencyResponse, bode, frequency_response, nyquist};
 pub use rlocus::{
     Asymptotes, BoundaryCrossing, Breakaway, MAX_GAINS, RootLocus, root_locus, root_locus_at,
 };

@@ -6,7 +6,8 @@ use std::f64::consts::PI;
 
 use nalgebra::Complex;
 
-use super::response::{Bode, FrequencyDomain, FrequencyResponse, siso, unwrapped_phase};
+use super::bode::{Bode, unwrapped_phase};
+use super::response::{FrequencyDomain, FrequencyResponse, siso};
 use crate::error::Error;
 
 /// How [`bode_with`] presents the phase: python-control's `wrap_phase`.

@@ -8,7 +8,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::response::{Bode, Nyquist};
+use super::bode::{Bode, Nyquist};
 use crate::error::Error;
 use plotters::coord::combinators::LogCoord;
 use plotters::coord::types::RangedCoordf64;
