@@ -41,6 +41,22 @@ pub enum ReducedOrder {
 
 /// A reduced model from balanced truncation, with the Hankel singular
 /// values of the full model and the error bound.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::DynStateSpace;
+/// use ctrlab::analysis::ReducedOrder;
+/// use ctrlab::nalgebra::dmatrix;
+///
+/// let sys = DynStateSpace::continuous(dmatrix![-1.0, 0.0; 0.0, -10.0], dmatrix![1.0; 1.0],
+///                                     dmatrix![1.0, 0.1], dmatrix![0.0])?;
+/// let reduced = sys.balred(ReducedOrder::States(1))?;
+/// assert_eq!((reduced.model.states(), reduced.hankel.len()), (1, 2));
+/// // The bound is twice the Hankel singular value dropped.
+/// assert!((reduced.error_bound - 2.0 * reduced.hankel[1]).abs() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct BalancedTruncation<S> {
     /// The reduced model: `r` states, the inputs, outputs, `D` and time

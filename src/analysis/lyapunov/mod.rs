@@ -49,6 +49,19 @@ pub use stein::dsylvester;
 /// rounding errors alone could put the eigenvalues on the condition.
 /// Farther, the equation is solved, and a nearly singular one shows in
 /// the size of `X` (its residual stays small).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::analysis::{Lyapunov, lyap};
+/// use ctrlab::nalgebra::{Matrix1, matrix};
+///
+/// // ẋ = −x + u: the Gramian is 1 / 2 (in units of Q times seconds).
+/// let sol: Lyapunov<Matrix1<f64>> = lyap(&matrix![-1.0], &matrix![1.0])?;
+/// assert!((sol.x[(0, 0)] - 0.5).abs() < 1e-15);
+/// assert!(sol.residual < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lyapunov<X> {
     /// The solution (in the units of `Q` (or `C`) times seconds for a
@@ -96,6 +109,24 @@ impl sealed::Matrix for DMatrix<f64> {
 /// The square matrices [`lyap`] and [`dlyap`] take: `SMatrix<f64, N, N>`
 /// (sizes checked at compile time) and `DMatrix<f64>` (checked when
 /// called). Sealed: implemented for those two only.
+///
+/// # Examples
+///
+/// [`lyap`] with a fixed-size and a run-time-sized matrix: the same
+/// solution, in the type of the data.
+///
+/// ```
+/// use ctrlab::analysis::lyap;
+/// use ctrlab::nalgebra::{DMatrix, Matrix2, dmatrix, matrix};
+///
+/// let fixed: Matrix2<f64> = lyap(&matrix![-1.0, 0.0; 0.0, -2.0], &Matrix2::identity())?.x;
+/// let dynamic: DMatrix<f64> =
+///     lyap(&dmatrix![-1.0, 0.0; 0.0, -2.0], &DMatrix::identity(2, 2))?.x;
+/// // Diagonal A: xᵢᵢ = 1 / (2 |aᵢᵢ|).
+/// assert_eq!(fixed.as_slice(), dynamic.as_slice());
+/// assert!((fixed - matrix![0.5, 0.0; 0.0, 0.25]).amax() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub trait SquareMatrix: sealed::Matrix {}
 
 impl<const N: usize> SquareMatrix for SMatrix<f64, N, N> {}
@@ -104,6 +135,25 @@ impl SquareMatrix for DMatrix<f64> {}
 /// The coefficient pairs [`sylvester`] takes: `A` an
 /// `SMatrix<f64, M, M>` and `B` an `SMatrix<f64, N, N>` (then `C` and `X`
 /// are `SMatrix<f64, M, N>`), or both `DMatrix<f64>`. Sealed.
+///
+/// # Examples
+///
+/// [`sylvester`] with fixed sizes (`A` 2 × 2, `B` 1 × 1, so `C` and `X`
+/// are 2 × 1) and with run-time sizes.
+///
+/// ```
+/// use ctrlab::analysis::sylvester;
+/// use ctrlab::nalgebra::{Vector2, dmatrix, matrix};
+///
+/// let x: Vector2<f64> = sylvester(&matrix![1.0, 0.0; 0.0, 3.0], &matrix![1.0], &matrix![2.0; 4.0])?.x;
+/// assert!((x - matrix![1.0; 1.0]).amax() < 1e-15);
+///
+/// let (a, b, c) = (dmatrix![1.0, 0.0; 0.0, 3.0], dmatrix![1.0], dmatrix![2.0; 4.0]);
+/// let xd = sylvester(&a, &b, &c)?.x;
+/// assert_eq!(xd.shape(), (2, 1));
+/// assert!((&a * &xd + &xd * &b - &c).amax() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub trait SylvesterOperands<B: SquareMatrix>: SquareMatrix {
     /// The type of `C` and of the solution `X`.
     type Rhs: sealed::Matrix;
@@ -304,6 +354,19 @@ where
 /// The Cholesky factor of a stable continuous Lyapunov equation's
 /// solution, from [`lyapchol`], and how well `X = Rᵀ R` satisfies the
 /// equation.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::analysis::{LyapunovFactor, lyapchol};
+/// use ctrlab::nalgebra::{Matrix1, matrix};
+///
+/// // ẋ = −2 x + 3 u: X = 9 / 4, so R = 3 / 2.
+/// let r: LyapunovFactor<Matrix1<f64>> = lyapchol(&matrix![-2.0], &matrix![3.0])?;
+/// assert!((r.factor[(0, 0)] - 1.5).abs() < 1e-15);
+/// assert!(r.residual < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LyapunovFactor<R> {
     /// `R`, upper triangular with a non-negative diagonal, `X = Rᵀ R`
@@ -316,6 +379,22 @@ pub struct LyapunovFactor<R> {
 
 /// The pairs [`lyapchol`] takes: `A` an `SMatrix<f64, N, N>` and `B` an
 /// `SMatrix<f64, N, M>`, or both `DMatrix<f64>`. Sealed.
+///
+/// # Examples
+///
+/// [`lyapchol`] with `A` 2 × 2 and `B` 2 × 1, fixed-size and
+/// run-time-sized: the same factor.
+///
+/// ```
+/// use ctrlab::analysis::lyapchol;
+/// use ctrlab::nalgebra::{dmatrix, matrix};
+///
+/// let fixed = lyapchol(&matrix![-1.0, 0.0; 0.0, -2.0], &matrix![1.0; 1.0])?.factor;
+/// let dynamic = lyapchol(&dmatrix![-1.0, 0.0; 0.0, -2.0], &dmatrix![1.0; 1.0])?.factor;
+/// assert!((fixed.transpose() * fixed - matrix![0.5, 1.0 / 3.0; 1.0 / 3.0, 0.25]).amax() < 1e-15);
+/// assert!((dynamic - fixed).amax() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub trait FactorOperands<B: sealed::Matrix>: SquareMatrix {}
 
 impl<const N: usize, const M: usize> FactorOperands<SMatrix<f64, N, M>> for SMatrix<f64, N, N> {}
