@@ -87,6 +87,27 @@ pub const MPC_SOLVER: QpSettings = QpSettings {
 
 /// Inputs over the horizon at most (`M · horizon`): bounds the QP's size,
 /// so the memory and the time of a tick.
+///
+/// # Examples
+///
+/// A single-input design may look 400 steps ahead, not 401:
+///
+/// ```
+/// # use ctrlab::StateSpace;
+/// # use ctrlab::design::mpc::{Estimation, Mpc, MpcDesign};
+/// # use ctrlab::nalgebra::matrix;
+/// use ctrlab::design::mpc::MAX_VARIABLES;
+/// # let model = StateSpace::discrete(matrix![1.0, 0.1; 0.0, 1.0], matrix![0.005; 0.1],
+/// #                                  matrix![1.0, 0.0], matrix![0.0], 0.1)?;
+/// # let estimation = Estimation { input_noise: matrix![1e-2], disturbance_noise: matrix![1e-4],
+/// #                               output_disturbance_noise: 0.0, measurement_noise: matrix![1e-6] };
+/// let mut design = MpcDesign::new(MAX_VARIABLES + 1, matrix![1.0, 0.0; 0.0, 0.0], matrix![0.1]);
+/// let err = Mpc::new(&model, &matrix![1.0], &design, &estimation).unwrap_err();
+/// assert!(matches!(err, ctrlab::Error::InvalidParameter { name: "horizon", .. }));
+/// design.horizon = MAX_VARIABLES;
+/// assert!(Mpc::new(&model, &matrix![1.0], &design, &estimation).is_ok());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const MAX_VARIABLES: usize = 400;
 
 /// A limit `min ≤ output · x ≤ max` on a combination of the states (the
@@ -172,6 +193,18 @@ pub struct MpcDesign<const N: usize, const M: usize> {
 impl<const N: usize, const M: usize> MpcDesign<N, M> {
     /// A design with `horizon`, `Q` and `R`, no rate weight, no limits,
     /// and at most 200 solver iterations per tick.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{MPC_SOLVER, MpcDesign};
+    /// use ctrlab::nalgebra::matrix;
+    ///
+    /// let d = MpcDesign::<2, 1>::new(20, matrix![1.0, 0.0; 0.0, 0.0], matrix![0.01]);
+    /// assert_eq!(d.rate_weight, matrix![0.0]);
+    /// assert!(d.input_min[0] == f64::NEG_INFINITY && d.output_limits.is_empty());
+    /// assert_eq!((d.integral_gain, d.solver), (0.0, MPC_SOLVER));
+    /// ```
     pub fn new(
         horizon: usize,
         state_weight: SMatrix<f64, N, N>,
@@ -310,6 +343,15 @@ pub enum TickStatus {
 
 impl TickStatus {
     /// Whether the tick's QP was solved.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{QpStatus, TickStatus};
+    /// assert!(TickStatus::Solved { iterations: 12 }.is_solved());
+    /// assert!(!TickStatus::NotStarted.is_solved());
+    /// assert!(!TickStatus::Fallback { reason: QpStatus::TimeLimit, shifted_plan: false }.is_solved());
+    /// ```
     pub fn is_solved(self) -> bool {
         matches!(self, Self::Solved { .. })
     }
@@ -360,6 +402,16 @@ pub struct MpcStats {
 
 impl MpcStats {
     /// Ticks whose input came from a fallback.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::MpcStats;
+    /// let s = MpcStats { ticks: 10, solved: 7, fallback_shifted: 2, fallback_lqr: 1,
+    ///                    ..Default::default() };
+    /// assert_eq!(s.fallbacks(), 3);
+    /// assert_eq!(s.solved + s.fallbacks(), s.ticks);
+    /// ```
     pub fn fallbacks(&self) -> usize {
         self.fallback_shifted + self.fallback_lqr
     }

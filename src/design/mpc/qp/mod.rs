@@ -212,11 +212,34 @@ impl DenseQp {
     }
 
     /// Number of variables `n`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{DenseQp, QpSettings, Row};
+    /// use ctrlab::nalgebra::{DMatrix, dmatrix};
+    /// // Two variables under three rows (G is 3 × 2).
+    /// let g = dmatrix![1.0, 0.0; 0.0, 1.0; 1.0, 1.0];
+    /// let qp = DenseQp::new(&DMatrix::identity(2, 2), &g, &[Row::Hard; 3], QpSettings::default())?;
+    /// assert_eq!(qp.variables(), 2);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn variables(&self) -> usize {
         self.x.len()
     }
 
     /// Number of rows `m`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{DenseQp, QpSettings, Row};
+    /// use ctrlab::nalgebra::{DMatrix, dmatrix};
+    /// let g = dmatrix![1.0, 0.0; 0.0, 1.0; 1.0, 1.0];
+    /// let qp = DenseQp::new(&DMatrix::identity(2, 2), &g, &[Row::Hard; 3], QpSettings::default())?;
+    /// assert_eq!(qp.rows(), g.nrows());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn rows(&self) -> usize {
         self.z.len()
     }
@@ -378,12 +401,41 @@ impl DenseQp {
     }
 
     /// The solution of the last solve (`n`, the problem's units).
+    ///
+    /// # Examples
+    ///
+    /// min ½ x² − 2 x subject to x ≤ 1: the bound holds the optimum at 1.
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{DenseQp, QpSettings, Row};
+    /// use ctrlab::nalgebra::DMatrix;
+    /// let one = DMatrix::identity(1, 1);
+    /// let mut qp = DenseQp::new(&one, &one, &[Row::Hard], QpSettings::default())?;
+    /// qp.solve(&[-2.0], &[f64::NEG_INFINITY], &[1.0])?;
+    /// assert!((qp.solution()[0] - 1.0).abs() < 1e-9);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn solution(&self) -> &[f64] {
         self.x_out.as_slice()
     }
 
     /// The multipliers of the rows at the last solve (`m`): positive where
     /// an upper bound binds, negative where a lower one does.
+    ///
+    /// # Examples
+    ///
+    /// min ½ x² − 2 x subject to x ≤ 1: the upper bound binds, and its
+    /// multiplier is the cost's slope there, `P x + q + y = 0`, so `y = 1`.
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{DenseQp, QpSettings, Row};
+    /// use ctrlab::nalgebra::DMatrix;
+    /// let one = DMatrix::identity(1, 1);
+    /// let mut qp = DenseQp::new(&one, &one, &[Row::Hard], QpSettings::default())?;
+    /// qp.solve(&[-2.0], &[f64::NEG_INFINITY], &[1.0])?;
+    /// assert!((qp.multipliers()[0] - 1.0).abs() < 1e-9);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn multipliers(&self) -> &[f64] {
         self.y_out.as_slice()
     }
@@ -429,6 +481,23 @@ impl DenseQp {
     }
 
     /// Forgets the last solution: the next solve starts from zero.
+    ///
+    /// # Examples
+    ///
+    /// The start changes the work, not the answer:
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{DenseQp, QpSettings, Row};
+    /// use ctrlab::nalgebra::DMatrix;
+    /// let one = DMatrix::identity(1, 1);
+    /// let mut qp = DenseQp::new(&one, &one, &[Row::Hard], QpSettings::default())?;
+    /// qp.solve(&[-2.0], &[f64::NEG_INFINITY], &[1.0])?;
+    /// let warm = qp.solution()[0];
+    /// qp.cold_start();
+    /// assert!(qp.solve(&[-2.0], &[f64::NEG_INFINITY], &[1.0])?.status.is_solved());
+    /// assert!((qp.solution()[0] - warm).abs() < 1e-9);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn cold_start(&mut self) {
         self.x.fill(0.0);
         self.y.fill(0.0);

@@ -141,6 +141,18 @@ pub enum QpStatus {
 
 impl QpStatus {
     /// Whether the solve met its tolerance.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::design::mpc::{DenseQp, QpSettings, QpStatus, Row};
+    /// use ctrlab::nalgebra::DMatrix;
+    /// let one = DMatrix::identity(1, 1);
+    /// let mut qp = DenseQp::new(&one, &one, &[Row::Hard], QpSettings::default())?;
+    /// assert!(qp.solve(&[-2.0], &[f64::NEG_INFINITY], &[1.0])?.status.is_solved());
+    /// assert!(!QpStatus::PrimalInfeasible.is_solved() && !QpStatus::TimeLimit.is_solved());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn is_solved(self) -> bool {
         self == Self::Solved
     }
