@@ -101,6 +101,28 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// motor supply is off (nothing written); [`ProbeError::NotFound`] for
     /// no counter that follows a cart, no direction away from the wall, or
     /// a clear bit that does not clear.
+    ///
+    /// # Examples
+    ///
+    /// The simulated rig's counters, found where its calibration says:
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// probe.check_id()?;
+    /// let [cart1, cart2] = probe.check_encoders()?; // the hand confirms: supply off
+    /// let (map, cal) = (&rig.card.map, &rig.calibration);
+    /// assert_eq!(cart1.address, map.encoder[cal.encoder_channels[0]]);
+    /// assert_eq!(cart2.address, map.encoder[cal.encoder_channels[1]]);
+    /// assert_eq!([f64::from(cart1.sign), f64::from(cart2.sign)], cal.sign);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn check_encoders(&mut self) -> Result<[Counter; 2], ProbeError> {
         self.check_stop()?;
         self.id.ok_or(ProbeError::OutOfOrder {
@@ -249,6 +271,26 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// [`ProbeError::NotFound`] when no channel moves a cart;
     /// [`ProbeError::ReversedMotor`] when positive duty moves it towards
     /// the wall.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// probe.check_id()?;
+    /// probe.check_encoders()?;
+    /// let drive = probe.check_drive()?; // the hand confirms: supply on
+    /// let channel = rig.calibration.pwm_channel;
+    /// assert_eq!((drive.low, drive.high), (rig.card.map.pwm_low[channel], rig.card.map.pwm_high[channel]));
+    /// assert!(drive.duty > 0); // per mille, away from the wall
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn check_drive(&mut self) -> Result<Drive, ProbeError> {
         self.driving(Self::check_drive_unguarded)
     }
@@ -302,6 +344,24 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// [`ProbeError::OutOfOrder`] before [`check_drive`](Self::check_drive);
     /// [`ProbeError::NotFound`] when a write 10 ms after a kick is not
     /// obeyed.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// probe.check_id()?;
+    /// probe.check_encoders()?;
+    /// probe.check_drive()?;
+    /// assert_eq!(probe.check_watchdog()?, Some(0.1)); // s, the simulated card's
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn check_watchdog(&mut self) -> Result<Option<f64>, ProbeError> {
         self.driving(Self::check_watchdog_unguarded)
     }

@@ -102,6 +102,26 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// [`ProbeError::NotFound`] when no pair moves a cart;
     /// [`ProbeError::ReversedMotor`] when positive duty moves it towards
     /// the wall (the PWM is zeroed first).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { scan: true, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// probe.scan()?;
+    /// probe.find_encoders()?;
+    /// let drive = probe.find_drive()?; // the hand confirms: supply on
+    /// let channel = rig.calibration.pwm_channel;
+    /// assert_eq!((drive.low, drive.high), (rig.card.map.pwm_low[channel], rig.card.map.pwm_high[channel]));
+    /// assert!(drive.duty > 0); // per mille, away from the wall
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn find_drive(&mut self) -> Result<Drive, ProbeError> {
         self.driving(Self::find_drive_unguarded)
     }
@@ -352,6 +372,24 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// [`ProbeError::OutOfOrder`] before [`find_drive`](Self::find_drive);
     /// [`ProbeError::NotFound`] when a write 10 ms after a kick is not
     /// obeyed, or no single bit kicks.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { scan: true, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// probe.scan()?;
+    /// probe.find_encoders()?;
+    /// probe.find_drive()?;
+    /// assert_eq!(probe.find_watchdog()?, Some(0.1)); // s, the simulated card's
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn find_watchdog(&mut self) -> Result<Option<f64>, ProbeError> {
         self.driving(Self::find_watchdog_unguarded)
     }

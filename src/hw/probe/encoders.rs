@@ -48,6 +48,28 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// motor supply is off (nothing written); [`ProbeError::Unsupported`]
     /// for counters that change without a latch or are big-endian;
     /// [`ProbeError::NotFound`] for a latch, counter or clear bit not found.
+    ///
+    /// # Examples
+    ///
+    /// Blind, on the simulated card: the counters its map and calibration name.
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { scan: true, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// probe.scan()?;
+    /// let [cart1, cart2] = probe.find_encoders()?; // the hand confirms: supply off
+    /// let (map, cal) = (&rig.card.map, &rig.calibration);
+    /// assert_eq!(cart1.address, map.encoder[cal.encoder_channels[0]]);
+    /// assert_eq!(cart2.address, map.encoder[cal.encoder_channels[1]]);
+    /// assert_eq!([f64::from(cart1.sign), f64::from(cart2.sign)], cal.sign);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn find_encoders(&mut self) -> Result<[Counter; 2], ProbeError> {
         let scan = *self.scan.as_ref().ok_or(ProbeError::OutOfOrder {
             step: "the encoder step",

@@ -72,6 +72,29 @@ pub use scan::{OPEN_BUS, RegisterClass, Scan, Snapshot};
 use super::{ConfigError, EppPort, PortError, RegisterMap, StopSignal};
 
 /// What the user's hands are doing, as the probe asks.
+///
+/// # Examples
+///
+/// The simulated hand records what the map check asks of it:
+///
+/// ```
+/// use ctrlab::hw::probe::{Probe, ProbeOptions};
+/// use ctrlab::hw::{Clock, VirtualClock};
+/// use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+///
+/// let (rig, clock) = (SimulatedRig::default(), VirtualClock::new());
+/// let card = rig.card(&Clock::Virtual(clock.clone()))?;
+/// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+/// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true]), options)?;
+/// probe.check_id()?;
+/// probe.check_encoders()?;
+/// let asked = &probe.operator().transcript;
+/// // Each cart moved by hand, then held away from the wall.
+/// for hands in ["Move(1)", "Move(2)", "Away(1)", "Away(2)"] {
+///     assert!(asked.contains(&format!("(hands: {hands})")), "{hands}");
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Hands {
     /// Hands off the carts; let them come to rest.
@@ -282,21 +305,101 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     }
 
     /// The port.
+    ///
+    /// # Examples
+    ///
+    /// The ID check reads the map's ID register, and only it:
+    ///
+    /// ```
+    /// use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// use ctrlab::hw::testing::{Cycle, RecordingPort, RegisterFile};
+    /// # use ctrlab::hw::probe::{Hands, Operator};
+    /// # struct Nobody;
+    /// # impl<P> Operator<P> for Nobody {
+    /// #     fn tell(&mut self, _: &str) {}
+    /// #     fn confirm(&mut self, _: &str) -> bool { false }
+    /// #     fn hands(&mut self, _: Hands) {}
+    /// #     fn wait(&mut self, _: &mut P, _: f64) {}
+    /// # }
+    /// let mut card = RegisterFile::new();
+    /// card.set(0x00, 0xa5);
+    /// let mut probe = Probe::new(RecordingPort::new(card), Nobody, ProbeOptions::default())?;
+    /// probe.check_id()?;
+    /// let only_id = |c: &Cycle| matches!(c, Cycle::AddressWrite(0x00) | Cycle::DataRead(0xa5));
+    /// assert!(probe.port().log().iter().all(only_id));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn port(&self) -> &P {
         &self.port
     }
 
     /// The port, mutable.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::probe::{Probe, ProbeError, ProbeOptions};
+    /// use ctrlab::hw::testing::RegisterFile;
+    /// # use ctrlab::hw::probe::{Hands, Operator};
+    /// # struct Nobody;
+    /// # impl<P> Operator<P> for Nobody {
+    /// #     fn tell(&mut self, _: &str) {}
+    /// #     fn confirm(&mut self, _: &str) -> bool { false }
+    /// #     fn hands(&mut self, _: Hands) {}
+    /// #     fn wait(&mut self, _: &mut P, _: f64) {}
+    /// # }
+    /// let mut probe = Probe::new(RegisterFile::new(), Nobody, ProbeOptions::default())?;
+    /// assert!(matches!(probe.check_id(), Err(ProbeError::WrongMap { .. }))); // reads 0x00
+    /// probe.port_mut().set(0x00, 0xa5); // an ID appears
+    /// assert_eq!(probe.check_id()?, 0xa5);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn port_mut(&mut self) -> &mut P {
         &mut self.port
     }
 
     /// The operator.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [false]), options)?;
+    /// probe.check_id()?;
+    /// assert!(probe.check_encoders().is_err()); // the hand said no
+    /// // It was asked before anything was written.
+    /// assert!(probe.operator().transcript.last().unwrap().ends_with(" no"));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn operator(&self) -> &O {
         &self.operator
     }
 
     /// The port and the operator back.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// probe.check_id()?;
+    /// let (card, hand) = probe.into_parts();
+    /// assert!(hand.transcript[0].starts_with("step 1/4, ID")); // told first
+    /// assert_eq!(card.true_state()[0], 0.0); // nothing moved
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn into_parts(self) -> (P, O) {
         (self.port, self.operator)
     }
@@ -315,6 +418,25 @@ impl<P: EppPort, O: Operator<P>> Probe<P, O> {
     /// # Errors
     ///
     /// The first step's that fails; the steps' own docs say which.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::hw::probe::{Probe, ProbeOptions};
+    /// # use ctrlab::hw::{Clock, VirtualClock};
+    /// # use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// # let rig = SimulatedRig::default();
+    /// # let clock = VirtualClock::new();
+    /// # let card = rig.card(&Clock::Virtual(clock.clone()))?;
+    /// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+    /// let mut probe = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?;
+    /// let report = probe.run()?;
+    /// // The map confirmed, and the calibration the rig was built with found.
+    /// assert_eq!(report.encoder_channels, rig.calibration.encoder_channels);
+    /// assert_eq!(report.signs, rig.calibration.sign);
+    /// assert_eq!(report.pwm_channel, rig.calibration.pwm_channel);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn run(&mut self) -> Result<ProbeReport, ProbeError> {
         // A second Ctrl-C during a pulse only raises the flag: the probe
         // zeroes the PWM (see StopSignal::on_interrupt).

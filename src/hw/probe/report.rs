@@ -3,6 +3,19 @@
 use crate::hw::RegisterMap;
 
 /// The control register and its latch and clear bits.
+///
+/// # Examples
+///
+/// Masks, as in a [`RegisterMap`]: one bit each, distinct.
+///
+/// ```
+/// use ctrlab::hw::RegisterMap;
+/// use ctrlab::hw::probe::Latch;
+/// let map = RegisterMap::default();
+/// let latch = Latch { control: map.control, latch_bit: map.latch_bit, clear_bit: map.clear_bit };
+/// assert_eq!((latch.latch_bit.count_ones(), latch.clear_bit.count_ones()), (1, 1));
+/// assert_eq!(latch.latch_bit & latch.clear_bit, 0);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Latch {
     /// Address of the control register.
@@ -14,6 +27,20 @@ pub struct Latch {
 }
 
 /// One encoder counter as found.
+///
+/// # Examples
+///
+/// A counter with sign −1 counts down as its cart moves away from the
+/// wall: its counts times the sign, times the metres per count, are the
+/// distance from the wall.
+///
+/// ```
+/// use ctrlab::hw::probe::Counter;
+/// let counter = Counter { address: 0x10, sign: -1 };
+/// let (raw, metres_per_count) = (-2048, 9.765625e-6); // counts; m per count, the rig's
+/// let away = f64::from(counter.sign) * f64::from(raw) * metres_per_count;
+/// assert_eq!(away, 0.02); // m
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Counter {
     /// Address of its least significant byte (little-endian, 4 bytes).
@@ -24,6 +51,17 @@ pub struct Counter {
 }
 
 /// The motor's PWM register pair as found.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::RegisterMap;
+/// use ctrlab::hw::probe::Drive;
+/// let map = RegisterMap::default();
+/// let drive = Drive { low: map.pwm_low[0], high: map.pwm_high[0], duty: 96 };
+/// // Per mille of the supply: 9.6 % of a 24 V supply.
+/// assert!((f64::from(drive.duty) / 1000.0 * 24.0 - 2.304).abs() < 1e-12); // V
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Drive {
     /// Low byte address.
@@ -35,6 +73,25 @@ pub struct Drive {
 }
 
 /// Everything the probe found.
+///
+/// # Examples
+///
+/// Everything the probe can measure of a calibration: probed on the
+/// simulated rig, the report gives back the calibration it was built with.
+///
+/// ```
+/// use ctrlab::hw::probe::{Probe, ProbeOptions};
+/// use ctrlab::hw::{Clock, VirtualClock};
+/// use ctrlab::lab::{Calibration, SimulatedOperator, SimulatedRig};
+///
+/// let (rig, clock) = (SimulatedRig::default(), VirtualClock::new());
+/// let card = rig.card(&Clock::Virtual(clock.clone()))?;
+/// let options = ProbeOptions { map: rig.card.map, ..Default::default() };
+/// let report = Probe::new(card, SimulatedOperator::new(clock, [true, true]), options)?.run()?;
+/// assert_eq!(report.map, rig.card.map);
+/// assert_eq!(Calibration::from_probe(&report, &rig.calibration), rig.calibration);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProbeReport {
     /// The register map, with channels that could not be observed placed

@@ -4,9 +4,29 @@ use super::super::{EppPort, PortError};
 
 /// The value an EPP data read returns where nothing drives the bus (the
 /// port's pull-ups): unmapped and write-only registers alike.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::probe::{OPEN_BUS, RegisterClass, Scan};
+/// let idle = [OPEN_BUS; 256]; // no card: the pull-ups everywhere
+/// let scan = Scan { first: idle, second: idle };
+/// assert_eq!(scan.class(0x42), RegisterClass::Open);
+/// assert_eq!(scan.id(), None);
+/// ```
 pub const OPEN_BUS: u8 = 0xff;
 
 /// One read of every address 0x00–0xff, in address order.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::hw::probe::{OPEN_BUS, Scan, Snapshot};
+/// let mut first: Snapshot = [OPEN_BUS; 256];
+/// first[0x07] = 0x3c; // indexed by address
+/// let scan = Scan { first, second: first };
+/// assert_eq!(scan.id(), Some((0x07, 0x3c)));
+/// ```
 pub type Snapshot = [u8; 256];
 
 /// Reads every address once (256 address and 256 data-read cycles, no
