@@ -34,6 +34,24 @@ pub use logm::{LOGM_MAX_ERROR, logm, logm_dyn};
 ///
 /// exactly as SciPy's `cont2discrete`. Note that Tustin and backward Euler
 /// change `C` and `D` as well; ZOH and forward Euler keep them.
+///
+/// # Examples
+///
+/// `ẋ = −x + u` at 0.1 s: every method keeps the pole inside the unit
+/// circle, at `e^{−0.1}` (ZOH) or an approximation of it.
+///
+/// ```
+/// use ctrlab::{Discretization, StateSpace};
+/// use ctrlab::nalgebra::matrix;
+///
+/// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+/// let pole = |m| -> Result<f64, ctrlab::Error> { Ok(sys.discretize(0.1, m)?.a()[(0, 0)]) };
+/// assert!((pole(Discretization::Zoh)? - (-0.1f64).exp()).abs() < 1e-15);
+/// assert!((pole(Discretization::ForwardEuler)? - 0.9).abs() < 1e-15); // 1 + h a
+/// assert!((pole(Discretization::BackwardEuler)? - 1.0 / 1.1).abs() < 1e-15); // 1 / (1 − h a)
+/// assert!((pole(Discretization::Tustin)? - 0.95 / 1.05).abs() < 1e-15);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Discretization {

@@ -12,6 +12,26 @@ use crate::model::Dynamics;
 /// A fixed-step integrator. The input `u` is held constant over the step.
 ///
 /// `step_mut` advances the state in place; `step` returns the new state.
+///
+/// # Examples
+///
+/// One simulation loop for either stepper: over 1 s of `ẋ = −x` at
+/// 0.1 s steps, RK4 is within 1e-6 of `e⁻¹`, Euler 2 % off.
+///
+/// ```
+/// use ctrlab::integrate::{Euler, Integrator, Rk4};
+/// use ctrlab::nalgebra::{SVector, vector};
+///
+/// fn at_one_second(method: &impl Integrator) -> f64 {
+///     let decay = |_t: f64, x: &SVector<f64, 1>, _u: &SVector<f64, 1>| -x;
+///     let mut x = vector![1.0];
+///     (0..10).for_each(|k| method.step_mut(&decay, k as f64 * 0.1, 0.1, &mut x, &vector![0.0]));
+///     x[0]
+/// }
+/// let exact = (-1.0f64).exp();
+/// assert!((at_one_second(&Rk4) - exact).abs() < 1e-6);
+/// assert!((at_one_second(&Euler) - exact).abs() > 0.01);
+/// ```
 pub trait Integrator {
     /// Advances `x` from time `t` by `h` seconds under dynamics `f` and input
     /// `u`, in place.

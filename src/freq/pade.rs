@@ -7,6 +7,16 @@ use crate::error::Error;
 /// coefficients span more decades than a double resolves (at T = 1 the
 /// constant term of order 20 is 1.3e30 times the leading one), and a
 /// delay that needs it is better simulated as a delay.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::freq::{MAX_PADE_ORDER, pade};
+/// // Order 20 is the last taken: degree 20 over degree 20.
+/// assert_eq!(pade(0.01, MAX_PADE_ORDER)?.den().len(), MAX_PADE_ORDER + 1);
+/// assert!(pade(0.01, MAX_PADE_ORDER + 1).is_err());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const MAX_PADE_ORDER: usize = 20;
 
 /// The Padé approximation of order `order` of a delay of `delay` seconds:

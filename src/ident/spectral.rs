@@ -11,13 +11,50 @@ use crate::kernels::reduce::pow2_floor;
 /// Bins of the ETFE whose input amplitude is below this fraction of the
 /// largest (−60 dB) are left out: the input did not excite them, so the
 /// ratio there is noise over nothing.
+///
+/// # Examples
+///
+/// A second tone at a tenth of the threshold is left out:
+///
+/// ```
+/// use ctrlab::ident::{ETFE_MIN_INPUT, etfe};
+/// let n = 64;
+/// let tone = |k: usize, f: f64| (std::f64::consts::TAU * f * k as f64 / n as f64).sin();
+/// let u: Vec<f64> = (0..n).map(|k| tone(k, 3.0) + 0.1 * ETFE_MIN_INPUT * tone(k, 5.0)).collect();
+/// let g = etfe(&u, &u, 0.01)?;
+/// assert_eq!(g.omega.len(), 1); // only the 3rd harmonic's bin
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const ETFE_MIN_INPUT: f64 = 1e-3;
 
 /// MATLAB's default lag window size for [`spa`]: `min(N / 10, 30)` samples.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::ident::{SPA_DEFAULT_LAG, spa};
+/// use ctrlab::signal::Rng;
+/// let mut rng = Rng::new(1);
+/// let u: Vec<f64> = (0..1000).map(|_| rng.gaussian()).collect();
+/// let y: Vec<f64> = u.iter().map(|v| 3.0 * v).collect();
+/// // 1000 samples: min(1000 / 10, 30) = 30, the default window.
+/// let g = spa(&u, &y, 0.01, None, &[1.0, 10.0])?;
+/// assert_eq!(g, spa(&u, &y, 0.01, Some(SPA_DEFAULT_LAG), &[1.0, 10.0])?);
+/// assert!(g.response.iter().all(|r| (r - 3.0).norm() < 1e-12));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const SPA_DEFAULT_LAG: usize = 30;
 
 /// The most samples either estimate takes (one hour at 2 ms is 1.8e6):
 /// bounds the work and the memory.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::ident::MAX_SPECTRAL_SAMPLES;
+/// // At the rig's 2 ms period, over nine hours of data.
+/// assert!(MAX_SPECTRAL_SAMPLES as f64 * 0.002 > 9.0 * 3600.0); // s
+/// ```
 pub const MAX_SPECTRAL_SAMPLES: usize = 1 << 24;
 
 /// A frequency response estimated from data: the response (output unit per

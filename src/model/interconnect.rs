@@ -16,6 +16,24 @@ use crate::model::{Domain, DynStateSpace, period_of};
 
 /// The sign of the feedback path in [`DynStateSpace::feedback`]:
 /// `u₁ = u − y₂` (negative, the usual case) or `u₁ = u + y₂`.
+///
+/// # Examples
+///
+/// A lag `1/(s+1)` under unit feedback: negative feedback moves its pole
+/// from −1 to −2 rad/s, positive feedback to 0 (an integrator).
+///
+/// ```
+/// use ctrlab::{DynStateSpace, model::Sign};
+/// use ctrlab::nalgebra::{DMatrix, dmatrix};
+///
+/// let lag = DynStateSpace::continuous(dmatrix![-1.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0])?;
+/// let unity = DynStateSpace::continuous(DMatrix::zeros(0, 0), DMatrix::zeros(0, 1),
+///                                       DMatrix::zeros(1, 0), dmatrix![1.0])?;
+/// assert_eq!(lag.feedback(&unity, Sign::Negative)?.a(), &dmatrix![-2.0]);
+/// assert_eq!(lag.feedback(&unity, Sign::Positive)?.a(), &dmatrix![0.0]);
+/// assert_eq!(Sign::default(), Sign::Negative);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Sign {
     /// `u₁ = u − y₂`.

@@ -27,14 +27,56 @@ mod sealed {
 /// The time domain of a [`StateSpace`]: [`Continuous`] or [`Discrete`].
 ///
 /// Sealed: the crate's algorithms are written for exactly these two.
+///
+/// # Examples
+///
+/// Code generic over the domain: the same `A = 0.5` is unstable in
+/// continuous time (`s = 0.5`) and stable in discrete time (`z = 0.5`).
+///
+/// ```
+/// use ctrlab::{Domain, StateSpace};
+/// use ctrlab::nalgebra::matrix;
+///
+/// fn stable<D: Domain>(sys: &StateSpace<1, 1, 1, D>) -> Result<bool, ctrlab::Error> {
+///     sys.is_stable()
+/// }
+/// let (a, b, c, d) = (matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0]);
+/// assert!(!stable(&StateSpace::continuous(a, b, c, d)?)?);
+/// assert!(stable(&StateSpace::discrete(a, b, c, d, 0.01)?)?);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub trait Domain: sealed::Sealed + Copy + core::fmt::Debug + PartialEq {}
 
 /// Marker for continuous-time models, `x' = A x + B u`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::{Continuous, Discretization, StateSpace};
+/// use ctrlab::nalgebra::matrix;
+///
+/// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+/// assert_eq!(sys.domain(), Continuous); // no period
+/// assert_eq!(sys.discretize(0.002, Discretization::Zoh)?.domain().dt(), 0.002); // s
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Continuous;
 
 /// Marker for discrete-time models, `x[k+1] = A x[k] + B u[k]`; carries the
 /// sampling period.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::StateSpace;
+/// use ctrlab::nalgebra::matrix;
+///
+/// let (a, b, c, d) = (matrix![0.5], matrix![1.0], matrix![1.0], matrix![0.0]);
+/// assert_eq!(StateSpace::discrete(a, b, c, d, 0.002)?.domain().dt(), 0.002); // s
+/// assert!(StateSpace::discrete(a, b, c, d, 0.0).is_err()); // a period must be > 0
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Discrete {
     dt: f64,

@@ -6,6 +6,21 @@ use super::{Signal, check_amplitude};
 use crate::error::Error;
 
 /// How a [`Chirp`]'s frequency moves from `f0` to `f1`.
+///
+/// # Examples
+///
+/// Halfway through a sweep from 1 to 100 Hz, the linear sweep is at the
+/// arithmetic mean, the logarithmic one at the geometric mean:
+///
+/// ```
+/// use ctrlab::signal::{Chirp, Sweep};
+/// let linear = Chirp::new(1.0, 1.0, 100.0, 10.0, Sweep::Linear)?;
+/// let log = Chirp::new(1.0, 1.0, 100.0, 10.0, Sweep::Logarithmic)?;
+/// assert!((linear.frequency(5.0) - 50.5).abs() < 1e-12); // Hz
+/// assert!((log.frequency(5.0) - 10.0).abs() < 1e-12); // Hz
+/// assert!(Chirp::new(1.0, 0.0, 100.0, 10.0, Sweep::Logarithmic).is_err()); // f0 > 0
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Sweep {
     /// `f(t) = f0 + (f1 − f0)·t / T`: the same time per hertz, a flat

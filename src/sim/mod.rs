@@ -58,6 +58,19 @@ use responses::Test;
 /// Largest number of samples a simulation will allocate for (10⁷, about
 /// 0.5 GB for the lab's 4-state plant); a longer request is almost certainly
 /// a unit mistake (ms for s) and is refused rather than exhausting memory.
+///
+/// # Examples
+///
+/// 20 s at 2 ms is 10 001 samples; 20 s written in ms, as 20 000 s, is
+/// 10⁷ and refused:
+///
+/// ```
+/// use ctrlab::sim::{MAX_SAMPLES, time_grid};
+/// assert_eq!(time_grid(20.0, 0.002)?.len(), 10_001);
+/// assert_eq!(20_000.0 / 0.002, MAX_SAMPLES as f64);
+/// assert!(time_grid(20_000.0, 0.002).is_err());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const MAX_SAMPLES: usize = 10_000_000;
 
 /// Largest number of RK4 steps one simulation will take, over all its
@@ -310,6 +323,24 @@ simulate_for! {
 }
 
 /// How [`simulate`] advances a continuous model between grid points.
+///
+/// # Examples
+///
+/// A unit step into `ẋ = −x + u`: at 1 s, `1 − e⁻¹`, exactly (ZOH) or
+/// to RK4's accuracy.
+///
+/// ```
+/// use ctrlab::{StateSpace, sim::{Solver, simulate}};
+/// use ctrlab::nalgebra::{matrix, vector};
+///
+/// let sys = StateSpace::continuous(matrix![-1.0], matrix![1.0], matrix![1.0], matrix![0.0])?;
+/// let exact = 1.0 - (-1.0f64).exp();
+/// for solver in [Solver::Zoh, Solver::Rk4 { substeps: 10 }] {
+///     let r = simulate(&sys, &[0.0, 1.0], vector![0.0], |_| vector![1.0], solver)?;
+///     assert!((r.y[1][0] - exact).abs() < 1e-6, "{solver:?}");
+/// }
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Solver {
