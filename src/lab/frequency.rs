@@ -356,20 +356,27 @@ pub struct Mode {
 ///
 /// # Examples
 ///
+/// A response put together by hand ([`frequency_response`] measures one
+/// from a 15 s run):
+///
 /// ```
-/// use ctrlab::OpenLoop;
-/// use ctrlab::lab::{SimulatedRig, frequency, lqi};
-/// use ctrlab::nalgebra::vector;
-/// use ctrlab::signal::Signal;
-/// # let sim = SimulatedRig::default();
-/// # let rig = lqi::predicted_rig(sim.truth, sim.friction.coulomb, &sim.calibration, sim.period);
-/// # let ms = frequency::multisine(8.0)?;
-/// # let rec = ctrlab::run_sampled(rig.plant(), rig.sensor(), OpenLoop, |t| vector![ms.value(t)],
-/// #                               vector![0.0, 0.0, 0.0, 0.0], &rig.sampled_config(frequency::DURATION))?;
-/// let r: frequency::FrequencyResponse = frequency::frequency_response(&rec, &rig, None, &ms)?;
-/// assert_eq!(r.omega.len(), frequency::GRID_POINTS); // rad/s
-/// assert_eq!(r.measured.omega.len(), ms.harmonics().len()); // one point per line
-/// assert!(r.truth.is_none() && r.modes[0].truth_hz.is_none());
+/// use ctrlab::freq::{bode, logspace};
+/// use ctrlab::ident::FrequencyEstimate;
+/// use ctrlab::lab::{Cart, MassSpring, frequency::{self, FrequencyResponse, Mode}};
+/// use ctrlab::nalgebra::Complex;
+/// let tau = std::f64::consts::TAU;
+/// let omega = logspace((0.2 * tau).log10(), (15.0 * tau).log10(), frequency::GRID_POINTS)?;
+/// # let plant = MassSpring::nominal();
+/// # let model = bode(&plant.state_space(Cart::Two)?, &omega)?;
+/// # let flat = FrequencyEstimate { omega: omega.clone(), response: vec![Complex::new(1e-3, 0.0); omega.len()] };
+/// # let hz = frequency::modes_hz(&plant)?;
+/// # let mode = |i: usize| Mode { model_hz: Some(hz[i]), simulated_hz: None, measured_hz: None, truth_hz: None };
+/// let r = FrequencyResponse { omega, measured: flat.clone(), smoothed: flat.clone(), simulated: flat,
+///     model, truth: None, modes: [mode(0), mode(1)], gap_linear: 0.3, gap_friction: 0.1 };
+/// // The grid is in rad/s: 0.2 to 15 Hz.
+/// let f = r.smoothed.frequency_hz();
+/// assert!((f[0] - 0.2).abs() < 1e-9 && (f[f.len() - 1] - 15.0).abs() < 1e-9);
+/// assert!(r.modes[0].model_hz < r.modes[1].model_hz); // in phase, then in opposition
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
