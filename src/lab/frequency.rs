@@ -32,16 +32,61 @@ use crate::signal::{Multisine, Phases, Signal};
 use crate::sim::run_sampled;
 
 /// One period of the multisine, s: lines every 0.2 Hz.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::frequency::{MS_PERIOD, multisine};
+/// assert_eq!(1.0 / MS_PERIOD, 0.2); // Hz between lines
+/// assert_eq!(multisine(8.0)?.period(), MS_PERIOD);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const MS_PERIOD: f64 = 5.0;
 /// Harmonics of `1 / MS_PERIOD`: 0.2 to 15 Hz, past both modes.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, frequency::{LINES, MS_PERIOD, modes_hz}};
+/// let top = *LINES.end() as f64 / MS_PERIOD;
+/// assert_eq!(top, 15.0); // Hz
+/// assert!(modes_hz(&MassSpring::nominal())?.iter().all(|&f| f < top));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const LINES: RangeInclusive<u32> = 1..=75;
 /// Periods run; the first lets the transient die out (the slowest mode
 /// decays in about a second) and is left out of the estimate.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::frequency::{DURATION, MS_PERIOD, PERIODS};
+/// // The estimate uses the periods after the first: 10 s.
+/// assert_eq!(DURATION - MS_PERIOD, (PERIODS - 1) as f64 * MS_PERIOD);
+/// assert_eq!(DURATION - MS_PERIOD, 10.0);
+/// ```
 pub const PERIODS: usize = 3;
 /// The smoothed estimate's lag window, s.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::frequency::{MS_PERIOD, SPA_WINDOW};
+/// use ctrlab::lab::protocol::PERIOD;
+/// assert_eq!(2.0 * SPA_WINDOW, MS_PERIOD); // half a multisine period
+/// assert!((SPA_WINDOW / PERIOD - 1250.0).abs() < 1e-9); // lags, samples
+/// ```
 pub const SPA_WINDOW: f64 = 2.5;
 /// Points of the smoothed estimate and the Bode plots, log-spaced from 0.2
 /// to 15 Hz.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::frequency::{GRID_POINTS, LINES};
+/// // The smoothed curve is finer than the ETFE's one point per line.
+/// assert!(GRID_POINTS > LINES.count());
+/// ```
 pub const GRID_POINTS: usize = 400;
 
 /// The multisine of [`LINES`] with Schroeder phases, scaled to `volts`
@@ -50,12 +95,31 @@ pub const GRID_POINTS: usize = 400;
 /// # Errors
 ///
 /// [`Error::InvalidParameter`] for a non-positive or non-finite `volts`.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::frequency::{LINES, multisine};
+/// let ms = multisine(8.0)?;
+/// assert!((ms.peak() - 8.0).abs() < 1e-9); // V
+/// assert_eq!(ms.harmonics().len(), LINES.count());
+/// assert!(multisine(f64::NAN).is_err());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub fn multisine(volts: f64) -> Result<Multisine, Error> {
     let unit = Multisine::new(1.0, MS_PERIOD, LINES, Phases::Schroeder)?;
     Multisine::new(volts / unit.peak(), MS_PERIOD, LINES, Phases::Schroeder)
 }
 
 /// The run's length, s: [`PERIODS`] periods.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{frequency::DURATION, protocol::PERIOD};
+/// assert_eq!(DURATION, 15.0);
+/// assert!((DURATION / PERIOD - 7500.0).abs() < 1e-9); // whole loop periods
+/// ```
 pub const DURATION: f64 = MS_PERIOD * PERIODS as f64;
 
 /// The natural frequencies of `model`'s two complex pole pairs, Hz,
@@ -64,6 +128,21 @@ pub const DURATION: f64 = MS_PERIOD * PERIODS as f64;
 /// # Errors
 ///
 /// An invalid model.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, frequency::modes_hz};
+/// let nominal = MassSpring::nominal();
+/// let slow = modes_hz(&nominal)?;
+/// assert!(slow[0] < slow[1]); // Hz, ascending
+/// // Four times the springs and twice the damping: both modes an octave up.
+/// let stiff = MassSpring { k1: 4000.0, k2: 4000.0, b1: 20.0, b2: 10.0, ..nominal };
+/// let fast = modes_hz(&stiff)?;
+/// assert!((fast[0] / slow[0] - 2.0).abs() < 1e-9 && (fast[1] / slow[1] - 2.0).abs() < 1e-9);
+/// assert!(modes_hz(&MassSpring { m1: -1.0, ..nominal }).is_err());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub fn modes_hz(model: &MassSpring) -> Result<Vec<f64>, Error> {
     let mut hz: Vec<f64> = model
         .state_space(Cart::Two)?
@@ -243,6 +322,24 @@ fn median_gap(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// One mode located four ways, Hz (`None` where not found).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, frequency::{Mode, modes_hz}};
+/// let identified = modes_hz(&MassSpring { k1: 980.0, ..MassSpring::nominal() })?;
+/// let truth = modes_hz(&MassSpring::nominal())?;
+/// let first = Mode {
+///     model_hz: identified.first().copied(),
+///     simulated_hz: None,
+///     measured_hz: None,
+///     truth_hz: truth.first().copied(),
+/// };
+/// // 2 % off a spring puts the model's first mode within 1 % of the truth's.
+/// let (m, t) = (first.model_hz.unwrap(), first.truth_hz.unwrap());
+/// assert!(m < t && (m / t - 1.0).abs() < 0.01);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Mode {
     /// The identified linear model's natural frequency.
@@ -256,6 +353,32 @@ pub struct Mode {
 }
 
 /// The measured response against the identified model.
+///
+/// # Examples
+///
+/// A response put together by hand ([`frequency_response`] measures one
+/// from a 15 s run):
+///
+/// ```
+/// use ctrlab::freq::{bode, logspace};
+/// use ctrlab::ident::FrequencyEstimate;
+/// use ctrlab::lab::{Cart, MassSpring, frequency::{self, FrequencyResponse, Mode}};
+/// use ctrlab::nalgebra::Complex;
+/// let tau = std::f64::consts::TAU;
+/// let omega = logspace((0.2 * tau).log10(), (15.0 * tau).log10(), frequency::GRID_POINTS)?;
+/// # let plant = MassSpring::nominal();
+/// # let model = bode(&plant.state_space(Cart::Two)?, &omega)?;
+/// # let flat = FrequencyEstimate { omega: omega.clone(), response: vec![Complex::new(1e-3, 0.0); omega.len()] };
+/// # let hz = frequency::modes_hz(&plant)?;
+/// # let mode = |i: usize| Mode { model_hz: Some(hz[i]), simulated_hz: None, measured_hz: None, truth_hz: None };
+/// let r = FrequencyResponse { omega, measured: flat.clone(), smoothed: flat.clone(), simulated: flat,
+///     model, truth: None, modes: [mode(0), mode(1)], gap_linear: 0.3, gap_friction: 0.1 };
+/// // The grid is in rad/s: 0.2 to 15 Hz.
+/// let f = r.smoothed.frequency_hz();
+/// assert!((f[0] - 0.2).abs() < 1e-9 && (f[f.len() - 1] - 15.0).abs() < 1e-9);
+/// assert!(r.modes[0].model_hz < r.modes[1].model_hz); // in phase, then in opposition
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrequencyResponse {
     /// The grid of the smoothed estimates and Bode plots, rad/s.

@@ -63,9 +63,27 @@ pub use search::{
 
 /// The largest predicted peak excursion of either cart, as a fraction of
 /// its travel limit: 60 %.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, ident_input::TRAVEL_FRACTION};
+/// // On the default ±50 mm travel a run may be predicted to swing 30 mm.
+/// let limit = Calibration::default().travel_limits[1];
+/// assert!((TRAVEL_FRACTION * limit - 0.030).abs() < 1e-15); // m
+/// ```
 pub const TRAVEL_FRACTION: f64 = 0.6;
 
 /// The probe runs' amplitudes, as fractions of the amplitude asked for.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{ident_input::PROBE_FRACTIONS, protocol::IDENT_VOLTS};
+/// // Asked for the lab's 8 V, the probes run at 2 V and 4 V: both well
+/// // under it, and apart, to see the friction's offset.
+/// assert_eq!(PROBE_FRACTIONS.map(|f| f * IDENT_VOLTS), [2.0, 4.0]);
+/// ```
 pub const PROBE_FRACTIONS: [f64; 2] = [0.25, 0.5];
 
 /// Each probe run's length, s: long enough for the square wave's response
@@ -74,6 +92,17 @@ pub const PROBE_FRACTIONS: [f64; 2] = [0.25, 0.5];
 /// whole 5 s run; a PRBS's cart 1 peaks later (4.7 s: at 4 V on the
 /// lighter rig the probe sees 11.8 of its 13.3 mm), which is why a PRBS's
 /// prediction is the least close (+2.5 % where it limits the amplitude).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident_input::PROBE_DURATION;
+/// use ctrlab::lab::protocol::{IDENT_DURATION, IDENT_HALF_PERIOD, PERIOD};
+/// assert!(PROBE_DURATION < IDENT_DURATION); // s
+/// // 15 half periods of the square wave, 1500 loop periods.
+/// assert!((PROBE_DURATION / IDENT_HALF_PERIOD - 15.0).abs() < 1e-12);
+/// assert!((PROBE_DURATION / PERIOD - 1500.0).abs() < 1e-9);
+/// ```
 pub const PROBE_DURATION: f64 = 3.0;
 
 /// The identification signal.

@@ -47,13 +47,55 @@ use crate::model::{Discrete, StateSpace};
 use crate::nalgebra::{SMatrix, matrix, vector};
 
 /// The controller on the rig's `[x1, v1, x2, v2]`: positions only.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Controller;
+/// use ctrlab::lab::{Calibration, Cart, MassSpring, lqi, mpc, protocol};
+/// use ctrlab::nalgebra::vector;
+/// # let model = lqi::position_model(&MassSpring::nominal(), protocol::PERIOD)?;
+/// let mut c: mpc::PositionsMpc = mpc::design(&model, Cart::Two, &Calibration::default())?;
+/// // Fed all four states, it reads only the positions: at rest on its
+/// // setpoint it does not push, however fast the readings say the carts move.
+/// let u = c.update(&vector![0.0, 5.0, 0.0, -5.0], &vector![0.0]);
+/// assert!(u[0].abs() < 1e-6);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub type PositionsMpc = SelectOutputs<Mpc<4, 1, 2, 1>, 4, 2>;
 
 /// Cart 2's case: its setpoint lies this far inside its travel limit, m.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, mpc::SETPOINT_MARGIN};
+/// // With the default ±50 mm travel, cart 2 goes to 45 mm.
+/// let limit = Calibration::default().travel_limits[1];
+/// assert!((limit - SETPOINT_MARGIN - 0.045).abs() < 1e-15);
+/// ```
 pub const SETPOINT_MARGIN: f64 = 0.005;
 /// Cart 1's case: Table 6's setpoint, m.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, mpc::{CART1_SETPOINT, Tuning}};
+/// // 15 mm: inside cart 1's soft travel limit, which the MPC keeps 2 mm in.
+/// let soft = Calibration::default().travel_limits[0] - Tuning::LAB.travel_margin;
+/// assert!(CART1_SETPOINT == 0.015 && CART1_SETPOINT < soft);
+/// ```
 pub const CART1_SETPOINT: f64 = 0.015;
 /// Largest change of drive from one period to the next, V (1 kV/s).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{mpc::RATE_LIMIT, protocol::PERIOD};
+/// assert!((RATE_LIMIT / PERIOD - 1000.0).abs() < 1e-9); // V/s
+/// // The full ±24 V swing takes 24 periods, 48 ms.
+/// assert_eq!(48.0 / RATE_LIMIT, 24.0);
+/// ```
 pub const RATE_LIMIT: f64 = 2.0;
 
 /// The lab MPC's horizon, weights, limits and estimator: [`Tuning::LAB`]
@@ -169,6 +211,13 @@ impl Tuning {
 /// spent by preemption instead: under normal scheduling beside a build,
 /// 100 µs made 230 of 317 ticks fall back. The clock is the wall clock,
 /// so under SCHED_FIFO (`--rt-priority`) the budget is the tick's work.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{mpc::TICK_TIME_LIMIT, protocol::PERIOD};
+/// assert_eq!(2.0 * TICK_TIME_LIMIT.as_secs_f64(), PERIOD); // half a period
+/// ```
 pub const TICK_TIME_LIMIT: Duration = Duration::from_millis(1);
 
 /// The lab's cases for `calibration`: cart 2 to [`SETPOINT_MARGIN`] inside
@@ -199,6 +248,23 @@ pub fn cases(calibration: &Calibration) -> [(Cart, f64); 2] {
 /// As [`Mpc::new`]: a model the design cannot use (uncontrollable, a zero
 /// at `z = 1`), a calibration whose travel limits leave no room inside
 /// the tuning's margin ([`Error::InvalidParameter`] `"travel_limits"`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Controller;
+/// use ctrlab::lab::{Calibration, Cart, MassSpring, lqi, mpc, protocol};
+/// use ctrlab::nalgebra::vector;
+/// let model = lqi::position_model(&MassSpring::nominal(), protocol::PERIOD)?;
+/// let mut c = mpc::design(&model, Cart::Two, &Calibration::default())?;
+/// // From rest toward 45 mm, the first tick's drive is rate-limited.
+/// let u = c.update(&vector![0.0, 0.0, 0.0, 0.0], &vector![0.045]);
+/// assert!(u[0] > 0.0 && u[0] <= mpc::RATE_LIMIT + 1e-9);
+/// // Travel limits inside the 2 mm margin leave the MPC no room.
+/// let tight = Calibration { travel_limits: [0.001, 0.05], ..Calibration::default() };
+/// assert!(mpc::design(&model, Cart::Two, &tight).is_err());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn design(
     model: &StateSpace<4, 1, 2, Discrete>,
     cart: Cart,
@@ -212,6 +278,20 @@ pub fn design(
 /// # Errors
 ///
 /// As [`design`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Controller;
+/// use ctrlab::lab::{Calibration, Cart, MassSpring, lqi, mpc, protocol};
+/// use ctrlab::nalgebra::vector;
+/// # let model = lqi::position_model(&MassSpring::nominal(), protocol::PERIOD)?;
+/// let gentle = mpc::Tuning { rate_limit: 0.5, ..mpc::Tuning::LAB };
+/// let mut c = mpc::design_with(&model, Cart::Two, &Calibration::default(), &gentle)?;
+/// let u = c.update(&vector![0.0, 0.0, 0.0, 0.0], &vector![0.045]);
+/// assert!(u[0] > 0.0 && u[0] <= 0.5 + 1e-9); // V per period
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn design_with(
     model: &StateSpace<4, 1, 2, Discrete>,
     cart: Cart,
@@ -297,6 +377,20 @@ impl Figures {
     /// # Errors
     ///
     /// [`Error::Channel`] for a channel missing from `rec`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Calibration, mpc::Figures};
+    /// use ctrlab::{Recording, lab};
+    /// let mut rec = Recording::new(lab::schema());
+    /// rec.push(0.000, &[24.0], &[0.0, 0.0, 0.0, 0.0])?;
+    /// rec.push(0.002, &[24.0], &[0.0, 0.0, -0.052, 0.0])?;
+    /// let f = Figures::of(&rec, &Calibration::default())?;
+    /// assert!((f.clearance[1] + 0.002).abs() < 1e-12); // 2 mm past cart 2's limit
+    /// assert_eq!((f.at_limit, f.max_step_u), (2, 0.0)); // held at full scale
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn of(rec: &Recording, calibration: &Calibration) -> Result<Self, Error> {
         let mut clearance = [f64::INFINITY; 2];
         for (i, cart) in [Cart::One, Cart::Two].into_iter().enumerate() {

@@ -8,6 +8,16 @@ use crate::model::{Continuous, Dynamics, StateSpace};
 
 /// One of the rig's two carts: which cart's position a model outputs, a
 /// controller moves, or a report talks about.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::Cart;
+/// let carts = [Cart::One, Cart::Two];
+/// assert_eq!(carts.map(Cart::number), [1, 2]);
+/// // Their positions x1 and x2 in the state [x1, v1, x2, v2].
+/// assert_eq!(carts.map(Cart::state_index), [0, 2]);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Cart {
     /// Cart 1, the one tied to the wall; position `x1`, m.

@@ -98,11 +98,30 @@ impl SimulatedOperator {
 
 impl SimulatedOperator {
     /// Records `message` in the [`transcript`](Self::transcript).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::VirtualClock, lab::SimulatedOperator};
+    /// let mut hand = SimulatedOperator::new(VirtualClock::new(), []);
+    /// hand.tell("Encoder 1 counts.");
+    /// assert_eq!(hand.transcript, ["Encoder 1 counts."]);
+    /// ```
     pub fn tell(&mut self, message: &str) {
         self.transcript.push(message.to_owned());
     }
 
     /// The next answer in the list (then "no"), recorded with `question`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{hw::VirtualClock, lab::SimulatedOperator};
+    /// let mut hand = SimulatedOperator::new(VirtualClock::new(), [true]);
+    /// assert!(hand.confirm("Carts at rest?"));
+    /// assert!(!hand.confirm("Again?")); // the list is used up: "no"
+    /// assert_eq!(hand.transcript, ["Carts at rest? yes", "Again? no"]);
+    /// ```
     pub fn confirm(&mut self, question: &str) -> bool {
         let answer = self.answers.pop_front().unwrap_or(false);
         self.transcript
@@ -111,6 +130,22 @@ impl SimulatedOperator {
     }
 
     /// Puts the hands as asked, restarting the back-and-forth motion.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Clock, VirtualClock, probe::Hands};
+    /// use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// let clock = VirtualClock::new();
+    /// let mut card = SimulatedRig::default().card(&Clock::Virtual(clock.clone()))?;
+    /// let mut hand = SimulatedOperator::new(clock, []);
+    /// hand.hands(Hands::Away(1));
+    /// hand.wait(&mut card, 0.05);
+    /// // Cart 1 held `amplitude` (20 mm) from the wall, cart 2 at rest.
+    /// assert!((card.true_state()[0] - hand.amplitude).abs() < 1e-3);
+    /// assert_eq!(hand.transcript, ["(hands: Away(1))"]);
+    /// # Ok::<(), ctrlab::hw::RigError>(())
+    /// ```
     pub fn hands(&mut self, hands: Hands) {
         self.transcript.push(format!("(hands: {hands:?})"));
         self.hands = hands;
@@ -121,6 +156,21 @@ impl SimulatedOperator {
     /// at most 5 ms, placing the held carts (at rest) before each. A card
     /// error (a plant that diverged) is left for the probe's next register
     /// access to report.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::hw::{Clock, VirtualClock};
+    /// use ctrlab::lab::{SimulatedOperator, SimulatedRig};
+    /// let clock = VirtualClock::new();
+    /// let mut card = SimulatedRig::default().card(&Clock::Virtual(clock.clone()))?;
+    /// let mut hand = SimulatedOperator::new(clock.clone(), []);
+    /// hand.wait(&mut card, 0.25);
+    /// assert_eq!(clock.now(), 0.25); // s of virtual time, no real waiting
+    /// hand.wait(&mut card, -1.0); // clamped to 0 s
+    /// assert_eq!(clock.now(), 0.25);
+    /// # Ok::<(), ctrlab::hw::RigError>(())
+    /// ```
     pub fn wait<D: Dynamics<4, 1>>(&mut self, card: &mut SimulatedCard<D, 4>, seconds: f64) {
         let seconds = if seconds.is_finite() {
             seconds.clamp(0.0, 3600.0)

@@ -35,6 +35,22 @@ use crate::data::Recording;
 use crate::error::Error;
 
 /// Which model is validated.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::validation::{ModelCheck, ModelKind, Validated};
+/// # use ctrlab::lab::MassSpring;
+/// # use ctrlab::lab::ident::{Refined, ResidualTest, Validation};
+/// # let white = ResidualTest { max_correlation: 0.02, lag: 1, bound: 0.05 };
+/// # let fit = |f: f64| Validation { fit_percent: [f; 2], rms_error: [1e-4; 2], whiteness: white, independence: white };
+/// # let refined = Refined { plant: MassSpring::nominal(), coulomb: [0.4, 0.6], start: fit(95.0), refined: fit(98.0), evaluations: 20 };
+/// # let check = |kind, f| ModelCheck { kind, plant: refined.plant, coulomb: refined.coulomb, validation: Ok(fit(f)) };
+/// let models = vec![check(ModelKind::LabFormulas, 90.0), check(ModelKind::Refined, 98.0)];
+/// let v = Validated { refined, models, bound: 0.05, spread: None };
+/// assert!(v.model(ModelKind::Refined).is_some());
+/// assert!(v.model(ModelKind::Truth).is_none()); // only on a simulated card
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ModelKind {
     /// The lab's formulas: equal springs, no Coulomb friction.
@@ -48,6 +64,23 @@ pub enum ModelKind {
 }
 
 /// One model simulated on the fresh run.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, ident::validate, validation::{ModelCheck, ModelKind}};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// # // The fixture's true plant.
+/// # let truth = MassSpring { k1: 950.0, k2: 950.0, b1: 12.3, b2: 6.1, gain: 8.5, ..MassSpring::nominal() };
+/// let check = ModelCheck {
+///     kind: ModelKind::Truth,
+///     plant: truth,
+///     coulomb: [0.0; 2], // N: the fixture has no dry friction
+///     validation: validate(&rec, &truth, [0.0; 2]),
+/// };
+/// assert!(check.validation?.fit_percent[1] > 99.0); // %
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelCheck {
     /// Which model.
@@ -62,6 +95,21 @@ pub struct ModelCheck {
 
 /// Every run refined: the parameters' spread, and the first run's
 /// refinement with its bootstrap standard errors.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{Bootstrap, Spread};
+/// use ctrlab::lab::validation::RefinedSpread;
+/// let k1 = [950.0, 960.0, 955.0]; // N/m, three runs refined
+/// let mut spread = [Spread { mean: 1.0, std_dev: 0.0 }; 7];
+/// spread[0] = Spread::of(&k1)?;
+/// let s = RefinedSpread { runs: k1.len(), spread, first: [950.0; 7], std_errors: [4.0; 7], bootstrap: Bootstrap::default() };
+/// // The spread over runs beside the first run's bootstrap standard error.
+/// assert!((s.spread[0].mean - 955.0).abs() < 1e-9);
+/// assert!(s.spread[0].std_dev > s.std_errors[0]);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefinedSpread {
     /// The runs refined.
@@ -78,6 +126,23 @@ pub struct RefinedSpread {
 }
 
 /// The models on a fresh run, and the refinement.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::validation::{ModelCheck, ModelKind, Validated};
+/// # use ctrlab::lab::MassSpring;
+/// # use ctrlab::lab::ident::{Refined, ResidualTest, Validation};
+/// # let white = ResidualTest { max_correlation: 0.02, lag: 1, bound: 0.05 };
+/// # let fit = |f: f64| Validation { fit_percent: [f; 2], rms_error: [1e-4; 2], whiteness: white, independence: white };
+/// # let refined = Refined { plant: MassSpring::nominal(), coulomb: [0.4, 0.6], start: fit(95.0), refined: fit(98.0), evaluations: 20 };
+/// # let check = |kind, f| ModelCheck { kind, plant: refined.plant, coulomb: refined.coulomb, validation: Ok(fit(f)) };
+/// let fresh_samples = 2500.0;
+/// let v = Validated { refined, models: vec![check(ModelKind::Refined, 98.0)], bound: 2.58 / f64::sqrt(fresh_samples), spread: None };
+/// // The refinement improved the fit on its own run.
+/// assert!(v.refined.refined.fit_percent[1] > v.refined.start.fit_percent[1]);
+/// assert!((v.bound - 0.0516).abs() < 1e-4); // 99 % whiteness bound
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Validated {
     /// The first run's refinement (its start and result on that run, the
@@ -95,6 +160,22 @@ pub struct Validated {
 
 impl Validated {
     /// The model of `kind`, if it was validated.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::validation::{ModelCheck, ModelKind, Validated};
+    /// # use ctrlab::lab::MassSpring;
+    /// # use ctrlab::lab::ident::{Refined, ResidualTest, Validation};
+    /// # let white = ResidualTest { max_correlation: 0.02, lag: 1, bound: 0.05 };
+    /// # let fit = |f: f64| Validation { fit_percent: [f; 2], rms_error: [1e-4; 2], whiteness: white, independence: white };
+    /// # let refined = Refined { plant: MassSpring::nominal(), coulomb: [0.4, 0.6], start: fit(95.0), refined: fit(98.0), evaluations: 20 };
+    /// # let check = |kind, f| ModelCheck { kind, plant: refined.plant, coulomb: refined.coulomb, validation: Ok(fit(f)) };
+    /// let v = Validated { refined, models: vec![check(ModelKind::LeastSquares, 95.0)], bound: 0.05, spread: None };
+    /// let fit = v.model(ModelKind::LeastSquares).map(|m| m.validation.as_ref().unwrap().fit_percent[1]);
+    /// assert_eq!(fit, Some(95.0)); // %
+    /// assert!(v.model(ModelKind::Truth).is_none());
+    /// ```
     pub fn model(&self, kind: ModelKind) -> Option<&ModelCheck> {
         self.models.iter().find(|m| m.kind == kind)
     }
@@ -113,6 +194,20 @@ impl Validated {
 /// [`Error::LengthMismatch`] when they hold different numbers of runs; a
 /// refinement's or the bootstrap's error. A model that cannot be simulated
 /// on `fresh` is not an error: its [`ModelCheck::validation`] says why.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// use ctrlab::lab::ident::{SimulationModel, summarize};
+/// use ctrlab::lab::validation::validate_models;
+/// let rec = Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let summary = summarize([&rec, &rec], 1.3, 0.7)?;
+/// // One recording per run identified: a missing one is refused.
+/// let err = validate_models(&summary, &[&rec], &rec, None, &SimulationModel::default()).unwrap_err();
+/// assert!(matches!(err, ctrlab::Error::LengthMismatch { expected: 2, found: 1, .. }));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn validate_models(
     summary: &Summary,
     runs: &[&Recording],

@@ -9,6 +9,23 @@ use crate::error::Error;
 use crate::signal::Rng;
 
 /// Most resamples [`bootstrap`] accepts: each is one refinement.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::MassSpring;
+/// use ctrlab::lab::ident::{Bootstrap, MAX_RESAMPLES, Refined, SEPARATE_SPRINGS, SimulationModel, bootstrap};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// # use ctrlab::lab::ident::{ResidualTest, Validation};
+/// # let white = ResidualTest { max_correlation: 0.02, lag: 1, bound: 0.05 };
+/// # let fit = Validation { fit_percent: [98.0; 2], rms_error: [1e-4; 2], whiteness: white, independence: white };
+/// # let r = Refined { plant: MassSpring::nominal(), coulomb: [0.0; 2], start: fit, refined: fit, evaluations: 1 };
+/// assert!(Bootstrap::default().resamples <= MAX_RESAMPLES);
+/// // One more is refused before any refinement runs.
+/// let too_many = Bootstrap { resamples: MAX_RESAMPLES + 1, ..Bootstrap::default() };
+/// assert!(bootstrap(&rec, &SEPARATE_SPRINGS, &r, &SimulationModel::default(), &too_many).is_err());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub const MAX_RESAMPLES: usize = 1000;
 
 /// How [`bootstrap`] resamples.
@@ -45,6 +62,17 @@ impl Default for Bootstrap {
 
 /// Standard errors of [`Refined`]'s parameters, in their units (N/m,
 /// N·s/m, N/V, N): the standard deviations of the bootstrap's refinements.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{Parameter, RefinedStdErrors};
+/// let se = RefinedStdErrors { k1: 1.2, k2: 1.5, b1: 0.1, b2: 0.05, gain: 0.02, coulomb: [0.03, 0.04], evaluations: 300 };
+/// let lines: Vec<String> = Parameter::ALL.iter().zip(se.to_array())
+///     .map(|(p, e)| format!("{} ± {e} {}", p.symbol(), p.unit()))
+///     .collect();
+/// assert_eq!((lines[0].as_str(), lines[4].as_str()), ("k1 ± 1.2 N/m", "K ± 0.02 N/V"));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefinedStdErrors {
     /// Of `k1`, N/m.

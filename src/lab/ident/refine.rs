@@ -20,12 +20,29 @@ use crate::kernels::reduce::pow2_floor;
 use crate::lab::MassSpring;
 
 /// Largest lag of the residual tests, samples.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{ident::RESIDUAL_LAGS, protocol::PERIOD};
+/// // 50 ms at the loop's 2 ms period.
+/// assert!((RESIDUAL_LAGS as f64 * PERIOD - 0.05).abs() < 1e-15);
+/// ```
 pub const RESIDUAL_LAGS: usize = 25;
 
 /// A residual test: the largest normalised correlation over lags
 /// `1..=RESIDUAL_LAGS` (autocorrelation) or `0..=RESIDUAL_LAGS`
 /// (cross-correlation with the input), against the 99 % bound `2.58 / √n`
 /// of white residuals independent of the input (MATLAB's `resid`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::ResidualTest;
+/// let bound = 2.58 / f64::sqrt(2500.0); // a 5 s run at 2 ms
+/// let t = ResidualTest { max_correlation: 0.08, lag: 12, bound };
+/// assert!(!t.passed()); // 0.08 > 0.0516: coloured at lag 12 (24 ms)
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ResidualTest {
     /// `max |ρ(τ)|` over the lags.
@@ -52,6 +69,19 @@ impl ResidualTest {
 }
 
 /// How well a model reproduces a recording when simulated from its input.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, ident::validate};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// // The fixture's true plant, simulated from the fixture's input.
+/// let truth = MassSpring { k1: 950.0, k2: 950.0, b1: 12.3, b2: 6.1, gain: 8.5, ..MassSpring::nominal() };
+/// let v = validate(&rec, &truth, [0.0; 2])?;
+/// assert!(v.fit_percent.iter().all(|&f| f > 99.0)); // %
+/// assert!((v.whiteness.bound - 2.58 / f64::sqrt(rec.len() as f64)).abs() < 1e-12);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Validation {
     /// Fit of each cart's simulated position, %:
@@ -68,6 +98,18 @@ pub struct Validation {
 }
 
 /// The result of [`refine`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{SEPARATE_SPRINGS, identify_with, refine};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let r = refine(&rec, &identify_with(&rec, 1.3, 0.7, &SEPARATE_SPRINGS)?)?;
+/// // Refining never makes the fit of cart 2 on its own run worse.
+/// assert!(r.refined.fit_percent[1] >= r.start.fit_percent[1] - 1e-9);
+/// assert!(r.evaluations > 0 && (r.plant.m1, r.plant.m2) == (1.3, 0.7));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Refined {
     /// The refined plant (masses as given to the least squares).

@@ -13,6 +13,17 @@ use crate::lab::{Friction, FrictionPlant, MassSpring, SimulatedRig};
 
 /// The separate-springs identification the lab's model comes from: the
 /// central scheme, with each cart's Coulomb friction.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{SEPARATE_SPRINGS, identify_with};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let e = identify_with(&rec, 1.3, 0.7, &SEPARATE_SPRINGS)?;
+/// assert!(e.coulomb.is_some()); // F1, F2 fitted
+/// assert!((e.k1().value / 950.0 - 1.0).abs() < 0.01 && (e.k2().value / 950.0 - 1.0).abs() < 0.01);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub const SEPARATE_SPRINGS: Options = Options {
     springs: SpringModel::Separate,
     scheme: Scheme::Central,
@@ -63,6 +74,13 @@ impl Parameter {
     ];
 
     /// Its symbol (`"k1"`, `"K"`, `"F2"`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident::Parameter;
+    /// assert_eq!(Parameter::ALL.map(Parameter::symbol), ["k1", "k2", "b1", "b2", "K", "F1", "F2"]);
+    /// ```
     pub fn symbol(self) -> &'static str {
         match self {
             Parameter::K1 => "k1",
@@ -76,6 +94,15 @@ impl Parameter {
     }
 
     /// Its SI unit.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident::Parameter;
+    /// assert_eq!(Parameter::K2.unit(), "N/m");
+    /// assert_eq!(Parameter::B1.unit(), "N·s/m");
+    /// assert_eq!(Parameter::F1.unit(), "N");
+    /// ```
     pub fn unit(self) -> &'static str {
         match self {
             Parameter::K1 | Parameter::K2 => "N/m",
@@ -86,6 +113,15 @@ impl Parameter {
     }
 
     /// Its value in `plant` with Coulomb forces `coulomb` (N).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{MassSpring, ident::Parameter};
+    /// let plant = MassSpring::nominal();
+    /// assert_eq!(Parameter::B2.of(&plant, [0.3, 0.4]), 5.0); // N·s/m
+    /// assert_eq!(Parameter::F2.of(&plant, [0.3, 0.4]), 0.4); // N
+    /// ```
     pub fn of(self, plant: &MassSpring, coulomb: [f64; 2]) -> f64 {
         match self {
             Parameter::K1 => plant.k1,
@@ -99,6 +135,19 @@ impl Parameter {
     }
 
     /// Its estimate in `e` (`None`: a Coulomb force not fitted).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident::{Options, Parameter, SpringModel, identify_with};
+    /// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let no_friction = Options { springs: SpringModel::Separate, ..Options::default() };
+    /// let e = identify_with(&rec, 1.3, 0.7, &no_friction)?;
+    /// assert!(Parameter::F1.estimate(&e).is_none());
+    /// let k1 = Parameter::K1.estimate(&e).unwrap();
+    /// assert!((k1.value / 950.0 - 1.0).abs() < 0.01); // N/m
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn estimate(self, e: &MassSpringEstimate) -> Option<Estimate> {
         match self {
             Parameter::K1 => Some(e.k1()),
@@ -113,6 +162,20 @@ impl Parameter {
 
     /// Its spread over the runs of `a` (`None`: a Coulomb force not
     /// fitted).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::ident::{Options, Parameter, SpringModel, average, identify_with};
+    /// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// let options = Options { springs: SpringModel::Separate, ..Options::default() };
+    /// let e = identify_with(&rec, 1.3, 0.7, &options)?;
+    /// let a = average(&[e.clone(), e])?;
+    /// let gain = Parameter::Gain.spread(&a).unwrap();
+    /// assert!((gain.mean / 8.5 - 1.0).abs() < 0.01 && gain.std_dev == 0.0); // N/V, one run twice
+    /// assert!(Parameter::F2.spread(&a).is_none());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn spread(self, a: &MassSpringAverage) -> Option<Spread> {
         match self {
             Parameter::K1 => Some(a.k1()),
@@ -127,6 +190,17 @@ impl Parameter {
 }
 
 /// Why repeated runs could not be summarised.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{SummaryError, summarize};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// assert!(matches!(summarize([&rec], 1.3, 0.7), Err(SummaryError::Average(_)))); // one run
+/// let err = summarize([&rec, &rec], -1.0, 0.7).unwrap_err();
+/// assert!(err.to_string().starts_with("run 1: ")); // counted from 1 in messages
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum SummaryError {
@@ -146,6 +220,17 @@ pub enum SummaryError {
 
 /// Repeated identification runs: every run three ways, their averages and
 /// the identified model.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::ident::{Summary, summarize};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let s: Summary = summarize([&rec, &rec], 1.3, 0.7)?;
+/// assert_eq!((s.lab.len(), s.central.len(), s.separate.len()), (2, 2, 2)); // per run
+/// assert!((s.average.gain.mean / 8.5 - 1.0).abs() < 0.01); // N/V
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Summary {
     /// The lab's formulas (equations (6)–(11)), one per run.
@@ -167,11 +252,33 @@ pub struct Summary {
 
 impl Summary {
     /// The identified model: the separate-springs averages' linear part.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// # let s = ctrlab::lab::ident::summarize([&rec, &rec], 1.3, 0.7)?;
+    /// let model = s.model();
+    /// assert_eq!((model.m1, model.m2), (1.3, 0.7)); // kg, as given
+    /// assert!((model.k2 / 950.0 - 1.0).abs() < 0.01); // N/m
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn model(&self) -> MassSpring {
         self.average.plant()
     }
 
     /// The identified Coulomb forces, N (cart 1, cart 2): the averages.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// # let s = ctrlab::lab::ident::summarize([&rec, &rec], 1.3, 0.7)?;
+    /// // The fixture's rig has no dry friction: both forces near 0 N.
+    /// assert!(s.coulomb().iter().all(|f| f.abs() < 0.05));
+    /// assert_eq!(s.coulomb()[0], s.coulomb[0].mean);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn coulomb(&self) -> [f64; 2] {
         self.coulomb.map(|s| s.mean)
     }
@@ -179,6 +286,19 @@ impl Summary {
     /// Each parameter's mean and spread over the runs beside the runs' own
     /// standard errors, against `truth` when it is known (a simulated
     /// card's plant and Coulomb forces).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{FrictionPlant, MassSpring, ident::Parameter};
+    /// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// # let s = ctrlab::lab::ident::summarize([&rec, &rec], 1.3, 0.7)?;
+    /// let truth = FrictionPlant::new(MassSpring { k1: 950.0, k2: 950.0, ..MassSpring::nominal() }, [0.0; 2]);
+    /// let u = s.uncertainty(Some(&truth));
+    /// assert_eq!(u.len(), 7); // every parameter: the fit has Coulomb forces
+    /// assert_eq!((u[0].parameter, u[0].runs, u[0].truth), (Parameter::K1, 2, Some(950.0)));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn uncertainty(&self, truth: Option<&FrictionPlant>) -> Vec<Uncertainty> {
         let n = self.separate.len() as f64;
         Parameter::ALL
@@ -204,6 +324,16 @@ impl Summary {
 
     /// How uncertain the spread over the runs itself is, relative:
     /// `1 / √(2 (n − 1))` for `n` runs.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+    /// # let s = ctrlab::lab::ident::summarize([&rec, &rec], 1.3, 0.7)?;
+    /// // With two runs, the spread itself is uncertain by ±71 %.
+    /// assert!((s.spread_uncertainty() - 0.5f64.sqrt()).abs() < 1e-15);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn spread_uncertainty(&self) -> f64 {
         1.0 / (2.0 * (self.separate.len() as f64 - 1.0)).sqrt()
     }
@@ -244,17 +374,44 @@ pub struct Uncertainty {
 impl Uncertainty {
     /// Standard error over spread: near 1 when the standard errors are
     /// right.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::ident::{Parameter, Spread, Uncertainty};
+    /// # let u = Uncertainty { parameter: Parameter::K1, spread: Spread { mean: 955.0, std_dev: 4.0 }, std_error: 2.0, runs: 4, truth: Some(950.0) };
+    /// // The runs scatter twice as much as each run's standard error says.
+    /// assert_eq!(u.ratio(), 0.5);
+    /// ```
     pub fn ratio(&self) -> f64 {
         self.std_error / self.spread.std_dev
     }
 
     /// The standard error of the mean, `sd / √n`, in the parameter's unit.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::ident::{Parameter, Spread, Uncertainty};
+    /// # let u = Uncertainty { parameter: Parameter::K1, spread: Spread { mean: 955.0, std_dev: 4.0 }, std_error: 2.0, runs: 4, truth: Some(950.0) };
+    /// assert_eq!(u.std_error_of_mean(), 2.0); // N/m: 4 N/m over √4 runs
+    /// ```
     pub fn std_error_of_mean(&self) -> f64 {
         self.spread.std_dev / (self.runs as f64).sqrt()
     }
 
     /// `(mean − truth) / (sd / √n)`: the mean's distance from the truth in
     /// its own standard errors (bias where it is more than a few).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::ident::{Parameter, Spread, Uncertainty};
+    /// # let u = Uncertainty { parameter: Parameter::K1, spread: Spread { mean: 955.0, std_dev: 4.0 }, std_error: 2.0, runs: 4, truth: Some(950.0) };
+    /// // 5 N/m above the truth, 2.5 standard errors of the mean.
+    /// assert_eq!(u.bias(), Some(2.5));
+    /// assert_eq!(Uncertainty { truth: None, ..u }.bias(), None);
+    /// ```
     pub fn bias(&self) -> Option<f64> {
         self.truth
             .map(|t| (self.spread.mean - t) / self.std_error_of_mean())
@@ -318,6 +475,19 @@ pub fn summarize<'a>(
 /// One run on a card whose springs are equal and without Coulomb friction,
 /// where the lab's model is exact: the schemes' own bias, free of model
 /// error.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, ident::EqualSprings};
+/// # let rec = ctrlab::Recording::read_csv(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/ident_square_wave.csv"))?;
+/// let truth = MassSpring { k1: 950.0, k2: 950.0, b1: 12.3, b2: 6.1, gain: 8.5, ..MassSpring::nominal() };
+/// let e = EqualSprings::identify(&rec, truth, 1.3, 0.7)?;
+/// // Where the lab's model is exact, each scheme's error is its own bias.
+/// let error = |k: f64| (k / e.truth.k1 - 1.0).abs();
+/// assert!(error(e.lab.k1().value) < 0.02 && error(e.central.k1().value) < 0.01);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct EqualSprings {
     /// The card's plant (k2 = k1).

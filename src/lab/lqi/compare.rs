@@ -8,9 +8,28 @@ use crate::lab::{Cart, MassSpring, SimulatedRig, position_channel};
 
 /// The tail of a run in which a cart's rest is judged, s: the second half
 /// of a [`DURATION`](super::DURATION) run.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{lqi::{DURATION, REST_TAIL}, protocol::PERIOD};
+/// assert_eq!(2.0 * REST_TAIL, DURATION); // the second half of a run
+/// assert!((REST_TAIL / PERIOD - 750.0).abs() < 1e-9); // samples judged
+/// ```
 pub const REST_TAIL: f64 = 1.5;
 /// Identified parameters within this (relative) of a simulated card's truth
 /// are not offered as a reason for a difference.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, SimulatedRig, lqi::KnownDifferences};
+/// let sim = SimulatedRig::default();
+/// let close = MassSpring { k2: 1.015 * sim.truth.k2, ..sim.truth }; // 1.5 % off
+/// let far = MassSpring { k2: 1.025 * sim.truth.k2, ..sim.truth }; // 2.5 % off
+/// assert!(KnownDifferences::of(&close, &sim).off().is_empty());
+/// assert_eq!(KnownDifferences::of(&far, &sim).off()[0].0, "k2");
+/// ```
 pub const IDENT_TOLERANCE: f64 = 0.02;
 
 /// How a cart rests over a run's tail: its lowest and highest reading,
@@ -33,6 +52,15 @@ pub struct Rest {
 }
 
 /// How still a cart rests.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::lqi::{Rest, RestKind};
+/// // Counts from the setpoint over the run's tail.
+/// let kinds = [(0.0, 0.0), (-1.0, 1.0), (-2.0, 3.0)].map(|(lo, hi)| Rest { lo, hi }.kind());
+/// assert_eq!(kinds, [RestKind::Still, RestKind::Jitter, RestKind::Hunting]);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RestKind {
     /// One reading throughout.
@@ -47,6 +75,22 @@ impl Rest {
     /// How the tracked cart of `spec` rests over the last [`REST_TAIL`] s of
     /// `rec` (sampled every `period` s), in counts of `metres_per_count`;
     /// `None` without that channel or samples.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::Recording;
+    /// use ctrlab::lab::{Cart, lqi::{Rest, RestKind, Spec}};
+    /// let count = 0.080 / 8192.0; // m
+    /// // Cart 2 at 30 mm, its reading flickering one count past it.
+    /// let t: Vec<f64> = (0..1500).map(|k| k as f64 * 0.002).collect();
+    /// let x2: Vec<f64> = (0..1500).map(|k| 0.030 + (k % 2) as f64 * count).collect();
+    /// # let z = vec![0.0; 1500];
+    /// let rec = Recording::from_columns(ctrlab::lab::schema(), t, vec![z.clone(), z.clone(), z.clone(), x2, z])?;
+    /// let rest = Rest::of(&rec, &Spec::new(Cart::Two, 0.030, 24.0), count, 0.002).unwrap();
+    /// assert_eq!((rest.lo, rest.hi, rest.kind()), (0.0, 1.0, RestKind::Jitter));
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn of(rec: &Recording, spec: &Spec, metres_per_count: f64, period: f64) -> Option<Self> {
         let y = rec.channel(position_channel(spec.cart)).ok()?;
         let from = y
@@ -62,6 +106,15 @@ impl Rest {
     }
 
     /// Still, jittering or hunting.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::lqi::{Rest, RestKind};
+    /// // Three counts between lowest and highest: more than encoder noise.
+    /// assert_eq!(Rest { lo: -3.0, hi: 0.0 }.kind(), RestKind::Hunting);
+    /// assert_eq!(Rest { lo: -3.0, hi: -1.0 }.kind(), RestKind::Jitter);
+    /// ```
     pub fn kind(&self) -> RestKind {
         if self.lo == self.hi {
             RestKind::Still
@@ -81,6 +134,14 @@ fn agree(a: f64, b: f64, abs: f64, rel: f64) -> bool {
 /// Which of the transient's figures agree between prediction and rig: rise
 /// within a sample or 10 %, overshoot within a percentage point, settling
 /// within 10 ms or 10 %.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::lqi::Transient;
+/// let t = Transient { rise: true, overshoot: true, settling: false };
+/// assert!(!t.agrees()); // one figure off is a disagreement
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Transient {
     /// The rise times agree.
@@ -93,6 +154,14 @@ pub struct Transient {
 
 impl Transient {
     /// Whether every figure agrees.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::lqi::Transient;
+    /// assert!(Transient { rise: true, overshoot: true, settling: true }.agrees());
+    /// assert!(!Transient { rise: false, overshoot: true, settling: true }.agrees());
+    /// ```
     pub fn agrees(&self) -> bool {
         self.rise && self.overshoot && self.settling
     }
@@ -135,6 +204,28 @@ pub struct Comparison {
 impl Comparison {
     /// The prediction `(recording, figures)` against the rig's, for `spec`,
     /// in counts of `metres_per_count` (m), sampled every `period` s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Cart, lqi::{Comparison, Metrics, Spec, Transient}};
+    /// # use ctrlab::Recording;
+    /// # // Cart 2 from rest to 30 mm, a first-order approach of `tau` s, 1 V drive.
+    /// # let approach = |tau: f64| {
+    /// #     let t: Vec<f64> = (0..1500).map(|k| k as f64 * 0.002).collect();
+    /// #     let x2: Vec<f64> = t.iter().map(|t| 0.030 * (1.0 - (-t / tau).exp())).collect();
+    /// #     let z = vec![0.0; 1500];
+    /// #     Recording::from_columns(ctrlab::lab::schema(), t, vec![vec![1.0; 1500], z.clone(), z.clone(), x2, z])
+    /// # };
+    /// let (spec, count) = (Spec::new(Cart::Two, 0.030, 24.0), 0.080 / 8192.0);
+    /// let (fast, slow) = (approach(0.1)?, approach(0.2)?);
+    /// let (mf, ms) = (Metrics::of(&fast, &spec, count)?, Metrics::of(&slow, &spec, count)?);
+    /// let c = Comparison::of((&fast, &mf), (&slow, &ms), &spec, count, 0.002);
+    /// // Twice as slow: rise and settling disagree; both rest on the setpoint.
+    /// assert_eq!(c.transient, Some(Transient { rise: false, overshoot: true, settling: false }));
+    /// assert!(c.rest_agrees && c.voltage_agrees);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn of(
         predicted: (&Recording, &Metrics),
         rig: (&Recording, &Metrics),
@@ -212,6 +303,31 @@ impl IntegratorWalk {
     /// on a drive of `gain` (N/V), in counts of `metres_per_count` (m).
     /// A run without figures (not settled) has no steady-state error:
     /// `error_counts`, `rate` and `time` are then NaN.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::lqi::IntegratorWalk;
+    /// # use ctrlab::lab::{Cart, MassSpring, lqi::{self, Candidate, Choice, Design, Metrics, Spec, Step}};
+    /// # let spec = Spec::new(Cart::Two, 0.030, 24.0);
+    /// # let model = lqi::position_model(&MassSpring::nominal(), 0.002)?;
+    /// # let (rho, q) = (1e7, lqi::weights(Cart::Two, 1e7));
+    /// # let lqi = lqi::positions_lqi(&model, Cart::Two, &q, 1e-5)?;
+    /// # let step = Step { rise: 0.1, overshoot: 2.0, settling: 0.3, error_mm: 0.0, error_counts: 0.0 };
+    /// # let good = Metrics { step: Ok(step), peak_u: 10.0, clipped: 0 };
+    /// # let slow = Metrics { step: Ok(Step { settling: 0.8, ..step }), ..good.clone() };
+    /// # let candidates = vec![Candidate { rho: 1e6, metrics: Some(slow) },
+    /// #     Candidate { rho: 1e7, metrics: Some(good.clone()) }, Candidate { rho: 1e8, metrics: None }];
+    /// # let predicted = ctrlab::Recording::new(ctrlab::lab::schema());
+    /// # let design = Design { spec, rho, q, lqi, choice: Choice::Isolated, predicted, metrics: good, candidates };
+    /// let rec = ctrlab::Recording::from_columns(ctrlab::lab::schema(), vec![0.0, 3.0], vec![vec![0.0; 2]; 5])?;
+    /// let measured = Metrics { step: Ok(Step { error_counts: -2.0, settling: 0.5, ..step }), ..design.metrics.clone() };
+    /// let w = IntegratorWalk::of(&design, (&rec, &measured), [1.0, 1.5], 8.5, 1e-5);
+    /// assert!((w.rate - w.kz * 2.0 * 1e-5).abs() < 1e-12); // V/s under 2 counts
+    /// assert!((w.band - 2.0 * 1.5 / 8.5).abs() < 1e-12); // V: twice cart 2's breakaway
+    /// assert_eq!((w.time, w.left), (w.band / w.rate, 2.5)); // s
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn of(
         design: &Design,
         rig: (&Recording, &Metrics),
@@ -240,6 +356,15 @@ impl IntegratorWalk {
     }
 
     /// Whether crossing the band can take longer than the run has left.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::lqi::IntegratorWalk;
+    /// // 1 V/s across a 0.5 V band: freed in 0.5 s, with 2.5 s of the run left.
+    /// let w = IntegratorWalk { kz: 5e4, error_counts: 2.0, rate: 1.0, band: 0.5, time: 0.5, left: 2.5 };
+    /// assert!(!w.exceeds_run());
+    /// ```
     pub fn exceeds_run(&self) -> bool {
         self.time > self.left
     }
@@ -273,6 +398,16 @@ pub struct KnownDifferences {
 
 impl KnownDifferences {
     /// The identified `model` against `truth`'s card.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{SimulatedRig, lqi::KnownDifferences};
+    /// let sim = SimulatedRig::default();
+    /// let d = KnownDifferences::of(&sim.truth, &sim); // identified exactly
+    /// assert_eq!((d.worst(), d.off().len()), (0.0, 0));
+    /// assert_eq!(d.parameters[0], ("K", sim.truth.gain, sim.truth.gain));
+    /// ```
     pub fn of(model: &MassSpring, truth: &SimulatedRig) -> Self {
         let t = &truth.truth;
         Self {
@@ -292,6 +427,16 @@ impl KnownDifferences {
 
     /// The parameters identified off the truth by more than
     /// [`IDENT_TOLERANCE`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{MassSpring, SimulatedRig, lqi::KnownDifferences};
+    /// let sim = SimulatedRig::default();
+    /// let model = MassSpring { b1: 0.9 * sim.truth.b1, ..sim.truth };
+    /// let off = KnownDifferences::of(&model, &sim).off();
+    /// assert_eq!(off, [("b1", model.b1, sim.truth.b1)]); // N·s/m, 10 % low
+    /// ```
     pub fn off(&self) -> Vec<(&'static str, f64, f64)> {
         self.parameters
             .iter()
@@ -301,6 +446,15 @@ impl KnownDifferences {
     }
 
     /// The largest relative identification error of the five.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{MassSpring, SimulatedRig, lqi::KnownDifferences};
+    /// let sim = SimulatedRig::default();
+    /// let model = MassSpring { k1: 1.01 * sim.truth.k1, gain: 0.95 * sim.truth.gain, ..sim.truth };
+    /// assert!((KnownDifferences::of(&model, &sim).worst() - 0.05).abs() < 1e-12); // K, 5 % low
+    /// ```
     pub fn worst(&self) -> f64 {
         self.parameters
             .iter()

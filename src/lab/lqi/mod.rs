@@ -59,9 +59,37 @@ pub use search::{Candidate, Choice, Design, design_search, rho_grid};
 pub use spec::{Item, Metrics, Spec, Step, Verdict};
 
 /// The controller on the rig's `[x1, v1, x2, v2]`: positions only.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Controller;
+/// use ctrlab::lab::{Cart, MassSpring, lqi};
+/// use ctrlab::nalgebra::vector;
+/// # let model = lqi::position_model(&MassSpring::nominal(), 0.002)?;
+/// let mut a: lqi::PositionsLqi = lqi::positions_lqi(&model, Cart::Two, &lqi::weights(Cart::Two, 1e7), 1e-5)?.controller;
+/// let mut b = a.clone();
+/// // The speeds it is handed are ignored: its filter estimates them.
+/// let ua = a.update(&vector![0.001, 0.0, 0.002, 0.0], &vector![0.030]);
+/// let ub = b.update(&vector![0.001, 9.0, 0.002, -9.0], &vector![0.030]);
+/// assert_eq!(ua, ub);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub type PositionsLqi = SelectOutputs<ObserverController<4, 1, 2, 1>, 4, 2>;
 
 /// A designed controller with its LQI gain and the closed loop's poles.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, MassSpring, lqi};
+/// let model = lqi::position_model(&MassSpring::nominal(), 0.002)?;
+/// let design: lqi::Lqi = lqi::positions_lqi(&model, Cart::Two, &lqi::weights(Cart::Two, 1e7), 1e-5)?;
+/// assert!(design.poles.iter().all(|z| z.norm() < 1.0)); // stable on the model
+/// // Cart 2 ahead of its setpoint is pushed back: a positive gain on x2, V/m.
+/// assert!(design.gain[(0, 2)] > 0.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Lqi {
     /// The controller, ready for `hw::run` or the sampled-data simulator.
@@ -75,23 +103,86 @@ pub struct Lqi {
 
 /// The Kalman filter's process noise: a force on cart 2 through the
 /// input, variance in V².
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, lqi::INPUT_NOISE, mpc::Tuning};
+/// // About 3.2 V RMS of unknown push, well inside the ±24 V drive.
+/// assert!(INPUT_NOISE.sqrt() < Calibration::default().volts_full_scale / 5.0);
+/// assert_eq!(Tuning::LAB.input_noise, INPUT_NOISE); // the MPC's estimator too
+/// ```
 pub const INPUT_NOISE: f64 = 10.0;
 /// Back-calculation past the drive's 24 mV step (see `AntiWindup`).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::design::AntiWindup;
+/// use ctrlab::lab::{Calibration, lqi::ANTI_WINDUP};
+/// let AntiWindup::BackCalculation { deadband, .. } = ANTI_WINDUP else { panic!() };
+/// // The drive's step: 0.1 % of its ±24 V full scale.
+/// assert!((deadband - 0.001 * Calibration::default().volts_full_scale).abs() < 1e-15);
+/// ```
 pub const ANTI_WINDUP: AntiWindup = AntiWindup::BackCalculation {
     tracking: 0.01,
     deadband: 0.024,
 };
 /// Weight on the integrated error relative to the tracked position,
 /// 1/s² (an integral time of about 32 ms).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, lqi};
+/// assert!((1.0 / lqi::INTEGRAL_RATIO.sqrt() - 0.032).abs() < 0.001); // s
+/// assert_eq!(lqi::weights(Cart::Two, 1e7)[(4, 4)], 1e7 * lqi::INTEGRAL_RATIO);
+/// ```
 pub const INTEGRAL_RATIO: f64 = 1e3;
 /// The drive's latch-to-PWM delay, s: its data sheet, not identified.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, MassSpring, lqi, protocol::PERIOD};
+/// assert!((lqi::DRIVE_DELAY / PERIOD - 0.075).abs() < 1e-12); // 7.5 % of a period
+/// let rig = lqi::predicted_rig(MassSpring::nominal(), [0.0; 2], &Calibration::default(), PERIOD);
+/// assert_eq!(rig.card.pwm_delay, lqi::DRIVE_DELAY);
+/// ```
 pub const DRIVE_DELAY: f64 = 0.15e-3;
 /// Length of each predicted and measured step, s.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{lqi::DURATION, protocol::{PERIOD, STEP_DURATION}};
+/// assert_eq!(DURATION, STEP_DURATION); // as long as a row of Tables 5 and 6
+/// assert!((DURATION / PERIOD - 1500.0).abs() < 1e-9);
+/// ```
 pub const DURATION: f64 = 3.0;
 /// The lab's design cases: cart 2 to Table 5's 30 mm, cart 1 to Table 6's
 /// 15 mm (m).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{lqi::CASES, tables::{TABLE5, TABLE6}};
+/// for ((cart, setpoint), table) in CASES.into_iter().zip([TABLE5, TABLE6]) {
+///     assert_eq!(cart, table.cart);
+///     assert!((setpoint * 1e3 - table.setpoint_mm).abs() < 1e-12); // m against mm
+/// }
+/// ```
 pub const CASES: [(Cart, f64); 2] = [(Cart::Two, 0.030), (Cart::One, 0.015)];
 /// The larger cart-1 setpoint the choice of 15 mm is weighed against, m.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, ident_input::TRAVEL_FRACTION, lqi::{CART1_ALTERNATIVE, CASES}};
+/// assert!(CART1_ALTERNATIVE > CASES[1].1); // 20 mm against 15 mm
+/// // Still a setpoint the lab accepts: within 60 % of cart 1's travel.
+/// assert!(CART1_ALTERNATIVE <= TRAVEL_FRACTION * Calibration::default().travel_limits[0]);
+/// ```
 pub const CART1_ALTERNATIVE: f64 = 0.020;
 
 /// The model the loop sees every `period` s (ZOH), outputs both positions
@@ -271,6 +362,17 @@ pub struct Hold {
 
 impl Hold {
     /// Cart 1 held at `r` (m) on `model`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{MassSpring, lqi::Hold};
+    /// // The fixture's identified rig: k1 = k2 = 950 N/m, K = 8.5 N/V.
+    /// let rig = MassSpring { k1: 950.0, k2: 950.0, gain: 8.5, ..MassSpring::nominal() };
+    /// let h = Hold::of(&rig, 0.015);
+    /// assert!((h.volts - 950.0 * 0.015 / 8.5).abs() < 1e-12); // about 1.7 V
+    /// assert!((h.x2 - 0.030).abs() < 1e-15); // equal springs: twice cart 1's 15 mm
+    /// ```
     pub fn of(model: &MassSpring, r: f64) -> Self {
         Self {
             volts: model.k1 * r / model.gain,

@@ -21,6 +21,17 @@ pub fn rho_grid() -> impl Iterator<Item = f64> {
 }
 
 /// One weight of the search and its predicted step.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, lqi::{Candidate, Metrics, Spec, Step}};
+/// let spec = Spec::new(Cart::Two, 0.030, 24.0);
+/// let step = Step { rise: 0.12, overshoot: 3.0, settling: 0.4, error_mm: 0.0, error_counts: 0.0 };
+/// let c = Candidate { rho: 1e7, metrics: Some(Metrics { step: Ok(step), peak_u: 9.0, clipped: 0 }) };
+/// assert!(c.passes(&spec));
+/// assert!(!Candidate { metrics: None, ..c }.passes(&spec)); // no design, no pass
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Candidate {
     /// ρ, 1/m².
@@ -32,12 +43,43 @@ pub struct Candidate {
 
 impl Candidate {
     /// Whether the prediction meets `spec`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Cart, lqi::{Candidate, Metrics, Spec, Step}};
+    /// let spec = Spec::new(Cart::Two, 0.030, 24.0);
+    /// let step = Step { rise: 0.12, overshoot: 7.0, settling: 0.4, error_mm: 0.0, error_counts: 0.0 };
+    /// let c = Candidate { rho: 1e9, metrics: Some(Metrics { step: Ok(step), peak_u: 9.0, clipped: 0 }) };
+    /// assert!(!c.passes(&spec)); // 7 % overshoot, the spec allows 5 %
+    /// ```
     pub fn passes(&self, spec: &Spec) -> bool {
         self.metrics.as_ref().is_some_and(|m| m.passes(spec))
     }
 }
 
 /// How the weight was chosen.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::lab::{Cart, MassSpring, lqi::{self, Candidate, Choice, Design, Metrics, Spec, Step}};
+/// # let spec = Spec::new(Cart::Two, 0.030, 24.0);
+/// # let model = lqi::position_model(&MassSpring::nominal(), 0.002)?;
+/// # let (rho, q) = (1e7, lqi::weights(Cart::Two, 1e7));
+/// # let lqi = lqi::positions_lqi(&model, Cart::Two, &q, 1e-5)?;
+/// # let step = Step { rise: 0.1, overshoot: 2.0, settling: 0.3, error_mm: 0.0, error_counts: 0.0 };
+/// # let good = Metrics { step: Ok(step), peak_u: 10.0, clipped: 0 };
+/// # let slow = Metrics { step: Ok(Step { settling: 0.8, ..step }), ..good.clone() };
+/// # let candidates = vec![Candidate { rho: 1e6, metrics: Some(slow) },
+/// #     Candidate { rho: 1e7, metrics: Some(good.clone()) }, Candidate { rho: 1e8, metrics: None }];
+/// # let predicted = ctrlab::Recording::new(ctrlab::lab::schema());
+/// # let design = Design { spec, rho, q, lqi, choice: Choice::Isolated, predicted, metrics: good, candidates };
+/// // ρ = 1e7 passes, but its neighbour 1e6 settles too slowly: isolated.
+/// assert_eq!(design.passing(), [1e7]);
+/// assert_eq!(design.choice, Choice::Isolated);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Choice {
     /// Its prediction and both neighbours' on the grid meet the spec.
@@ -50,6 +92,27 @@ pub enum Choice {
 
 /// The design for a spec: the chosen weight and controller, its predicted
 /// step, and the whole search.
+///
+/// # Examples
+///
+/// ```
+/// # use ctrlab::lab::{Cart, MassSpring, lqi::{self, Candidate, Choice, Design, Metrics, Spec, Step}};
+/// # let spec = Spec::new(Cart::Two, 0.030, 24.0);
+/// # let model = lqi::position_model(&MassSpring::nominal(), 0.002)?;
+/// # let (rho, q) = (1e7, lqi::weights(Cart::Two, 1e7));
+/// # let lqi = lqi::positions_lqi(&model, Cart::Two, &q, 1e-5)?;
+/// # let step = Step { rise: 0.1, overshoot: 2.0, settling: 0.3, error_mm: 0.0, error_counts: 0.0 };
+/// # let good = Metrics { step: Ok(step), peak_u: 10.0, clipped: 0 };
+/// # let slow = Metrics { step: Ok(Step { settling: 0.8, ..step }), ..good.clone() };
+/// # let candidates = vec![Candidate { rho: 1e6, metrics: Some(slow) },
+/// #     Candidate { rho: 1e7, metrics: Some(good.clone()) }, Candidate { rho: 1e8, metrics: None }];
+/// # let predicted = ctrlab::Recording::new(ctrlab::lab::schema());
+/// # let design = Design { spec, rho, q, lqi, choice: Choice::Isolated, predicted, metrics: good, candidates };
+/// assert_eq!(design.q, lqi::weights(design.spec.cart, design.rho)); // 1/m²
+/// assert!(design.metrics.passes(&design.spec));
+/// assert!(design.lqi.poles.iter().all(|z| z.norm() < 1.0));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct Design {
     /// The spec designed for.
@@ -72,6 +135,26 @@ pub struct Design {
 
 impl Design {
     /// The weights whose prediction meets the spec, 1/m².
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::{Cart, MassSpring, lqi::{self, Candidate, Choice, Design, Metrics, Spec, Step}};
+    /// # let spec = Spec::new(Cart::Two, 0.030, 24.0);
+    /// # let model = lqi::position_model(&MassSpring::nominal(), 0.002)?;
+    /// # let (rho, q) = (1e7, lqi::weights(Cart::Two, 1e7));
+    /// # let lqi = lqi::positions_lqi(&model, Cart::Two, &q, 1e-5)?;
+    /// # let step = Step { rise: 0.1, overshoot: 2.0, settling: 0.3, error_mm: 0.0, error_counts: 0.0 };
+    /// # let good = Metrics { step: Ok(step), peak_u: 10.0, clipped: 0 };
+    /// # let slow = Metrics { step: Ok(Step { settling: 0.8, ..step }), ..good.clone() };
+    /// # let candidates = vec![Candidate { rho: 1e6, metrics: Some(slow) },
+    /// #     Candidate { rho: 1e7, metrics: Some(good.clone()) }, Candidate { rho: 1e8, metrics: None }];
+    /// # let predicted = ctrlab::Recording::new(ctrlab::lab::schema());
+    /// # let design = Design { spec, rho, q, lqi, choice: Choice::Isolated, predicted, metrics: good, candidates };
+    /// // 1e6 settles in 0.8 s (the spec: 0.5 s); 1e8 has no prediction.
+    /// assert_eq!(design.passing(), [1e7]);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn passing(&self) -> Vec<f64> {
         self.candidates
             .iter()

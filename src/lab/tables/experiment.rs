@@ -21,10 +21,28 @@ use crate::lab::{Calibration, Cart, LabGains, MassSpringRig};
 /// The simulated card's noise seed of a table's first row; row `i` (from
 /// 0) has `ROW_SEEDS_FROM + i`, as lab5 runs them
 /// ([`GainTable::row_seed`]).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::tables::{ROW_SEEDS_FROM, TABLE5, TABLE6};
+/// assert_eq!(TABLE5.experiment(0).unwrap().seed(), ROW_SEEDS_FROM);
+/// // Each table numbers its rows' seeds afresh.
+/// assert_eq!(TABLE6.row_seed(0), TABLE5.row_seed(0));
+/// ```
 pub const ROW_SEEDS_FROM: u64 = 100;
 
 /// The longest experiment accepted, s: the lab's runs are 3 s; a minute
 /// bounds the recording and the time a spring rig is held under drive.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, protocol::STEP_DURATION, tables::{ExperimentError, MAX_DURATION, TABLE5}};
+/// assert_eq!(MAX_DURATION / STEP_DURATION, 20.0); // twenty lab runs' worth
+/// let long = ctrlab::lab::tables::Experiment { duration: MAX_DURATION + 1.0, ..TABLE5.experiment(0).unwrap() };
+/// assert_eq!(long.validate(&Calibration::default()), Err(ExperimentError::Duration(61.0)));
+/// ```
 pub const MAX_DURATION: f64 = 60.0;
 
 impl GainTable {
@@ -103,6 +121,17 @@ pub struct Experiment {
 }
 
 /// Why an [`Experiment`] is refused before anything is driven.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, LabGains, tables::{ExperimentError, TABLE5}};
+/// let e = TABLE5.experiment(0).unwrap();
+/// let bad = ctrlab::lab::tables::Experiment { gains: LabGains { kf: [0.0, 0.0, f64::NAN, 0.0], ..e.gains }, ..e };
+/// let err = bad.validate(&Calibration::default()).unwrap_err();
+/// assert!(matches!(&err, ExperimentError::Gain { name, .. } if name == "Kf3"));
+/// assert!(err.to_string().contains("not a finite number"));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum ExperimentError {
@@ -143,6 +172,18 @@ impl Experiment {
     /// [`ExperimentError`]: a non-finite gain, a setpoint beyond
     /// [`TRAVEL_FRACTION`] of the cart's travel, a duration not in
     /// (0, [`MAX_DURATION`]] s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Calibration, tables::{Experiment, ExperimentError}};
+    /// # use ctrlab::lab::tables::TABLE5;
+    /// # let e = TABLE5.experiment(7).unwrap(); // Kf = [0 0 10 0.1], cart 2 to 30 mm
+    /// let c = Calibration::default();
+    /// assert!(Experiment { setpoint_mm: -30.0, ..e }.validate(&c).is_ok()); // 60 % of 50 mm
+    /// assert!(matches!(Experiment { setpoint_mm: 31.0, ..e }.validate(&c), Err(ExperimentError::Setpoint { cart: 2, .. })));
+    /// assert_eq!(Experiment { duration: 0.0, ..e }.validate(&c), Err(ExperimentError::Duration(0.0)));
+    /// ```
     pub fn validate(&self, calibration: &Calibration) -> Result<(), ExperimentError> {
         let named = |prefix: &str, values: [f64; 4]| {
             values
@@ -175,6 +216,16 @@ impl Experiment {
 
     /// The rig table and row (from 0) this experiment is, if it is one:
     /// the same cart, gains, `G`, setpoint and duration.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{Experiment, TABLE6};
+    /// let e = TABLE6.experiment(14).unwrap();
+    /// assert_eq!(e.table_row(), Some((TABLE6, 14)));
+    /// // The same gains for 5 s are no row of the lab's.
+    /// assert_eq!(Experiment { duration: 5.0, ..e }.table_row(), None);
+    /// ```
     pub fn table_row(&self) -> Option<(GainTable, usize)> {
         RIG_TABLES.into_iter().find_map(|table| {
             (0..table.rows().len())
@@ -186,6 +237,15 @@ impl Experiment {
     /// The simulated card's noise seed: the matching row's
     /// ([`GainTable::row_seed`]), so that the row run alone gives the
     /// batch's numbers; [`ROW_SEEDS_FROM`] for any other experiment.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{Experiment, ROW_SEEDS_FROM, TABLE6};
+    /// let e = TABLE6.experiment(3).unwrap();
+    /// assert_eq!(e.seed(), 103); // as in the batch
+    /// assert_eq!(Experiment { setpoint_mm: 10.0, ..e }.seed(), ROW_SEEDS_FROM);
+    /// ```
     pub fn seed(&self) -> u64 {
         self.table_row()
             .map_or(ROW_SEEDS_FROM, |(table, row)| table.row_seed(row))
@@ -196,11 +256,32 @@ impl Experiment {
     /// # Errors
     ///
     /// [`Error::NonFinite`] for a non-finite gain.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::tables::TABLE5;
+    /// # let e = TABLE5.experiment(7).unwrap(); // Kf = [0 0 10 0.1], cart 2 to 30 mm
+    /// let c = e.controller()?;
+    /// // Kf3 = 10 V/mm is 10 000 V/m in SI; Kf4 = 0.1 V/(mm/s) is 100 V/(m/s).
+    /// assert!((c.gain()[(0, 2)] - 1e4).abs() < 1e-9 && (c.gain()[(0, 3)] - 100.0).abs() < 1e-9);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn controller(&self) -> Result<StateFeedback<4, 1>, Error> {
         self.gains.state_feedback()
     }
 
     /// The reference the loop takes: the setpoint in metres, constant.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::tables::TABLE5;
+    /// # let e = TABLE5.experiment(7).unwrap(); // Kf = [0 0 10 0.1], cart 2 to 30 mm
+    /// let mut r = e.reference();
+    /// assert_eq!(r(0.0)[0], 0.030); // m: 30 mm
+    /// assert_eq!(r(2.5)[0], r(0.0)[0]);
+    /// ```
     pub fn reference(&self) -> impl FnMut(f64) -> SVector<f64, 1> + use<> {
         let setpoint = self.setpoint_mm / 1e3;
         move |_| SVector::<f64, 1>::new(setpoint)
@@ -214,6 +295,23 @@ impl Experiment {
     /// # Errors
     ///
     /// [`Error::Channel`] when the recording lacks the lab's channels.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::Recording;
+    /// use ctrlab::hw::{LoopFault, LoopStats, RigError, RunError};
+    /// use ctrlab::lab::tables::{Halt, RigOutcome};
+    /// # use ctrlab::lab::tables::TABLE5;
+    /// # let e = TABLE5.experiment(7).unwrap(); // Kf = [0 0 10 0.1], cart 2 to 30 mm
+    /// # let recording = Recording::from_columns(ctrlab::lab::schema(), vec![0.0, 0.002], vec![vec![0.0; 2]; 5])?;
+    /// let error = RigError::Fault(LoopFault::TravelLimit { axis: 2, position: 0.051, limit: 0.05 });
+    /// let halted = RunError { error, recording, last_measurement: None, stats: LoopStats::default() };
+    /// let run = e.measure(Err(Box::new(halted)), 24.0)?;
+    /// assert!(run.fault.is_some());
+    /// assert!(matches!(run.outcome, RigOutcome::Diverged { why: Halt::TravelLimit { cart: 2, .. }, .. }));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn measure(
         &self,
         run: Result<RunOutcome, Box<RunError>>,
@@ -304,6 +402,20 @@ impl fmt::Display for Experiment {
 
 /// A run of an [`Experiment`]: how it ended, with its recording (to the
 /// halt, if it halted) and the loop's timing.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// use ctrlab::hw::LoopStats;
+/// use ctrlab::lab::tables::{ExperimentRun, RigOutcome};
+/// # let columns = vec![vec![0.0, 12.0, 24.0], vec![0.0; 3], vec![0.0; 3], vec![0.0, 0.004, 0.012], vec![0.0; 3]];
+/// # let recording = Recording::from_columns(ctrlab::lab::schema(), vec![0.0, 0.002, 0.004], columns)?;
+/// let run = ExperimentRun { outcome: RigOutcome::TooSlow { y_end_mm: 12.0 }, recording, stats: LoopStats::default(), fault: None };
+/// assert_eq!(run.recording.channel("x2")?.last(), Some(&0.012)); // m, where the outcome says 12 mm
+/// assert!(run.fault.is_none() && run.outcome.step().is_none()); // ran to the end, no metrics
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug)]
 pub struct ExperimentRun {
     /// The metrics, or why there are none.

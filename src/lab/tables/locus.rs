@@ -156,6 +156,18 @@ impl GroupLocus {
     /// # Errors
     ///
     /// The errors of [`gain_loop`] and [`root_locus`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::{Cart, MassSpring};
+    /// use ctrlab::lab::tables::{Gain, GroupLocus, TABLE6};
+    /// let kf2 = &TABLE6.groups[1]; // Kf2 with Kf1 = 1 V/mm
+    /// let l = GroupLocus::of(&MassSpring::nominal(), Cart::One, kf2, 0.002)?;
+    /// assert_eq!((l.varied, l.base), (Gain::Kf2, [1.0, 0.0, 0.0, 0.0]));
+    /// assert_eq!(l.values, kf2.values); // V/(mm/s), where the rows sit on the locus
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn of(
         model: &MassSpring,
         cart: Cart,

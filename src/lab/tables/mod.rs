@@ -87,6 +87,15 @@ impl Gain {
     pub const ALL: [Gain; 4] = [Gain::Kf1, Gain::Kf2, Gain::Kf3, Gain::Kf4];
 
     /// Index into `Kf` (0-based).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{Gain, TABLE5};
+    /// // Table 5's last row, read by gain.
+    /// let kf = TABLE5.rows()[8];
+    /// assert_eq!((kf[Gain::Kf3.index()], kf[Gain::Kf4.index()]), (10.0, 0.2));
+    /// ```
     pub fn index(self) -> usize {
         match self {
             Gain::Kf1 => 0,
@@ -97,6 +106,14 @@ impl Gain {
     }
 
     /// The state it multiplies, in words (`"cart 1 position"`).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::Gain;
+    /// assert_eq!(Gain::Kf2.acts_on(), "cart 1 velocity");
+    /// assert_eq!(Gain::Kf3.acts_on(), "cart 2 position");
+    /// ```
     pub fn acts_on(self) -> &'static str {
         match self {
             Gain::Kf1 => "cart 1 position",
@@ -137,6 +154,17 @@ pub struct GainGroup {
 
 impl GainGroup {
     /// The group's rows `Kf`, in order.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{Gain, TABLE5};
+    /// let kf4 = &TABLE5.groups[1];
+    /// assert_eq!(kf4.varied, Gain::Kf4);
+    /// // Kf3 held at 10 V/mm in every row, Kf4 as the table lists it.
+    /// assert!(kf4.rows().all(|kf| kf[2] == 10.0));
+    /// assert_eq!(kf4.rows().map(|kf| kf[3]).collect::<Vec<_>>(), [0.02, 0.05, 0.1, 0.2]);
+    /// ```
     pub fn rows(&self) -> impl Iterator<Item = [f64; 4]> + '_ {
         self.values.iter().map(move |&v| {
             let mut kf = self.base;
@@ -146,6 +174,14 @@ impl GainGroup {
     }
 
     /// The gains held at a non-zero value, with their values.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{Gain, TABLE6};
+    /// assert!(TABLE6.groups[0].held().is_empty()); // Kf1 alone
+    /// assert_eq!(TABLE6.groups[2].held(), [(Gain::Kf1, 1.0)]); // Kf4 with Kf1 = 1
+    /// ```
     pub fn held(&self) -> Vec<(Gain, f64)> {
         Gain::ALL
             .into_iter()
@@ -181,11 +217,30 @@ pub struct GainTable {
 
 impl GainTable {
     /// Every row `Kf` (per mm), in the table's order.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::TABLE2;
+    /// let rows = TABLE2.rows();
+    /// assert_eq!(rows.len(), TABLE2.groups.iter().map(|g| g.values.len()).sum::<usize>());
+    /// assert_eq!(rows[3], [0.0, 0.0, 10.0, 0.1]); // the first Kf4 row
+    /// ```
     pub fn rows(&self) -> Vec<[f64; 4]> {
         self.groups.iter().flat_map(GainGroup::rows).collect()
     }
 
     /// Each group with the range of its rows in [`rows`](Self::rows).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{Gain, TABLE5};
+    /// let rows = TABLE5.rows();
+    /// let (group, range) = TABLE5.group_ranges().nth(1).unwrap();
+    /// assert_eq!((group.varied, range.clone()), (Gain::Kf4, 5..9));
+    /// assert_eq!(rows[range].to_vec(), group.rows().collect::<Vec<_>>());
+    /// ```
     pub fn group_ranges(&self) -> impl Iterator<Item = (&GainGroup, Range<usize>)> + '_ {
         let mut start = 0;
         self.groups.iter().map(move |g| {
@@ -208,6 +263,14 @@ const fn cart1(kf1: f64, kf2: f64, kf4: f64) -> [f64; 4] {
 
 /// Table 2 (simulation, nominal model): cart 2 to 30 mm; Kf3 = 0.1, 1, 10,
 /// then Kf4 = 0.1, 0.3, 0.5 with Kf3 = 10.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, tables::TABLE2};
+/// assert_eq!((TABLE2.cart, TABLE2.setpoint_mm), (Cart::Two, 30.0));
+/// assert_eq!(TABLE2.rows().len(), 6);
+/// ```
 pub const TABLE2: GainTable = GainTable {
     number: 2,
     cart: Cart::Two,
@@ -228,6 +291,15 @@ pub const TABLE2: GainTable = GainTable {
 
 /// Table 5 (rig): cart 2 to 30 mm; Kf3 = 0.1, 0.5, 1, 5, 10, then Kf4 =
 /// 0.02, 0.05, 0.1, 0.2 with Kf3 = 10.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, tables::{TABLE2, TABLE5}};
+/// // The rig's version of Table 2: same cart and setpoint, more rows.
+/// assert_eq!((TABLE5.cart, TABLE5.setpoint_mm), (TABLE2.cart, TABLE2.setpoint_mm));
+/// assert_eq!((TABLE5.cart, TABLE5.rows().len()), (Cart::Two, 9));
+/// ```
 pub const TABLE5: GainTable = GainTable {
     number: 5,
     cart: Cart::Two,
@@ -248,6 +320,15 @@ pub const TABLE5: GainTable = GainTable {
 
 /// Table 6 (rig): cart 1 to 15 mm; Kf1 = 0.2, 0.5, 1, 1.5, 2, then Kf2 =
 /// 0.001 … 0.01 with Kf1 = 1, then Kf4 = 0.01 … 0.2 with Kf1 = 1.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, Calibration, tables::TABLE6};
+/// assert_eq!(TABLE6.cart, Cart::One);
+/// // 15 mm, well inside cart 1's ±50 mm travel.
+/// assert!(TABLE6.setpoint_mm / 1000.0 < Calibration::default().travel_limits[0]);
+/// ```
 pub const TABLE6: GainTable = GainTable {
     number: 6,
     cart: Cart::One,
@@ -272,6 +353,15 @@ pub const TABLE6: GainTable = GainTable {
 };
 
 /// The rig's tables, in the lab's order.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::tables::RIG_TABLES;
+/// assert_eq!(RIG_TABLES.map(|t| t.number), [5, 6]);
+/// let rows: usize = RIG_TABLES.iter().map(|t| t.rows().len()).sum();
+/// assert_eq!(rows, 24); // closed-loop runs on the rig
+/// ```
 pub const RIG_TABLES: [GainTable; 2] = [TABLE5, TABLE6];
 
 /// `Kf` as the lab writes it: `[0 0 10 0.1]`.

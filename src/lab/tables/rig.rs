@@ -60,6 +60,19 @@ impl Prediction {
     /// A non-finite gain, an invalid model or period, or an eigenvalue
     /// iteration that fails. A closed loop with a pole at `s = 0` has no
     /// rest position: `dc_gain` and `compliance` are then infinite or NaN.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Cart, MassSpring, tables::Prediction};
+    /// let plant = MassSpring::nominal();
+    /// let p = Prediction::of(&plant, [0.0, 0.0, 10.0, 0.1], Cart::Two, 0.002)?;
+    /// // 10 V/mm = 10 000 N/m against the springs' 500 N/m in series.
+    /// assert!(p.is_stable() && (p.dc_gain - 10_000.0 / 10_500.0).abs() < 1e-9);
+    /// assert!(p.poles.iter().all(|s| s.re < 0.0)); // 1/s
+    /// assert!(Prediction::of(&plant, [0.0, 0.0, 10.0, 0.1], Cart::Two, 0.0).is_err());
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn of(model: &MassSpring, kf: [f64; 4], cart: Cart, period: f64) -> Result<Self, Error> {
         let sys = model.state_space(cart)?;
         // The rig samples every period: the loop that can be stable or not
@@ -96,18 +109,56 @@ impl Prediction {
     }
 
     /// Whether the sampled loop is stable.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::tables::Prediction;
+    /// # use ctrlab::nalgebra::Complex;
+    /// # let tau = std::f64::consts::TAU;
+    /// # // A lightly damped mode of 50 samples per cycle (10 Hz at 2 ms).
+    /// # let p = Prediction { radius: 0.99, dominant: Complex::from_polar(0.99, tau / 50.0),
+    /// #     poles: [Complex::new(-1.0, 0.0); 4], dc_gain: 0.95, compliance: [-1e-4, 2e-4] };
+    /// assert!(p.is_stable());
+    /// // A pole on the unit circle never decays: not stable.
+    /// assert!(!Prediction { radius: 1.0, ..p }.is_stable());
+    /// ```
     pub fn is_stable(&self) -> bool {
         self.radius < 1.0
     }
 
     /// The linear model's steady-state error for a setpoint of
     /// `setpoint_mm`, mm: `r (1 − dc_gain)`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Cart, MassSpring, tables::Prediction};
+    /// let p = Prediction::of(&MassSpring::nominal(), [0.0, 0.0, 10.0, 0.0], Cart::Two, 0.002)?;
+    /// // Table 5's 30 mm: short by 30 · 500 / 10 500 mm.
+    /// assert!((p.steady_state_error_mm(30.0) - 30.0 / 21.0).abs() < 1e-9);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn steady_state_error_mm(&self, setpoint_mm: f64) -> f64 {
         setpoint_mm * (1.0 - self.dc_gain)
     }
 
     /// How far Coulomb friction `coulomb` (N on cart 1 and cart 2) can hold
     /// the tracked cart from the linear rest position, mm.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::tables::Prediction;
+    /// # use ctrlab::nalgebra::Complex;
+    /// # let tau = std::f64::consts::TAU;
+    /// # // A lightly damped mode of 50 samples per cycle (10 Hz at 2 ms).
+    /// # let p = Prediction { radius: 0.99, dominant: Complex::from_polar(0.99, tau / 50.0),
+    /// #     poles: [Complex::new(-1.0, 0.0); 4], dc_gain: 0.95, compliance: [-1e-4, 2e-4] };
+    /// // |−0.1 mm/N| · 0.5 N + 0.2 mm/N · 1 N.
+    /// assert!((p.friction_band_mm([0.5, 1.0]) - 0.25).abs() < 1e-12);
+    /// assert_eq!(p.friction_band_mm([0.0; 2]), 0.0); // no friction, no band
+    /// ```
     pub fn friction_band_mm(&self, coulomb: [f64; 2]) -> f64 {
         1e3 * (self.compliance[0].abs() * coulomb[0] + self.compliance[1].abs() * coulomb[1])
     }
@@ -115,6 +166,21 @@ impl Prediction {
     /// How much the sampled loop's slowest-decaying (or growing) mode's
     /// amplitude changes over one of its cycles: `radius^(2π / arg z)`,
     /// e.g. 1.18 for 18 % growth per cycle; `None` for a real pole.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::tables::Prediction;
+    /// # use ctrlab::nalgebra::Complex;
+    /// # let tau = std::f64::consts::TAU;
+    /// # // A lightly damped mode of 50 samples per cycle (10 Hz at 2 ms).
+    /// # let p = Prediction { radius: 0.99, dominant: Complex::from_polar(0.99, tau / 50.0),
+    /// #     poles: [Complex::new(-1.0, 0.0); 4], dc_gain: 0.95, compliance: [-1e-4, 2e-4] };
+    /// // 0.99 per sample over 50 samples: 40 % of the amplitude is gone per cycle.
+    /// assert!((p.per_cycle().unwrap() - 0.99f64.powi(50)).abs() < 1e-12);
+    /// let real = Prediction { dominant: Complex::new(0.99, 0.0), ..p };
+    /// assert_eq!(real.per_cycle(), None);
+    /// ```
     pub fn per_cycle(&self) -> Option<f64> {
         let angle = self.dominant.arg();
         (angle > 1e-9).then(|| self.radius.powf(std::f64::consts::TAU / angle))
@@ -122,12 +188,39 @@ impl Prediction {
 
     /// The dominant mode's frequency, rad/s, on a rig sampled every
     /// `period` s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// # use ctrlab::lab::tables::Prediction;
+    /// # use ctrlab::nalgebra::Complex;
+    /// # let tau = std::f64::consts::TAU;
+    /// # // A lightly damped mode of 50 samples per cycle (10 Hz at 2 ms).
+    /// # let p = Prediction { radius: 0.99, dominant: Complex::from_polar(0.99, tau / 50.0),
+    /// #     poles: [Complex::new(-1.0, 0.0); 4], dc_gain: 0.95, compliance: [-1e-4, 2e-4] };
+    /// let w = p.dominant_frequency(0.002); // rad/s
+    /// assert!((w / tau - 10.0).abs() < 1e-9); // 10 Hz
+    /// ```
     pub fn dominant_frequency(&self, period: f64) -> f64 {
         self.dominant.arg() / period
     }
 }
 
 /// Why a run stopped before its end, or has no metrics.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// use ctrlab::hw::{LoopFault, RigError};
+/// use ctrlab::lab::tables::{Halt, RigOutcome};
+/// # let rec = Recording::from_columns(ctrlab::lab::schema(), vec![0.0, 0.002], vec![vec![0.0; 2]; 5])?;
+/// let stop = RigError::Fault(LoopFault::Interrupted { at: 0.002 });
+/// let RigOutcome::Diverged { at, why } = RigOutcome::halted(&rec, &stop) else { unreachable!() };
+/// assert_eq!(at, 0.002); // s
+/// assert!(matches!(why, Halt::Fault(message) if message.contains("interrupted")));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub enum Halt {
     /// The rig halted a cart beyond its travel limit.
@@ -148,6 +241,22 @@ pub enum Halt {
 
 /// Fraction of the time at full scale above which a sustained oscillation
 /// is the drive chattering between its limits.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::Recording;
+/// use ctrlab::lab::{Cart, tables::{RigOutcome, SATURATED_OSCILLATION}};
+/// // Cart 2 swinging ±5 mm about 30 mm at 2 Hz, the drive slammed ±24 V.
+/// let t: Vec<f64> = (0..1500).map(|k| k as f64 * 0.002).collect();
+/// let x2: Vec<f64> = t.iter().map(|t| 0.030 * (1.0 - (-t / 0.05).exp()) + 0.005 * (12.566 * t).sin()).collect();
+/// let u: Vec<f64> = t.iter().map(|t| 24.0f64.copysign((12.566 * t).cos())).collect();
+/// # let z = vec![0.0; 1500];
+/// let rec = Recording::from_columns(ctrlab::lab::schema(), t, vec![u, z.clone(), z.clone(), x2, z])?;
+/// let o = RigOutcome::classify(&rec, Cart::Two, 30.0, 24.0)?;
+/// assert!(matches!(o, RigOutcome::Oscillating { saturated, .. } if saturated > SATURATED_OSCILLATION));
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const SATURATED_OSCILLATION: f64 = 0.2;
 
 /// How a closed-loop rig run ended.
@@ -206,6 +315,23 @@ impl RigOutcome {
     /// # Errors
     ///
     /// [`Error::Channel`] when `rec` lacks the cart's position or `u`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Cart, tables::RigOutcome};
+    /// # use ctrlab::Recording;
+    /// # // Cart 2 from rest to 30 mm, a first-order approach of 0.1 s.
+    /// # let t: Vec<f64> = (0..1500).map(|k| k as f64 * 0.002).collect();
+    /// # let x2: Vec<f64> = t.iter().map(|t| 0.030 * (1.0 - (-t / 0.1).exp())).collect();
+    /// # let z = vec![0.0; 1500];
+    /// # let rec = Recording::from_columns(ctrlab::lab::schema(), t, vec![vec![1.0; 1500], z.clone(), z.clone(), x2, z])?;
+    /// let o = RigOutcome::classify(&rec, Cart::Two, 30.0, 24.0)?;
+    /// let step = o.step().expect("settled");
+    /// assert!(step.overshoot < 0.1 && step.steady_state_error.unwrap().abs() < 0.01); // %, mm
+    /// assert!(step.settling_time > 0.35 && step.settling_time < 0.45); // s: 2 % at 4 time constants
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn classify(
         rec: &Recording,
         cart: Cart,
@@ -275,6 +401,22 @@ impl RigOutcome {
     }
 
     /// The step metrics, when the run settled.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::{Cart, tables::RigOutcome};
+    /// # use ctrlab::Recording;
+    /// # // Cart 2 from rest to 30 mm, a first-order approach of 0.1 s.
+    /// # let t: Vec<f64> = (0..1500).map(|k| k as f64 * 0.002).collect();
+    /// # let x2: Vec<f64> = t.iter().map(|t| 0.030 * (1.0 - (-t / 0.1).exp())).collect();
+    /// # let z = vec![0.0; 1500];
+    /// # let rec = Recording::from_columns(ctrlab::lab::schema(), t, vec![vec![1.0; 1500], z.clone(), z.clone(), x2, z])?;
+    /// let o = RigOutcome::classify(&rec, Cart::Two, 30.0, 24.0)?;
+    /// assert!((o.step().unwrap().steady_state_value - 30.0).abs() < 0.01); // mm
+    /// assert_eq!(RigOutcome::TooSlow { y_end_mm: 29.0 }.step(), None);
+    /// # Ok::<(), ctrlab::Error>(())
+    /// ```
     pub fn step(&self) -> Option<&StepInfo> {
         match self {
             Self::Settled(info) => Some(info),
@@ -283,6 +425,14 @@ impl RigOutcome {
     }
 
     /// Whether the run settled.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::RigOutcome;
+    /// assert!(!RigOutcome::TooSlow { y_end_mm: 29.0 }.is_settled());
+    /// assert!(!RigOutcome::Oscillating { lo_mm: 25.0, hi_mm: 35.0, saturated: 0.0 }.is_settled());
+    /// ```
     pub fn is_settled(&self) -> bool {
         self.step().is_some()
     }
@@ -318,6 +468,18 @@ fn unsettled(y_mm: &[f64], u: &[f64], full_scale: f64) -> RigOutcome {
 }
 
 /// One row of a rig table: the gains, the prediction and the outcome.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, MassSpring, tables::{Prediction, RigOutcome, RigRun}};
+/// let kf = [0.0, 0.0, 10.0, 0.1];
+/// let prediction = Prediction::of(&MassSpring::nominal(), kf, Cart::Two, 0.002)?;
+/// // Predicted stable, but friction held the cart short of the 2 % band.
+/// let run = RigRun { kf, prediction, outcome: RigOutcome::TooSlow { y_end_mm: 27.5 } };
+/// assert!(run.prediction.is_stable() && !run.prediction_agrees());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct RigRun {
     /// The lab's gains, per mm.
@@ -368,18 +530,43 @@ impl RigRun {
 
 /// Overshoot's noise between two rig runs: 35 % of the larger, at least
 /// 1.5 percentage points.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::tables::OVERSHOOT_NOISE;
+/// assert_eq!(OVERSHOOT_NOISE.between(13.8, 20.3), 0.35 * 20.3); // %: the measured spread is noise
+/// assert_eq!(OVERSHOOT_NOISE.between(0.35, 1.39), 1.5); // small overshoots: the floor
+/// ```
 pub const OVERSHOOT_NOISE: Noise = Noise {
     relative: 0.35,
     floor: 1.5,
 };
 /// Settling time's noise between two rig runs: 35 % of the larger, at
 /// least 0.01 s (five periods).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{protocol::PERIOD, tables::SETTLING_NOISE};
+/// assert!((SETTLING_NOISE.floor / PERIOD - 5.0).abs() < 1e-12);
+/// assert!(2.28 - 1.62 <= SETTLING_NOISE.between(1.62, 2.28)); // s: within the noise
+/// ```
 pub const SETTLING_NOISE: Noise = Noise {
     relative: 0.35,
     floor: 0.01,
 };
 /// Steady-state error's noise between two rig runs: 25 % of the larger, at
 /// least 0.05 mm (five encoder counts of 9.77 µm).
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Calibration, tables::ERROR_NOISE};
+/// let count_mm = Calibration::default().metres_per_count * 1e3;
+/// assert!((ERROR_NOISE.floor / count_mm - 5.0).abs() < 0.2); // about five counts
+/// assert!(1.44 - 1.15 <= ERROR_NOISE.between(1.15, 1.44)); // mm: within the noise
+/// ```
 pub const ERROR_NOISE: Noise = Noise {
     relative: 0.25,
     floor: 0.05,
@@ -435,6 +622,18 @@ impl GroupEffect {
     /// The effect of `group`'s gain from its rows' `outcomes` (in the
     /// group's order; fewer outcomes than rows, when the lab stopped
     /// early, use the rows that have one).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{GroupEffect, RigOutcome, TABLE6};
+    /// let kf4 = &TABLE6.groups[2];
+    /// // The lab stopped after two rows, neither settled.
+    /// let outcomes = [RigOutcome::TooSlow { y_end_mm: 14.0 }, RigOutcome::TooSlow { y_end_mm: 14.5 }];
+    /// let e = GroupEffect::of(kf4, &outcomes);
+    /// assert_eq!((e.values.len(), e.not_settled.clone()), (2, vec![0.01, 0.02]));
+    /// assert_eq!(e.overshoot, None); // no trend without two settled rows
+    /// ```
     pub fn of(group: &GainGroup, outcomes: &[RigOutcome]) -> Self {
         let n = group.values.len().min(outcomes.len());
         let values = group.values[..n].to_vec();
@@ -464,6 +663,20 @@ impl GroupEffect {
 
     /// The gain's values at the settled rows, in order: what a
     /// [`Trend`]'s index counts.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::StepInfo;
+    /// use ctrlab::lab::tables::{GroupEffect, RigOutcome, TABLE5};
+    /// # let info = StepInfo { overshoot: 5.0, steady_state_error: Some(1.0), rise_time: 0.1, settling_time: 0.5,
+    /// #     transient_time: 0.5, settling_min: 28.0, settling_max: 30.5, undershoot: 0.0, peak: 30.5,
+    /// #     peak_time: 0.2, steady_state_value: 29.0 };
+    /// let slow = RigOutcome::TooSlow { y_end_mm: 20.0 };
+    /// let outcomes = [slow.clone(), RigOutcome::Settled(info), slow, RigOutcome::Settled(info)];
+    /// let e = GroupEffect::of(&TABLE5.groups[0], &outcomes); // Kf3 = 0.1, 0.5, 1, 5
+    /// assert_eq!(e.settled(), [0.5, 5.0]);
+    /// ```
     pub fn settled(&self) -> Vec<f64> {
         self.values
             .iter()

@@ -9,19 +9,74 @@ use crate::metrics::{StepInfo, StepInfoOptions, step_info};
 use crate::sim::{Solver, simulate, time_grid};
 
 /// Table 1's forces, N.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, tables::FORCES};
+/// // 10 N to 50 N in steps of 10 N.
+/// assert!(FORCES.windows(2).all(|w| w[1] - w[0] == 10.0) && FORCES[0] == 10.0);
+/// // The largest pushes cart 2 100 mm at rest on the nominal springs.
+/// let (_, x2) = MassSpring::nominal().static_deflection(FORCES[4])?;
+/// assert!((x2 - 0.100).abs() < 1e-12); // m
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 pub const FORCES: [f64; 5] = [10.0, 20.0, 30.0, 40.0, 50.0];
 /// How long Table 1 simulates each force, s: the nominal model's slowest
 /// pole decays at 3.70 /s, so what is left after 10 s is e^−37.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::tables::{TABLE1_DURATION, TABLE1_STEP};
+/// assert!((-3.70 * TABLE1_DURATION).exp() < 1e-16); // the transient is gone
+/// assert!((TABLE1_DURATION / TABLE1_STEP - 5000.0).abs() < 1e-9); // whole steps
+/// ```
 pub const TABLE1_DURATION: f64 = 10.0;
 /// Table 1's time step, s.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{protocol::PERIOD, tables::TABLE1_STEP};
+/// assert_eq!(TABLE1_STEP, PERIOD); // the loop's 2 ms
+/// ```
 pub const TABLE1_STEP: f64 = 0.002;
 /// Table 2's simulated time, s.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{protocol::STEP_DURATION, tables::TABLE2_DURATION};
+/// assert_eq!(TABLE2_DURATION, STEP_DURATION); // as long as a rig run (Tables 5, 6)
+/// ```
 pub const TABLE2_DURATION: f64 = 3.0;
 /// Table 2's time step, s: the python-control reference's grid.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{protocol::PERIOD, tables::{TABLE2_DURATION, TABLE2_STEP}};
+/// assert!((PERIOD / TABLE2_STEP - 4.0).abs() < 1e-12); // four per loop period
+/// assert!((TABLE2_DURATION / TABLE2_STEP - 6000.0).abs() < 1e-9);
+/// ```
 pub const TABLE2_STEP: f64 = 0.0005;
 
 /// One row of Table 1: a constant force on cart 2 from rest, the simulated
 /// final positions beside the static deflection.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{MassSpring, tables::Table1Row};
+/// let force = 20.0; // N
+/// let (s1, s2) = MassSpring::nominal().static_deflection(force)?;
+/// let row = Table1Row { force, x1_mm: 20.0, x1_static_mm: s1 * 1e3, x2_mm: 40.0, x2_static_mm: s2 * 1e3 };
+/// // Cart 2 moves twice as far: both springs stretch, k1 = k2.
+/// assert!((row.x2_static_mm - 2.0 * row.x1_static_mm).abs() < 1e-9);
+/// assert!((row.x2_mm - row.x2_static_mm).abs() < 1e-9); // mm
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Table1Row {
     /// The force on cart 2, N.
@@ -38,6 +93,17 @@ pub struct Table1Row {
 
 /// Table 1: open loop on the nominal model, one row per force of
 /// [`FORCES`].
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::tables::{FORCES, table1};
+/// let t = table1()?;
+/// assert_eq!(t.rows.len(), FORCES.len());
+/// // Linear: five times the force, five times the deflection.
+/// assert!((t.rows[4].x2_mm - 5.0 * t.rows[0].x2_mm).abs() < 1e-6); // mm
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table1 {
     /// The rows, by force.
@@ -82,6 +148,18 @@ pub fn table1() -> Result<Table1, Error> {
 }
 
 /// A simulated step of Table 2: its metrics and the response.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::{Cart, MassSpring, tables::{TABLE2_STEP, linear_step}};
+/// let s = linear_step(&MassSpring::nominal(), [0.0, 0.0, 10.0, 0.0], Cart::Two, 30.0)?;
+/// assert_eq!(s.t.len(), s.y_mm.len());
+/// assert!((s.t[1] - s.t[0] - TABLE2_STEP).abs() < 1e-15); // s
+/// // Kf3 = 10 alone: the final value falls short of 30 mm by the steady-state error.
+/// assert!(s.info.steady_state_error.unwrap() > 0.0);
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimulatedStep {
     /// Step metrics of cart 2's position in mm against the setpoint (the
@@ -94,6 +172,17 @@ pub struct SimulatedStep {
 }
 
 /// One row of Table 2.
+///
+/// # Examples
+///
+/// ```
+/// let t = ctrlab::lab::tables::table2()?;
+/// let row = &t.rows[3]; // Kf = [0 0 10 0.1]
+/// assert_eq!(row.kf, [0.0, 0.0, 10.0, 0.1]);
+/// // A stable closed loop: every pole in the left half plane, and a step.
+/// assert!(row.poles.iter().all(|p| p.re < 0.0) && row.step.is_some());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table2Row {
     /// The lab's gains, per mm.
@@ -106,6 +195,16 @@ pub struct Table2Row {
 }
 
 /// Table 2: state feedback `u = Kf (G r − x_mm)` on the nominal model.
+///
+/// # Examples
+///
+/// ```
+/// use ctrlab::lab::tables::{TABLE2, table2};
+/// let t = table2()?;
+/// assert_eq!(t.setpoint_mm, TABLE2.setpoint_mm); // 30 mm
+/// assert_eq!(t.rows.iter().map(|r| r.kf).collect::<Vec<_>>(), TABLE2.rows());
+/// # Ok::<(), ctrlab::Error>(())
+/// ```
 #[derive(Debug, Clone, PartialEq)]
 pub struct Table2 {
     /// The setpoint, mm.

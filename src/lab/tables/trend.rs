@@ -25,6 +25,15 @@ pub struct Noise {
 
 impl Noise {
     /// The largest change between `a` and `b` that is noise.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::Noise;
+    /// let n = Noise { relative: 0.25, floor: 0.05 }; // mm
+    /// assert_eq!(n.between(1.2, 1.6), 0.4); // 25 % of the larger
+    /// assert_eq!(n.between(0.01, 0.02), 0.05); // but never below the floor
+    /// ```
     pub fn between(&self, a: f64, b: f64) -> f64 {
         (self.relative * a.abs().max(b.abs())).max(self.floor)
     }
@@ -224,6 +233,16 @@ impl Trend {
 
     /// The index of the turn, for [`Peaks`](Self::Peaks) and
     /// [`Dips`](Self::Dips).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use ctrlab::lab::tables::{Noise, Trend};
+    /// let noise = Noise { relative: 0.1, floor: 0.0 };
+    /// let overshoot = Trend::of(&[2.0, 18.0, 34.0, 20.0], noise).unwrap(); // %
+    /// assert_eq!(overshoot.turn(), Some(2)); // peaks at the third row
+    /// assert_eq!(Trend::of(&[1.0, 2.0, 4.0], noise).unwrap().turn(), None); // rises
+    /// ```
     pub fn turn(&self) -> Option<usize> {
         match self {
             Self::Peaks { at, .. } | Self::Dips { at, .. } => Some(*at),
