@@ -184,9 +184,11 @@ fn samples(period: f64, duration: f64) -> usize {
 /// let all = inputs(8.0, 5.0, 0.2)?;
 /// assert!(all.iter().all(|i| i.peak(0.002, 5.0) <= 8.0 + 1e-9)); // V
 /// assert!(inputs(8.0, 5.0, 0.0).is_err()); // no half period
+/// assert!(inputs(0.0, 5.0, 0.2).is_err() && inputs(-8.0, 5.0, 0.2).is_err()); // no peak drive
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn inputs(volts: f64, duration: f64, half_period: f64) -> Result<[Input; 4], Error> {
+    super::protocol::check_volts(volts)?;
     let square = SquareWave::new(volts, half_period)?;
     let prbs = Prbs::new(volts, PRBS_CLOCK, PRBS_BITS, PRBS_SEED)?;
     let unit = Multisine::new(1.0, duration, MULTISINE_LINES, Phases::Schroeder)?;

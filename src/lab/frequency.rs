@@ -104,9 +104,11 @@ pub const GRID_POINTS: usize = 400;
 /// assert!((ms.peak() - 8.0).abs() < 1e-9); // V
 /// assert_eq!(ms.harmonics().len(), LINES.count());
 /// assert!(multisine(f64::NAN).is_err());
+/// assert!(multisine(0.0).is_err() && multisine(-8.0).is_err());
 /// # Ok::<(), ctrlab::Error>(())
 /// ```
 pub fn multisine(volts: f64) -> Result<Multisine, Error> {
+    super::protocol::check_volts(volts)?;
     let unit = Multisine::new(1.0, MS_PERIOD, LINES, Phases::Schroeder)?;
     Multisine::new(volts / unit.peak(), MS_PERIOD, LINES, Phases::Schroeder)
 }

@@ -119,3 +119,18 @@ pub const STEP_DURATION: f64 = 3.0;
 pub fn ident_square_wave() -> Result<SquareWave, Error> {
     SquareWave::new(IDENT_VOLTS, IDENT_HALF_PERIOD)
 }
+
+/// [`Error::InvalidParameter`] named `"volts"` unless `volts` (a peak drive,
+/// V) is finite and positive: a drive of zero identifies nothing, and the
+/// lab's inputs are given by their peak.
+pub(crate) fn check_volts(volts: f64) -> Result<(), Error> {
+    if volts.is_finite() && volts > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            name: "volts",
+            value: volts,
+            reason: "must be finite and > 0 V",
+        })
+    }
+}

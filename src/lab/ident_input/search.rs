@@ -267,13 +267,7 @@ impl AmplitudeSearch {
     /// assert!(AmplitudeSearch::new(f64::NAN, [0.05, 0.05]).is_err());
     /// ```
     pub fn new(asked: f64, limits: [f64; 2]) -> Result<Self, Error> {
-        if !(asked.is_finite() && asked > 0.0) {
-            return Err(Error::InvalidParameter {
-                name: "volts",
-                value: asked,
-                reason: "must be finite and > 0 V",
-            });
-        }
+        crate::lab::protocol::check_volts(asked)?;
         if let Some(&l) = limits.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
             return Err(Error::InvalidParameter {
                 name: "travel_limits",
