@@ -34,6 +34,7 @@
 
 mod experiment;
 mod locus;
+mod prediction;
 mod rig;
 mod simulated;
 mod trend;
@@ -49,9 +50,10 @@ pub use experiment::{
     Experiment, ExperimentError, ExperimentRun, MAX_DURATION, ROW_SEEDS_FROM, drive,
 };
 pub use locus::{GroupLocus, gain_loop, sampled_gain_loop};
+pub use prediction::Prediction;
 pub use rig::{
-    ERROR_NOISE, GroupEffect, Halt, OVERSHOOT_NOISE, Prediction, RigOutcome, RigRun,
-    SATURATED_OSCILLATION, SETTLING_NOISE,
+    ERROR_NOISE, GroupEffect, Halt, OVERSHOOT_NOISE, RigOutcome, RigRun, SATURATED_OSCILLATION,
+    SETTLING_NOISE,
 };
 pub use simulated::{
     FORCES, SimulatedStep, TABLE1_DURATION, TABLE1_STEP, TABLE2_DURATION, TABLE2_STEP, Table1,
