@@ -13,8 +13,8 @@ use std::ops::Range;
 
 const BOM: &[u8] = b"\xef\xbb\xbf";
 
-/// How much is read from the source at a time.
-const CHUNK: usize = 64 * 1024;
+/// How much is read from the source at a time, usually.
+pub(super) const CHUNK: usize = 64 * 1024;
 
 /// What a line of a log is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -69,12 +69,8 @@ pub(super) struct Lines<R> {
 }
 
 impl<R: Read> Lines<R> {
-    pub(super) fn new(inner: R) -> Self {
-        Self::with_capacity(inner, CHUNK)
-    }
-
-    /// As [`new`](Self::new), reading `capacity` bytes at a time (at least
-    /// 4); the buffer grows for a longer line.
+    /// The lines of `inner`, read `capacity` bytes at a time (at least 4;
+    /// [`CHUNK`] usually); the buffer grows for a longer line.
     pub(super) fn with_capacity(inner: R, capacity: usize) -> Self {
         Self {
             inner,

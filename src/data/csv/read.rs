@@ -6,15 +6,19 @@
 //! tokenizer, which splits them into fields (quotes included), except a row
 //! without a quote, split at the separator in place as the tokenizer would
 //! ([`records`]); each field is trimmed and parsed from its bytes (one
-//! UTF-8 check a row), and only the header is read as text.
+//! UTF-8 check a row), and only the header is read as text. A large file
+//! is read a block at a time, its rows on a thread per CPU ([`parallel`]),
+//! into columns sized once from the file's length ([`columns`]).
 
 use std::io::Read;
 use std::path::Path;
 
+use self::columns::{Columns, ESTIMATE_AFTER, size_columns};
 use self::fast::{Fast, Stop};
+use self::parallel::{Pace, Parallel};
 use self::records::{Records, field_text, trim};
 use super::header::{Scale, parse_header};
-use super::lines::{Kind, Lines, separator, without_break};
+use super::lines::{CHUNK, Kind, Lines, separator, without_break};
 use super::value::{self, BadValue};
 use super::{CsvError, CsvOptions, csv_error, is_input_name};
 use crate::data::{Channel, Recording, Schema};
@@ -31,11 +35,11 @@ struct Slot<'a> {
 }
 
 /// Reads the values of the current row (of the right width, on line
-/// `line`) into `cols`, one per slot, in SI.
+/// `line`) into `values`, one per slot, in SI.
 fn read_row<R: Read>(
     records: &Records<R>,
     slots: &[Slot],
-    cols: &mut [Vec<f64>],
+    values: &mut [f64],
     decimal_comma: bool,
     scratch: &mut String,
     line: u64,
@@ -43,7 +47,7 @@ fn read_row<R: Read>(
     // One check that the row is text; a field cut out of it at characters
     // is then text too (a number always is).
     let row = records.text();
-    for (slot, col) in slots.iter().zip(cols.iter_mut()) {
+    for (slot, out) in slots.iter().zip(values.iter_mut()) {
         let cut = match row {
             Some(row) => row.get(records.bounds(slot.index)),
             None => None,
@@ -74,7 +78,7 @@ fn read_row<R: Read>(
         if !value.is_finite() {
             return Err(not_finite(line, slot, text));
         }
-        col.push(value);
+        *out = value;
     }
     Ok(())
 }
@@ -113,47 +117,20 @@ fn not_finite(line: u64, slot: &Slot, text: &str) -> CsvError {
     )
 }
 
-/// How many rows a file of `size` bytes holds, from the first `rows` rows
-/// in `bytes` bytes: an estimate a little high, to size the columns once.
-/// Each row of `width` fields needs at least `2 width - 1` bytes.
-fn estimate_rows(size: u64, consumed: u64, rows: usize, bytes: u64, width: usize) -> usize {
-    let left = size.saturating_sub(consumed);
-    let at_most = left / (2 * width as u64 - 1).max(1) + 1;
-    let guess = (left as f64 * rows as f64 / bytes.max(1) as f64 * 1.05) as u64 + 16;
-    usize::try_from(guess.min(at_most)).unwrap_or(0)
-}
-
-/// After how many rows the columns are sized from the file's length.
-const ESTIMATE_AFTER: usize = 256;
-
-/// Once `cols` hold [`ESTIMATE_AFTER`] rows (`sized` still false), reserves
-/// room for the rows a file of `size` bytes has left, from the first rows
-/// (`bytes` long, from byte `start`), and sets `sized`.
-fn size_columns(
-    sized: &mut bool,
-    cols: &mut [Vec<f64>],
-    size: Option<u64>,
-    bytes: u64,
-    start: u64,
-    width: usize,
-) {
-    let rows = cols.first().map_or(0, Vec::len);
-    if *sized || rows < ESTIMATE_AFTER {
-        return;
-    }
-    *sized = true;
-    let Some(size) = size else {
-        return;
-    };
-    let more = estimate_rows(size, start + bytes, rows, bytes, width);
-    for col in cols {
-        col.reserve(more);
-    }
-}
-
 impl Recording {
     /// Reads a recording from a CSV file; see [`from_reader`](Self::from_reader)
     /// for the format.
+    ///
+    /// **Threads.** A file of 4 MiB or more (about 130 000 rows of the
+    /// lab's log) is read in blocks of 2 MiB a thread, on a thread per CPU
+    /// the process may use ([`std::thread::available_parallelism`], which
+    /// honours CPU affinity and quotas; at most 8), started for each block
+    /// and ended with it. Values and errors are those of a read on one
+    /// thread, bit for bit. A file with comment lines or rows the fast
+    /// path leaves to the general one (quotes, exponents, errors) is read
+    /// on the calling thread from the first of them. To read on the
+    /// calling thread only, pass the opened file to
+    /// [`from_reader_with`](Self::from_reader_with).
     ///
     /// # Errors
     ///
@@ -201,7 +178,7 @@ impl Recording {
             .map_err(|e| CsvError::io(format!("opening {}", path.display()), e))?;
         // The file's length sizes the columns once (0 for a pipe: unknown).
         let size = file.metadata().ok().map(|m| m.len()).filter(|&n| n > 0);
-        read(file, options, size, Some(path), true)
+        read(file, options, size, Some(path), Pace::for_size(size))
     }
 
     /// Reads a recording from CSV text with the default [`CsvOptions`]: any
@@ -324,7 +301,7 @@ impl Recording {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn from_reader_with(reader: impl Read, options: &CsvOptions) -> Result<Self, CsvError> {
-        read(reader, options, None, None, true)
+        read(reader, options, None, None, Pace::FAST)
     }
 }
 
@@ -339,16 +316,17 @@ fn reading(path: Option<&Path>, header: bool, line: u64) -> String {
 }
 
 /// Reads a recording from `reader` (of `size` bytes when known, to size
-/// the columns once; the file at `path` when there is one, for errors).
+/// the columns once; the file at `path` when there is one, for errors), at
+/// `pace`.
 fn read<R: Read>(
     reader: R,
     options: &CsvOptions,
     size: Option<u64>,
     path: Option<&Path>,
-    fast_path: bool,
+    pace: Pace,
 ) -> Result<Recording, CsvError> {
     options.check()?;
-    let mut lines = Lines::new(reader);
+    let mut lines = Lines::with_capacity(reader, pace.buffer(CHUNK));
     let header = loop {
         match lines.next() {
             Ok(Some(line)) if line.kind == Kind::Content => break line,
@@ -493,7 +471,8 @@ fn read<R: Read>(
         .collect();
 
     let width = headers.len();
-    let mut cols: Vec<Vec<f64>> = (0..slots.len()).map(|_| Vec::new()).collect();
+    let mut cols = Columns::new(slots.len());
+    let mut values = vec![0.0; slots.len()];
     let mut scratch = String::new();
     // The line of the last row read (the header's at first).
     let mut last = header_line;
@@ -502,6 +481,7 @@ fn read<R: Read>(
     // The first interval that overflows: (line, previous time, time).
     let mut overflow: Option<(u64, f64, f64)> = None;
     let mut fast = Fast::new(&slots, width, separator, decimal_comma);
+    let mut parallel = Parallel::new(&fast, pace);
     // Whether the columns are sized (or cannot be: the length is unknown).
     let mut sized = size.is_none();
     loop {
@@ -514,13 +494,21 @@ fn read<R: Read>(
             rows_start,
             width,
         );
-        if fast_path && let Some(pending) = records.lines.pending() {
-            // Up to the row after which the columns are sized, then all.
-            let limit = match ESTIMATE_AFTER.checked_sub(cols[0].len()) {
+        if pace.fast
+            && let Some(pending) = records.lines.pending()
+        {
+            // Up to the row after which the columns are sized, then all:
+            // on several threads when a block of rows is buffered.
+            let limit = match ESTIMATE_AFTER.checked_sub(cols.len()) {
                 Some(left) if !sized && left > 0 => left,
                 _ => usize::MAX,
             };
-            let (bytes, lines, stop) = fast.rows(pending, &mut cols, limit);
+            let parallel = match limit {
+                usize::MAX => parallel.rows(pending, &mut cols),
+                _ => None,
+            };
+            let (bytes, lines, stop) =
+                parallel.unwrap_or_else(|| fast.rows(pending, &mut cols, limit));
             if lines > 0 {
                 records.lines.skip(bytes, lines);
                 last = records.lines.line();
@@ -554,16 +542,16 @@ fn read<R: Read>(
         read_row(
             &records,
             &slots,
-            &mut cols,
+            &mut values,
             decimal_comma,
             &mut scratch,
             last,
         )?;
+        cols.push(&values);
         // Increasing, but not necessarily uniform: a rig's recording has its
         // actual sampling instants, jitter and gaps included, and must read
         // back; `sample_period` and identification judge the timing.
-        let t = &cols[0];
-        if let [.., before, now] = t[..] {
+        if let Some((before, now)) = cols.last_two() {
             if now <= before {
                 return Err(csv_error(
                     last,
@@ -576,7 +564,7 @@ fn read<R: Read>(
         }
     }
 
-    let rows = cols[0].len();
+    let rows = cols.len();
     if rows < 2 {
         return Err(csv_error(
             last,
@@ -592,7 +580,7 @@ fn read<R: Read>(
             format!("the interval from {before} s to {now} s overflows"),
         ));
     }
-    let mut cols = cols.into_iter();
+    let mut cols = cols.into_vecs().into_iter();
     let t = cols.next().unwrap_or_default();
     Ok(Recording {
         schema,
@@ -601,7 +589,9 @@ fn read<R: Read>(
     })
 }
 
+mod columns;
 mod fast;
+mod parallel;
 mod records;
 #[cfg(test)]
 mod tests;

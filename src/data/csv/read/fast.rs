@@ -10,6 +10,7 @@
 //! same line.
 
 use super::Slot;
+use super::columns::Sink;
 use super::records::trim;
 use crate::data::csv::value;
 
@@ -24,7 +25,8 @@ pub(super) enum Stop {
     Limit,
 }
 
-/// What the fast path needs to know of a file, from its header.
+/// What the fast path needs to know of a file, from its header (one for
+/// each thread that reads rows: [`for_thread`](Self::for_thread)).
 pub(super) struct Fast {
     separator: u8,
     decimal_comma: bool,
@@ -55,13 +57,29 @@ impl Fast {
         }
     }
 
+    /// A copy for another thread. Its row, written for every row read,
+    /// is allocated a cache line longer than needed, so that it shares no
+    /// line with another thread's: a shared one costs half the speed.
+    pub(super) fn for_thread(&self) -> Self {
+        let mut row = Vec::with_capacity(self.row.len() + 16);
+        row.resize(self.row.len(), 0.0);
+        Self {
+            separator: self.separator,
+            decimal_comma: self.decimal_comma,
+            scales: self.scales.clone(),
+            columns: self.columns.clone(),
+            row,
+            scratch: String::new(),
+        }
+    }
+
     /// Reads at most `limit` rows from the start of `bytes` into `cols`
-    /// (one per channel, time first); returns how many bytes and lines
+    /// (a value per channel, time first); returns how many bytes and lines
     /// (one a row) it read, and why it stopped.
-    pub(super) fn rows(
+    pub(super) fn rows<S: Sink>(
         &mut self,
         bytes: &[u8],
-        cols: &mut [Vec<f64>],
+        cols: &mut S,
         limit: usize,
     ) -> (usize, u64, Stop) {
         let mut at = 0;
@@ -84,26 +102,23 @@ impl Fast {
                     end + 1
                 }
             };
-            if !self.increases(cols) {
+            if !self.increases(cols.last_time()) {
                 return (at, rows as u64, Stop::Unusual);
             }
-            for (col, &column) in cols.iter_mut().zip(&self.columns) {
-                col.push(self.row[column]);
-            }
+            cols.put(&self.row, &self.columns);
             at += used;
             rows += 1;
         }
         (at, rows as u64, Stop::Limit)
     }
 
-    /// Whether the current row's time comes after the last one read, and
-    /// the interval is finite (else the general path says what is wrong).
-    fn increases(&self, cols: &[Vec<f64>]) -> bool {
+    /// Whether the current row's time comes after the last one read
+    /// (`before`), and the interval is finite (else the general path says
+    /// what is wrong).
+    #[inline]
+    fn increases(&self, before: Option<f64>) -> bool {
         let now = self.columns.first().map_or(0.0, |&c| self.row[c]);
-        match cols.first().and_then(|t| t.last()) {
-            Some(&before) => now > before && (now - before).is_finite(),
-            None => true,
-        }
+        before.is_none_or(|before| follows(before, now))
     }
 
     /// Reads the row at the start of `bytes` into `self.row`, in SI, when
@@ -195,6 +210,13 @@ impl Fast {
         let text = trim(std::str::from_utf8(field).ok()?);
         value::parse(text, self.decimal_comma, &mut self.scratch).ok()
     }
+}
+
+/// Whether time `now` may follow `before` on the fast path: it increases,
+/// by a finite interval.
+#[inline]
+pub(super) fn follows(before: f64, now: f64) -> bool {
+    now > before && (now - before).is_finite()
 }
 
 /// Exact powers of ten, as doubles.

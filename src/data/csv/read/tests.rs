@@ -1,5 +1,6 @@
 //! The reader's internals: splitting, trimming, row estimates.
 
+use super::columns::estimate_rows;
 use super::records::split;
 use super::*;
 use csv_core::ReadRecordResult;

@@ -32,15 +32,29 @@ fn outcome(result: Result<Recording, CsvError>) -> Result<(String, Vec<Vec<u64>>
 }
 
 /// `text` read by both paths, in reads of `fill` bytes, with its length
-/// known or not: the fast path's outcome, checked to be the general's.
+/// known or not, and on three threads in parts of 64 bytes: the fast
+/// path's outcome, checked to be the general's.
 fn both(text: &[u8], fill: usize, sized: bool) -> Result<(String, Vec<Vec<u64>>), String> {
     let options = CsvOptions {
         metres_per_count: Some(1.0 / 102_400.0),
     };
     let size = sized.then_some(text.len() as u64);
-    let general = outcome(read(Trickle(text, fill), &options, size, None, false));
-    let fast = outcome(read(Trickle(text, fill), &options, size, None, true));
+    let general = outcome(read(
+        Trickle(text, fill),
+        &options,
+        size,
+        None,
+        Pace::GENERAL,
+    ));
+    let fast = outcome(read(Trickle(text, fill), &options, size, None, Pace::FAST));
     assert_eq!(fast, general, "{}", String::from_utf8_lossy(text));
+    let threads = Pace {
+        workers: 3,
+        part: 64,
+        ..Pace::FAST
+    };
+    let parallel = outcome(read(Trickle(text, fill), &options, size, None, threads));
+    assert_eq!(parallel, general, "{}", String::from_utf8_lossy(text));
     fast
 }
 
@@ -199,12 +213,70 @@ fn the_fast_path_reads_clean_rows_itself() {
         let text = clean(sep, decimal, newline, 3000);
         let rows = &text.as_bytes()[text.find(newline).unwrap() + newline.len()..];
         let mut fast = fast::Fast::new(&slots, 4, sep as u8, decimal == ',');
-        let mut cols = vec![Vec::new(); 4];
+        let mut cols = Columns::new(4);
         let got = fast.rows(rows, &mut cols, usize::MAX);
         assert_eq!(got, (rows.len(), 3000, fast::Stop::Partial));
         // A comment stops it where it is.
         let commented = [rows, b"# end\n"].concat();
-        let got = fast.rows(&commented, &mut vec![Vec::new(); 4], usize::MAX);
+        let got = fast.rows(&commented, &mut Columns::new(4), usize::MAX);
         assert_eq!(got, (rows.len(), 3000, fast::Stop::Unusual));
+
+        // On three threads, the same rows, bit for bit.
+        let pace = Pace {
+            workers: 3,
+            part: 1000,
+            ..Pace::FAST
+        };
+        let mut threads = Parallel::new(&fast, pace);
+        let mut parallel = Columns::new(4);
+        let got = threads.rows(rows, &mut parallel);
+        assert_eq!(got, Some((rows.len(), 3000, fast::Stop::Partial)));
+        assert_eq!(bits(parallel), bits(cols));
+        // A comment in the middle ends the block there, and the threads
+        // are not asked again.
+        let middle = rows.len() / 2
+            + rows[rows.len() / 2..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .unwrap()
+            + 1;
+        let commented = [&rows[..middle], b"# note\n", &rows[middle..]].concat();
+        let mut cols = Columns::new(4);
+        let got = Parallel::new(&fast, pace).rows(&commented, &mut cols);
+        let lines = rows[..middle].iter().filter(|&&b| b == b'\n').count() as u64;
+        assert_eq!(got, Some((middle, lines, fast::Stop::Unusual)));
+        assert_eq!(cols.len() as u64, lines);
+        let mut threads = Parallel::new(&fast, pace);
+        let _ = threads.rows(&commented, &mut Columns::new(4));
+        assert_eq!(threads.rows(rows, &mut Columns::new(4)), None);
+    }
+}
+
+/// Every value's bits, per column.
+fn bits(cols: Columns) -> Vec<Vec<u64>> {
+    cols.into_vecs()
+        .iter()
+        .map(|c| c.iter().map(|v| v.to_bits()).collect())
+        .collect()
+}
+
+#[test]
+fn a_time_that_does_not_increase_is_found_on_every_row_by_every_path() {
+    // Wherever the parts are cut, a time that does not increase is the
+    // general path's error, on its line.
+    let text = clean(',', '.', "\n", 400);
+    let lines: Vec<&str> = text.lines().collect();
+    for row in 2..lines.len() {
+        let time = lines[row - 1].split(',').next().unwrap();
+        let rest = lines[row].split_once(',').unwrap().1;
+        let repeated = format!("{time},{rest}");
+        let mut edited = lines.clone();
+        edited[row] = &repeated;
+        let edited = edited.join("\n") + "\n";
+        let err = both(edited.as_bytes(), 1 << 20, true).unwrap_err();
+        assert!(
+            err.starts_with(&format!("CSV line {}: time", row + 1)),
+            "{err}"
+        );
     }
 }
