@@ -8,7 +8,9 @@ to a temporary directory, and the same log as Excel writes it in a German
 locale (`;`, decimal commas; no comments); builds and runs
 `examples/csv_bench.rs` (release) on both, times pandas on the same files,
 and prints one table. Each time is the minimum over `rounds` rounds of
-`repeats` reads (wall clock, this machine, one thread).
+`repeats` reads (wall clock, this machine). pandas reads on one thread;
+ctrlab's `read_csv` reads a file of 4 MiB or more on a thread per CPU the
+process may use (`taskset -c 0 python3 scripts/ahead_csv.py`: one).
 
 `rows()` is what `scripts/ahead_vs_peers.py` calls.
 """

@@ -1,5 +1,5 @@
 """What the side-by-side timing scripts share. Import it before NumPy: it
-pins the BLAS libraries to one thread (ctrlab runs on one), unless the
+pins the BLAS libraries to one thread (ctrlab's solvers run on one), unless the
 caller set them."""
 
 import json
