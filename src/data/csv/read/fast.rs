@@ -89,8 +89,19 @@ impl Fast {
             let used = match self.quick(rest) {
                 Some(used) => used,
                 None => {
-                    let Some(end) = memchr::memchr(b'\n', rest) else {
+                    // The line's end: a `\n` or `\r\n`; a lone `\r` is the
+                    // general path's. Found within the line, so that a file
+                    // with `\r` line breaks is not searched to its end for a
+                    // `\n` at every row.
+                    let Some(end) = memchr::memchr2(b'\n', b'\r', rest) else {
                         return (at, rows as u64, Stop::Partial);
+                    };
+                    let end = match (rest[end], rest.get(end + 1)) {
+                        (b'\n', _) => end,
+                        (_, Some(b'\n')) => end + 1,
+                        (_, Some(_)) => return (at, rows as u64, Stop::Unusual),
+                        // A `\r` last: its `\n` may come in the next read.
+                        (_, None) => return (at, rows as u64, Stop::Partial),
                     };
                     let line = match &rest[..end] {
                         [line @ .., b'\r'] => line,

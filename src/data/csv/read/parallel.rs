@@ -101,10 +101,16 @@ impl Parallel {
     /// and lines (one a row) were read, and why it stopped. `None` when it
     /// does not apply (one thread, or less than a part of whole lines).
     pub(super) fn rows(&mut self, bytes: &[u8], cols: &mut Columns) -> Option<(usize, u64, Stop)> {
-        if !self.on {
+        if !self.on || bytes.len() < self.part {
             return None;
         }
-        let end = memchr::memrchr(b'\n', bytes)? + 1;
+        let Some(last) = memchr::memrchr(b'\n', bytes) else {
+            // A part's worth and no `\n`: `\r` line breaks, or a line
+            // longer than a part, for the calling thread (searched once).
+            self.on = false;
+            return None;
+        };
+        let end = last + 1;
         if end < self.part {
             return None;
         }
