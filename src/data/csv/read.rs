@@ -129,7 +129,8 @@ impl Recording {
     /// thread, bit for bit. A file with comment lines or rows the fast
     /// path leaves to the general one (quotes, exponents, errors) is read
     /// on the calling thread from the first of them. To read on the
-    /// calling thread only, pass the opened file to
+    /// calling thread only (from a real-time thread, say, whose scheduling
+    /// policy the threads it starts inherit), pass the opened file to
     /// [`from_reader_with`](Self::from_reader_with).
     ///
     /// # Errors

@@ -280,3 +280,23 @@ fn a_time_that_does_not_increase_is_found_on_every_row_by_every_path() {
         );
     }
 }
+
+#[test]
+fn a_wrong_length_only_costs_room() {
+    // The length sizes the columns; a file that grew or shrank since
+    // (or a pipe that says something else) reads the same.
+    let text = clean(';', ',', "\n", 5000);
+    let options = CsvOptions::default();
+    let pace = Pace {
+        workers: 2,
+        part: 256,
+        ..Pace::FAST
+    };
+    let want = outcome(read(text.as_bytes(), &options, None, None, Pace::GENERAL));
+    for size in [1, 100, text.len() as u64 / 3, 10 * text.len() as u64] {
+        for pace in [Pace::FAST, pace] {
+            let got = outcome(read(text.as_bytes(), &options, Some(size), None, pace));
+            assert_eq!(got, want, "size {size}, {pace:?}");
+        }
+    }
+}
