@@ -39,12 +39,19 @@ impl Columns {
 
     /// Appends one row, a value per channel in order.
     pub(super) fn push(&mut self, values: &[f64]) {
+        self.append(|k| values[k]);
+    }
+
+    /// Appends one row, `value(k)` for channel `k`: into the room when
+    /// there is some, else pushed.
+    #[inline]
+    fn append(&mut self, value: impl Fn(usize) -> f64) {
         let at = self.len;
-        for (col, &v) in self.cols.iter_mut().zip(values) {
+        for (k, col) in self.cols.iter_mut().enumerate() {
             if at < col.len() {
-                col[at] = v;
+                col[at] = value(k);
             } else {
-                col.push(v);
+                col.push(value(k));
             }
         }
         self.len += 1;
@@ -107,24 +114,21 @@ impl Columns {
     }
 }
 
+/// The last of the first `len` times in `t`, if any.
+#[inline]
+fn last_time(t: Option<&[f64]>, len: usize) -> Option<f64> {
+    t.zip(len.checked_sub(1)).map(|(t, last)| t[last])
+}
+
 impl Sink for Columns {
     #[inline]
     fn last_time(&self) -> Option<f64> {
-        let t = self.cols.first()?;
-        self.len.checked_sub(1).map(|last| t[last])
+        last_time(self.cols.first().map(Vec::as_slice), self.len)
     }
 
     #[inline]
     fn put(&mut self, row: &[f64], map: &[usize]) {
-        let at = self.len;
-        for (col, &from) in self.cols.iter_mut().zip(map) {
-            if at < col.len() {
-                col[at] = row[from];
-            } else {
-                col.push(row[from]);
-            }
-        }
-        self.len += 1;
+        self.append(|k| row[map[k]]);
     }
 }
 
@@ -187,8 +191,7 @@ impl Part<'_> {
 impl Sink for Part<'_> {
     #[inline]
     fn last_time(&self) -> Option<f64> {
-        let t = self.cols.first()?;
-        self.len.checked_sub(1).map(|last| t[last])
+        last_time(self.cols.first().map(|t| &**t), self.len)
     }
 
     #[inline]
