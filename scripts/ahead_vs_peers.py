@@ -34,6 +34,17 @@ def machine():
     return f"{cpu}, {os.cpu_count()} CPUs, load {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}"
 
 
+def threads():
+    """Who reads and solves on how many threads: `read_csv` takes a thread
+    per CPU the process may use (at most 8) for a file of 4 MiB or more."""
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    blas = os.environ.get("OPENBLAS_NUM_THREADS", "?")
+    return (
+        f"ctrlab read_csv {min(cpus or 1, 8)}, pandas read_csv 1; "
+        f"identification: ctrlab 1, NumPy BLAS {blas}"
+    )
+
+
 def fmt(seconds):
     if seconds >= 1e-3:
         return f"{seconds * 1e3:.2f} ms"
@@ -46,6 +57,7 @@ def main():
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
     print(f"machine: {machine()}")
+    print(f"threads: {threads()}")
     rows = ahead_csv.rows(args.rounds, args.repeats)
     rows += ahead_metrics_ident.rows(args.rounds, args.repeats)
     print("| work | ctrlab | peer | peer time | ratio | target | holds |")
