@@ -99,7 +99,8 @@ impl Parallel {
     /// Reads the whole lines at the start of `bytes` into `cols`, a part
     /// on each thread, as [`Fast::rows`] would read them: how many bytes
     /// and lines (one a row) were read, and why it stopped. `None` when it
-    /// does not apply (one thread, or less than a part of whole lines).
+    /// does not apply (one thread, less than a part of whole lines, or no
+    /// thread could start): then [`Fast::rows`] reads them.
     pub(super) fn rows(&mut self, bytes: &[u8], cols: &mut Columns) -> Option<(usize, u64, Stop)> {
         if !self.on || bytes.len() < self.part {
             return None;
