@@ -66,13 +66,18 @@ impl Pace {
         }
     }
 
+    /// The threads that read the usual rows: `workers` on the fast path,
+    /// else the calling thread alone.
+    fn threads(&self) -> usize {
+        if self.fast { self.workers.max(1) } else { 1 }
+    }
+
     /// The reading buffer's size, bytes: a block of parts when several
     /// threads read, else `chunk`.
     pub(super) fn buffer(&self, chunk: usize) -> usize {
-        if self.fast && self.workers > 1 {
-            self.workers.saturating_mul(self.part).max(chunk)
-        } else {
-            chunk
+        match self.threads() {
+            1 => chunk,
+            threads => threads.saturating_mul(self.part).max(chunk),
         }
     }
 }
@@ -87,12 +92,19 @@ pub(super) struct Parallel {
 }
 
 impl Parallel {
+    /// The readers for `pace`'s threads; none (and off) for one thread,
+    /// whose rows [`Fast::rows`] reads.
     pub(super) fn new(fast: &Fast, pace: Pace) -> Self {
-        let workers = if pace.fast { pace.workers.max(1) } else { 1 };
+        let threads = pace.threads();
+        let on = threads > 1;
         Self {
-            fasts: (0..workers).map(|_| fast.for_thread()).collect(),
+            fasts: if on {
+                (0..threads).map(|_| fast.for_thread()).collect()
+            } else {
+                Vec::new()
+            },
             part: pace.part.max(1),
-            on: workers > 1,
+            on,
         }
     }
 
