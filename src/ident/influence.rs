@@ -108,10 +108,25 @@ pub(crate) fn sensitivity_of(
     z: &[f64],
     u: &mut Vec<f64>,
 ) -> (DVector<f64>, i32) {
-    let p = rinv.ncols();
     let e_z = binary_exponent(max_abs(z));
-    let f = pow2(-e_z);
-    let qz = DVector::from_fn(p, |j, _| {
+    let qz = sensitivity_sums(a, stride, rows, rinv, z, pow2(-e_z), u);
+    (rinv * qz, e_z)
+}
+
+/// `Uᵀ (z f)` of the rows in `a` (as [`sensitivity_of`]): a block's part
+/// of the sums, `f` a power of two that keeps `z f` at most 2 in size.
+#[cfg(feature = "lab")]
+pub(crate) fn sensitivity_sums(
+    a: &[f64],
+    stride: usize,
+    rows: usize,
+    rinv: &DMatrix<f64>,
+    z: &[f64],
+    f: f64,
+    u: &mut Vec<f64>,
+) -> DVector<f64> {
+    let p = rinv.ncols();
+    DVector::from_fn(p, |j, _| {
         u.clear();
         u.extend_from_slice(&a[j * stride..j * stride + rows]);
         let d = rinv[(j, j)];
@@ -123,13 +138,10 @@ pub(crate) fn sensitivity_of(
                 u.iter_mut().zip(other).for_each(|(v, &x)| *v += c * x);
             }
         }
-        zip_sum(u, z, |q, z| q * (z * f))
-    });
-    (rinv * qz, e_z)
+        zip_sum(u, &z[..rows], |q, z| q * (z * f))
+    })
 }
 
-/// `e = λ − Φ θ` in place of `λ` (`rows` of them; `Φ`'s columns `stride`
-/// apart), column by column.
 pub(crate) fn residuals(phi: &[f64], lambda: &mut [f64], stride: usize, theta: &DVector<f64>) {
     let rows = lambda.len();
     for (j, &t) in theta.iter().enumerate() {

@@ -78,6 +78,9 @@ mod stages;
 mod summary;
 mod timing;
 
+#[cfg(test)]
+mod streamed_tests;
+
 pub use average::{AverageError, MassSpringAverage, Mismatch, Spread, average};
 pub use bootstrap::{Bootstrap, MAX_RESAMPLES, RefinedStdErrors, bootstrap};
 pub use estimates::{Estimate, MassSpringEstimate, PLAUSIBLE_MASS_KG, Springs, Warning};
@@ -366,17 +369,20 @@ pub fn identify_with(
     options: &Options,
 ) -> Result<MassSpringEstimate, Error> {
     match options.scheme {
-        Scheme::Lab => identify_by::<LabDifferences>(recording, m1, m2, options),
-        Scheme::Central => identify_by::<CentralDifferences>(recording, m1, m2, options),
+        Scheme::Lab => identify_by::<LabDifferences>(recording, m1, m2, options, None),
+        Scheme::Central => identify_by::<CentralDifferences>(recording, m1, m2, options, None),
     }
 }
 
 /// [`identify_with`] with the differences of its scheme.
+/// `solver`: the default (`None`) or, in tests, one that streams from
+/// another length.
 fn identify_by<D: Differences>(
     recording: &Recording,
     m1: f64,
     m2: f64,
     options: &Options,
+    solver: Option<Solver>,
 ) -> Result<MassSpringEstimate, Error> {
     let (data, timing, dt) = prepare(recording, m1, m2, options)?;
     let fixed_m2 = (!options.free_m2).then_some(m2);
@@ -388,7 +394,7 @@ fn identify_by<D: Differences>(
         None => [None, None],
     };
     // Stage 1: the springs, b1 (and F1).
-    let mut solver = Solver::new(options.covariance);
+    let mut solver = solver.unwrap_or_else(|| Solver::new(options.covariance));
     let first_spec = Spec {
         kind: Kind::First { springs: model, m1 },
         data: &data,

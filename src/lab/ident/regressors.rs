@@ -291,6 +291,22 @@ impl Spec<'_, '_> {
         with_z: bool,
         out: Out<'_>,
     ) -> usize {
+        if self.keep.is_none() {
+            self.fill_every_row::<D>((from, to), with_z, out)
+        } else {
+            self.fill_by_columns::<D>((from, to), compact, with_z, out)
+        }
+    }
+
+    /// [`fill`](Self::fill) a column at a time, each column's rows
+    /// filtered by [`keep`](Self::keep) when `compact`.
+    pub(super) fn fill_by_columns<D: Differences>(
+        &self,
+        (from, to): (usize, usize),
+        compact: bool,
+        with_z: bool,
+        out: Out<'_>,
+    ) -> usize {
         let data = self.data;
         let (u, x1, x2) = (data.u, data.x1, data.x2);
         let keep = self.keep.filter(|_| compact);
@@ -390,5 +406,137 @@ impl Spec<'_, '_> {
             }
         }
         rows
+    }
+}
+
+/// The samples a row of the segment reads: `x1`, `x2` at `k − 1, k, k + 1`
+/// and `u` at `k − 1, k`.
+type Around = ([f64; 3], [f64; 3], (f64, f64));
+
+impl Spec<'_, '_> {
+    /// [`fill`](Self::fill) of a stage that keeps every row: each row's
+    /// columns computed at once from the samples around it (the same
+    /// operations in the same order as the column by column fill, so the
+    /// same values bit for bit), the samples read once.
+    fn fill_every_row<D: Differences>(
+        &self,
+        (from, to): (usize, usize),
+        with_z: bool,
+        out: Out<'_>,
+    ) -> usize {
+        match self.kind {
+            Kind::First {
+                springs: SpringModel::Equal,
+                m1,
+            } => self.rows_into::<3>((from, to), out, move |dt, (x1, x2, _)| {
+                let t2 = dt * dt;
+                [
+                    t2 * (2.0 * D::pos(x1) - D::pos(x2)),
+                    dt * D::vel(x1),
+                    m1 * (2.0 * x1[1] - x1[0] - x1[2]),
+                ]
+            }),
+            Kind::First {
+                springs: SpringModel::Separate,
+                m1,
+            } => self.rows_into::<4>((from, to), out, move |dt, (x1, x2, _)| {
+                let t2 = dt * dt;
+                [
+                    t2 * D::pos(x1),
+                    t2 * (D::pos(x1) - D::pos(x2)),
+                    dt * D::vel(x1),
+                    m1 * (2.0 * x1[1] - x1[0] - x1[2]),
+                ]
+            }),
+            Kind::Second { m2, k2 } => {
+                let row = move |dt: f64, (x1, x2, (a, b)): Around| {
+                    let t2 = dt * dt;
+                    [
+                        t2 * D::input(a, b),
+                        -dt * D::vel(x2),
+                        m2 * second_difference(x2) + k2 * t2 * (D::pos(x2) - D::pos(x1)),
+                        t2 * (D::pos(x2) - D::pos(x1)),
+                    ]
+                };
+                if with_z {
+                    self.rows_into::<4>((from, to), out, row)
+                } else {
+                    self.rows_into::<3>((from, to), out, move |dt, around| {
+                        let [a, b, c, _] = row(dt, around);
+                        [a, b, c]
+                    })
+                }
+            }
+            Kind::FreeMass { .. } => {
+                self.rows_into::<4>((from, to), out, move |dt, (x1, x2, (a, b))| {
+                    let t2 = dt * dt;
+                    [
+                        t2 * D::input(a, b),
+                        -dt * D::vel(x2),
+                        -(t2 * (D::pos(x2) - D::pos(x1))),
+                        second_difference(x2),
+                    ]
+                })
+            }
+        }
+    }
+
+    /// Rows `from .. to` (every one kept) of `W` columns, each row's
+    /// values from `row(dt, samples)` with its segment's period.
+    fn rows_into<const W: usize>(
+        &self,
+        (from, to): (usize, usize),
+        out: Out<'_>,
+        row: impl Fn(f64, Around) -> [f64; W],
+    ) -> usize {
+        let data = self.data;
+        let count = to.saturating_sub(from);
+        let (buf, stride) = match out {
+            Out::Slices(buf, stride) => (buf, stride),
+            Out::Push(v) => {
+                let at = v.len();
+                v.resize(at + W * count, 0.0);
+                (&mut v[at..], count)
+            }
+        };
+        let mut chunks = buf.chunks_mut(stride.max(1));
+        let mut cols: [&mut [f64]; W] = std::array::from_fn(|_| chunks.next().unwrap_or_default());
+        let first = data.segments.partition_point(|s| s.row0 + s.rows() <= from);
+        let mut written = 0;
+        for seg in &data.segments[first..] {
+            if seg.row0 >= to {
+                break;
+            }
+            let (a, b) = (
+                from.max(seg.row0) - seg.row0,
+                to.min(seg.row0 + seg.rows()) - seg.row0,
+            );
+            let len = b - a;
+            let x1 = &samples(data.x1, seg, a, b)[..len + 2];
+            let x2 = &samples(data.x2, seg, a, b)[..len + 2];
+            let u = &samples(data.u, seg, a, b)[..len + 1];
+            // This segment's rows of each column, the rest kept for the next.
+            let mut out: [&mut [f64]; W] = std::array::from_fn(|j| {
+                let col = std::mem::take(&mut cols[j]);
+                let (head, tail) = col.split_at_mut(len.min(col.len()));
+                cols[j] = tail;
+                head
+            });
+            debug_assert!(out.iter().all(|c| c.len() == len), "room for the rows");
+            let len = out.iter().map(|c| c.len()).min().unwrap_or(0);
+            let dt = seg.dt;
+            for i in 0..len {
+                let around = (
+                    [x1[i], x1[i + 1], x1[i + 2]],
+                    [x2[i], x2[i + 1], x2[i + 2]],
+                    (u[i], u[i + 1]),
+                );
+                for (col, v) in out.iter_mut().zip(row(dt, around)) {
+                    col[i] = v;
+                }
+            }
+            written += len;
+        }
+        written
     }
 }

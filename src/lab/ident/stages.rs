@@ -3,10 +3,11 @@
 //! solved as stored; a longer one is streamed, its rows built
 //! [`BLOCK_ROWS`] at a time and factored under the `R` of the rows before
 //! ([`Tsqr`]): the stored problem's factor, bit for bit, with no column
-//! of the recording's length held. With Newey–West the stage is built
-//! whole (streamed through the factor all the same when long): the sums
-//! need every row's influence twice, and its equilibrated copy becomes
-//! that influence in place, cheaper than building the rows again.
+//! of the recording's length held. With Newey–West a streamed stage is
+//! then built again, a block at a time, into each row's influence (the
+//! stored stage's, bit for bit): the one series of the recording's length
+//! the sums need. A stored stage becomes that influence in place of an
+//! equilibrated copy.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -15,10 +16,11 @@ use super::regressors::{Differences, Kind, Out, Spec};
 use crate::error::Error;
 use crate::ident::{
     BLOCK_ROWS, BLOCKED_FROM_ROWS, Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, NARROW,
-    Scratch, Series, Stats, Triangular, Tsqr, classical, equilibrate, fit_from, householder_narrow,
-    influence_rows, newey_west_of, scale_column, scale_pow2, sensitivity_of, spread, triangular,
+    Scratch, Series, Stats, Triangular, Tsqr, binary_exponent, classical, equilibrate, fit_from,
+    householder_narrow, influence_rows, newey_west_of, pow2, scale_column, scale_pow2,
+    sensitivity_of, sensitivity_sums, spread, triangular,
 };
-use crate::kernels::reduce::max_ss;
+use crate::kernels::reduce::{max_abs, max_ss};
 
 /// Most parameters of stage 2: `K`, `b2`, `m2`, `F2`.
 pub(super) const MAX_STAGE2: usize = 4;
@@ -30,12 +32,12 @@ pub(super) struct FirstStage;
 /// A stage's factorisation: its triangular solve, the columns' exponents,
 /// `λ`'s spread, and with Newey–West where its equilibrated copy (and
 /// stage 2's `z`) lie in the solver's buffer.
-struct Factored {
-    tri: Triangular,
-    exponents: Vec<i32>,
-    sst: f64,
-    copy_at: usize,
-    z_at: usize,
+pub(super) struct Factored {
+    pub tri: Triangular,
+    pub exponents: Vec<i32>,
+    pub sst: f64,
+    pub copy_at: usize,
+    pub z_at: usize,
 }
 
 /// The buffers of the stages, kept between them.
@@ -53,6 +55,8 @@ pub(super) struct Solver {
     scratch: Scratch,
     stats: Stats,
     starts: Vec<usize>,
+    /// Stages of at least this many rows are streamed.
+    stream_from: usize,
 }
 
 impl Solver {
@@ -66,7 +70,24 @@ impl Solver {
             scratch: Scratch::default(),
             stats: Stats::default(),
             starts: Vec::new(),
+            stream_from: BLOCKED_FROM_ROWS,
         }
+    }
+
+    /// A solver that streams stages of at least `rows` rows (tests compare
+    /// the streamed and the stored stages on short recordings).
+    #[cfg(test)]
+    pub fn streaming_from(covariance: Covariance, rows: usize) -> Self {
+        Self {
+            stream_from: rows.max(1),
+            ..Self::new(covariance)
+        }
+    }
+
+    /// The stage's buffer (`[Φ | λ (| z)]`, or the influence series).
+    #[cfg(test)]
+    pub fn buf_for_tests(&mut self) -> &mut Vec<f64> {
+        &mut self.buf
     }
 
     /// Solves the stage `spec`. Stage 1 (`k2_index`: its parameter `k2`)
@@ -101,10 +122,11 @@ impl Solver {
             Covariance::NeweyWest { lags } => Some(lags),
         };
         let want_z = lags.is_some() && matches!(spec.kind, Kind::Second { .. });
-        let f = if lags.is_some() || m < BLOCKED_FROM_ROWS {
-            self.factor_stored::<D>(spec, m, lags.is_some(), want_z)?
-        } else {
+        let streamed = m >= self.stream_from;
+        let f = if streamed {
             self.factor_streamed::<D>(spec, m)?
+        } else {
+            self.factor_stored::<D>(spec, m, lags.is_some(), want_z)?
         };
         let Factored {
             tri,
@@ -134,26 +156,11 @@ impl Solver {
             return finite(fit).map(|fit| (fit, None));
         };
         let n = data.rows;
-        // Each row's influence in place of the equilibrated copy (stage
-        // 2's g from U = Φ R⁻¹ and z first), as the stored solve.
-        let (work, z): (&mut [f64], &[f64]) = if !want_z {
-            (&mut self.buf[copy_at..], &[])
-        } else if z_at < copy_at {
-            let (head, work) = self.buf.split_at_mut(copy_at);
-            (work, &head[z_at..z_at + m])
+        let g = if streamed {
+            self.influence_streamed::<D>(spec, m, &tri, &exponents, want_z)
         } else {
-            let (work, tail) = self.buf.split_at_mut(z_at);
-            (&mut work[copy_at..], &tail[..m])
+            self.influence_stored(m, p, &tri, &exponents, want_z, copy_at, z_at)
         };
-        let work = &mut work[..m * (p + 1)];
-        let g: Option<Vec<f64>> = want_z.then(|| {
-            let (gz, e_z) = sensitivity_of(work, m, m, &tri.rinv, z, &mut self.block);
-            (0..p)
-                .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
-                .collect()
-        });
-        let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
-        influence_rows(work, m, m, &tri.theta, &tri.rinv, &d);
         if let Some(g) = &g
             && !g.iter().all(|v| v.is_finite())
         {
@@ -240,12 +247,126 @@ impl Solver {
         Ok((fit, state))
     }
 
+    /// Each row's influence in place of the stored stage's equilibrated
+    /// copy at `copy_at` (stage 2's `g` from `U = Φ R⁻¹` and `z` at
+    /// `z_at` first).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn influence_stored(
+        &mut self,
+        m: usize,
+        p: usize,
+        tri: &Triangular,
+        exponents: &[i32],
+        want_z: bool,
+        copy_at: usize,
+        z_at: usize,
+    ) -> Option<Vec<f64>> {
+        let (work, z): (&mut [f64], &[f64]) = if !want_z {
+            (&mut self.buf[copy_at..], &[])
+        } else if z_at < copy_at {
+            let (head, work) = self.buf.split_at_mut(copy_at);
+            (work, &head[z_at..z_at + m])
+        } else {
+            let (work, tail) = self.buf.split_at_mut(z_at);
+            (&mut work[copy_at..], &tail[..m])
+        };
+        let work = &mut work[..m * (p + 1)];
+        let g = want_z.then(|| {
+            let (gz, e_z) = sensitivity_of(work, m, m, &tri.rinv, z, &mut self.block);
+            (0..p)
+                .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
+                .collect()
+        });
+        let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
+        influence_rows(work, m, m, &tri.theta, &tri.rinv, &d);
+        g
+    }
+
+    /// Each row's influence into the buffer (`m × p`, as the stored
+    /// stage's), the stage built again a block at a time after its
+    /// factor: the same rows, equilibrated by the same powers of two, so
+    /// the same influence bit for bit. Stage 2's `g` sums each block's
+    /// part, `z` divided by the power of two of its largest entry so far
+    /// (the sums rescaled exactly when a later block raises it).
+    pub(super) fn influence_streamed<D: Differences>(
+        &mut self,
+        spec: &Spec<'_, '_>,
+        m: usize,
+        tri: &Triangular,
+        exponents: &[i32],
+        want_z: bool,
+    ) -> Option<Vec<f64>> {
+        let (p, n) = (spec.p, spec.data.rows);
+        let width = spec.width();
+        let stride = BLOCK_ROWS;
+        let mut block = std::mem::take(&mut self.block);
+        block.clear();
+        block.resize((width + usize::from(want_z)) * stride, 0.0);
+        // Every entry is written below: stage 2 reuses stage 1's without
+        // clearing it.
+        self.buf.truncate(m * p);
+        self.buf.resize(m * p, 0.0);
+        let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
+        let mut qz = DVector::<f64>::zeros(p);
+        let mut e_z: Option<i32> = None;
+        let mut u = std::mem::take(&mut self.series);
+        let (mut from, mut have, mut at) = (0, 0, 0);
+        while from < n {
+            let to = (from + BLOCK_ROWS - have).min(n);
+            have += spec.fill::<D>(
+                (from, to),
+                true,
+                want_z,
+                Out::Slices(&mut block[have..], stride),
+            );
+            from = to;
+            if have < BLOCK_ROWS && !(from == n && have > 0) {
+                continue;
+            }
+            for (col, &e) in block.chunks_exact_mut(stride).zip(exponents) {
+                scale_column(&mut col[..have], e);
+            }
+            if want_z {
+                let z = &block[width * stride..width * stride + have];
+                let largest = max_abs(z);
+                if largest > 0.0 {
+                    let e = binary_exponent(largest);
+                    match e_z {
+                        Some(now) if now >= e => {}
+                        Some(now) => {
+                            let f = pow2(now - e);
+                            qz.iter_mut().for_each(|v| *v *= f);
+                            e_z = Some(e);
+                        }
+                        None => e_z = Some(e),
+                    }
+                    let f = pow2(-e_z.unwrap_or(0));
+                    qz += sensitivity_sums(&block, stride, have, &tri.rinv, z, f, &mut u);
+                }
+            }
+            influence_rows(&mut block, stride, have, &tri.theta, &tri.rinv, &d);
+            for (j, col) in block.chunks_exact(stride).take(p).enumerate() {
+                self.buf[j * m + at..j * m + at + have].copy_from_slice(&col[..have]);
+            }
+            at += have;
+            have = 0;
+        }
+        debug_assert_eq!(at, m);
+        self.block = block;
+        self.series = u;
+        want_z.then(|| {
+            let gz = &tri.rinv * qz;
+            let e_z = e_z.unwrap_or(0);
+            (0..p)
+                .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
+                .collect()
+        })
+    }
+
     /// Builds the stage whole (`m` rows, then stage 2's `z` with
-    /// `want_z`) and factors it: under [`BLOCKED_FROM_ROWS`] rows as the
-    /// stored solve does, equilibrated then factored in place (with
-    /// `copy`, after a copy of the equilibrated `[Φ | λ]`); longer, its
-    /// blocks streamed through [`Tsqr`] and then equilibrated in place,
-    /// the copy.
+    /// `want_z`) and factors it as the stored solve does, equilibrated
+    /// then factored in place (with `copy`, after a copy of the
+    /// equilibrated `[Φ | λ]`).
     fn factor_stored<D: Differences>(
         &mut self,
         spec: &Spec<'_, '_>,
@@ -259,39 +380,6 @@ impl Solver {
         self.buf.clear();
         let rows = spec.fill::<D>((0, n), true, want_z, Out::Push(&mut self.buf));
         debug_assert_eq!((rows, self.buf.len()), (m, m * filled));
-        if m >= BLOCKED_FROM_ROWS {
-            // Long: the blocks through the streamed factor, then the
-            // columns equilibrated with its powers of two (the same).
-            let mut tsqr = Tsqr::new(width);
-            let mut at = 0;
-            while at < m {
-                let rows = BLOCK_ROWS.min(m - at);
-                let (staging, stride) = tsqr.staging();
-                for (j, col) in self.buf.chunks_exact(m).take(width).enumerate() {
-                    staging[j * stride..j * stride + rows].copy_from_slice(&col[at..at + rows]);
-                }
-                if tsqr.push_staged(rows).is_err() {
-                    // The stored problem's error, naming the first entry.
-                    let mut exponents = vec![0; width];
-                    equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
-                    unreachable!("a block held a non-finite entry the columns do not");
-                }
-                at += rows;
-            }
-            let f = tsqr.finish();
-            for (col, &e) in self.buf.chunks_exact_mut(m).zip(&f.exponents) {
-                scale_column(col, e);
-            }
-            let sst = spread(&self.buf[p * m..width * m]);
-            let tri = triangular(|i, j| f.r(i, j), p, DEFAULT_MAX_CONDITION)?;
-            return Ok(Factored {
-                tri,
-                exponents: f.exponents,
-                sst,
-                copy_at: 0,
-                z_at: m * width,
-            });
-        }
         let mut exponents = vec![0; width];
         equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
         let sst = spread(&self.buf[p * m..width * m]);
@@ -313,7 +401,7 @@ impl Solver {
 
     /// Streams the stage (`m` rows) through [`Tsqr`] in blocks of
     /// [`BLOCK_ROWS`] kept rows, built in place.
-    fn factor_streamed<D: Differences>(
+    pub(super) fn factor_streamed<D: Differences>(
         &mut self,
         spec: &Spec<'_, '_>,
         m: usize,
