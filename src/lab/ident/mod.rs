@@ -187,29 +187,26 @@ fn prepare<'a>(
             got: rec.len(),
         });
     }
-    // Every value finite, time included (as `Recording::sample_period`).
-    let channels = rec.schema().channels().map(|c| c.name.as_str());
-    for name in std::iter::once("t").chain(channels) {
-        let column = if name == "t" {
-            rec.time()
-        } else {
-            rec.channel(name)?
-        };
-        if let Some(k) = first_non_finite(column) {
-            return Err(Error::InvalidRecording {
-                index: k,
-                reason: format!("{name} = {} is not finite", column[k]),
-            });
-        }
+    // Every value finite, time included (as `Recording::sample_period`);
+    // `u`, `x1` and `x2` later, by the stages, when they read them all.
+    let deferred: &[&str] = if reads_every_sample(options) {
+        &["u", "x1", "x2"]
+    } else {
+        &[]
+    };
+    if let Some(e) = non_finite(rec, deferred) {
+        return Err(non_finite(rec, &[]).unwrap_or(e));
     }
-    let (segments, timing, dt) = timing::segments(rec.time(), options.max_jitter)?;
+    let checked = |e: Error| first_error(rec, options, e);
+    let (segments, timing, dt) =
+        timing::segments(rec.time(), options.max_jitter).map_err(checked)?;
     // Three unknowns and a residual degree of freedom, as MIN_SAMPLES.
     if timing.rows < MIN_SAMPLES - 2 {
-        return Err(Error::TooFewSamples {
+        return Err(checked(Error::TooFewSamples {
             what: "mass-spring identification: rows within segments between gaps",
             needed: MIN_SAMPLES - 2,
             got: timing.rows,
-        });
+        }));
     }
     let data = Data {
         u,
@@ -219,6 +216,75 @@ fn prepare<'a>(
         rows: timing.rows,
     };
     Ok((data, timing, dt))
+}
+
+/// Whether the stages read every sample of `u`, `x1` and `x2` that a
+/// row can read: when they keep every row (no Coulomb columns). A row's
+/// columns are then not all finite when a sample it reads is not (each
+/// sample enters some column through sums and products with finite,
+/// non-zero factors), so a stage's error, or a sample no row reads,
+/// stands for a non-finite value, and [`prepare`] leaves those three to
+/// the stages: one pass over them less.
+fn reads_every_sample(options: &Options) -> bool {
+    !options.coulomb
+}
+
+/// The first value of the recording that is not finite, time first, then
+/// the channels in the schema's order, but those in `skip`.
+fn non_finite(rec: &Recording, skip: &[&str]) -> Option<Error> {
+    let channels = rec.schema().channels().map(|c| c.name.as_str());
+    for name in std::iter::once("t").chain(channels) {
+        if skip.contains(&name) {
+            continue;
+        }
+        let column = if name == "t" {
+            rec.time()
+        } else {
+            rec.channel(name).ok()?
+        };
+        if let Some(k) = first_non_finite(column) {
+            return Some(Error::InvalidRecording {
+                index: k,
+                reason: format!("{name} = {} is not finite", column[k]),
+            });
+        }
+    }
+    None
+}
+
+/// The error the identification reports: a value that is not finite
+/// before `e`, as if every value had been checked first.
+#[cold]
+fn first_error(rec: &Recording, options: &Options, e: Error) -> Error {
+    if reads_every_sample(options) {
+        non_finite(rec, &[]).unwrap_or(e)
+    } else {
+        e
+    }
+}
+
+/// Whether the samples of `u`, `x1`, `x2` that no row reads (a
+/// segment's last input, the first with the lab's differences, every
+/// sample of a segment too short for a row) are finite.
+fn unread_finite(data: &Data<'_>, scheme: Scheme) -> bool {
+    let n = data.x1.len();
+    // The samples from..to, when there are any, all finite.
+    let finite = |x: &[f64], from: usize, to: usize| {
+        from >= to || first_non_finite(&x[from..to.min(n)]).is_none()
+    };
+    // The segments in order: the samples between what they read are not.
+    let (mut x_at, mut u_at, mut ok) = (0, 0, true);
+    for seg in data.segments.iter().filter(|s| s.end - s.start >= 3) {
+        let (u_from, u_to) = match scheme {
+            Scheme::Lab => (seg.start + 1, seg.end - 1),
+            Scheme::Central => (seg.start, seg.end - 1),
+        };
+        ok &= finite(data.x1, x_at, seg.start) && finite(data.x2, x_at, seg.start);
+        ok &= finite(data.u, u_at, u_from);
+        x_at = x_at.max(seg.end);
+        u_at = u_at.max(u_to);
+    }
+    ok && finite(data.x1, x_at, n) && finite(data.x2, x_at, n) && finite(data.u, u_at, n)
 }
 
 /// Where each cart moves, for the Coulomb columns; `None` without them.
@@ -385,10 +451,36 @@ fn identify_by<D: Differences>(
     solver: Option<Solver>,
 ) -> Result<MassSpringEstimate, Error> {
     let (data, timing, dt) = prepare(recording, m1, m2, options)?;
+    let estimate = stages::<D>(&data, timing, dt, m1, m2, options, solver)
+        .map_err(|e| first_error(recording, options, e))?;
+    if reads_every_sample(options) && !unread_finite(&data, options.scheme) {
+        return Err(first_error(
+            recording,
+            options,
+            Error::InvalidRecording {
+                index: 0,
+                reason: "a sample is not finite".into(),
+            },
+        ));
+    }
+    Ok(estimate)
+}
+
+/// Both stages on the prepared data.
+#[allow(clippy::too_many_arguments)]
+fn stages<D: Differences>(
+    data: &Data<'_>,
+    timing: Timing,
+    dt: f64,
+    m1: f64,
+    m2: f64,
+    options: &Options,
+    solver: Option<Solver>,
+) -> Result<MassSpringEstimate, Error> {
     let fixed_m2 = (!options.free_m2).then_some(m2);
     // Stage 1's parameters with the Coulomb column: the springs, b1, F1.
     let model = options.springs;
-    let motion = motions(&data, options, model.parameters() + 2)?;
+    let motion = motions(data, options, model.parameters() + 2)?;
     let [cart1, cart2] = match &motion {
         Some([a, b]) => [Some(a), Some(b)],
         None => [None, None],
@@ -397,7 +489,7 @@ fn identify_by<D: Differences>(
     let mut solver = solver.unwrap_or_else(|| Solver::new(options.covariance));
     let first_spec = Spec {
         kind: Kind::First { springs: model, m1 },
-        data: &data,
+        data,
         keep: cart1,
         p: model.parameters() + 1 + usize::from(cart1.is_some()),
     };
@@ -421,7 +513,7 @@ fn identify_by<D: Differences>(
     };
     let second_spec = Spec {
         kind,
-        data: &data,
+        data,
         keep: cart2,
         p: 2 + usize::from(fixed_m2.is_none()) + usize::from(cart2.is_some()),
     };
