@@ -11,7 +11,7 @@ use super::hac::Scratch;
 use super::influence::influence_rows;
 use super::{Covariance, LeastSquaresFit};
 use crate::error::Error;
-use crate::kernels::reduce::{dot, first_non_finite, max_abs, pow2_floor, sum_by};
+use crate::kernels::reduce::{dot, finite_max_abs, first_non_finite, pow2_floor, sum_by};
 
 /// How [`solve_augmented`] solves and what it reports.
 #[derive(Debug, Clone, Copy)]
@@ -123,15 +123,17 @@ pub(crate) fn householder_blocked(a: &mut [f64], m: usize, n: usize) {
 /// 1e308, another of 1e-200). The results are unscaled at the end.
 pub(crate) fn equilibrate(a: &mut [f64], m: usize, exponents: &mut [i32]) -> Result<(), Error> {
     for (j, (col, e)) in a.chunks_exact_mut(m).zip(exponents.iter_mut()).enumerate() {
-        if let Some(i) = first_non_finite(col) {
+        // One pass for both: the maximum and whether every entry is finite.
+        let Some(largest) = finite_max_abs(col) else {
+            let i = first_non_finite(col).unwrap_or(0);
             return Err(Error::NonFinite {
                 matrix: "regressor",
                 row: i,
                 col: j,
                 value: col[i],
             });
-        }
-        *e = binary_exponent(max_abs(col));
+        };
+        *e = binary_exponent(largest);
         scale_column(col, *e);
     }
     Ok(())

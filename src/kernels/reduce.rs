@@ -118,7 +118,6 @@ pub(crate) fn max_abs(x: &[f64]) -> f64 {
 /// [`max_abs`] of a slice whose entries are all finite, `None` otherwise,
 /// in one pass: `x · 0` is 0 only for a finite `x`, and the test is an
 /// integer "and" across lanes.
-#[cfg(any(feature = "lab", test))]
 #[inline]
 pub(crate) fn finite_max_abs(x: &[f64]) -> Option<f64> {
     let mut acc = [0.0f64; LANES];

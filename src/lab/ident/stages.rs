@@ -11,7 +11,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::influence::{Carry, carry, overflows};
+use super::influence::{Carry, carry, carry_max_ss, overflows};
 use super::regressors::{Differences, Kind, Out, Spec};
 use crate::error::Error;
 use crate::ident::{
@@ -194,26 +194,31 @@ impl Solver {
                 &mut self.series
             }
         };
-        if first.is_some() {
-            let how = match (&g, &map) {
-                (Some(g), _) => Some(Carry::Sensitivity(g)),
-                (None, Some(map)) => Some(Carry::FreeMass(map)),
-                (None, None) => None,
-            };
-            if let Some(how) = how {
-                carry(series, n, p, &self.k2, &how);
+        let how = match (&g, &map) {
+            _ if first.is_none() => None,
+            (Some(g), _) => Some(Carry::Sensitivity(g)),
+            (None, Some(map)) => Some(Carry::FreeMass(map)),
+            (None, None) => None,
+        };
+        // Each column's largest entry and sum of squares, for the sums.
+        if let Some(Carry::Sensitivity(g)) = how {
+            let (max, ss) = (&mut self.stats.max, &mut self.stats.ss);
+            carry_max_ss(series, n, &self.k2, g, max, ss);
+        } else if streamed && how.is_none() {
+            // Found block by block (the scattered rows' zeros add none).
+        } else {
+            if let Some(how) = &how {
+                carry(series, n, p, &self.k2, how);
+            }
+            self.stats.max.clear();
+            self.stats.ss.clear();
+            for col in series.chunks_exact(n) {
+                let (max, ss) = max_ss(col);
+                self.stats.max.push(max);
+                self.stats.ss.push(ss);
             }
         }
-        // Each column's largest entry and sum of squares, for the sums.
-        self.stats.max.clear();
-        self.stats.ss.clear();
-        let mut known = true;
-        for col in series.chunks_exact(n) {
-            let (max, ss) = max_ss(col);
-            known &= max.is_finite() && ss.is_finite();
-            self.stats.max.push(max);
-            self.stats.ss.push(ss);
-        }
+        let known = (self.stats.max.iter().chain(&self.stats.ss)).all(|v| v.is_finite());
         // Not finite: the stored solve's error if a row's own influence
         // was not (else the sums overflow, which `finite` reports).
         if !known && overflows::<D>(spec, &tri, &exponents, &mut self.block) {
@@ -310,6 +315,10 @@ impl Solver {
         let mut qz = DVector::<f64>::zeros(p);
         let mut e_z: Option<i32> = None;
         let mut u = std::mem::take(&mut self.series);
+        self.stats.max.clear();
+        self.stats.max.resize(p, 0.0);
+        self.stats.ss.clear();
+        self.stats.ss.resize(p, 0.0);
         let (mut from, mut have, mut at) = (0, 0, 0);
         while from < n {
             let to = (from + BLOCK_ROWS - have).min(n);
@@ -346,7 +355,13 @@ impl Solver {
             }
             influence_rows(&mut block, stride, have, &tri.theta, &tri.rinv, &d);
             for (j, col) in block.chunks_exact(stride).take(p).enumerate() {
-                self.buf[j * m + at..j * m + at + have].copy_from_slice(&col[..have]);
+                let h = &col[..have];
+                self.buf[j * m + at..j * m + at + have].copy_from_slice(h);
+                // Each column's largest entry and sum of squares, while
+                // the block is at hand.
+                let (max, ss) = max_ss(h);
+                self.stats.max[j] = self.stats.max[j].max(max);
+                self.stats.ss[j] += ss;
             }
             at += have;
             have = 0;
@@ -377,9 +392,18 @@ impl Solver {
         let (p, n) = (spec.p, spec.data.rows);
         let width = spec.width();
         let filled = width + usize::from(want_z);
-        self.buf.clear();
-        let rows = spec.fill::<D>((0, n), true, want_z, Out::Push(&mut self.buf));
-        debug_assert_eq!((rows, self.buf.len()), (m, m * filled));
+        // Every entry is written: stage 2 reuses stage 1's room unzeroed.
+        // Room for the copy too, so that it moves nothing (nor does a
+        // larger room move stage 1's rows).
+        // Stage 1 reserves what stage 2 can need (pages untouched cost
+        // nothing): growing would copy.
+        let most = n * (2 * (MAX_STAGE2 + 1) + 1);
+        let room = (m * filled + if copy { m * width } else { 0 }).max(most);
+        self.buf.truncate(m * filled);
+        self.buf.reserve(room - self.buf.len());
+        self.buf.resize(m * filled, 0.0);
+        let rows = spec.fill::<D>((0, n), true, want_z, Out::Slices(&mut self.buf, m));
+        debug_assert_eq!(rows, m);
         let mut exponents = vec![0; width];
         equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
         let sst = spread(&self.buf[p * m..width * m]);
