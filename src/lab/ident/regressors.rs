@@ -211,6 +211,25 @@ impl<'o> Cols<'o> {
     }
 }
 
+/// The segments that hold rows `from .. to` (global row numbers), each
+/// with the part of them it holds, as its own rows `a .. b`.
+fn segment_rows<'d>(
+    data: &'d Data<'_>,
+    (from, to): (usize, usize),
+) -> impl Iterator<Item = (&'d Segment, usize, usize)> + 'd {
+    let first = data.segments.partition_point(|s| s.row0 + s.rows() <= from);
+    data.segments[first..]
+        .iter()
+        .take_while(move |seg| seg.row0 < to)
+        .map(move |seg| {
+            let (a, b) = (
+                from.max(seg.row0) - seg.row0,
+                to.min(seg.row0 + seg.rows()) - seg.row0,
+            );
+            (seg, a, b)
+        })
+}
+
 /// Writes `rows(segment, a, b)` (the segment's rows `a .. b`) for the
 /// rows `from .. to` of the segments (global row numbers), in order, to
 /// `out`; with `keep`, only the rows whose direction is not 0. Returns the
@@ -222,16 +241,8 @@ fn put<I: Iterator<Item = f64>>(
     keep: Option<&Motion>,
     mut rows: impl FnMut(&Segment, usize, usize) -> I,
 ) -> usize {
-    let first = data.segments.partition_point(|s| s.row0 + s.rows() <= from);
     let mut at = 0;
-    for seg in &data.segments[first..] {
-        if seg.row0 >= to {
-            break;
-        }
-        let (a, b) = (
-            from.max(seg.row0) - seg.row0,
-            to.min(seg.row0 + seg.rows()) - seg.row0,
-        );
+    for (seg, a, b) in segment_rows(data, (from, to)) {
         let values = rows(seg, a, b);
         let direction = keep.map(|m| &m.direction[seg.row0 + a..seg.row0 + b]);
         match (&mut out, direction) {
@@ -501,16 +512,8 @@ impl Spec<'_, '_> {
         };
         let mut chunks = buf.chunks_mut(stride.max(1));
         let mut cols: [&mut [f64]; W] = std::array::from_fn(|_| chunks.next().unwrap_or_default());
-        let first = data.segments.partition_point(|s| s.row0 + s.rows() <= from);
         let mut written = 0;
-        for seg in &data.segments[first..] {
-            if seg.row0 >= to {
-                break;
-            }
-            let (a, b) = (
-                from.max(seg.row0) - seg.row0,
-                to.min(seg.row0 + seg.rows()) - seg.row0,
-            );
+        for (seg, a, b) in segment_rows(data, (from, to)) {
             let len = b - a;
             let x1 = &samples(data.x1, seg, a, b)[..len + 2];
             let x2 = &samples(data.x2, seg, a, b)[..len + 2];
