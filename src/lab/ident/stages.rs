@@ -392,11 +392,9 @@ impl Solver {
         let (p, n) = (spec.p, spec.data.rows);
         let width = spec.width();
         let filled = width + usize::from(want_z);
-        // Every entry is written: stage 2 reuses stage 1's room unzeroed.
-        // Room for the copy too, so that it moves nothing (nor does a
-        // larger room move stage 1's rows).
-        // Stage 1 reserves what stage 2 can need (pages untouched cost
-        // nothing): growing would copy.
+        // Every entry is written, so stage 2 reuses stage 1's room
+        // unzeroed; stage 1 reserves what either stage can need, the copy
+        // included (untouched pages cost nothing), as growing would copy.
         let most = n * (2 * (MAX_STAGE2 + 1) + 1);
         let room = (m * filled + if copy { m * width } else { 0 }).max(most);
         self.buf.truncate(m * filled);
