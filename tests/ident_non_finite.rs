@@ -7,6 +7,8 @@
 //! with a plain scan of the recording: time first, then the channels in
 //! the schema's order.
 
+#![cfg(feature = "lab")]
+
 use ctrlab::Error;
 use ctrlab::data::Recording;
 use ctrlab::ident::Covariance;
