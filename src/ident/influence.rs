@@ -142,6 +142,8 @@ pub(crate) fn sensitivity_sums(
     })
 }
 
+/// `e = λ − Φ θ` in place of `λ` (`rows` of them; `Φ`'s columns `stride`
+/// apart), column by column.
 pub(crate) fn residuals(phi: &[f64], lambda: &mut [f64], stride: usize, theta: &DVector<f64>) {
     let rows = lambda.len();
     for (j, &t) in theta.iter().enumerate() {
