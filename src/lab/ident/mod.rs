@@ -195,7 +195,7 @@ fn prepare<'a>(
         &[]
     };
     if let Some(e) = non_finite(rec, deferred) {
-        return Err(non_finite(rec, &[]).unwrap_or(e));
+        return Err(first_error(rec, options, e));
     }
     let checked = |e: Error| first_error(rec, options, e);
     let (segments, timing, dt) =
@@ -453,15 +453,12 @@ fn identify_by<D: Differences>(
     let (data, timing, dt) = prepare(recording, m1, m2, options)?;
     let estimate = stages::<D>(&data, timing, dt, m1, m2, options, solver)
         .map_err(|e| first_error(recording, options, e))?;
-    if reads_every_sample(options) && !unread_finite(&data, options.scheme) {
-        return Err(first_error(
-            recording,
-            options,
-            Error::InvalidRecording {
-                index: 0,
-                reason: "a sample is not finite".into(),
-            },
-        ));
+    // A sample no row read is not finite: the first such value is named.
+    if reads_every_sample(options)
+        && !unread_finite(&data, options.scheme)
+        && let Some(e) = non_finite(recording, &[])
+    {
+        return Err(e);
     }
     Ok(estimate)
 }

@@ -278,12 +278,9 @@ impl Solver {
         let work = &mut work[..m * (p + 1)];
         let g = want_z.then(|| {
             let (gz, e_z) = sensitivity_of(work, m, m, &tri.rinv, z, &mut self.block);
-            (0..p)
-                .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
-                .collect()
+            unscaled(&gz, e_z, exponents)
         });
-        let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
-        influence_rows(work, m, m, &tri.theta, &tri.rinv, &d);
+        influence_rows(work, m, m, &tri.theta, &tri.rinv, &units(exponents, p));
         g
     }
 
@@ -311,7 +308,7 @@ impl Solver {
         // clearing it.
         self.buf.truncate(m * p);
         self.buf.resize(m * p, 0.0);
-        let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
+        let d = units(exponents, p);
         let mut qz = DVector::<f64>::zeros(p);
         let mut e_z: Option<i32> = None;
         let mut u = std::mem::take(&mut self.series);
@@ -369,13 +366,7 @@ impl Solver {
         debug_assert_eq!(at, m);
         self.block = block;
         self.series = u;
-        want_z.then(|| {
-            let gz = &tri.rinv * qz;
-            let e_z = e_z.unwrap_or(0);
-            (0..p)
-                .map(|j| scale_pow2(gz[j], e_z - exponents[j]))
-                .collect()
-        })
+        want_z.then(|| unscaled(&(&tri.rinv * qz), e_z.unwrap_or(0), exponents))
     }
 
     /// Builds the stage whole (`m` rows, then stage 2's `z` with
@@ -475,6 +466,21 @@ impl Solver {
             },
         }
     }
+}
+
+/// Each parameter's power of two in the influence: `λ`'s column's
+/// exponent less the parameter's column's (`exponents` has `p + 1`).
+fn units(exponents: &[i32], p: usize) -> Vec<i32> {
+    (0..p).map(|j| exponents[p] - exponents[j]).collect()
+}
+
+/// Stage 2's sensitivity `g` in the parameters' units, from its sums of
+/// the equilibrated columns with `z` divided by `2^e_z`.
+fn unscaled(gz: &DVector<f64>, e_z: i32, exponents: &[i32]) -> Vec<f64> {
+    gz.iter()
+        .zip(exponents)
+        .map(|(&g, &e)| scale_pow2(g, e_z - e))
+        .collect()
 }
 
 /// `fit`, unless a covariance or standard error overflowed.
