@@ -46,13 +46,13 @@ pub use covariance::{Covariance, MAX_LAGS, newey_west_lags};
 #[cfg(feature = "lab")]
 pub(crate) use hac::{Scratch, Series, Stats};
 #[cfg(feature = "lab")]
-pub(crate) use influence::{influence_rows, sensitivity_of, sensitivity_sums};
+pub(crate) use influence::{Sink, Source, influence_into};
 pub use least_squares::{DEFAULT_MAX_CONDITION, LeastSquares, LeastSquaresFit};
 pub use rls::Rls;
 #[cfg(feature = "lab")]
 pub(crate) use solve::{
     BLOCK_ROWS, BLOCKED_FROM_ROWS, NARROW, Triangular, binary_exponent, classical, equilibrate,
-    fit_from, householder_narrow, pow2, scale_column, scale_pow2, spread, triangular,
+    equilibrate_into, fit_from, householder_narrow, pow2, scale_pow2, spread, triangular,
 };
 pub use spectral::{
     ETFE_MIN_INPUT, FrequencyEstimate, MAX_SPECTRAL_SAMPLES, SPA_DEFAULT_LAG, etfe, spa,

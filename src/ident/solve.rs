@@ -8,7 +8,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::covariance::newey_west;
 use super::hac::Scratch;
-use super::influence::influence_rows;
+use super::influence::{Sink, Source, influence_into};
 use super::{Covariance, LeastSquaresFit};
 use crate::error::Error;
 use crate::kernels::reduce::{dot, finite_max_abs, first_non_finite, pow2_floor, sum_by};
@@ -123,20 +123,48 @@ pub(crate) fn householder_blocked(a: &mut [f64], m: usize, n: usize) {
 /// 1e308, another of 1e-200). The results are unscaled at the end.
 pub(crate) fn equilibrate(a: &mut [f64], m: usize, exponents: &mut [i32]) -> Result<(), Error> {
     for (j, (col, e)) in a.chunks_exact_mut(m).zip(exponents.iter_mut()).enumerate() {
-        // One pass for both: the maximum and whether every entry is finite.
-        let Some(largest) = finite_max_abs(col) else {
-            let i = first_non_finite(col).unwrap_or(0);
-            return Err(Error::NonFinite {
-                matrix: "regressor",
-                row: i,
-                col: j,
-                value: col[i],
-            });
-        };
-        *e = binary_exponent(largest);
+        *e = column_exponent(col, j)?;
         scale_column(col, *e);
     }
     Ok(())
+}
+
+/// [`equilibrate`] of `src` into `dst` (as long), `src` left as it is:
+/// the same values and errors, with no copy made first.
+#[cfg(feature = "lab")]
+pub(crate) fn equilibrate_into(
+    src: &[f64],
+    dst: &mut [f64],
+    m: usize,
+    exponents: &mut [i32],
+) -> Result<(), Error> {
+    let cols = src.chunks_exact(m).zip(dst.chunks_exact_mut(m));
+    for (j, ((col, out), e)) in cols.zip(exponents.iter_mut()).enumerate() {
+        *e = column_exponent(col, j)?;
+        let f = pow2(-*e);
+        if *e == 0 {
+            out.copy_from_slice(col);
+        } else {
+            out.iter_mut().zip(col).for_each(|(o, &v)| *o = v * f);
+        }
+    }
+    Ok(())
+}
+
+/// The exponent [`equilibrate`] divides column `j` by, or the error naming
+/// its first non-finite entry.
+fn column_exponent(col: &[f64], j: usize) -> Result<i32, Error> {
+    // One pass for both: the maximum and whether every entry is finite.
+    let Some(largest) = finite_max_abs(col) else {
+        let i = first_non_finite(col).unwrap_or(0);
+        return Err(Error::NonFinite {
+            matrix: "regressor",
+            row: i,
+            col: j,
+            value: col[i],
+        });
+    };
+    Ok(binary_exponent(largest))
 }
 
 /// `col` divided by `2^e` (unchanged for `e = 0`).
@@ -372,10 +400,22 @@ pub(crate) fn solve_augmented(
         None => (classical(&t, m, p), options.covariance),
         Some(lags) => {
             // Each row's influence, in the equilibrated units (unscaled
-            // with the covariance).
-            influence_rows(hac, m, m, &t.theta, &t.rinv, &vec![0; p]);
+            // with the covariance), where the spent factor was.
+            let ones = vec![1.0; p + 1];
+            let source = Source {
+                cols: hac,
+                stride: m,
+                factors: &ones,
+            };
+            let sink = Sink {
+                cols: &mut a[..m * p],
+                stride: m,
+                z: None,
+                stats: None,
+            };
+            influence_into(source, m, &t.theta, &t.rinv, &vec![0; p], sink);
             let (cov, used) = newey_west(
-                &hac[..m * p],
+                &a[..m * p],
                 m,
                 p,
                 options.segment_starts,

@@ -139,7 +139,6 @@ pub(crate) fn finite_max_abs(x: &[f64]) -> Option<f64> {
 
 /// `(max |x|, Σ x²)` in one pass (eight lanes each): both finite only if
 /// every entry is (a NaN is left out of the maximum, not of the sum).
-#[cfg(any(feature = "lab", test))]
 #[inline]
 pub(crate) fn max_ss(x: &[f64]) -> (f64, f64) {
     let mut acc = [0.0f64; LANES];
@@ -157,6 +156,86 @@ pub(crate) fn max_ss(x: &[f64]) -> (f64, f64) {
     let worst = rest.iter().fold(worst, |m, v| m.max(v.abs()));
     let ss = squares.iter().sum::<f64>() + rest.iter().map(|v| v * v).sum::<f64>();
     (worst, ss)
+}
+
+/// [`zip_sum`]'s eight accumulators filled a value at a time, for a
+/// kernel that makes the values itself: the value of position `k` of a
+/// chunk of eight goes to lane `k`, the rows past the last whole chunk to
+/// a tail summed in order, so that [`total`](Self::total) is `zip_sum`'s
+/// result bit for bit.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SumLanes {
+    acc: Pairs,
+    tail: f64,
+}
+
+impl SumLanes {
+    pub fn new() -> Self {
+        // `Sum`'s neutral element for the tail, as `zip_sum`'s `.sum()`.
+        Self {
+            acc: [[0.0; 2]; LANES / 2],
+            tail: -0.0,
+        }
+    }
+
+    /// Adds `v` at position `k < 8` of a whole chunk.
+    #[inline(always)]
+    pub fn add(&mut self, k: usize, v: f64) {
+        self.acc[k / 2][k % 2] += v;
+    }
+
+    /// Adds `v`, a row past the last whole chunk (in order).
+    #[inline(always)]
+    pub fn add_tail(&mut self, v: f64) {
+        self.tail += v;
+    }
+
+    pub fn total(&self) -> f64 {
+        total(&self.acc) + self.tail
+    }
+}
+
+/// [`max_ss`]'s lanes filled a value at a time (as [`SumLanes`]): the
+/// same `(max |x|, Σ x²)` bit for bit.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct MaxSsLanes {
+    top: [f64; LANES],
+    squares: [f64; LANES],
+    rest_top: f64,
+    rest_squares: f64,
+}
+
+impl MaxSsLanes {
+    pub fn new() -> Self {
+        Self {
+            top: [0.0; LANES],
+            squares: [0.0; LANES],
+            rest_top: 0.0,
+            rest_squares: -0.0,
+        }
+    }
+
+    /// Takes `v` at position `k < 8` of a whole chunk.
+    #[inline(always)]
+    pub fn add(&mut self, k: usize, v: f64) {
+        let a = v.abs();
+        self.top[k] = if a > self.top[k] { a } else { self.top[k] };
+        self.squares[k] += v * v;
+    }
+
+    /// Takes `v`, a row past the last whole chunk (in order).
+    #[inline(always)]
+    pub fn add_tail(&mut self, v: f64) {
+        self.rest_top = self.rest_top.max(v.abs());
+        self.rest_squares += v * v;
+    }
+
+    /// `(max |x|, Σ x²)`.
+    pub fn finish(&self) -> (f64, f64) {
+        let worst = self.top.iter().fold(0.0f64, |m, &v| m.max(v));
+        let squares = self.squares.iter().sum::<f64>();
+        (worst.max(self.rest_top), squares + self.rest_squares)
+    }
 }
 
 /// The power of two `s` with `s ≤ x < 2 s`, from the exponent bits of a
@@ -200,6 +279,47 @@ pub(crate) fn first_non_finite(x: &[f64]) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The lanes filled a value at a time are `zip_sum` and `max_ss`, bit
+    /// for bit, at lengths around the chunks (a NaN left out of the
+    /// maximum as there).
+    #[test]
+    fn lanes_filled_one_at_a_time_are_the_slice_reductions() {
+        for len in [0, 1, 7, 8, 9, 15, 16, 17, 61, 1000] {
+            let a: Vec<f64> = (0..len)
+                .map(|i| ((i * 37) % 11) as f64 * 0.3 - 1.7)
+                .collect();
+            let c: Vec<f64> = (0..len)
+                .map(|i| ((i * 13) % 17) as f64 * 1e-3 - 7e-3)
+                .collect();
+            let mut b = c.clone();
+            if len > 9 {
+                b[9] = f64::NAN;
+            }
+            let (mut sum, mut stats) = (SumLanes::new(), MaxSsLanes::new());
+            let whole = len / LANES * LANES;
+            for i in 0..len {
+                let (v, w) = (a[i] * c[i], b[i] * 0.5);
+                if i < whole {
+                    sum.add(i % LANES, v);
+                    stats.add(i % LANES, w);
+                } else {
+                    sum.add_tail(v);
+                    stats.add_tail(w);
+                }
+            }
+            let want = zip_sum(&a, &c, |x, y| x * y);
+            assert_eq!(sum.total().to_bits(), want.to_bits(), "{len}");
+            let half: Vec<f64> = b.iter().map(|v| v * 0.5).collect();
+            let (m, s) = max_ss(&half);
+            let (gm, gs) = stats.finish();
+            assert_eq!(
+                (gm.to_bits(), gs.to_bits()),
+                (m.to_bits(), s.to_bits()),
+                "{len}"
+            );
+        }
+    }
 
     #[test]
     fn sums_and_finds_non_finite() {

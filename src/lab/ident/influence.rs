@@ -8,7 +8,7 @@ use nalgebra::DMatrix;
 
 use super::regressors::{Differences, Out, Spec};
 use super::stages::MAX_STAGE2;
-use crate::ident::{Triangular, influence_rows, scale_column};
+use crate::ident::{Sink, Source, Triangular, influence_into, pow2};
 use crate::kernels::reduce::first_non_finite;
 
 /// What stage 2's own influence becomes: plus `g` times stage 1's
@@ -101,12 +101,22 @@ pub(super) fn overflows<D: Differences>(
     let p = spec.p;
     block.clear();
     let m = spec.fill::<D>((0, spec.data.rows), true, false, Out::Push(block));
-    for (col, &e) in block.chunks_exact_mut(m).zip(exponents) {
-        scale_column(col, e);
-    }
+    let factors: Vec<f64> = exponents.iter().map(|&e| pow2(-e)).collect();
     let d: Vec<i32> = (0..p).map(|j| exponents[p] - exponents[j]).collect();
-    influence_rows(block, m, m, &tri.theta, &tri.rinv, &d);
-    first_non_finite(&block[..m * p]).is_some()
+    let mut out = vec![0.0; m * p];
+    let source = Source {
+        cols: block,
+        stride: m,
+        factors: &factors,
+    };
+    let sink = Sink {
+        cols: &mut out,
+        stride: m,
+        z: None,
+        stats: None,
+    };
+    influence_into(source, m, &tri.theta, &tri.rinv, &d, sink);
+    first_non_finite(&out).is_some()
 }
 
 #[cfg(test)]

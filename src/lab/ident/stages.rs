@@ -16,9 +16,9 @@ use super::regressors::{Differences, Kind, Out, Spec};
 use crate::error::Error;
 use crate::ident::{
     BLOCK_ROWS, BLOCKED_FROM_ROWS, Covariance, DEFAULT_MAX_CONDITION, LeastSquaresFit, NARROW,
-    Scratch, Series, Stats, Triangular, Tsqr, binary_exponent, classical, equilibrate, fit_from,
-    householder_narrow, influence_rows, newey_west_of, pow2, scale_column, scale_pow2,
-    sensitivity_of, sensitivity_sums, spread, triangular,
+    Scratch, Series, Sink, Source, Stats, Triangular, Tsqr, binary_exponent, classical,
+    equilibrate, equilibrate_into, fit_from, householder_narrow, influence_into, newey_west_of,
+    pow2, scale_pow2, spread, triangular,
 };
 use crate::kernels::reduce::{max_abs, max_ss};
 
@@ -30,20 +30,22 @@ pub(super) const MAX_STAGE2: usize = 4;
 pub(super) struct FirstStage;
 
 /// A stage's factorisation: its triangular solve, the columns' exponents,
-/// `λ`'s spread, and with Newey–West where its equilibrated copy (and
-/// stage 2's `z`) lie in the solver's buffer.
+/// `λ`'s spread, and with Newey–West where the stored stage's rows as
+/// built (and stage 2's `z`) lie in the solver's buffer.
 pub(super) struct Factored {
     pub tri: Triangular,
     pub exponents: Vec<i32>,
     pub sst: f64,
-    pub copy_at: usize,
+    pub raw_at: usize,
     pub z_at: usize,
 }
 
 /// The buffers of the stages, kept between them.
 pub(super) struct Solver {
     covariance: Covariance,
-    /// A stage's `[Φ | λ (| z)]` and its copy.
+    /// A stored stage's equilibrated `[Φ | λ]` (factored in place, then
+    /// the influence series) and, with Newey–West, its rows as built and
+    /// `z`; a streamed stage's influence series.
     buf: Vec<f64>,
     /// Stage 1's influence on `k2` at every row of the segments (zero
     /// where it used none).
@@ -132,7 +134,7 @@ impl Solver {
             tri,
             exponents,
             sst,
-            copy_at,
+            raw_at,
             z_at,
         } = f;
         let mut fit = fit_from(
@@ -156,10 +158,14 @@ impl Solver {
             return finite(fit).map(|fit| (fit, None));
         };
         let n = data.rows;
+        // Stage 1's series is its influence: its stats are found on the
+        // way, unless the rows kept are scattered (a stored stage sums
+        // the scattered series).
+        let found = first.is_none() && (streamed || spec.keep.is_none());
         let g = if streamed {
-            self.influence_streamed::<D>(spec, m, &tri, &exponents, want_z)
+            self.influence_streamed::<D>(spec, m, &tri, &exponents, want_z, found)
         } else {
-            self.influence_stored(m, p, &tri, &exponents, want_z, copy_at, z_at)
+            self.influence_stored(m, p, &tri, &exponents, want_z, raw_at, z_at, found)
         };
         if let Some(g) = &g
             && !g.iter().all(|v| v.is_finite())
@@ -175,12 +181,12 @@ impl Solver {
         // The series at every row of the segments, scattered when the
         // stage keeps some, then carried or mapped.
         let series: &mut [f64] = match spec.keep {
-            None => &mut self.buf[copy_at..copy_at + n * p],
+            None => &mut self.buf[..n * p],
             Some(keep) => {
                 self.series.clear();
                 self.series.resize(n * p, 0.0);
                 for j in 0..p {
-                    let h = &self.buf[copy_at + j * m..copy_at + (j + 1) * m];
+                    let h = &self.buf[j * m..(j + 1) * m];
                     let to = &mut self.series[j * n..(j + 1) * n];
                     let rows = keep
                         .direction
@@ -204,8 +210,9 @@ impl Solver {
         if let Some(Carry::Sensitivity(g)) = how {
             let (max, ss) = (&mut self.stats.max, &mut self.stats.ss);
             carry_max_ss(series, n, &self.k2, g, max, ss);
-        } else if streamed && how.is_none() {
-            // Found block by block (the scattered rows' zeros add none).
+        } else if found {
+            // Found with the influence (the scattered rows' zeros add
+            // none to a streamed stage's, found block by block).
         } else {
             if let Some(how) = &how {
                 carry(series, n, p, &self.k2, how);
@@ -241,7 +248,7 @@ impl Solver {
         // Stage 1 keeps its influence on k2 for stage 2.
         let state = matches!(spec.kind, Kind::First { .. }).then(|| {
             let series = match spec.keep {
-                None => &self.buf[copy_at..copy_at + n * p],
+                None => &self.buf[..n * p],
                 Some(_) => &self.series[..n * p],
             };
             self.k2.clear();
@@ -252,9 +259,10 @@ impl Solver {
         Ok((fit, state))
     }
 
-    /// Each row's influence in place of the stored stage's equilibrated
-    /// copy at `copy_at` (stage 2's `g` from `U = Φ R⁻¹` and `z` at
-    /// `z_at` first).
+    /// Each row's influence in place of the stored stage's spent factor
+    /// (at the buffer's start), from its rows as built at `raw_at`
+    /// equilibrated as they are read (stage 2's `g` from `U = Φ R⁻¹` and
+    /// `z` at `z_at` on the way; with `found`, the series' stats).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn influence_stored(
         &mut self,
@@ -263,33 +271,59 @@ impl Solver {
         tri: &Triangular,
         exponents: &[i32],
         want_z: bool,
-        copy_at: usize,
+        raw_at: usize,
         z_at: usize,
+        found: bool,
     ) -> Option<Vec<f64>> {
-        let (work, z): (&mut [f64], &[f64]) = if !want_z {
-            (&mut self.buf[copy_at..], &[])
-        } else if z_at < copy_at {
-            let (head, work) = self.buf.split_at_mut(copy_at);
-            (work, &head[z_at..z_at + m])
-        } else {
-            let (work, tail) = self.buf.split_at_mut(z_at);
-            (&mut work[copy_at..], &tail[..m])
-        };
-        let work = &mut work[..m * (p + 1)];
-        let g = want_z.then(|| {
-            let (gz, e_z) = sensitivity_of(work, m, m, &tri.rinv, z, &mut self.block);
-            unscaled(&gz, e_z, exponents)
+        let factors: Vec<f64> = exponents.iter().map(|&e| pow2(-e)).collect();
+        let (series, rest) = self.buf.split_at_mut(raw_at);
+        let rest = &rest[..z_at - raw_at + usize::from(want_z) * m];
+        let z = want_z.then(|| {
+            let z = &rest[z_at - raw_at..];
+            (z, binary_exponent(max_abs(z)))
         });
-        influence_rows(work, m, m, &tri.theta, &tri.rinv, &units(exponents, p));
-        g
+        let e_z = z.map_or(0, |(_, e)| e);
+        let mut stats = vec![(0.0, 0.0); p];
+        let sink = Sink {
+            cols: &mut series[..m * p],
+            stride: m,
+            z: z.map(|(z, e_z)| (z, pow2(-e_z))),
+            stats: found.then_some(&mut stats[..p]),
+        };
+        let source = Source {
+            cols: rest,
+            stride: m,
+            factors: &factors,
+        };
+        let qz = influence_into(source, m, &tri.theta, &tri.rinv, &units(exponents, p), sink);
+        if found {
+            self.keep_stats(&stats[..p], false);
+        }
+        qz.map(|qz| unscaled(&(&tri.rinv * qz), e_z, exponents))
+    }
+
+    /// Takes `stats` as the series' (`add`: as one more block's).
+    fn keep_stats(&mut self, stats: &[(f64, f64)], add: bool) {
+        let (max, ss) = (&mut self.stats.max, &mut self.stats.ss);
+        if !add {
+            max.clear();
+            max.resize(stats.len(), 0.0);
+            ss.clear();
+            ss.resize(stats.len(), 0.0);
+        }
+        for ((max, ss), &(m, s)) in max.iter_mut().zip(ss.iter_mut()).zip(stats) {
+            *max = max.max(m);
+            *ss += s;
+        }
     }
 
     /// Each row's influence into the buffer (`m × p`, as the stored
     /// stage's), the stage built again a block at a time after its
-    /// factor: the same rows, equilibrated by the same powers of two, so
-    /// the same influence bit for bit. Stage 2's `g` sums each block's
-    /// part, `z` divided by the power of two of its largest entry so far
-    /// (the sums rescaled exactly when a later block raises it).
+    /// factor: the same rows, equilibrated by the same powers of two as
+    /// they are read, so the same influence bit for bit. Stage 2's `g` sums
+    /// each block's part, `z` divided by the power of two of its largest
+    /// entry so far (the sums rescaled exactly when a later block raises
+    /// it); with `found`, the series' stats are summed block by block.
     pub(super) fn influence_streamed<D: Differences>(
         &mut self,
         spec: &Spec<'_, '_>,
@@ -297,6 +331,7 @@ impl Solver {
         tri: &Triangular,
         exponents: &[i32],
         want_z: bool,
+        found: bool,
     ) -> Option<Vec<f64>> {
         let (p, n) = (spec.p, spec.data.rows);
         let width = spec.width();
@@ -309,13 +344,13 @@ impl Solver {
         self.buf.truncate(m * p);
         self.buf.resize(m * p, 0.0);
         let d = units(exponents, p);
+        let factors: Vec<f64> = exponents.iter().map(|&e| pow2(-e)).collect();
         let mut qz = DVector::<f64>::zeros(p);
         let mut e_z: Option<i32> = None;
-        let mut u = std::mem::take(&mut self.series);
-        self.stats.max.clear();
-        self.stats.max.resize(p, 0.0);
-        self.stats.ss.clear();
-        self.stats.ss.resize(p, 0.0);
+        let mut stats = vec![(0.0, 0.0); p];
+        if found {
+            self.keep_stats(&stats, false);
+        }
         let (mut from, mut have, mut at) = (0, 0, 0);
         while from < n {
             let to = (from + BLOCK_ROWS - have).min(n);
@@ -329,11 +364,10 @@ impl Solver {
             if have < BLOCK_ROWS && !(from == n && have > 0) {
                 continue;
             }
-            for (col, &e) in block.chunks_exact_mut(stride).zip(exponents) {
-                scale_column(&mut col[..have], e);
-            }
+            let (rows, z) = block.split_at(width * stride);
+            let mut z_f = None;
             if want_z {
-                let z = &block[width * stride..width * stride + have];
+                let z = &z[..have];
                 let largest = max_abs(z);
                 if largest > 0.0 {
                     let e = binary_exponent(largest);
@@ -346,69 +380,80 @@ impl Solver {
                         }
                         None => e_z = Some(e),
                     }
-                    let f = pow2(-e_z.unwrap_or(0));
-                    qz += sensitivity_sums(&block, stride, have, &tri.rinv, z, f, &mut u);
+                    z_f = Some((z, pow2(-e_z.unwrap_or(0))));
                 }
             }
-            influence_rows(&mut block, stride, have, &tri.theta, &tri.rinv, &d);
-            for (j, col) in block.chunks_exact(stride).take(p).enumerate() {
-                let h = &col[..have];
-                self.buf[j * m + at..j * m + at + have].copy_from_slice(h);
-                // Each column's largest entry and sum of squares, while
-                // the block is at hand.
-                let (max, ss) = max_ss(h);
-                self.stats.max[j] = self.stats.max[j].max(max);
-                self.stats.ss[j] += ss;
+            let source = Source {
+                cols: rows,
+                stride,
+                factors: &factors,
+            };
+            let sink = Sink {
+                cols: &mut self.buf[at..],
+                stride: m,
+                z: z_f,
+                stats: found.then_some(&mut stats[..]),
+            };
+            if let Some(sums) = influence_into(source, have, &tri.theta, &tri.rinv, &d, sink) {
+                qz += sums;
+            }
+            if found {
+                self.keep_stats(&stats, true);
             }
             at += have;
             have = 0;
         }
         debug_assert_eq!(at, m);
         self.block = block;
-        self.series = u;
         want_z.then(|| unscaled(&(&tri.rinv * qz), e_z.unwrap_or(0), exponents))
     }
 
     /// Builds the stage whole (`m` rows, then stage 2's `z` with
     /// `want_z`) and factors it as the stored solve does, equilibrated
-    /// then factored in place (with `copy`, after a copy of the
-    /// equilibrated `[Φ | λ]`).
+    /// then factored in place; with `keep_raw` (Newey–West), built after
+    /// the room of its equilibrated copy and kept as built for the
+    /// influence (`[A | raw [Φ | λ] | z]`), so no copy is made.
     fn factor_stored<D: Differences>(
         &mut self,
         spec: &Spec<'_, '_>,
         m: usize,
-        copy: bool,
+        keep_raw: bool,
         want_z: bool,
     ) -> Result<Factored, Error> {
         let (p, n) = (spec.p, spec.data.rows);
         let width = spec.width();
         let filled = width + usize::from(want_z);
+        let raw_at = if keep_raw { m * width } else { 0 };
+        let len = raw_at + m * filled;
         // Every entry is written, so stage 2 reuses stage 1's room
-        // unzeroed; stage 1 reserves what either stage can need, the copy
-        // included (untouched pages cost nothing), as growing would copy.
+        // unzeroed; stage 1 reserves what either stage can need (untouched
+        // pages cost nothing), as growing would copy.
         let most = n * (2 * (MAX_STAGE2 + 1) + 1);
-        let room = (m * filled + if copy { m * width } else { 0 }).max(most);
-        self.buf.truncate(m * filled);
-        self.buf.reserve(room - self.buf.len());
-        self.buf.resize(m * filled, 0.0);
-        let rows = spec.fill::<D>((0, n), true, want_z, Out::Slices(&mut self.buf, m));
+        self.buf.truncate(len);
+        self.buf.reserve(len.max(most) - self.buf.len());
+        self.buf.resize(len, 0.0);
+        let (a, raw) = self.buf.split_at_mut(raw_at);
+        let rows = spec.fill::<D>((0, n), true, want_z, Out::Slices(raw, m));
         debug_assert_eq!(rows, m);
         let mut exponents = vec![0; width];
-        equilibrate(&mut self.buf[..m * width], m, &mut exponents)?;
-        let sst = spread(&self.buf[p * m..width * m]);
-        if copy {
-            self.buf.extend_from_within(..m * width);
-        }
+        let a = if keep_raw {
+            equilibrate_into(&raw[..m * width], a, m, &mut exponents)?;
+            a
+        } else {
+            let a = &mut raw[..m * width];
+            equilibrate(a, m, &mut exponents)?;
+            a
+        };
+        let sst = spread(&a[p * m..width * m]);
         assert!(width <= NARROW, "the lab's stages have at most six columns");
-        householder_narrow(&mut self.buf[..m * width], m, width);
-        let buf = &self.buf;
-        let tri = triangular(|i, j| buf[j * m + i], p, DEFAULT_MAX_CONDITION)?;
+        householder_narrow(a, m, width);
+        let tri = triangular(|i, j| a[j * m + i], p, DEFAULT_MAX_CONDITION)?;
         Ok(Factored {
             tri,
             exponents,
             sst,
-            copy_at: m * filled,
-            z_at: m * width,
+            raw_at,
+            z_at: raw_at + m * width,
         })
     }
 
@@ -447,7 +492,7 @@ impl Solver {
             tri,
             exponents: f.exponents,
             sst: f.sst,
-            copy_at: 0,
+            raw_at: 0,
             z_at: 0,
         })
     }

@@ -6,7 +6,6 @@ use super::stages::{Factored, Solver};
 use super::{MassSpringEstimate, Options, Scheme, SpringModel, identify_by, prepare};
 use crate::data::{Channel, Recording, Schema};
 use crate::ident::Covariance;
-use crate::ident::scale_column;
 use crate::signal::Rng;
 
 /// A two-cart rig's response (semi-implicit Euler at 2 ms, the lab's
@@ -120,17 +119,25 @@ fn the_streamed_influence_is_the_stored_one_bit_for_bit() {
         let Factored { tri, exponents, .. } = solver
             .factor_streamed::<CentralDifferences>(&spec, m)
             .unwrap();
-        let g = solver.influence_streamed::<CentralDifferences>(&spec, m, &tri, &exponents, want_z);
+        let g = solver
+            .influence_streamed::<CentralDifferences>(&spec, m, &tri, &exponents, want_z, false);
         let streamed = solver.buf_for_tests()[..m * p].to_vec();
-        // The stored layout: [Φ | λ] equilibrated, then z.
+        // The stored layout: room for the factor, [Φ | λ] as built, z.
+        let width = p + 1;
         let mut stored = Solver::new(options.covariance);
         let buf = stored.buf_for_tests();
+        buf.resize(m * width, 0.0);
         spec.fill::<CentralDifferences>((0, m), true, want_z, Out::Push(buf));
-        for (col, &e) in buf.chunks_exact_mut(m).zip(&exponents) {
-            scale_column(col, e);
-        }
-        let width = p + 1;
-        let g_stored = stored.influence_stored(m, p, &tri, &exponents, want_z, 0, m * width);
+        let g_stored = stored.influence_stored(
+            m,
+            p,
+            &tri,
+            &exponents,
+            want_z,
+            m * width,
+            2 * m * width,
+            false,
+        );
         let same = stored.buf_for_tests()[..m * p]
             .iter()
             .zip(&streamed)
