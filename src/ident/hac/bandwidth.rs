@@ -2,7 +2,10 @@
 
 use super::running::prefix_sums;
 use super::{Scratch, Series};
-use crate::kernels::reduce::{max_abs, pow2_floor, sum_by};
+use crate::kernels::reduce::{SumLanes, max_abs, pow2_floor, sum_by};
+
+/// The lanes of [`SumLanes`].
+const LANES: usize = 8;
 
 /// Rows per block: the running sums start afresh every block, which bounds
 /// their rounding.
@@ -50,35 +53,33 @@ pub(crate) fn automatic_lags(
     }
 }
 
-/// The moving sums of one column's block: its rows with the `pre + 1`
-/// before them (`y`, zeros outside the segment), their running sum (`pp`,
-/// one longer), and per row of the block `W(pre)` and `W(pre − 1)`.
+/// The moving sums of one block: its rows of `h` with the `pre + 1`
+/// before them (`y`, zeros outside the segment) and their running sum
+/// (`pp`, one longer).
 struct Windows<'w> {
     y: &'w mut [f64],
     pp: &'w mut [f64],
-    w1: &'w mut [f64],
-    w2: &'w mut [f64],
 }
 
-/// The room [`Windows`] needs per column.
+/// The room [`Windows`] needs.
 fn room(pre: usize) -> usize {
-    2 * (pre + 2 + SUB) + 2 * SUB
+    2 * (pre + 2 + SUB)
 }
 
 impl<'w> Windows<'w> {
     fn split(col: &'w mut [f64], pre: usize) -> Self {
-        let (y, rest) = col.split_at_mut(pre + 2 + SUB);
-        let (pp, rest) = rest.split_at_mut(pre + 2 + SUB);
-        let (w1, w2) = rest.split_at_mut(SUB);
-        Self { y, pp, w1, w2 }
+        let (y, pp) = col.split_at_mut(pre + 2 + SUB);
+        Self { y, pp }
     }
 
-    /// With `y[..rows + pre + 1]` set (rows `a − pre − 1 … a + rows`),
-    /// times `scale`: `w1`, `w2` of the block's `rows` rows.
-    fn sums(&mut self, rows: usize, pre: usize, scale: f64) {
+    /// With `y[..rows + pre + 1]` set (rows `a − pre − 1 … a + rows`):
+    /// `Σ W(pre)²` and `Σ W(pre − 1)²` over the block's `rows` rows, each
+    /// summed in the lanes of [`sum_by`] (the same sums, bit for bit, as
+    /// the two windows stored and summed).
+    fn sums(&mut self, rows: usize, pre: usize) -> (f64, f64) {
         let n = rows + pre + 1;
         self.pp[0] = 0.0;
-        prefix_sums(&self.y[..n], scale, &mut self.pp[1..=n]);
+        prefix_sums(&self.y[..n], 1.0, &mut self.pp[1..=n]);
         // Row i of the block is y's row i + pre + 1: W(pre) = pp[i + pre +
         // 2] − pp[i + 1], W(pre − 1) = pp[i + pre + 2] − pp[i + 2].
         let (at, back1, back2) = (
@@ -86,16 +87,22 @@ impl<'w> Windows<'w> {
             &self.pp[1..=rows],
             &self.pp[2..rows + 2],
         );
-        for (((w1, w2), &at), (&b1, &b2)) in self
-            .w1
-            .iter_mut()
-            .zip(self.w2.iter_mut())
-            .zip(at)
-            .zip(back1.iter().zip(back2))
-        {
-            *w1 = at - b1;
-            *w2 = at - b2;
+        let (mut s1, mut s2) = (SumLanes::new(), SumLanes::new());
+        let whole = rows / LANES * LANES;
+        for c in (0..whole).step_by(LANES) {
+            let (at, b1, b2) = (&at[c..c + LANES], &back1[c..c + LANES], &back2[c..c + LANES]);
+            for k in 0..LANES {
+                let (w1, w2) = (at[k] - b1[k], at[k] - b2[k]);
+                s1.add(k, w1 * w1);
+                s2.add(k, w2 * w2);
+            }
         }
+        for i in whole..rows {
+            let (w1, w2) = (at[i] - back1[i], at[i] - back2[i]);
+            s1.add_tail(w1 * w1);
+            s2.add_tail(w2 * w2);
+        }
+        (s1.total(), s2.total())
     }
 }
 
@@ -128,21 +135,32 @@ pub(super) fn bandwidth_sums(
             let b = (a + SUB).min(len + pre);
             let rows = b - a;
             let y = &mut m.y[..rows + pre + 1];
-            y.fill(0.0);
-            // y's row k is the segment's row a − pre − 1 + k.
+            // y's row k is the segment's row a − pre − 1 + k: zero outside
+            // the segment, else `0 + Σ c_j x_j` (columns with c_j = 0
+            // left out), added a column at a time.
             let (lo, hi) = (a.saturating_sub(pre + 1), b.min(len));
-            if lo < hi {
-                let h = &mut y[lo + pre + 1 - a..hi + pre + 1 - a];
-                for (col, &c) in x.chunks_exact(n).zip(&c) {
-                    if c != 0.0 {
-                        let col = &col[start + lo..start + hi];
+            let (head, rest) = y.split_at_mut((lo + pre + 1).saturating_sub(a).min(y.len()));
+            head.fill(0.0);
+            let (h, tail) = rest.split_at_mut(hi.saturating_sub(lo).min(rest.len()));
+            tail.fill(0.0);
+            let mut first = true;
+            for (col, &c) in x.chunks_exact(n).zip(&c) {
+                if c != 0.0 && !h.is_empty() {
+                    let col = &col[start + lo..start + hi];
+                    if first {
+                        h.iter_mut().zip(col).for_each(|(h, &v)| *h = 0.0 + c * v);
+                    } else {
                         h.iter_mut().zip(col).for_each(|(h, &v)| *h += c * v);
                     }
+                    first = false;
                 }
             }
-            m.sums(rows, pre, 1.0);
-            b1 += sum_by(&m.w1[..rows], |v| v * v);
-            b2 += sum_by(&m.w2[..rows], |v| v * v);
+            if first {
+                h.fill(0.0);
+            }
+            let (w1, w2) = m.sums(rows, pre);
+            b1 += w1;
+            b2 += w2;
             a = b;
         }
     }
