@@ -90,7 +90,11 @@ impl<'w> Windows<'w> {
         let (mut s1, mut s2) = (SumLanes::new(), SumLanes::new());
         let whole = rows / LANES * LANES;
         for c in (0..whole).step_by(LANES) {
-            let (at, b1, b2) = (&at[c..c + LANES], &back1[c..c + LANES], &back2[c..c + LANES]);
+            let (at, b1, b2) = (
+                &at[c..c + LANES],
+                &back1[c..c + LANES],
+                &back2[c..c + LANES],
+            );
             for k in 0..LANES {
                 let (w1, w2) = (at[k] - b1[k], at[k] - b2[k]);
                 s1.add(k, w1 * w1);
