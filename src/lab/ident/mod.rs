@@ -62,7 +62,10 @@
 //! position difference), in which the encoder's noise is the same for all
 //! rows whatever their period. Under the default Newey–West covariance the
 //! standard errors of stage 2 carry stage 1's error in `k2`; the classical
-//! ones treat `k2` as exact (see [`Options::covariance`]).
+//! ones treat `k2` as exact (see [`Options::covariance`]). On a recording of
+//! 65 536 rows or more, with a second CPU, stage 1's Newey–West work runs on
+//! a thread of its own while stage 2 is solved: the same operations, so the
+//! same figures bit for bit.
 //!
 //! [`hw::run`]: crate::hw::run
 
@@ -97,7 +100,7 @@ pub use timing::{DEFAULT_MAX_JITTER, GAP_RATIO, Timing};
 use self::regressors::{
     CentralDifferences, Data, Differences, Kind, LabDifferences, Motion, Spec, motion,
 };
-use self::stages::Solver;
+use self::stages::{Solver, both_beside, one_after_the_other};
 use crate::data::Recording;
 use crate::error::Error;
 use crate::ident::LeastSquaresFit;
@@ -491,19 +494,10 @@ fn stages<D: Differences>(
         p: model.parameters() + 1 + usize::from(cart1.is_some()),
     };
     let k2_index = model.parameters() - 1;
-    let (first, stage1) = solver.solve::<D>(&first_spec, k2_index, None)?;
-    let (springs, b1) = match model {
-        SpringModel::Equal => {
-            let [k12, b1] = estimates::<2>(&first);
-            (Springs::Equal { k12 }, b1)
-        }
-        SpringModel::Separate => {
-            let [k1, k2, b1] = estimates::<3>(&first);
-            (Springs::Separate { k1, k2 }, b1)
-        }
-    };
-    // Stage 2 takes the spring between the carts, stage 1's last spring.
-    let k2 = springs.k2().value;
+    let head = solver.head::<D>(&first_spec)?;
+    // Stage 2 takes the spring between the carts, stage 1's last spring
+    // (its value: the Newey–West errors leave the estimates as they are).
+    let k2 = head.fit.theta[k2_index];
     let kind = match fixed_m2 {
         Some(m2) => Kind::Second { m2, k2 },
         None => Kind::FreeMass { k2 },
@@ -514,7 +508,27 @@ fn stages<D: Differences>(
         keep: cart2,
         p: 2 + usize::from(fixed_m2.is_none()) + usize::from(cart2.is_some()),
     };
-    let (second, _) = solver.solve::<D>(&second_spec, 0, stage1.as_ref())?;
+    let specs = [&first_spec, &second_spec];
+    let ((first, _), (second, _)) = if solver.beside(&head) {
+        let spare = solver.sibling();
+        match both_beside::<D>(solver, spare.sibling(), head, specs, k2_index) {
+            Some(both) => both?,
+            // No thread: stage 1 again, on this one.
+            None => one_after_the_other::<D>(spare, None, specs, k2_index)?,
+        }
+    } else {
+        one_after_the_other::<D>(solver, Some(head), specs, k2_index)?
+    };
+    let (springs, b1) = match model {
+        SpringModel::Equal => {
+            let [k12, b1] = estimates::<2>(&first);
+            (Springs::Equal { k12 }, b1)
+        }
+        SpringModel::Separate => {
+            let [k1, k2, b1] = estimates::<3>(&first);
+            (Springs::Separate { k1, k2 }, b1)
+        }
+    };
     let [gain, b2] = estimates::<2>(&second);
     let m2_estimate = fitted_m2(options.free_m2, &second);
     Ok(MassSpringEstimate {

@@ -91,6 +91,69 @@ fn streamed_stages_give_the_stored_estimates_and_errors() {
     eprintln!("largest relative difference {largest:e}");
 }
 
+/// Stage 1's Newey–West work on a thread beside stage 2 gives every
+/// figure (estimates, errors, covariances, lags) and every error of the
+/// two one after the other, bit for bit.
+#[test]
+fn stage_1_beside_stage_2_is_one_after_the_other_bit_for_bit() {
+    let rec = recording(6000);
+    // Cart 2 still: stage 2's columns are degenerate, its error the same.
+    let mut still = Recording::with_capacity(rec.schema().clone(), rec.len());
+    for k in 0..rec.len() {
+        let (u, x) = (rec.input(0).unwrap(), rec.measurement(0).unwrap());
+        let (t, u, x) = (rec.time()[k], u[k], x[k]);
+        still.push(t, &[u], &[x, 0.0]).unwrap();
+    }
+    let newey_west = Covariance::NeweyWest { lags: None };
+    let mut compared = 0;
+    for rec in [&rec, &still] {
+        for springs in [SpringModel::Equal, SpringModel::Separate] {
+            for (coulomb, free_m2) in [(false, false), (true, false), (false, true), (true, true)] {
+                for scheme in [Scheme::Lab, Scheme::Central] {
+                    let options = Options {
+                        springs,
+                        coulomb,
+                        free_m2,
+                        covariance: newey_west,
+                        ..Options::with_scheme(scheme)
+                    };
+                    let run = |beside| {
+                        let solver = Solver::streaming_from(newey_west, 1).with_beside(beside);
+                        let e = match scheme {
+                            Scheme::Lab => {
+                                identify_by::<LabDifferences>(rec, 1.3, 0.7, &options, Some(solver))
+                            }
+                            Scheme::Central => identify_by::<CentralDifferences>(
+                                rec,
+                                1.3,
+                                0.7,
+                                &options,
+                                Some(solver),
+                            ),
+                        };
+                        e.map(|e| {
+                            let fits = [&e.first, &e.second];
+                            let bits: Vec<u64> = fits
+                                .iter()
+                                .flat_map(|f| {
+                                    f.theta.iter().chain(&f.std_errors).chain(&f.covariance)
+                                })
+                                .map(|v| v.to_bits())
+                                .collect();
+                            (bits, fits.map(|f| f.covariance_kind))
+                        })
+                        .map_err(|e| format!("{e:?}"))
+                    };
+                    let (beside, after) = (run(true), run(false));
+                    assert_eq!(beside, after, "{options:?}");
+                    compared += usize::from(beside.is_ok());
+                }
+            }
+        }
+    }
+    assert!(compared >= 16, "{compared} fits compared");
+}
+
 /// Given one factor, the influence built again block by block is the
 /// stored stage's, bit for bit, and stage 2's sensitivity `g` its sums in
 /// another order.
