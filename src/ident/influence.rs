@@ -253,7 +253,8 @@ impl<const P: usize> Kernel<'_, P> {
 
 /// `Uᵀ (z f)` of the equilibrated `Φ` in `a` (`rows` rows, columns
 /// `stride` apart), `U = Φ R⁻¹` formed a column at a time in `u` (as
-/// [`to_u`] forms it): stage 2's sensitivity to `k2` is `g = R⁻¹ Uᵀ z`, `f` a power of two that keeps `z f` at most 2 in size.
+/// [`to_u`] forms it), `f` a power of two that keeps `z f` at most 2 in
+/// size: stage 2's sensitivity to `k2` is `g = R⁻¹ Uᵀ z`.
 pub(crate) fn sensitivity_sums(
     a: &[f64],
     stride: usize,
